@@ -1,0 +1,1 @@
+//! Figures, CSV tables and HTML reports.

@@ -1,0 +1,125 @@
+//! The one error type of the library.
+//!
+//! Errors are for *bad input*: a malformed file, an unknown name, a non-finite number, a
+//! dimension that does not match, an inconsistent limit or setting. A well-formed problem that
+//! happens to be hard (an infeasible QP, an empty acceleration box) is not an error: it is
+//! reported as a *status* in the solution.
+
+/// Everything that can be wrong with the input given to iktc.
+///
+/// Every variant names what is wrong and, where it helps, what was expected.
+#[non_exhaustive]
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum Error {
+    /// A robot description (URDF) could not be read or is inconsistent.
+    #[error("invalid robot description: {message}")]
+    Urdf {
+        /// What is wrong, in words.
+        message: String,
+    },
+    /// A joint, link, frame or other named item does not exist.
+    #[error("unknown {kind} `{name}`; valid names are: {}", valid.join(", "))]
+    UnknownName {
+        /// What kind of name it is ("joint", "frame", "link", ...).
+        kind: &'static str,
+        /// The name that was asked for.
+        name: String,
+        /// The names that exist.
+        valid: Vec<String>,
+    },
+    /// A number that must be finite is NaN or infinite.
+    #[error("{what} is not finite (got {value})")]
+    NonFinite {
+        /// Which quantity, with its index if any.
+        what: String,
+        /// The offending value.
+        value: f64,
+    },
+    /// A vector or matrix has the wrong size.
+    #[error("dimension mismatch in {what}: expected {expected}, got {got}")]
+    DimensionMismatch {
+        /// Which quantity.
+        what: String,
+        /// The size that was expected.
+        expected: usize,
+        /// The size that was given.
+        got: usize,
+    },
+    /// A limit has its lower end above its upper end, or is otherwise unusable.
+    #[error("invalid limit for {what}: lower {lower} > upper {upper}")]
+    InvalidLimit {
+        /// Which joint or quantity.
+        what: String,
+        /// The lower end.
+        lower: f64,
+        /// The upper end.
+        upper: f64,
+    },
+    /// A setting or parameter is out of its valid range.
+    #[error("invalid setting {name} = {value}: expected {expected}")]
+    InvalidSetting {
+        /// The setting's name.
+        name: String,
+        /// Its value, as text.
+        value: String,
+        /// What would have been valid.
+        expected: String,
+    },
+    /// A text file (motion capture, mapping, configuration) is malformed.
+    #[error("{source_name}:{line}: {message}")]
+    Parse {
+        /// The file's name or a description of the source.
+        source_name: String,
+        /// The 1-based line the problem was found on (0 if unknown).
+        line: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// Input data are insufficient for the requested computation (too few points, ...).
+    #[error("insufficient data for {what}: {message}")]
+    InsufficientData {
+        /// Which computation.
+        what: String,
+        /// What was missing.
+        message: String,
+    },
+}
+
+/// The result type of the library.
+pub type Result<T> = std::result::Result<T, Error>;
+
+/// Returns an error naming `what` if `value` is NaN or infinite.
+pub fn check_finite(what: impl FnOnce() -> String, value: f64) -> Result<f64> {
+    if value.is_finite() {
+        Ok(value)
+    } else {
+        Err(Error::NonFinite {
+            what: what(),
+            value,
+        })
+    }
+}
+
+/// Returns an error naming `what` if any entry of `values` is NaN or infinite.
+pub fn check_all_finite(what: &str, values: &[f64]) -> Result<()> {
+    match values.iter().position(|v| !v.is_finite()) {
+        None => Ok(()),
+        Some(i) => Err(Error::NonFinite {
+            what: format!("{what}[{i}]"),
+            value: values[i],
+        }),
+    }
+}
+
+/// Returns an error if `got != expected`.
+pub fn check_dim(what: &str, expected: usize, got: usize) -> Result<()> {
+    if expected == got {
+        Ok(())
+    } else {
+        Err(Error::DimensionMismatch {
+            what: what.to_string(),
+            expected,
+            got,
+        })
+    }
+}

@@ -1,0 +1,43 @@
+//! # iktc — inverse kinematic control of humanoids under joint constraints
+//!
+//! A Rust implementation of Kim & Oh, *Inverse Kinematic Control of Humanoids Under Joint
+//! Constraints* (IJARS 2013), with the corrections of the project's errata:
+//!
+//! * second-order (acceleration-level) task-priority inverse kinematics with damped least
+//!   squares and closed-loop (CLIK) feedback (paper eqs. 2–12);
+//! * joint position, velocity and acceleration limits turned into one box on q̈
+//!   (Proposition 3.1, eq. 14, and discrete-time-safe "viable" bounds);
+//! * IKTC: when the prioritized solution leaves the box, an optimal correction of the
+//!   lowest-priority tasks by one small QP (eqs. 19–25, Algorithms 1–2);
+//! * baselines: the cascade of QPs (GF, Kanoun et al.) and clamping;
+//! * the ZMP damping controller on the inverted pendulum with a compliant joint (Section 4).
+//!
+//! The flow of one control tick is
+//! *state → [`model::Kinematics`] → tasks (plain `J q̈ = h` data) → acceleration box → solver*.
+//!
+//! ## Notation
+//!
+//! | symbol | meaning | unit |
+//! |---|---|---|
+//! | `q` | configuration: floating-base position and unit quaternion (if any), then joint positions | m, –, rad or m |
+//! | `q̇` (`qd`) | generalized velocity, length `nv`: base twist (linear, angular, world axes) then joint rates | m/s, rad/s |
+//! | `q̈` (`qdd`) | generalized acceleration, length `nv` | m/s², rad/s² |
+//! | `J_i` | Jacobian of task *i*, `m_i × nv` | – |
+//! | `h_i` | right-hand side of task *i*, `ẍ_d + k_v(ẋ_d − ẋ) + k_p(x_d − x) − J̇q̇` (eqs. 3, 11) | task units / s² |
+//! | `b_l, b_u` | lower and upper acceleration bounds (eq. 14) | rad/s² |
+//! | `Δh_i` | correction of task *i* (eq. 19) | task units / s² |
+//! | `G` | correction-to-acceleration map (eqs. 20–21, Algorithm 1) | – |
+//! | `Δt` | control period | s |
+
+#![warn(missing_docs)]
+
+pub mod balance;
+pub mod error;
+pub mod limits;
+pub mod model;
+pub mod motion;
+pub mod sim;
+pub mod solver;
+pub mod task;
+
+pub use error::{Error, Result};

@@ -1,0 +1,1 @@
+//! Robot model, state and kinematics.

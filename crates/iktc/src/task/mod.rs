@@ -1,0 +1,1 @@
+//! Tasks, linearised to plain data J q̈ = h.
