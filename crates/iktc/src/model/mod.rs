@@ -1,1 +1,24 @@
-//! Robot model, state and kinematics.
+//! Robot model (immutable), state and kinematics.
+//!
+//! * [`Robot`]: links, joints, frames, the layout of q and q̇; from URDF
+//!   ([`Robot::from_urdf_str`]), built in code ([`RobotBuilder`]) or built in ([`planar3r`],
+//!   [`jvrc1`]).
+//! * [`State`]: q and q̇, and their integration over a control period.
+//! * [`Kinematics`]: link poses, frame Jacobians and drifts, centre of mass, computed once per
+//!   state without allocation.
+
+mod builtin;
+mod joint;
+mod kinematics;
+mod robot;
+pub mod spatial;
+mod state;
+mod urdf;
+
+pub use builtin::{builtin_robot, jvrc1, planar3r, BUILTIN_ROBOTS, JVRC1_FINGERS, JVRC1_URDF};
+pub use joint::{Joint, JointKind, JointLimit, JointRole};
+pub use kinematics::Kinematics;
+pub use robot::{
+    BaseKind, Frame, FrameId, JointSpec, Link, MimicPolicy, ModelOptions, Robot, RobotBuilder,
+};
+pub use state::{State, QUATERNION_NORM_TOLERANCE};

@@ -1,0 +1,666 @@
+//! The immutable robot model: links, joints, frames and the layout of q and q̇.
+
+use std::collections::HashMap;
+
+use nalgebra::{Isometry3, Matrix3, Vector3};
+
+use super::joint::{Joint, JointKind, JointLimit, JointRole};
+use crate::error::{Error, Result};
+
+/// A rigid link.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Link {
+    /// The link's name.
+    pub name: String,
+    /// Mass [kg].
+    pub mass: f64,
+    /// Centre of mass in the link frame [m].
+    pub com: Vector3<f64>,
+    /// Inertia about the centre of mass, in link axes [kg·m²].
+    pub inertia: Matrix3<f64>,
+}
+
+impl Link {
+    /// A massless link.
+    pub fn massless(name: impl Into<String>) -> Self {
+        Self {
+            name: name.into(),
+            mass: 0.0,
+            com: Vector3::zeros(),
+            inertia: Matrix3::zeros(),
+        }
+    }
+}
+
+/// How the root link is attached to the world.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum BaseKind {
+    /// The root link is fixed at the world origin.
+    Fixed,
+    /// The root link is free: q starts with its position [m] and unit quaternion (x, y, z, w);
+    /// q̇ starts with its body twist: linear velocity [m/s] then angular velocity [rad/s], both
+    /// in the root link's own axes (Pinocchio's free-flyer convention).
+    Floating,
+}
+
+/// A named frame rigidly attached to a link. Every link is also a frame of the same name.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Frame {
+    /// The frame's name.
+    pub name: String,
+    /// The link it is attached to.
+    pub link: usize,
+    /// Its pose in the link frame.
+    pub offset: Isometry3<f64>,
+}
+
+/// What to do with URDF `<mimic>` joints whose master is not locked.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum MimicPolicy {
+    /// The mimic joint follows its master (q = multiplier · q_master + offset): it has no
+    /// coordinate of its own and its motion adds to its master's Jacobian column.
+    #[default]
+    Follow,
+    /// A mimic joint with an unlocked master is an error.
+    Reject,
+}
+
+/// Options that shape a model at construction.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ModelOptions {
+    /// Fixed or floating root.
+    pub base: BaseKind,
+    /// Joints held at a value [rad] or [m]: they drop out of q. Locking a mimic master also
+    /// locks its mimics.
+    pub locked: Vec<(String, f64)>,
+    /// Acceleration limits [rad/s²] or [m/s²] by joint name (URDF has none).
+    pub acceleration_limits: Vec<(String, f64)>,
+    /// Default acceleration limit as a multiple of the joint's velocity limit [1/s]: the joint
+    /// reaches full speed from rest in 1/this seconds. Default 10 s⁻¹, the ratio of the paper's
+    /// 3R arm (180°/s, 1800°/s²). Used for joints with no explicit acceleration limit.
+    pub acceleration_per_velocity: f64,
+    /// Acceleration limit [rad/s²] for joints that have neither an acceleration nor a velocity
+    /// limit. Default +∞ (no limit).
+    pub fallback_acceleration: f64,
+    /// What to do with mimic joints.
+    pub mimic: MimicPolicy,
+}
+
+impl Default for ModelOptions {
+    fn default() -> Self {
+        Self {
+            base: BaseKind::Fixed,
+            locked: Vec::new(),
+            acceleration_limits: Vec::new(),
+            acceleration_per_velocity: 10.0,
+            fallback_acceleration: f64::INFINITY,
+            mimic: MimicPolicy::Follow,
+        }
+    }
+}
+
+/// A joint as described before the model is built (URDF or code).
+#[derive(Debug, Clone, PartialEq)]
+pub struct JointSpec {
+    /// Joint name.
+    pub name: String,
+    /// Parent link name.
+    pub parent: String,
+    /// Child link name.
+    pub child: String,
+    /// Pose of the joint frame in the parent link frame.
+    pub origin: Isometry3<f64>,
+    /// Motion type.
+    pub kind: JointKind,
+    /// Limits; the acceleration field may be +∞, then [`ModelOptions`] decides.
+    pub limit: JointLimit,
+    /// `<mimic>`: master joint name, multiplier, offset.
+    pub mimic: Option<(String, f64, f64)>,
+}
+
+/// Collects links, joints and frames, then validates them into a [`Robot`].
+#[derive(Debug, Clone, Default)]
+pub struct RobotBuilder {
+    name: String,
+    links: Vec<Link>,
+    joints: Vec<JointSpec>,
+    frames: Vec<(String, String, Isometry3<f64>)>,
+}
+
+impl RobotBuilder {
+    /// A new, empty description.
+    pub fn new(name: impl Into<String>) -> Self {
+        Self {
+            name: name.into(),
+            ..Default::default()
+        }
+    }
+
+    /// Adds a link.
+    pub fn link(mut self, link: Link) -> Self {
+        self.links.push(link);
+        self
+    }
+
+    /// Adds a joint.
+    pub fn joint(mut self, joint: JointSpec) -> Self {
+        self.joints.push(joint);
+        self
+    }
+
+    /// Adds a named frame attached to `link` with pose `offset` in the link frame.
+    pub fn frame(
+        mut self,
+        name: impl Into<String>,
+        link: impl Into<String>,
+        offset: Isometry3<f64>,
+    ) -> Self {
+        self.frames.push((name.into(), link.into(), offset));
+        self
+    }
+
+    /// Validates the description and builds the immutable model.
+    ///
+    /// Errors: duplicate or unknown names, a link with two parents, no single root, a cycle,
+    /// a non-finite number, a limit with lower > upper or a non-positive speed, a zero axis,
+    /// a locked joint that does not exist or is fixed, a mimic that is rejected by the options.
+    pub fn build(self, options: &ModelOptions) -> Result<Robot> {
+        Robot::from_builder(self, options)
+    }
+}
+
+/// The immutable robot model.
+///
+/// Joints are stored in depth-first order from the root (children in the order given), so a
+/// joint's parent link is always placed by an earlier joint. q = (base, active joints),
+/// q̇ = (base twist, active joint rates); see [`BaseKind`] for the base part.
+#[derive(Debug, Clone)]
+pub struct Robot {
+    pub(crate) name: String,
+    pub(crate) base: BaseKind,
+    pub(crate) links: Vec<Link>,
+    pub(crate) joints: Vec<Joint>,
+    pub(crate) root: usize,
+    pub(crate) frames: Vec<Frame>,
+    /// Joint indices of the active joints, in q order.
+    pub(crate) active: Vec<usize>,
+    /// For each joint: (velocity index, scale) of the coordinate that drives it, if any.
+    pub(crate) drive: Vec<Option<(usize, f64)>>,
+    /// For each link: the joint whose child it is (None for the root).
+    pub(crate) parent_joint: Vec<Option<usize>>,
+    pub(crate) total_mass: f64,
+}
+
+fn finite_vec(what: &str, v: &Vector3<f64>) -> Result<()> {
+    crate::error::check_all_finite(what, v.as_slice())
+}
+
+fn finite_iso(what: &str, t: &Isometry3<f64>) -> Result<()> {
+    finite_vec(what, &t.translation.vector)?;
+    crate::error::check_all_finite(what, t.rotation.coords.as_slice())
+}
+
+impl Robot {
+    fn from_builder(b: RobotBuilder, options: &ModelOptions) -> Result<Robot> {
+        crate::error::check_finite(
+            || "ModelOptions::acceleration_per_velocity".into(),
+            options.acceleration_per_velocity,
+        )?;
+        if options.acceleration_per_velocity <= 0.0 {
+            return Err(Error::InvalidSetting {
+                name: "acceleration_per_velocity".into(),
+                value: options.acceleration_per_velocity.to_string(),
+                expected: "a positive number [1/s]".into(),
+            });
+        }
+        if b.links.is_empty() {
+            return Err(Error::Urdf {
+                message: "the robot has no link".into(),
+            });
+        }
+        // Links.
+        let mut link_index: HashMap<&str, usize> = HashMap::new();
+        for (i, l) in b.links.iter().enumerate() {
+            if link_index.insert(l.name.as_str(), i).is_some() {
+                return Err(Error::Urdf {
+                    message: format!("duplicate link name `{}`", l.name),
+                });
+            }
+            crate::error::check_finite(|| format!("mass of link `{}`", l.name), l.mass)?;
+            if l.mass < 0.0 {
+                return Err(Error::Urdf {
+                    message: format!("link `{}` has negative mass {}", l.name, l.mass),
+                });
+            }
+            finite_vec(&format!("centre of mass of link `{}`", l.name), &l.com)?;
+            crate::error::check_all_finite(
+                &format!("inertia of link `{}`", l.name),
+                l.inertia.as_slice(),
+            )?;
+        }
+        let link_names = || b.links.iter().map(|l| l.name.clone()).collect::<Vec<_>>();
+        let find_link = |name: &str| -> Result<usize> {
+            link_index
+                .get(name)
+                .copied()
+                .ok_or_else(|| Error::UnknownName {
+                    kind: "link",
+                    name: name.to_string(),
+                    valid: link_names(),
+                })
+        };
+        // Joints: parent/child indices, one parent per link.
+        let mut joint_names: HashMap<&str, usize> = HashMap::new();
+        let mut parent_of: Vec<Option<usize>> = vec![None; b.links.len()];
+        let mut children: Vec<Vec<usize>> = vec![Vec::new(); b.links.len()];
+        for (j, s) in b.joints.iter().enumerate() {
+            if joint_names.insert(s.name.as_str(), j).is_some() {
+                return Err(Error::Urdf {
+                    message: format!("duplicate joint name `{}`", s.name),
+                });
+            }
+            let p = find_link(&s.parent)?;
+            let c = find_link(&s.child)?;
+            if let Some(other) = parent_of[c] {
+                return Err(Error::Urdf {
+                    message: format!(
+                        "link `{}` is the child of two joints, `{}` and `{}`",
+                        s.child, b.joints[other].name, s.name
+                    ),
+                });
+            }
+            parent_of[c] = Some(j);
+            children[p].push(j);
+            finite_iso(&format!("origin of joint `{}`", s.name), &s.origin)?;
+            let l = &s.limit;
+            for (what, v) in [("lower", l.lower), ("upper", l.upper)] {
+                if v.is_nan() {
+                    return Err(Error::NonFinite {
+                        what: format!("{what} limit of joint `{}`", s.name),
+                        value: v,
+                    });
+                }
+            }
+            if l.lower > l.upper {
+                return Err(Error::InvalidLimit {
+                    what: format!("joint `{}`", s.name),
+                    lower: l.lower,
+                    upper: l.upper,
+                });
+            }
+            for (what, v) in [
+                ("velocity", l.velocity),
+                ("acceleration", l.acceleration),
+                ("effort", l.effort),
+            ] {
+                if v.is_nan() || v < 0.0 || (what != "effort" && v == 0.0) {
+                    return Err(Error::InvalidSetting {
+                        name: format!("{what} limit of joint `{}`", s.name),
+                        value: v.to_string(),
+                        expected: "a positive number or +inf".into(),
+                    });
+                }
+            }
+        }
+        let roots: Vec<usize> = (0..b.links.len())
+            .filter(|&i| parent_of[i].is_none())
+            .collect();
+        if roots.len() != 1 {
+            return Err(Error::Urdf {
+                message: format!(
+                    "expected exactly one root link (a link that is no joint's child), found {}: {}",
+                    roots.len(),
+                    roots
+                        .iter()
+                        .map(|&i| b.links[i].name.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
+            });
+        }
+        let root = roots[0];
+        // Depth-first order from the root.
+        let mut order: Vec<usize> = Vec::with_capacity(b.joints.len());
+        let mut stack: Vec<usize> = children[root].iter().rev().copied().collect();
+        while let Some(j) = stack.pop() {
+            order.push(j);
+            let c = find_link(&b.joints[j].child)?;
+            stack.extend(children[c].iter().rev().copied());
+        }
+        if order.len() != b.joints.len() {
+            return Err(Error::Urdf {
+                message: "the joints do not form a tree: some links are not reachable from the root (a cycle?)".into(),
+            });
+        }
+        // Locked values and acceleration limits by name.
+        let all_joint_names = || b.joints.iter().map(|j| j.name.clone()).collect::<Vec<_>>();
+        let mut locked: HashMap<usize, f64> = HashMap::new();
+        for (name, value) in &options.locked {
+            let j = *joint_names
+                .get(name.as_str())
+                .ok_or_else(|| Error::UnknownName {
+                    kind: "joint",
+                    name: name.clone(),
+                    valid: all_joint_names(),
+                })?;
+            crate::error::check_finite(|| format!("locked value of joint `{name}`"), *value)?;
+            if matches!(b.joints[j].kind, JointKind::Fixed) {
+                return Err(Error::InvalidSetting {
+                    name: format!("locked joint `{name}`"),
+                    value: value.to_string(),
+                    expected: "a revolute, continuous or prismatic joint (this one is fixed)"
+                        .into(),
+                });
+            }
+            locked.insert(j, *value);
+        }
+        let mut accel: HashMap<usize, f64> = HashMap::new();
+        for (name, value) in &options.acceleration_limits {
+            let j = *joint_names
+                .get(name.as_str())
+                .ok_or_else(|| Error::UnknownName {
+                    kind: "joint",
+                    name: name.clone(),
+                    valid: all_joint_names(),
+                })?;
+            if value.is_nan() || *value <= 0.0 {
+                return Err(Error::InvalidSetting {
+                    name: format!("acceleration limit of joint `{name}`"),
+                    value: value.to_string(),
+                    expected: "a positive number [rad/s²] or +inf".into(),
+                });
+            }
+            accel.insert(j, *value);
+        }
+        // Roles. First pass: active / locked / fixed; mimics resolved after.
+        let nbase_v = if options.base == BaseKind::Floating {
+            6
+        } else {
+            0
+        };
+        let mut joints: Vec<Joint> = Vec::with_capacity(order.len());
+        let mut new_index: Vec<usize> = vec![0; b.joints.len()];
+        for (k, &j) in order.iter().enumerate() {
+            new_index[j] = k;
+        }
+        let mut active: Vec<usize> = Vec::new();
+        for &j in &order {
+            let s = &b.joints[j];
+            let role = if matches!(s.kind, JointKind::Fixed) {
+                JointRole::Fixed
+            } else if let Some(v) = locked.get(&j) {
+                JointRole::Locked { value: *v }
+            } else if s.mimic.is_some() {
+                JointRole::Fixed // placeholder, resolved below
+            } else {
+                active.push(new_index[j]);
+                JointRole::Active {
+                    index: active.len() - 1,
+                }
+            };
+            let mut limit = s.limit;
+            if let Some(a) = accel.get(&j) {
+                limit.acceleration = *a;
+            } else if !limit.acceleration.is_finite() && !matches!(s.kind, JointKind::Fixed) {
+                limit.acceleration = if limit.velocity.is_finite() {
+                    options.acceleration_per_velocity * limit.velocity
+                } else {
+                    options.fallback_acceleration
+                };
+            }
+            joints.push(Joint {
+                name: s.name.clone(),
+                parent: find_link(&s.parent)?,
+                child: find_link(&s.child)?,
+                origin: s.origin,
+                kind: s.kind,
+                limit,
+                role,
+            });
+        }
+        for &j in &order {
+            let s = &b.joints[j];
+            let Some((master, mult, off)) = &s.mimic else {
+                continue;
+            };
+            if locked.contains_key(&j) || matches!(s.kind, JointKind::Fixed) {
+                continue;
+            }
+            let m = *joint_names
+                .get(master.as_str())
+                .ok_or_else(|| Error::UnknownName {
+                    kind: "joint (mimic master)",
+                    name: master.clone(),
+                    valid: all_joint_names(),
+                })?;
+            crate::error::check_all_finite(
+                &format!("mimic of joint `{}`", s.name),
+                &[*mult, *off],
+            )?;
+            let role = match joints[new_index[m]].role {
+                JointRole::Locked { value } => JointRole::Locked {
+                    value: mult * value + off,
+                },
+                JointRole::Active { index } => match options.mimic {
+                    MimicPolicy::Follow => JointRole::Mimic {
+                        master: index,
+                        multiplier: *mult,
+                        offset: *off,
+                    },
+                    MimicPolicy::Reject => {
+                        return Err(Error::Urdf {
+                            message: format!(
+                                "joint `{}` mimics `{master}`, which is not locked, and the mimic policy is Reject; lock `{master}` or use MimicPolicy::Follow",
+                                s.name
+                            ),
+                        })
+                    }
+                },
+                _ => {
+                    return Err(Error::Urdf {
+                        message: format!(
+                            "joint `{}` mimics `{master}`, which is fixed or itself a mimic; chains of mimics are not supported",
+                            s.name
+                        ),
+                    })
+                }
+            };
+            joints[new_index[j]].role = role;
+        }
+        let drive = joints
+            .iter()
+            .map(|j| match j.role {
+                JointRole::Active { index } => Some((nbase_v + index, 1.0)),
+                JointRole::Mimic {
+                    master, multiplier, ..
+                } => Some((nbase_v + master, multiplier)),
+                _ => None,
+            })
+            .collect();
+        let mut parent_joint = vec![None; b.links.len()];
+        for (k, j) in joints.iter().enumerate() {
+            parent_joint[j.child] = Some(k);
+        }
+        // Frames: every link, then the extra frames.
+        let mut frames: Vec<Frame> = b
+            .links
+            .iter()
+            .enumerate()
+            .map(|(i, l)| Frame {
+                name: l.name.clone(),
+                link: i,
+                offset: Isometry3::identity(),
+            })
+            .collect();
+        for (name, link, offset) in &b.frames {
+            if frames.iter().any(|f| &f.name == name) {
+                return Err(Error::Urdf {
+                    message: format!("duplicate frame name `{name}`"),
+                });
+            }
+            finite_iso(&format!("offset of frame `{name}`"), offset)?;
+            frames.push(Frame {
+                name: name.clone(),
+                link: find_link(link)?,
+                offset: *offset,
+            });
+        }
+        let total_mass = b.links.iter().map(|l| l.mass).sum();
+        Ok(Robot {
+            name: b.name,
+            base: options.base,
+            links: b.links,
+            joints,
+            root,
+            frames,
+            active,
+            drive,
+            parent_joint,
+            total_mass,
+        })
+    }
+
+    /// The robot's name.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// Fixed or floating base.
+    pub fn base(&self) -> BaseKind {
+        self.base
+    }
+
+    /// Number of configuration coordinates: 7 (position, quaternion) for a floating base plus
+    /// one per active joint.
+    pub fn nq(&self) -> usize {
+        self.base_nq() + self.active.len()
+    }
+
+    /// Number of velocity coordinates (degrees of freedom): 6 for a floating base plus one per
+    /// active joint.
+    pub fn nv(&self) -> usize {
+        self.base_nv() + self.active.len()
+    }
+
+    /// Configuration coordinates of the base: 7 or 0.
+    pub fn base_nq(&self) -> usize {
+        match self.base {
+            BaseKind::Floating => 7,
+            BaseKind::Fixed => 0,
+        }
+    }
+
+    /// Velocity coordinates of the base: 6 or 0.
+    pub fn base_nv(&self) -> usize {
+        match self.base {
+            BaseKind::Floating => 6,
+            BaseKind::Fixed => 0,
+        }
+    }
+
+    /// Number of active joints (joints with a coordinate of their own).
+    pub fn n_active(&self) -> usize {
+        self.active.len()
+    }
+
+    /// All links.
+    pub fn links(&self) -> &[Link] {
+        &self.links
+    }
+
+    /// All joints, depth-first from the root.
+    pub fn joints(&self) -> &[Joint] {
+        &self.joints
+    }
+
+    /// The active joints in q order.
+    pub fn active_joints(&self) -> impl ExactSizeIterator<Item = &Joint> + '_ {
+        self.active.iter().map(move |&j| &self.joints[j])
+    }
+
+    /// Index of the root link.
+    pub fn root_link(&self) -> usize {
+        self.root
+    }
+
+    /// All frames: first one per link (same names and order as [`Robot::links`]), then the
+    /// extra frames.
+    pub fn frames(&self) -> &[Frame] {
+        &self.frames
+    }
+
+    /// Total mass [kg].
+    pub fn total_mass(&self) -> f64 {
+        self.total_mass
+    }
+
+    /// The frame called `name`; the error lists the valid names.
+    pub fn frame_id(&self, name: &str) -> Result<FrameId> {
+        self.frames
+            .iter()
+            .position(|f| f.name == name)
+            .map(FrameId)
+            .ok_or_else(|| Error::UnknownName {
+                kind: "frame",
+                name: name.into(),
+                valid: self.frames.iter().map(|f| f.name.clone()).collect(),
+            })
+    }
+
+    /// Index among the active joints (the joint part of q and q̇) of the joint `name`.
+    /// Locked, mimic and fixed joints are not active: the error says so and lists the valid
+    /// names.
+    pub fn active_joint_index(&self, name: &str) -> Result<usize> {
+        match self.active_joints().position(|j| j.name == name) {
+            Some(i) => Ok(i),
+            None => Err(Error::UnknownName {
+                kind: if self.joints.iter().any(|j| j.name == name) {
+                    "active joint (this joint is fixed, locked or a mimic)"
+                } else {
+                    "joint"
+                },
+                name: name.into(),
+                valid: self.active_joints().map(|j| j.name.clone()).collect(),
+            }),
+        }
+    }
+
+    /// Index in q̇ of the active joint `name`.
+    pub fn joint_v_index(&self, name: &str) -> Result<usize> {
+        Ok(self.base_nv() + self.active_joint_index(name)?)
+    }
+
+    /// Index in q of the active joint `name`.
+    pub fn joint_q_index(&self, name: &str) -> Result<usize> {
+        Ok(self.base_nq() + self.active_joint_index(name)?)
+    }
+
+    /// Per-velocity-coordinate limits, nv entries: unbounded for the base, then the limits of
+    /// each active joint.
+    pub fn dof_limits(&self) -> Vec<JointLimit> {
+        let mut v = vec![JointLimit::UNBOUNDED; self.base_nv()];
+        v.extend(self.active_joints().map(|j| j.limit));
+        v
+    }
+
+    /// Names of the velocity coordinates: `base_vx, …, base_wz` then the active joints.
+    pub fn dof_names(&self) -> Vec<String> {
+        let mut v: Vec<String> = match self.base {
+            BaseKind::Floating => [
+                "base_vx", "base_vy", "base_vz", "base_wx", "base_wy", "base_wz",
+            ]
+            .iter()
+            .map(|s| s.to_string())
+            .collect(),
+            BaseKind::Fixed => Vec::new(),
+        };
+        v.extend(self.active_joints().map(|j| j.name.clone()));
+        v
+    }
+}
+
+/// Index of a frame in a [`Robot`], from [`Robot::frame_id`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct FrameId(pub usize);
