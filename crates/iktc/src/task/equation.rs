@@ -1,0 +1,115 @@
+//! The plain data every task linearises to: J q̈ = h.
+
+use nalgebra::{DMatrix, DVector};
+
+use crate::error::{check_finite, Error, Result};
+
+/// CLIK gains of a task (paper eq. 11): ẍ = ẍ_d + k_v (ẋ_d − ẋ) + k_p (x_d − x).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Gains {
+    /// Position gain k_p [1/s²].
+    pub kp: f64,
+    /// Velocity gain k_v [1/s].
+    pub kv: f64,
+}
+
+impl Gains {
+    /// Critically damped gains for a given k_p [1/s²]: k_v = 2 √k_p. The paper's 3R
+    /// experiment uses k_p = 100 s⁻², k_v = 20 s⁻¹.
+    pub fn critical(kp: f64) -> Self {
+        Self {
+            kp,
+            kv: 2.0 * kp.max(0.0).sqrt(),
+        }
+    }
+
+    /// Checks that both gains are finite and non-negative.
+    pub fn validate(&self) -> Result<()> {
+        for (n, v) in [("kp", self.kp), ("kv", self.kv)] {
+            check_finite(|| format!("gain {n}"), v)?;
+            if v < 0.0 {
+                return Err(Error::InvalidSetting {
+                    name: format!("gain {n}"),
+                    value: v.to_string(),
+                    expected: "a non-negative number".into(),
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+impl Default for Gains {
+    fn default() -> Self {
+        Self::critical(100.0)
+    }
+}
+
+/// One level of the hierarchy as plain data (eqs. 2, 3, 11): `jacobian · q̈ = rhs`, with
+/// rhs = ẍ_d + k_v (ẋ_d − ẋ) + k_p (x_d − x) − J̇q̇, plus the current errors for reporting.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TaskEquation {
+    /// A name for reports ("feet", "com", …).
+    pub name: String,
+    /// J, m × nv.
+    pub jacobian: DMatrix<f64>,
+    /// h, length m [task unit/s²].
+    pub rhs: DVector<f64>,
+    /// x_d − x, length m [task unit] (rotation vector [rad] for orientations).
+    pub error: DVector<f64>,
+    /// ẋ_d − ẋ, length m [task unit/s].
+    pub error_rate: DVector<f64>,
+}
+
+impl TaskEquation {
+    /// A zero equation of `m` rows for `nv` velocity coordinates.
+    pub fn zeros(name: impl Into<String>, m: usize, nv: usize) -> Self {
+        Self {
+            name: name.into(),
+            jacobian: DMatrix::zeros(m, nv),
+            rhs: DVector::zeros(m),
+            error: DVector::zeros(m),
+            error_rate: DVector::zeros(m),
+        }
+    }
+
+    /// Number of rows m.
+    pub fn dim(&self) -> usize {
+        self.rhs.len()
+    }
+
+    /// Number of columns nv.
+    pub fn nv(&self) -> usize {
+        self.jacobian.ncols()
+    }
+
+    /// Checks that sizes agree and every entry is finite.
+    pub fn validate(&self) -> Result<()> {
+        let m = self.rhs.len();
+        crate::error::check_dim(&format!("rows of J of `{}`", self.name), m, self.jacobian.nrows())?;
+        crate::error::check_all_finite(&format!("J of `{}`", self.name), self.jacobian.as_slice())?;
+        crate::error::check_all_finite(&format!("h of `{}`", self.name), self.rhs.as_slice())
+    }
+}
+
+/// Writes row `r` of a task: J row, error e, error rate ė, reference acceleration a_d and
+/// drift d, so that h = a_d + k_v ė + k_p e − d.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+pub(crate) fn write_row(
+    out: &mut TaskEquation,
+    r: usize,
+    jrow: impl Iterator<Item = f64>,
+    e: f64,
+    edot: f64,
+    acc_ref: f64,
+    drift: f64,
+    gains: &Gains,
+) {
+    for (c, v) in jrow.enumerate() {
+        out.jacobian[(r, c)] = v;
+    }
+    out.error[r] = e;
+    out.error_rate[r] = edot;
+    out.rhs[r] = acc_ref + gains.kv * edot + gains.kp * e - drift;
+}

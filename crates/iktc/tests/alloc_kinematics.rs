@@ -1,0 +1,64 @@
+//! The control tick allocates nothing: kinematics and task linearisation on a built model,
+//! checked with a counting global allocator (its own test binary).
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use iktc::model::*;
+use iktc::task::*;
+use nalgebra::DMatrix;
+
+struct Counting;
+static ALLOCS: AtomicUsize = AtomicUsize::new(0);
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, l: Layout) -> *mut u8 {
+        ALLOCS.fetch_add(1, Ordering::SeqCst);
+        unsafe { System.alloc(l) }
+    }
+    unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
+        unsafe { System.dealloc(p, l) }
+    }
+    unsafe fn realloc(&self, p: *mut u8, l: Layout, n: usize) -> *mut u8 {
+        ALLOCS.fetch_add(1, Ordering::SeqCst);
+        unsafe { System.realloc(p, l, n) }
+    }
+}
+
+#[global_allocator]
+static A: Counting = Counting;
+
+#[test]
+fn kinematics_and_tasks_allocate_nothing() {
+    let robot = jvrc1(&ModelOptions::default()).unwrap();
+    let mut s = State::neutral(&robot);
+    s.qd.fill(0.3);
+    let mut kin = Kinematics::new(&robot, &s).unwrap();
+    let g = Gains::default();
+    let mut stack = TaskStack::default();
+    stack.push(
+        "feet",
+        vec![
+            Task::Frame(FrameTask::new(&robot, "r_ankle", Axes::ALL, g).unwrap()),
+            Task::Frame(FrameTask::new(&robot, "l_ankle", Axes::ALL, g).unwrap()),
+        ],
+    );
+    stack.push("com", vec![Task::Com(ComTask::new(&robot, [true, true, false], g).unwrap())]);
+    stack.push("pelvis", vec![Task::Frame(FrameTask::new(&robot, "PELVIS_S", Axes::ORIENTATION, g).unwrap())]);
+    stack.push("upper", vec![Task::Joint(JointTask::new(&robot, &["WAIST_Y", "NECK_Y"], g).unwrap())]);
+    let mut eqs = stack.equations(&robot);
+    let mut j6 = DMatrix::zeros(6, robot.nv());
+    let mut j3 = DMatrix::zeros(3, robot.nv());
+    let foot = robot.frame_id("r_ankle").unwrap();
+    let before = ALLOCS.load(Ordering::SeqCst);
+    for k in 0..10 {
+        s.q[7 + k] += 0.01;
+        kin.update(&robot, &s).unwrap();
+        kin.frame_jacobian(&robot, foot, &mut j6).unwrap();
+        let _ = kin.frame_drift(&robot, foot).unwrap();
+        kin.com_jacobian(&robot, &mut j3).unwrap();
+        stack.linearize(&robot, &kin, &s, &mut eqs).unwrap();
+    }
+    let after = ALLOCS.load(Ordering::SeqCst);
+    assert_eq!(after - before, 0, "the tick allocated {} times", after - before);
+}
