@@ -108,7 +108,13 @@ impl TaskStack {
     ) -> Result<()> {
         check_dim("number of task levels", self.levels.len(), out.len())?;
         for (level, eq) in self.levels.iter_mut().zip(out.iter_mut()) {
-            check_dim(&format!("rows of level `{}`", level.name), level.dim(), eq.dim())?;
+            if level.dim() != eq.dim() {
+                return Err(crate::Error::DimensionMismatch {
+                    what: format!("rows of level `{}`", level.name),
+                    expected: level.dim(),
+                    got: eq.dim(),
+                });
+            }
             let mut offset = 0;
             for t in level.tasks.iter_mut() {
                 t.linearize(robot, kin, state, eq, offset)?;
