@@ -3,6 +3,9 @@
 
 use clap::{Parser, Subcommand};
 
+mod cmd_model;
+mod robot_arg;
+
 #[derive(Parser)]
 #[command(
     name = "iktc",
@@ -15,9 +18,21 @@ struct Cli {
 }
 
 #[derive(Subcommand)]
-enum Command {}
+enum Command {
+    /// Describe a robot model; with --config, its kinematics at a configuration.
+    Model(cmd_model::Args),
+}
 
-fn main() -> anyhow::Result<()> {
+fn main() -> std::process::ExitCode {
     let cli = Cli::parse();
-    match cli.command {}
+    let result = match &cli.command {
+        Command::Model(a) => cmd_model::run(a),
+    };
+    match result {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            std::process::ExitCode::FAILURE
+        }
+    }
 }

@@ -43,9 +43,24 @@ fn kinematics_and_tasks_allocate_nothing() {
             Task::Frame(FrameTask::new(&robot, "l_ankle", Axes::ALL, g).unwrap()),
         ],
     );
-    stack.push("com", vec![Task::Com(ComTask::new(&robot, [true, true, false], g).unwrap())]);
-    stack.push("pelvis", vec![Task::Frame(FrameTask::new(&robot, "PELVIS_S", Axes::ORIENTATION, g).unwrap())]);
-    stack.push("upper", vec![Task::Joint(JointTask::new(&robot, &["WAIST_Y", "NECK_Y"], g).unwrap())]);
+    stack.push(
+        "com",
+        vec![Task::Com(
+            ComTask::new(&robot, [true, true, false], g).unwrap(),
+        )],
+    );
+    stack.push(
+        "pelvis",
+        vec![Task::Frame(
+            FrameTask::new(&robot, "PELVIS_S", Axes::ORIENTATION, g).unwrap(),
+        )],
+    );
+    stack.push(
+        "upper",
+        vec![Task::Joint(
+            JointTask::new(&robot, &["WAIST_Y", "NECK_Y"], g).unwrap(),
+        )],
+    );
     let mut eqs = stack.equations(&robot);
     let mut j6 = DMatrix::zeros(6, robot.nv());
     let mut j3 = DMatrix::zeros(3, robot.nv());
@@ -60,5 +75,10 @@ fn kinematics_and_tasks_allocate_nothing() {
         stack.linearize(&robot, &kin, &s, &mut eqs).unwrap();
     }
     let after = ALLOCS.load(Ordering::SeqCst);
-    assert_eq!(after - before, 0, "the tick allocated {} times", after - before);
+    assert_eq!(
+        after - before,
+        0,
+        "the tick allocated {} times",
+        after - before
+    );
 }

@@ -32,27 +32,40 @@ fn malformed_urdf() {
 #[test]
 fn lower_above_upper() {
     let e = load(&GOOD.replace("lower=\"-1\"", "lower=\"2\"")).unwrap_err();
-    assert!(matches!(e, Error::InvalidLimit { ref what, lower, upper } if what.contains('j') && lower == 2.0 && upper == 1.0), "{e}");
+    assert!(
+        matches!(e, Error::InvalidLimit { ref what, lower, upper } if what.contains('j') && lower == 2.0 && upper == 1.0),
+        "{e}"
+    );
 }
 
 #[test]
 fn nan_in_urdf() {
     let e = load(&GOOD.replace("lower=\"-1\"", "lower=\"nan\"")).unwrap_err();
-    assert!(matches!(e, Error::NonFinite { .. } | Error::Urdf { .. }), "{e}");
+    assert!(
+        matches!(e, Error::NonFinite { .. } | Error::Urdf { .. }),
+        "{e}"
+    );
 }
 
 #[test]
 fn unknown_link_and_two_roots() {
     let e = load(&GOOD.replace("<child link=\"b\"/>", "<child link=\"c\"/>")).unwrap_err();
-    assert!(e.to_string().contains("c") && e.to_string().contains("a, b"), "{e}");
-    let e = load(&GOOD.replace("<link name=\"b\"/>", "<link name=\"b\"/><link name=\"z\"/>")).unwrap_err();
+    assert!(
+        e.to_string().contains("c") && e.to_string().contains("a, b"),
+        "{e}"
+    );
+    let e = load(&GOOD.replace("<link name=\"b\"/>", "<link name=\"b\"/><link name=\"z\"/>"))
+        .unwrap_err();
     assert!(e.to_string().contains("exactly one root"), "{e}");
 }
 
 #[test]
 fn unsupported_joint_type() {
     let e = load(&GOOD.replace("revolute", "planar")).unwrap_err();
-    assert!(e.to_string().contains("Planar") || e.to_string().contains("planar"), "{e}");
+    assert!(
+        e.to_string().contains("Planar") || e.to_string().contains("planar"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -63,14 +76,24 @@ fn zero_axis() {
 
 #[test]
 fn unknown_locked_joint_lists_valid_names() {
-    let o = ModelOptions { locked: vec![("nope".into(), 0.0)], ..Default::default() };
+    let o = ModelOptions {
+        locked: vec![("nope".into(), 0.0)],
+        ..Default::default()
+    };
     let e = Robot::from_urdf_str(GOOD, &o).unwrap_err();
-    assert!(matches!(e, Error::UnknownName { ref valid, .. } if valid == &vec!["j".to_string()]), "{e}");
+    assert!(
+        matches!(e, Error::UnknownName { ref valid, .. } if valid == &vec!["j".to_string()]),
+        "{e}"
+    );
 }
 
 #[test]
 fn mimic_reject_policy() {
-    let o = ModelOptions { mimic: MimicPolicy::Reject, base: BaseKind::Fixed, ..Default::default() };
+    let o = ModelOptions {
+        mimic: MimicPolicy::Reject,
+        base: BaseKind::Fixed,
+        ..Default::default()
+    };
     let e = Robot::from_urdf_str(JVRC1_URDF, &o).unwrap_err();
     assert!(e.to_string().contains("mimics"), "{e}");
 }
@@ -80,7 +103,10 @@ fn unknown_frame_lists_valid_names() {
     let r = planar3r();
     let e = r.frame_id("hand").unwrap_err();
     let m = e.to_string();
-    assert!(m.contains("hand") && m.contains("tip") && m.contains("link1"), "{m}");
+    assert!(
+        m.contains("hand") && m.contains("tip") && m.contains("link1"),
+        "{m}"
+    );
 }
 
 #[test]
@@ -88,9 +114,22 @@ fn bad_states() {
     let r = jvrc1(&ModelOptions::default()).unwrap();
     let mut s = State::neutral(&r);
     s.q[10] = f64::NAN;
-    assert!(matches!(Kinematics::new(&r, &s), Err(Error::NonFinite { .. })));
-    let s = State { q: DVector::zeros(5), qd: DVector::zeros(38) };
-    assert!(matches!(Kinematics::new(&r, &s), Err(Error::DimensionMismatch { expected: 39, got: 5, .. })));
+    assert!(matches!(
+        Kinematics::new(&r, &s),
+        Err(Error::NonFinite { .. })
+    ));
+    let s = State {
+        q: DVector::zeros(5),
+        qd: DVector::zeros(38),
+    };
+    assert!(matches!(
+        Kinematics::new(&r, &s),
+        Err(Error::DimensionMismatch {
+            expected: 39,
+            got: 5,
+            ..
+        })
+    ));
     let mut s = State::neutral(&r);
     s.q[6] = 0.0; // zero quaternion
     assert!(Kinematics::new(&r, &s).is_err());
@@ -111,9 +150,18 @@ fn builtin_names() {
 
 #[test]
 fn bad_acceleration_option() {
-    let o = ModelOptions { acceleration_limits: vec![("j".into(), -1.0)], ..Default::default() };
-    assert!(matches!(Robot::from_urdf_str(GOOD, &o), Err(Error::InvalidSetting { .. })));
-    let o = ModelOptions { acceleration_limits: vec![("j".into(), 7.0)], ..Default::default() };
+    let o = ModelOptions {
+        acceleration_limits: vec![("j".into(), -1.0)],
+        ..Default::default()
+    };
+    assert!(matches!(
+        Robot::from_urdf_str(GOOD, &o),
+        Err(Error::InvalidSetting { .. })
+    ));
+    let o = ModelOptions {
+        acceleration_limits: vec![("j".into(), 7.0)],
+        ..Default::default()
+    };
     let r = Robot::from_urdf_str(GOOD, &o).unwrap();
     assert_eq!(r.active_joints().next().unwrap().limit.acceleration, 7.0);
 }

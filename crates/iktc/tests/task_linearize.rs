@@ -32,10 +32,19 @@ fn frame_position_error_follows_eq_12() {
     let robot = planar3r();
     let mut s = State::neutral(&robot);
     s.q = DVector::from_vec(vec![1.5, -1.2, 1.0]);
-    let mut t = FrameTask::new(&robot, "tip", Axes([true, true, false, false, false, false]), Gains::critical(100.0)).unwrap();
+    let mut t = FrameTask::new(
+        &robot,
+        "tip",
+        Axes([true, true, false, false, false, false]),
+        Gains::critical(100.0),
+    )
+    .unwrap();
     let kin = Kinematics::new(&robot, &s).unwrap();
     let p0 = kin.frame_pose(&robot, t.frame()).unwrap();
-    let target = Isometry3::from_parts(Translation3::from(p0.translation.vector + Vector3::new(0.05, -0.03, 0.0)), p0.rotation);
+    let target = Isometry3::from_parts(
+        Translation3::from(p0.translation.vector + Vector3::new(0.05, -0.03, 0.0)),
+        p0.rotation,
+    );
     t.set_reference(FrameReference::hold(target)).unwrap();
     let mut eq = TaskEquation::zeros("tip", 2, robot.nv());
     let mut task = Task::Frame(t);
@@ -46,8 +55,15 @@ fn frame_position_error_follows_eq_12() {
         kin.update(&robot, &s).unwrap();
         task.linearize(&robot, &kin, &s, &mut eq, 0).unwrap();
         let time = step as f64 * dt;
-        let (ex, ey) = (closed_form(e0x, 0.0, 100.0, time), closed_form(e0y, 0.0, 100.0, time));
-        assert!((eq.error[0] - ex).abs() < TRACKING_TOL * e0x.abs(), "t={time}: {} vs {ex}", eq.error[0]);
+        let (ex, ey) = (
+            closed_form(e0x, 0.0, 100.0, time),
+            closed_form(e0y, 0.0, 100.0, time),
+        );
+        assert!(
+            (eq.error[0] - ex).abs() < TRACKING_TOL * e0x.abs(),
+            "t={time}: {} vs {ex}",
+            eq.error[0]
+        );
         assert!((eq.error[1] - ey).abs() < TRACKING_TOL * e0y.abs());
         let qdd = solve(&eq);
         s.integrate(&robot, &qdd, dt).unwrap();
@@ -62,12 +78,26 @@ fn orientation_and_com_errors_follow_eq_12_on_jvrc1() {
     let pelvis = robot.frame_id("PELVIS_S").unwrap();
     let p0 = kin0.frame_pose(&robot, pelvis).unwrap();
     let rot_err = Vector3::new(0.04, -0.02, 0.03);
-    let target = Isometry3::from_parts(p0.translation, UnitQuaternion::from_scaled_axis(rot_err) * p0.rotation);
-    let mut ft = FrameTask::new(&robot, "PELVIS_S", Axes::ORIENTATION, Gains::critical(100.0)).unwrap();
+    let target = Isometry3::from_parts(
+        p0.translation,
+        UnitQuaternion::from_scaled_axis(rot_err) * p0.rotation,
+    );
+    let mut ft = FrameTask::new(
+        &robot,
+        "PELVIS_S",
+        Axes::ORIENTATION,
+        Gains::critical(100.0),
+    )
+    .unwrap();
     ft.set_reference(FrameReference::hold(target)).unwrap();
     let mut ct = ComTask::new(&robot, [true, true, false], Gains::critical(100.0)).unwrap();
     let c0 = kin0.com();
-    ct.set_reference(ComReference { position: c0 + Vector3::new(0.02, 0.01, 0.0), velocity: Vector3::zeros(), acceleration: Vector3::zeros() }).unwrap();
+    ct.set_reference(ComReference {
+        position: c0 + Vector3::new(0.02, 0.01, 0.0),
+        velocity: Vector3::zeros(),
+        acceleration: Vector3::zeros(),
+    })
+    .unwrap();
     let mut stack = TaskStack::default();
     stack.push("pelvis+com", vec![Task::Frame(ft), Task::Com(ct)]);
     let mut eqs = stack.equations(&robot);
@@ -82,7 +112,11 @@ fn orientation_and_com_errors_follow_eq_12_on_jvrc1() {
         for k in 0..5 {
             let want = closed_form(e0[k], 0.0, 100.0, time);
             // Rotation-vector errors compose non-linearly: allow a little more.
-            assert!((eqs[0].error[k] - want).abs() < 2e-2 * e0[k].abs(), "row {k} t={time}: {} vs {want}", eqs[0].error[k]);
+            assert!(
+                (eqs[0].error[k] - want).abs() < 2e-2 * e0[k].abs(),
+                "row {k} t={time}: {} vs {want}",
+                eqs[0].error[k]
+            );
         }
         let qdd = solve(&eqs[0]);
         s.integrate(&robot, &qdd, dt).unwrap();
@@ -95,8 +129,14 @@ fn joint_task_rows_select_joints() {
     let mut r = rng(4);
     let s = random_state(&mut r, &robot);
     let kin = Kinematics::new(&robot, &s).unwrap();
-    let mut jt = JointTask::new(&robot, &["WAIST_Y", "L_ELBOW_P"], Gains { kp: 4.0, kv: 3.0 }).unwrap();
-    jt.set_reference(&[0.1, -0.5], &[0.2, 0.0], &[1.0, -1.0]).unwrap();
+    let mut jt = JointTask::new(
+        &robot,
+        &["WAIST_Y", "L_ELBOW_P"],
+        Gains { kp: 4.0, kv: 3.0 },
+    )
+    .unwrap();
+    jt.set_reference(&[0.1, -0.5], &[0.2, 0.0], &[1.0, -1.0])
+        .unwrap();
     let mut eq = TaskEquation::zeros("j", 2, robot.nv());
     jt.linearize(&robot, &kin, &s, &mut eq, 0).unwrap();
     let iw = robot.joint_v_index("WAIST_Y").unwrap();
@@ -113,17 +153,29 @@ fn tasks_reject_bad_input() {
     let robot = jvrc1(&ModelOptions::default()).unwrap();
     let e = FrameTask::new(&robot, "no_such_frame", Axes::ALL, Gains::default()).unwrap_err();
     let msg = e.to_string();
-    assert!(msg.contains("no_such_frame") && msg.contains("PELVIS_S"), "{msg}");
+    assert!(
+        msg.contains("no_such_frame") && msg.contains("PELVIS_S"),
+        "{msg}"
+    );
     let e = JointTask::new(&robot, &["R_UTHUMB"], Gains::default()).unwrap_err();
     assert!(e.to_string().contains("locked"), "{e}");
     let mut jt = JointTask::new(&robot, &["WAIST_Y"], Gains::default()).unwrap();
-    assert!(matches!(jt.set_reference(&[f64::NAN], &[0.0], &[0.0]), Err(iktc::Error::NonFinite { .. })));
-    assert!(matches!(jt.set_reference(&[0.0, 1.0], &[0.0], &[0.0]), Err(iktc::Error::DimensionMismatch { .. })));
+    assert!(matches!(
+        jt.set_reference(&[f64::NAN], &[0.0], &[0.0]),
+        Err(iktc::Error::NonFinite { .. })
+    ));
+    assert!(matches!(
+        jt.set_reference(&[0.0, 1.0], &[0.0], &[0.0]),
+        Err(iktc::Error::DimensionMismatch { .. })
+    ));
     assert!(FrameTask::new(&robot, "PELVIS_S", Axes([false; 6]), Gains::default()).is_err());
     assert!(ComTask::new(&robot, [true, false, false], Gains { kp: -1.0, kv: 0.0 }).is_err());
     let s = State::neutral(&robot);
     let kin = Kinematics::new(&robot, &s).unwrap();
     let mut eq = TaskEquation::zeros("too small", 1, robot.nv());
     let mut ft = FrameTask::new(&robot, "PELVIS_S", Axes::ALL, Gains::default()).unwrap();
-    assert!(matches!(ft.linearize(&robot, &kin, &s, &mut eq, 0), Err(iktc::Error::DimensionMismatch { .. })));
+    assert!(matches!(
+        ft.linearize(&robot, &kin, &s, &mut eq, 0),
+        Err(iktc::Error::DimensionMismatch { .. })
+    ));
 }

@@ -86,7 +86,11 @@ impl TaskEquation {
     /// Checks that sizes agree and every entry is finite.
     pub fn validate(&self) -> Result<()> {
         let m = self.rhs.len();
-        crate::error::check_dim(&format!("rows of J of `{}`", self.name), m, self.jacobian.nrows())?;
+        crate::error::check_dim(
+            &format!("rows of J of `{}`", self.name),
+            m,
+            self.jacobian.nrows(),
+        )?;
         crate::error::check_all_finite(&format!("J of `{}`", self.name), self.jacobian.as_slice())?;
         crate::error::check_all_finite(&format!("h of `{}`", self.name), self.rhs.as_slice())
     }

@@ -107,8 +107,14 @@ impl FrameTask {
 
     /// Sets the reference; errors on a non-finite entry.
     pub fn set_reference(&mut self, r: FrameReference) -> Result<()> {
-        check_all_finite("frame reference position", r.pose.translation.vector.as_slice())?;
-        check_all_finite("frame reference orientation", r.pose.rotation.coords.as_slice())?;
+        check_all_finite(
+            "frame reference position",
+            r.pose.translation.vector.as_slice(),
+        )?;
+        check_all_finite(
+            "frame reference orientation",
+            r.pose.rotation.coords.as_slice(),
+        )?;
         check_all_finite("frame reference velocity", r.velocity.as_slice())?;
         check_all_finite("frame reference acceleration", r.acceleration.as_slice())?;
         self.reference = r;
