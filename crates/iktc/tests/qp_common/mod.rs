@@ -241,13 +241,43 @@ pub enum Kind {
     Infeasible,
 }
 
-/// A random problem of the given kind; sizes n in 1..=40, inequality rows 0..=60,
-/// equalities 0..=n/2 (plus redundant copies for `Degenerate`).
+/// Size ranges of random problems.
+#[derive(Debug, Clone, Copy)]
+pub struct Sizes {
+    /// Largest number of variables (at least 1).
+    pub max_vars: usize,
+    /// Largest number of inequality rows before the kind adds its own.
+    pub max_ineq: usize,
+    /// Largest number of equality rows, as a fraction of n.
+    pub eq_fraction: f64,
+}
+
+/// The sizes of the task: n in 1..=40, inequality rows 0..=60, equalities 0..=n/2.
+pub const SMALL: Sizes = Sizes {
+    max_vars: 40,
+    max_ineq: 60,
+    eq_fraction: 0.5,
+};
+
+/// The largest sizes the solver is meant for: n up to 60, 80 inequality rows, m_eq up to n.
+pub const LARGE: Sizes = Sizes {
+    max_vars: 60,
+    max_ineq: 80,
+    eq_fraction: 1.0,
+};
+
+/// A random problem of the given kind with [`SMALL`] sizes (plus the rows the kind adds:
+/// redundant copies, combinations, conflicting rows).
 pub fn random_problem(seed: u64, kind: Kind) -> OwnedQp {
+    random_problem_sized(seed, kind, SMALL)
+}
+
+/// A random problem of the given kind and sizes.
+pub fn random_problem_sized(seed: u64, kind: Kind, sizes: Sizes) -> OwnedQp {
     let mut rng = rng(seed);
-    let n = rng.random_range(1..=40);
-    let m_in = rng.random_range(0..=60);
-    let m_eq = rng.random_range(0..=n / 2);
+    let n = rng.random_range(1..=sizes.max_vars);
+    let m_in = rng.random_range(0..=sizes.max_ineq);
+    let m_eq = rng.random_range(0..=(n as f64 * sizes.eq_fraction) as usize);
     let x_feas: Vec<f64> = (0..n).map(|_| uniform(&mut rng, -1.0, 1.0)).collect();
     let xf = DVector::from_column_slice(&x_feas);
     let h = if kind == Kind::Identity || rng.random_range(0..5) == 0 && kind != Kind::Generic {
@@ -437,6 +467,37 @@ fn add_nearly_conflicting_row(rng: &mut ChaCha8Rng, p: &mut OwnedQp, xf: &DVecto
     // feasible: x_feas satisfies it; the set {a_i x ≥ l_i, a x ≤ upper} is thin
     let upper = v.max(bound) + 1e-5;
     p.push_in(&row, f64::NEG_INFINITY, upper);
+}
+
+/// Multiplies each row of `A_eq`, `A_in` and its bounds by `10^U(−2, 2)`: the solution is
+/// unchanged, the multipliers scale inversely.
+pub fn scale_rows(p: &mut OwnedQp, seed: u64) {
+    let mut rng = rng(seed);
+    for i in 0..p.a_eq.nrows() {
+        let f = 10f64.powf(uniform(&mut rng, -2.0, 2.0));
+        p.a_eq.row_mut(i).scale_mut(f);
+        p.b_eq[i] *= f;
+    }
+    for i in 0..p.a_in.nrows() {
+        let f = 10f64.powf(uniform(&mut rng, -2.0, 2.0));
+        p.a_in.row_mut(i).scale_mut(f);
+        p.l[i] *= f;
+        p.u[i] *= f;
+    }
+}
+
+/// Number of rows of `A_in` within `tol` of an end at `x`, plus the rows of `A_eq`.
+pub fn tight_rows(p: &OwnedQp, x: &DVector<f64>, tol: f64) -> usize {
+    let mut count = p.a_eq.nrows();
+    if p.a_in.nrows() > 0 {
+        let ax = &p.a_in * x;
+        for ((v, l), u) in ax.iter().zip(&p.l).zip(&p.u) {
+            if (v - l).abs() <= tol || (v - u).abs() <= tol {
+                count += 1;
+            }
+        }
+    }
+    count
 }
 
 /// Solves with a fresh workspace.

@@ -204,3 +204,73 @@ pub(crate) fn axpy(a: f64, x: &[f64], y: &mut [f64]) {
         *yi += a * xi;
     }
 }
+
+#[cfg(test)]
+mod tests {
+    //! The invariant `Jᵀ N = [R; 0]`, `J Jᵀ = H⁻¹` through random add/remove sequences, checked
+    //! against products computed directly with nalgebra.
+
+    use super::*;
+    use nalgebra::DVector;
+
+    /// Residual bound for products of O(n) rotated columns of size O(1), n ≤ 12.
+    const TOL: f64 = 1e-12;
+
+    /// Small deterministic pseudo-random numbers in [−1, 1) (a linear congruential generator, so
+    /// the unit test needs no dev-dependency).
+    struct Lcg(u64);
+    impl Lcg {
+        fn next(&mut self) -> f64 {
+            self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            ((self.0 >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+        }
+    }
+
+    fn check(basis: &ActiveBasis, l: &DMatrix<f64>, normals: &[Vec<f64>]) {
+        let n = basis.n;
+        let q = basis.q;
+        assert_eq!(q, normals.len());
+        let j = basis.j.view((0, 0), (n, n)).into_owned();
+        // J Jᵀ = H⁻¹ = L⁻ᵀ L⁻¹  ⇔  Lᵀ J Jᵀ L = I
+        let m = l.transpose() * &j * j.transpose() * l;
+        assert!((m - DMatrix::identity(n, n)).amax() < TOL);
+        for (k, nk) in normals.iter().enumerate() {
+            let col = j.transpose() * DVector::from_column_slice(nk);
+            for i in 0..n {
+                let expected = if i <= k { basis.r[(i, k)] } else { 0.0 };
+                assert!((col[i] - expected).abs() < TOL, "entry ({i}, {k})");
+            }
+        }
+    }
+
+    #[test]
+    fn add_and_remove_keep_the_factorisation() {
+        let mut rng = Lcg(7);
+        for n in 1..=12 {
+            let m = DMatrix::from_fn(n, n, |_, _| rng.next());
+            let h = m.transpose() * &m + DMatrix::identity(n, n);
+            let mut chol = DMatrix::zeros(n, n);
+            super::super::factor::cholesky(&h.as_view(), chol.as_mut_slice(), n, 1e-14)
+                .expect("positive definite");
+            let l = chol.lower_triangle();
+            let mut basis = ActiveBasis::new(n);
+            basis.reset_from_factor(chol.as_slice(), n);
+            let mut normals: Vec<Vec<f64>> = Vec::new();
+            let mut d = vec![0.0; n];
+            for step in 0..4 * n {
+                let remove = !normals.is_empty() && (normals.len() == n || step % 3 == 2);
+                if remove {
+                    let k = (rng.next().abs() * normals.len() as f64) as usize % normals.len();
+                    basis.remove(k);
+                    normals.remove(k);
+                } else {
+                    let v: Vec<f64> = (0..n).map(|_| rng.next()).collect();
+                    basis.project(&v, &mut d);
+                    basis.add(&mut d);
+                    normals.push(v);
+                }
+                check(&basis, &l, &normals);
+            }
+        }
+    }
+}
