@@ -1,1 +1,60 @@
-//! (module under construction in this session)
+//! Joint position, velocity and acceleration limits turned into one box on the joint
+//! accelerations, `b_l ≤ q̈ ≤ b_u` (paper eqs. 13–14), for a control period `Δt`.
+//!
+//! Two methods, side by side ([`BoundMethod`]):
+//!
+//! | method | formula | discrete-time safe |
+//! |---|---|---|
+//! | [`BoundMethod::Paper`] | Proposition 3.1, eq. (14), as printed ([`paper`]) | no: the box can empty and the joint overshoot (errata §3.1) |
+//! | [`BoundMethod::Viable`] | position with in-step peak, exact velocity, viability at the next state, `±a_max`; Del Prete, IEEE RA-L 2018 ([`viable`]) | yes, from a viable state |
+//!
+//! Each source of bound (acceleration, velocity, position, viability) is computed separately,
+//! as in TSID, then intersected ([`intersect`]). When the sources of `Viable` conflict, the
+//! acceleration limit is dropped first, then viability; position and velocity are kept, and if
+//! they conflict the box is reported empty. The [`AccelerationBox`] records every source value,
+//! the source that binds each side and what was dropped, so the caller can see why a joint is
+//! constrained.
+//!
+//! Data are plain and independent of the robot model: [`JointLimits`] holds one
+//! [`DofLimits`] per velocity dof (`nv` entries; floating-base dofs and continuous joints have
+//! infinite limits), and [`compute_box`] takes the state as slices.
+//!
+//! ```
+//! use iktc::limits::{compute_box, AccelerationBox, BoundMethod, DofLimits, JointLimits};
+//!
+//! let joint = DofLimits {
+//!     position_min: -1.0,
+//!     position_max: 1.0,
+//!     velocity_max: std::f64::consts::PI,
+//!     acceleration_max: 10.0 * std::f64::consts::PI,
+//! };
+//! let limits = JointLimits::new(vec![DofLimits::unlimited(), joint])?;
+//! let mut bounds = AccelerationBox::new(limits.nv());
+//! compute_box(&limits, &BoundMethod::default(), &[0.0, 0.95], &[0.0, 1.2], 0.005, &mut bounds)?;
+//! assert!(!bounds.is_empty());
+//! assert_eq!(bounds.upper[0], f64::INFINITY); // unlimited dof
+//! assert!(bounds.upper[1] < 0.0); // 0.05 rad from the limit at 1.2 rad/s: must brake
+//! # Ok::<(), iktc::Error>(())
+//! ```
+
+mod acceleration_box;
+mod compute;
+mod integrator;
+mod intersect;
+mod joint_limits;
+mod method;
+pub mod paper;
+mod source;
+mod velocity;
+pub mod viable;
+
+pub use acceleration_box::AccelerationBox;
+pub use compute::{compute_box, compute_dof};
+pub use integrator::{integrate_constant_acceleration, peak_in_step, StepExtremes};
+pub use intersect::{intersect, DofBounds};
+pub use joint_limits::{DofLimits, JointLimits};
+pub use method::{BoundMethod, ViableSettings};
+pub use paper::paper_sources;
+pub use source::{BoundSource, DofBoundSources, DroppedSources, SourceBounds};
+pub use velocity::{velocity_lower, velocity_upper};
+pub use viable::viable_sources;

@@ -1,1 +1,8 @@
 //! Solvers.
+
+pub mod qp;
+
+pub use qp::{
+    ActiveConstraint, Hessian, QpConstraint, QpProblem, QpReport, QpSettings, QpStatus,
+    QpWorkspace,
+};

@@ -1,0 +1,330 @@
+//! Drawing a [`Figure`] onto any plotters backend (SVG or bitmap).
+
+use plotters::coord::ranged1d::ValueFormatter;
+use plotters::coord::types::RangedCoordf64;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+
+use crate::error::ReportError;
+use crate::figure::{Figure, LineStyle, Panel, Series};
+use crate::font::FONT_FAMILY;
+use crate::range::{
+    equalize, finite_bounds, linear_formatter, linear_range, log_formatter, log_range,
+};
+
+/// Series colours (Tableau-like, red left out: red is reserved for limit lines).
+const PALETTE: [RGBColor; 9] = [
+    RGBColor(31, 119, 180),
+    RGBColor(255, 127, 14),
+    RGBColor(44, 160, 44),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(127, 127, 127),
+    RGBColor(188, 189, 34),
+    RGBColor(23, 190, 207),
+];
+/// Colour of horizontal reference (limit) lines.
+const LIMIT_COLOR: RGBColor = RGBColor(200, 30, 30);
+/// Space around each chart [px].
+const MARGIN: u32 = 8;
+/// Extra space right of each chart so the last tick label fits [px].
+const MARGIN_RIGHT: u32 = 20;
+/// Height reserved for x tick labels and the x-axis label [px].
+const X_LABEL_AREA: u32 = 42;
+/// Width reserved for y tick labels and the y-axis label [px].
+const Y_LABEL_AREA: u32 = 78;
+/// Line width of series [px].
+const LINE_WIDTH: u32 = 2;
+/// Marker radius of point series [px].
+const POINT_RADIUS: u32 = 3;
+
+fn err<E: std::fmt::Display>(context: &str) -> impl FnOnce(E) -> ReportError + '_ {
+    move |e| ReportError::plot(context, e)
+}
+
+/// Draws the whole figure (white background, title row, grid of panels) onto `root`.
+pub(crate) fn draw_figure<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    fig: &Figure,
+) -> Result<(), ReportError> {
+    root.fill(&WHITE).map_err(err("filling the background"))?;
+    let title_h = fig.title_height();
+    let body = if title_h > 0 {
+        let (top, body) = root.split_vertically(title_h);
+        let (w, h) = top.dim_in_pixel();
+        let style = TextStyle::from((FONT_FAMILY, 22).into_font().style(FontStyle::Bold))
+            .pos(Pos::new(HPos::Center, VPos::Center));
+        top.draw(&Text::new(
+            fig.title.clone(),
+            ((w / 2) as i32, (h / 2) as i32 + 2),
+            style,
+        ))
+        .map_err(err("drawing the figure title"))?;
+        body
+    } else {
+        root.clone()
+    };
+    let cols = fig.columns.max(1).min(fig.panels.len().max(1));
+    let areas = body.split_evenly((fig.rows().max(1), cols));
+    for (panel, area) in fig.panels.iter().zip(areas.iter()) {
+        draw_panel(area, panel)?;
+    }
+    Ok(())
+}
+
+/// Finite points of a series that can be placed on the panel's axes.
+fn valid(p: (f64, f64), log_x: bool) -> bool {
+    p.0.is_finite() && p.1.is_finite() && (!log_x || p.0 > 0.0)
+}
+
+fn series_points(s: &Series) -> impl Iterator<Item = (f64, f64)> + '_ {
+    s.x.iter().copied().zip(s.y.iter().copied())
+}
+
+/// Maximal runs of consecutive valid points (lines are broken at NaN/inf).
+fn segments(s: &Series, log_x: bool) -> Vec<Vec<(f64, f64)>> {
+    let mut out = Vec::new();
+    let mut cur = Vec::new();
+    for p in series_points(s) {
+        if valid(p, log_x) {
+            cur.push(p);
+        } else if !cur.is_empty() {
+            out.push(std::mem::take(&mut cur));
+        }
+    }
+    if !cur.is_empty() {
+        out.push(cur);
+    }
+    out
+}
+
+fn draw_panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    panel: &Panel,
+) -> Result<(), ReportError> {
+    let area = if panel.title.trim().is_empty() {
+        area.clone()
+    } else {
+        let style = (FONT_FAMILY, 17).into_font().style(FontStyle::Bold);
+        area.titled(&panel.title, style)
+            .map_err(err("drawing a panel title"))?
+    };
+    let log_x = panel.log_x;
+    let pts = || {
+        panel
+            .series
+            .iter()
+            .flat_map(series_points)
+            .filter(move |p| valid(*p, log_x))
+    };
+    let xb = finite_bounds(pts().map(|p| p.0));
+    let yb = finite_bounds(pts().map(|p| p.1).chain(panel.hlines.iter().map(|h| h.y)));
+    let has_data = xb.is_some();
+    let mut y_range = linear_range(yb);
+    let mut builder = ChartBuilder::on(&area);
+    builder
+        .margin(MARGIN)
+        .margin_right(MARGIN_RIGHT)
+        .x_label_area_size(X_LABEL_AREA)
+        .y_label_area_size(Y_LABEL_AREA);
+    if log_x {
+        let x_range = log_range(xb);
+        let mut chart = builder
+            .build_cartesian_2d((x_range.0..x_range.1).log_scale(), y_range.0..y_range.1)
+            .map_err(err("building a log-x chart"))?;
+        fill_chart(
+            &mut chart,
+            panel,
+            x_range,
+            y_range,
+            &log_formatter,
+            has_data,
+        )
+    } else {
+        let mut x_range = linear_range(xb);
+        if panel.equal_aspect {
+            let (w, h) = area.dim_in_pixel();
+            let plot_w = f64::from(w) - f64::from(2 * MARGIN + MARGIN_RIGHT + Y_LABEL_AREA);
+            let plot_h = f64::from(h) - f64::from(2 * MARGIN + X_LABEL_AREA);
+            (x_range, y_range) = equalize(x_range, y_range, plot_w, plot_h);
+        }
+        let mut chart = builder
+            .build_cartesian_2d(x_range.0..x_range.1, y_range.0..y_range.1)
+            .map_err(err("building a chart"))?;
+        let x_fmt = linear_formatter(x_range);
+        fill_chart(&mut chart, panel, x_range, y_range, &x_fmt, has_data)
+    }
+}
+
+/// Which corner of the plot holds the fewest data points (there the legend hides least).
+fn legend_corner(panel: &Panel, x: (f64, f64), y: (f64, f64)) -> SeriesLabelPosition {
+    let nx = |v: f64| {
+        if panel.log_x {
+            (v.ln() - x.0.ln()) / (x.1.ln() - x.0.ln())
+        } else {
+            (v - x.0) / (x.1 - x.0)
+        }
+    };
+    let ny = |v: f64| (v - y.0) / (y.1 - y.0);
+    // upper-right, upper-left, lower-right, lower-left
+    let mut counts = [0usize; 4];
+    for p in panel
+        .series
+        .iter()
+        .flat_map(series_points)
+        .filter(|p| valid(*p, panel.log_x))
+    {
+        let (u, v) = (nx(p.0), ny(p.1));
+        let right = u > 0.55;
+        let left = u < 0.45;
+        let up = v > 0.5;
+        let down = v < 0.5;
+        counts[0] += usize::from(right && up);
+        counts[1] += usize::from(left && up);
+        counts[2] += usize::from(right && down);
+        counts[3] += usize::from(left && down);
+    }
+    let best = (0..4).min_by_key(|&i| counts[i]).unwrap_or(0);
+    match best {
+        1 => SeriesLabelPosition::UpperLeft,
+        2 => SeriesLabelPosition::LowerRight,
+        3 => SeriesLabelPosition::LowerLeft,
+        _ => SeriesLabelPosition::UpperRight,
+    }
+}
+
+fn fill_chart<'a, DB, X>(
+    chart: &mut ChartContext<'a, DB, Cartesian2d<X, RangedCoordf64>>,
+    panel: &Panel,
+    x_range: (f64, f64),
+    y_range: (f64, f64),
+    x_fmt: &dyn Fn(&f64) -> String,
+    has_data: bool,
+) -> Result<(), ReportError>
+where
+    DB: DrawingBackend + 'a,
+    X: Ranged<ValueType = f64> + ValueFormatter<f64>,
+{
+    let y_fmt = linear_formatter(y_range);
+    chart
+        .configure_mesh()
+        .x_desc(panel.x_label.as_str())
+        .y_desc(panel.y_label.as_str())
+        .x_label_formatter(x_fmt)
+        .y_label_formatter(&y_fmt)
+        .x_labels(10)
+        .y_labels(7)
+        .label_style((FONT_FAMILY, 13))
+        .axis_desc_style((FONT_FAMILY, 15))
+        .bold_line_style(RGBColor(215, 215, 215))
+        .light_line_style(RGBColor(240, 240, 240))
+        .axis_style(RGBColor(90, 90, 90))
+        .draw()
+        .map_err(err("drawing axes"))?;
+
+    let mut entries = 0usize;
+    let mut seen_limit_labels: Vec<&str> = Vec::new();
+    for h in panel.hlines.iter().filter(|h| h.y.is_finite()) {
+        let style = LIMIT_COLOR.stroke_width(LINE_WIDTH);
+        let anno = chart
+            .draw_series(DashedLineSeries::new(
+                vec![(x_range.0, h.y), (x_range.1, h.y)],
+                10,
+                6,
+                style,
+            ))
+            .map_err(err("drawing a limit line"))?;
+        if !h.label.is_empty() && !seen_limit_labels.contains(&h.label.as_str()) {
+            seen_limit_labels.push(&h.label);
+            entries += 1;
+            anno.label(h.label.as_str()).legend(move |(x, y)| {
+                EmptyElement::at((x, y))
+                    + PathElement::new(vec![(0, 0), (8, 0)], style)
+                    + PathElement::new(vec![(13, 0), (21, 0)], style)
+            });
+        }
+    }
+
+    for (i, s) in panel.series.iter().enumerate() {
+        let color = PALETTE[i % PALETTE.len()];
+        let line = color.stroke_width(LINE_WIDTH);
+        let segs = segments(s, panel.log_x);
+        let ctx = format!("drawing series '{}'", s.label);
+        for seg in &segs {
+            match s.style {
+                LineStyle::Solid => {
+                    chart
+                        .draw_series(LineSeries::new(seg.iter().copied(), line))
+                        .map_err(err(&ctx))?;
+                }
+                LineStyle::Dashed => {
+                    chart
+                        .draw_series(DashedLineSeries::new(seg.iter().copied(), 9, 5, line))
+                        .map_err(err(&ctx))?;
+                }
+                LineStyle::Points => {
+                    chart
+                        .draw_series(
+                            seg.iter()
+                                .map(|&p| Circle::new(p, POINT_RADIUS, color.filled())),
+                        )
+                        .map_err(err(&ctx))?;
+                }
+            }
+        }
+        if s.label.is_empty() {
+            continue;
+        }
+        entries += 1;
+        let anno = chart
+            .draw_series(std::iter::empty::<PathElement<(f64, f64)>>())
+            .map_err(err(&ctx))?;
+        let anno = anno.label(s.label.as_str());
+        match s.style {
+            LineStyle::Solid => {
+                anno.legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 21, y)], line));
+            }
+            LineStyle::Dashed => {
+                anno.legend(move |(x, y)| {
+                    EmptyElement::at((x, y))
+                        + PathElement::new(vec![(0, 0), (8, 0)], line)
+                        + PathElement::new(vec![(13, 0), (21, 0)], line)
+                });
+            }
+            LineStyle::Points => {
+                anno.legend(move |(x, y)| {
+                    Circle::new((x + 10, y), POINT_RADIUS + 1, color.filled())
+                });
+            }
+        }
+    }
+
+    if !has_data {
+        let area = chart.plotting_area();
+        let (w, h) = area.dim_in_pixel();
+        let style = TextStyle::from((FONT_FAMILY, 16).into_font())
+            .color(&RGBColor(120, 120, 120))
+            .pos(Pos::new(HPos::Center, VPos::Center));
+        area.strip_coord_spec()
+            .draw(&Text::new(
+                "no finite data",
+                ((w / 2) as i32, (h / 2) as i32),
+                style,
+            ))
+            .map_err(err("drawing the no-data note"))?;
+    }
+
+    if entries > 1 {
+        chart
+            .configure_series_labels()
+            .position(legend_corner(panel, x_range, y_range))
+            .background_style(WHITE.mix(0.85))
+            .border_style(RGBColor(160, 160, 160))
+            .label_font((FONT_FAMILY, 13))
+            .draw()
+            .map_err(err("drawing the legend"))?;
+    }
+    Ok(())
+}

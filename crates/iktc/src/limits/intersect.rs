@@ -1,0 +1,104 @@
+//! Intersecting the sources of one dof, with the conflict resolution of errata §3.1.
+
+use super::method::BoundMethod;
+use super::source::{BoundSource, DofBoundSources, DroppedSources, SourceBounds};
+
+/// The acceleration interval of one dof after intersection and conflict resolution [rad/s²].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DofBounds {
+    /// Lower bound `b_l` on `q̈` [rad/s²]; `-inf` when nothing bounds it.
+    pub lower: f64,
+    /// Upper bound `b_u` on `q̈` [rad/s²]; `+inf` when nothing bounds it.
+    pub upper: f64,
+    /// The source that gives `lower`.
+    pub lower_source: BoundSource,
+    /// The source that gives `upper`.
+    pub upper_source: BoundSource,
+    /// The sources removed to resolve a conflict.
+    pub dropped: DroppedSources,
+}
+
+impl DofBounds {
+    /// Whether the interval is empty (`lower > upper`).
+    pub fn is_empty(&self) -> bool {
+        self.lower > self.upper
+    }
+}
+
+/// Intersects the sources of one dof: `b_u = min` and `b_l = max` over the sources.
+///
+/// * [`BoundMethod::Paper`]: eq. (14) as printed; an empty interval stays empty.
+/// * [`BoundMethod::Viable`]: if `b_l > b_u`, the acceleration limit is dropped (both sides)
+///   and the intersection redone; if still empty, the viability bound is dropped too. The
+///   position and velocity bounds are never dropped: if they conflict, the interval is
+///   returned empty, with the sources that conflict (errata §3.1).
+///
+/// The binding source of a side is the one attaining the bound among those kept; on a tie the
+/// first of position, viability, velocity, acceleration is named. A side with no finite bound
+/// is [`BoundSource::None`].
+pub fn intersect(sources: &DofBoundSources, method: &BoundMethod) -> DofBounds {
+    let position_source = match method {
+        BoundMethod::Paper => BoundSource::PaperPosition,
+        BoundMethod::Viable(_) => BoundSource::Position,
+    };
+    let mut dropped = DroppedSources::default();
+    let mut bounds = intersect_kept(sources, position_source, dropped);
+    if let BoundMethod::Viable(_) = method {
+        if bounds.is_empty() {
+            dropped.acceleration = true;
+            bounds = intersect_kept(sources, position_source, dropped);
+        }
+        if bounds.is_empty() {
+            dropped.viability = true;
+            bounds = intersect_kept(sources, position_source, dropped);
+        }
+    }
+    bounds
+}
+
+fn intersect_kept(
+    sources: &DofBoundSources,
+    position_source: BoundSource,
+    dropped: DroppedSources,
+) -> DofBounds {
+    // Negating the lower side turns its max into a min, so one routine serves both sides.
+    let (neg_lower, lower_source) = tightest(&negate(&sources.lower), position_source, dropped);
+    let (upper, upper_source) = tightest(&sources.upper, position_source, dropped);
+    DofBounds {
+        lower: -neg_lower,
+        upper,
+        lower_source,
+        upper_source,
+        dropped,
+    }
+}
+
+fn negate(side: &SourceBounds) -> SourceBounds {
+    SourceBounds {
+        acceleration: -side.acceleration,
+        velocity: -side.velocity,
+        position: -side.position,
+        viability: -side.viability,
+    }
+}
+
+/// The smallest kept upper bound of one side and its source (`+inf`, `None` if all infinite).
+fn tightest(
+    side: &SourceBounds,
+    position_source: BoundSource,
+    dropped: DroppedSources,
+) -> (f64, BoundSource) {
+    let candidates = [
+        (side.position, position_source, true),
+        (side.viability, BoundSource::Viability, !dropped.viability),
+        (side.velocity, BoundSource::Velocity, true),
+        (side.acceleration, BoundSource::Acceleration, !dropped.acceleration),
+    ];
+    let mut best = (f64::INFINITY, BoundSource::None);
+    for (value, source, kept) in candidates {
+        if kept && value < best.0 {
+            best = (value, source);
+        }
+    }
+    best
+}

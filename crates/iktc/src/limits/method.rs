@@ -1,0 +1,88 @@
+//! Which formula turns the limits into acceleration bounds, and its settings.
+
+use crate::error::{Error, Result};
+
+/// How joint limits become the acceleration box `b_l ≤ q̈ ≤ b_u`.
+///
+/// Both variants are kept side by side so that their difference can be seen (errata §3.1).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum BoundMethod {
+    /// Proposition 3.1, eq. (14) of the paper, exactly as printed (see [`paper`](super::paper)).
+    ///
+    /// Not safe in discrete time: the box can empty and the joint overshoot its range
+    /// (errata §3.1). No conflict resolution: an empty box is reported as empty.
+    Paper,
+    /// The discrete-time bounds of Del Prete, *Joint position and velocity bounds in
+    /// discrete-time acceleration/torque control of robot manipulators*, IEEE RA-L 3(1), 2018,
+    /// as given in errata §3.1 (see [`viable`](super::viable)), with conflict resolution.
+    Viable(ViableSettings),
+}
+
+impl Default for BoundMethod {
+    /// [`BoundMethod::Viable`] with default settings: the safe one.
+    fn default() -> Self {
+        Self::Viable(ViableSettings::default())
+    }
+}
+
+impl BoundMethod {
+    /// [`BoundMethod::Viable`] with default settings.
+    pub fn viable() -> Self {
+        Self::default()
+    }
+
+    /// Checks the settings of the method.
+    ///
+    /// # Errors
+    /// [`Error::InvalidSetting`] as described in [`ViableSettings::validate`].
+    pub fn validate(&self) -> Result<()> {
+        match self {
+            Self::Paper => Ok(()),
+            Self::Viable(settings) => settings.validate(),
+        }
+    }
+}
+
+/// Settings of [`BoundMethod::Viable`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ViableSettings {
+    /// The braking acceleration assumed by the viability bound, as a fraction of the joint's
+    /// acceleration limit: `a_stop = braking_fraction · a_max` [–], in `(0, 1]`.
+    ///
+    /// Default 0.5 (errata §3.1). The viability bound keeps the next state able to stop before
+    /// the range ends while braking at `a_stop`. At `a_stop = a_max` a joint that sits on its
+    /// braking curve needs every bit of its acceleration authority to stay there, so joints
+    /// coupled to it through the tasks have none left (in the 3R run it chatters at the limit
+    /// and loses higher-priority tasks); a smaller fraction starts braking earlier and more
+    /// gently, trading some reachable speed near the range ends for that authority. Too small
+    /// a fraction makes the joint crawl toward its limits.
+    pub braking_fraction: f64,
+}
+
+impl Default for ViableSettings {
+    fn default() -> Self {
+        Self {
+            braking_fraction: 0.5,
+        }
+    }
+}
+
+impl ViableSettings {
+    /// Checks that `braking_fraction` is finite and in `(0, 1]`.
+    ///
+    /// # Errors
+    /// [`Error::InvalidSetting`] naming `braking_fraction`.
+    pub fn validate(&self) -> Result<()> {
+        let f = self.braking_fraction;
+        if f.is_finite() && f > 0.0 && f <= 1.0 {
+            Ok(())
+        } else {
+            Err(Error::InvalidSetting {
+                name: "ViableSettings::braking_fraction".to_string(),
+                value: f.to_string(),
+                expected: "a fraction of the acceleration limit in (0, 1] [–] (default 0.5)"
+                    .to_string(),
+            })
+        }
+    }
+}

@@ -1,0 +1,95 @@
+//! The separate sources of an acceleration bound, and which one binds.
+
+/// Which limit a side of the acceleration box comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum BoundSource {
+    /// No limit applies to this side: the bound is infinite.
+    #[default]
+    None,
+    /// The acceleration limit `±a_max`.
+    Acceleration,
+    /// The velocity limit: `q̇⁺ = q̇ + Δt q̈` within `±v_max`.
+    Velocity,
+    /// The discrete-time position bound of [`BoundMethod::Viable`](super::BoundMethod):
+    /// the position stays in range over the whole step, in-step peak included.
+    Position,
+    /// The viability bound of [`BoundMethod::Viable`](super::BoundMethod): the next state can
+    /// still stop inside the range braking at `a_stop`.
+    Viability,
+    /// The third term of the paper's eq. (14), `(±√(2 a_max d) − q̇)/Δt`, used by
+    /// [`BoundMethod::Paper`](super::BoundMethod).
+    PaperPosition,
+}
+
+/// Which sources conflict resolution removed for one dof (both sides).
+///
+/// Only [`BoundMethod::Viable`](super::BoundMethod) drops sources: first the acceleration
+/// limit, then the viability bound; position and velocity bounds are never dropped.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub struct DroppedSources {
+    /// The acceleration limit was dropped: the box lets `|q̈|` exceed `a_max`.
+    pub acceleration: bool,
+    /// The viability bound was dropped as well: the next state may be unable to stop inside
+    /// the range.
+    pub viability: bool,
+}
+
+impl DroppedSources {
+    /// Whether any source was dropped.
+    pub fn any(&self) -> bool {
+        self.acceleration || self.viability
+    }
+}
+
+/// The value of every source of bound on one side of one dof [rad/s²].
+///
+/// On the upper side each entry is an upper bound on `q̈` (`+inf` when that limit does not
+/// apply); on the lower side a lower bound (`-inf` when it does not apply). A source that the
+/// method does not use is infinite.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SourceBounds {
+    /// From the acceleration limit: `±a_max`.
+    pub acceleration: f64,
+    /// From the velocity limit: `(±v_max − q̇)/Δt`.
+    pub velocity: f64,
+    /// From the position range: [`BoundSource::Position`] for `Viable`,
+    /// [`BoundSource::PaperPosition`] for `Paper`.
+    pub position: f64,
+    /// From viability (`Viable` only; infinite for `Paper`).
+    pub viability: f64,
+}
+
+impl SourceBounds {
+    /// Every source absent on the upper side (`+inf`).
+    pub const UPPER_NONE: Self = Self::all(f64::INFINITY);
+    /// Every source absent on the lower side (`-inf`).
+    pub const LOWER_NONE: Self = Self::all(f64::NEG_INFINITY);
+
+    const fn all(value: f64) -> Self {
+        Self {
+            acceleration: value,
+            velocity: value,
+            position: value,
+            viability: value,
+        }
+    }
+}
+
+/// Every source of bound of one dof, before intersection [rad/s²].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DofBoundSources {
+    /// Lower bounds on `q̈`, one per source.
+    pub lower: SourceBounds,
+    /// Upper bounds on `q̈`, one per source.
+    pub upper: SourceBounds,
+}
+
+impl Default for DofBoundSources {
+    /// No bound at all.
+    fn default() -> Self {
+        Self {
+            lower: SourceBounds::LOWER_NONE,
+            upper: SourceBounds::UPPER_NONE,
+        }
+    }
+}

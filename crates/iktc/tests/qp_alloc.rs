@@ -1,0 +1,86 @@
+//! `QpWorkspace::solve` allocates nothing once the workspace exists.
+//!
+//! A counting global allocator wraps the system one; it is per test binary, hence this file.
+
+mod qp_common;
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+
+use iktc::solver::{QpSettings, QpStatus, QpWorkspace};
+use nalgebra::DVector;
+use qp_common::{random_problem_sized, Kind, LARGE};
+
+struct Counting;
+
+thread_local! {
+    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
+}
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        // try_with: the thread-local may be gone while a thread shuts down
+        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
+        unsafe { System.alloc(layout) }
+    }
+
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+fn allocations() -> usize {
+    ALLOCATIONS.with(|c| c.get())
+}
+
+#[test]
+fn solve_does_not_allocate() {
+    let settings = QpSettings::default();
+    let mut ws = QpWorkspace::new(60, 120, 120);
+    let kinds = [
+        Kind::Generic,
+        Kind::Identity,
+        Kind::Degenerate,
+        Kind::NearlyInfeasible,
+        Kind::Infeasible,
+    ];
+    let mut statuses = [0usize; 3];
+    for seed in 0..100u64 {
+        let p = random_problem_sized(seed, kinds[(seed % 5) as usize], LARGE);
+        let problem = p.view();
+        let mut x = DVector::zeros(p.n());
+        let before = allocations();
+        let report = ws.solve(&problem, &settings, &mut x);
+        let after = allocations();
+        let report = report.expect("valid problem");
+        assert_eq!(after, before, "seed {seed}: solve allocated");
+        // the accessors do not allocate either
+        let before = allocations();
+        let n = ws.active_set().len() + ws.multipliers_eq().len() + ws.multipliers_in().len();
+        assert_eq!(allocations(), before);
+        assert!(n >= report.active_count);
+        statuses[match report.status {
+            QpStatus::Optimal => 0,
+            QpStatus::Infeasible { .. } => 1,
+            QpStatus::MaxIterations => 2,
+        }] += 1;
+    }
+    // both outcomes were exercised
+    assert!(statuses[0] > 0 && statuses[1] > 0, "{statuses:?}");
+}
+
+#[test]
+fn the_counter_sees_allocations() {
+    let before = allocations();
+    let v: Vec<u64> = std::hint::black_box(Vec::with_capacity(16));
+    assert!(allocations() > before);
+    drop(v);
+}
