@@ -47,13 +47,7 @@ pub fn compute_box(
     check_all_finite("position", position)?;
     check_all_finite("velocity", velocity)?;
 
-    for (i, ((dof, &q), &qd)) in limits
-        .dofs()
-        .iter()
-        .zip(position)
-        .zip(velocity)
-        .enumerate()
-    {
+    for (i, ((dof, &q), &qd)) in limits.dofs().iter().zip(position).zip(velocity).enumerate() {
         let sources = sources_unchecked(dof, method, q, qd, dt);
         out.set(i, sources, intersect(&sources, method));
     }

@@ -92,7 +92,11 @@ fn tightest(
         (side.position, position_source, true),
         (side.viability, BoundSource::Viability, !dropped.viability),
         (side.velocity, BoundSource::Velocity, true),
-        (side.acceleration, BoundSource::Acceleration, !dropped.acceleration),
+        (
+            side.acceleration,
+            BoundSource::Acceleration,
+            !dropped.acceleration,
+        ),
     ];
     let mut best = (f64::INFINITY, BoundSource::None);
     for (value, source, kept) in candidates {

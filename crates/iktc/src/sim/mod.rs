@@ -1,1 +1,9 @@
-//! (module under construction in this session)
+//! Scenarios: the paper's experiments as runnable, recorded simulations.
+
+pub mod margins;
+pub mod planar3r;
+
+pub use margins::{dof_margins, median, percentile, DofMargins};
+pub use planar3r::{
+    run_planar3r, ArmTask, Planar3rConfig, Planar3rRun, Planar3rStep, Planar3rSummary,
+};

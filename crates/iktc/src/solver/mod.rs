@@ -3,6 +3,15 @@
 pub mod qp;
 
 pub use qp::{
-    ActiveConstraint, Hessian, QpConstraint, QpProblem, QpReport, QpSettings, QpStatus,
-    QpWorkspace,
+    ActiveConstraint, Hessian, QpConstraint, QpProblem, QpReport, QpSettings, QpStatus, QpWorkspace,
 };
+
+mod hierarchy;
+mod report;
+mod settings;
+mod solve;
+
+pub use hierarchy::Hierarchy;
+pub use report::{Fallback, Method, SolveReport};
+pub use settings::{Damping, SolverSettings};
+pub use solve::Solver;

@@ -5,9 +5,7 @@ use nalgebra::{DMatrix, DVector};
 use super::basis::{axpy, dot, ActiveBasis};
 use super::factor::cholesky;
 use super::problem::Dims;
-use super::{
-    ActiveConstraint, Hessian, QpConstraint, QpProblem, QpReport, QpSettings, QpStatus,
-};
+use super::{ActiveConstraint, Hessian, QpConstraint, QpProblem, QpReport, QpSettings, QpStatus};
 use crate::error::check_dim;
 use crate::Result;
 

@@ -1,0 +1,367 @@
+//! The 3R planar arm experiment of Section 3.3 (errata 2.1).
+//!
+//! Three prioritized tasks on the tip of [`planar3r`](crate::model::planar3r): P_y, P_x and the
+//! tip angle θ3 (default order 1 = P_y, 2 = P_x, 3 = θ3). References: P_y,d = 2, θ3,d = 90°,
+//! P_x,d(t) = 1.5 − 0.5 cos(πt) for t ≤ 1 s, then 2. CLIK gains k_p = 100 s⁻², k_v = 20 s⁻¹,
+//! Δt = 5 ms, 2 s, no DLS damping. From q = (90°, −90°, 90°), q1 falls to its 60° limit and
+//! the three tasks become incompatible: the lowest one is sacrificed.
+
+use std::time::Instant;
+
+use nalgebra::{DVector, Isometry3, Translation3, UnitQuaternion, Vector3, Vector6};
+use serde::Serialize;
+
+use super::margins::{dof_margins, median, DofMargins};
+use crate::error::{Error, Result};
+use crate::limits::{compute_box, AccelerationBox, BoundMethod, DofLimits, JointLimits};
+use crate::model::{planar3r, Kinematics, State};
+use crate::solver::{Method, Solver, SolverSettings};
+use crate::task::{Axes, FrameReference, FrameTask, Gains, Task, TaskStack};
+
+/// One of the three tasks of the experiment.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, serde::Deserialize)]
+pub enum ArmTask {
+    /// Tip x [m].
+    Px,
+    /// Tip y [m].
+    Py,
+    /// Tip angle θ3 = q1 + q2 + q3 [rad].
+    Theta,
+}
+
+impl ArmTask {
+    /// Short name.
+    pub fn name(&self) -> &'static str {
+        match self {
+            ArmTask::Px => "Px",
+            ArmTask::Py => "Py",
+            ArmTask::Theta => "theta3",
+        }
+    }
+
+    fn index(&self) -> usize {
+        match self {
+            ArmTask::Px => 0,
+            ArmTask::Py => 1,
+            ArmTask::Theta => 2,
+        }
+    }
+}
+
+/// Settings of the run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Planar3rConfig {
+    /// Solver.
+    pub method: Method,
+    /// Joint bounds.
+    pub bounds: BoundMethod,
+    /// Control period Δt [s].
+    pub dt: f64,
+    /// Duration [s].
+    pub duration: f64,
+    /// Priority order, highest first.
+    pub priority: [ArmTask; 3],
+    /// CLIK gains of every task.
+    pub gains: Gains,
+    /// Solver settings.
+    pub solver: SolverSettings,
+}
+
+impl Default for Planar3rConfig {
+    fn default() -> Self {
+        Self {
+            method: Method::Iktc,
+            bounds: BoundMethod::viable(),
+            dt: 0.005,
+            duration: 2.0,
+            priority: [ArmTask::Py, ArmTask::Px, ArmTask::Theta],
+            gains: Gains {
+                kp: 100.0,
+                kv: 20.0,
+            },
+            solver: SolverSettings::default(),
+        }
+    }
+}
+
+/// One recorded step (state at its start, command applied over it).
+#[derive(Debug, Clone, Serialize)]
+pub struct Planar3rStep {
+    /// Time [s].
+    pub t: f64,
+    /// Joint positions [rad].
+    pub q: [f64; 3],
+    /// Joint rates [rad/s].
+    pub qd: [f64; 3],
+    /// Joint accelerations commanded [rad/s²].
+    pub qdd: [f64; 3],
+    /// Acceleration box lower / upper [rad/s²].
+    pub box_lower: [f64; 3],
+    /// Upper side of the box [rad/s²].
+    pub box_upper: [f64; 3],
+    /// References (P_x [m], P_y [m], θ3 [rad]).
+    pub reference: [f64; 3],
+    /// Values (P_x, P_y, θ3).
+    pub value: [f64; 3],
+    /// Errors reference − value.
+    pub error: [f64; 3],
+    /// IKTC corrections Δh of (P_x, P_y, θ3) [m/s², rad/s²].
+    pub correction: [f64; 3],
+    /// Level (1-based, priority order) the correction started from; 0 = none.
+    pub corrected_from: usize,
+    /// QPs solved this step.
+    pub qp_solves: usize,
+    /// Dofs with an empty box.
+    pub empty_dofs: usize,
+    /// Time of the tick (kinematics, tasks, bounds, solve) [µs].
+    pub tick_us: f64,
+}
+
+/// The run's summary (`summary.json`).
+#[derive(Debug, Clone, Serialize)]
+pub struct Planar3rSummary {
+    /// Solver name.
+    pub solver: String,
+    /// Bound method name.
+    pub bounds: String,
+    /// Δt [s].
+    pub dt: f64,
+    /// Priority order, highest first.
+    pub priority: Vec<String>,
+    /// Margins per joint (q1, q2, q3).
+    pub margins: Vec<DofMargins>,
+    /// Largest position excursion over all joints [rad] (≤ 0: no limit exceeded).
+    pub worst_position_margin: f64,
+    /// Largest velocity excursion [rad/s].
+    pub worst_velocity_margin: f64,
+    /// Largest acceleration excursion [rad/s²].
+    pub worst_acceleration_margin: f64,
+    /// Steps with an empty box.
+    pub empty_box_steps: usize,
+    /// Final error of (P_x [m], P_y [m], θ3 [rad]).
+    pub final_error: [f64; 3],
+    /// Largest |error| of each task over the run.
+    pub max_error: [f64; 3],
+    /// Lowest q1 reached [rad].
+    pub min_q1: f64,
+    /// Mean and largest number of QPs per step.
+    pub qp_per_step_mean: f64,
+    /// Largest number of QPs in a step.
+    pub qp_per_step_max: usize,
+    /// Steps where a correction was made.
+    pub corrected_steps: usize,
+    /// Steps where the correction had to climb above the lowest level.
+    pub climbed_steps: usize,
+    /// Median tick time [µs].
+    pub tick_median_us: f64,
+}
+
+/// A whole run.
+#[derive(Debug, Clone, Serialize)]
+pub struct Planar3rRun {
+    /// Every step.
+    pub steps: Vec<Planar3rStep>,
+    /// Summary.
+    pub summary: Planar3rSummary,
+}
+
+/// The reference (P_x, P_y, θ3) and its first two derivatives at time t [s].
+pub fn reference(t: f64) -> ([f64; 3], [f64; 3], [f64; 3]) {
+    let pi = std::f64::consts::PI;
+    let theta = 0.5 * pi;
+    if t <= 1.0 {
+        (
+            [1.5 - 0.5 * (pi * t).cos(), 2.0, theta],
+            [0.5 * pi * (pi * t).sin(), 0.0, 0.0],
+            [0.5 * pi * pi * (pi * t).cos(), 0.0, 0.0],
+        )
+    } else {
+        ([2.0, 2.0, theta], [0.0; 3], [0.0; 3])
+    }
+}
+
+/// Runs the experiment.
+pub fn run_planar3r(cfg: &Planar3rConfig) -> Result<Planar3rRun> {
+    if !(cfg.dt.is_finite() && cfg.dt > 0.0 && cfg.duration.is_finite() && cfg.duration > 0.0) {
+        return Err(Error::InvalidSetting {
+            name: "dt / duration".into(),
+            value: format!("{} / {}", cfg.dt, cfg.duration),
+            expected: "positive, finite times [s]".into(),
+        });
+    }
+    let mut sorted = cfg.priority.map(|t| t.index());
+    sorted.sort();
+    if sorted != [0, 1, 2] {
+        return Err(Error::InvalidSetting {
+            name: "priority".into(),
+            value: format!("{:?}", cfg.priority),
+            expected: "each of Px, Py, theta3 exactly once".into(),
+        });
+    }
+    let robot = planar3r();
+    let deg = std::f64::consts::PI / 180.0;
+    let mut state = State::neutral(&robot);
+    state.q = DVector::from_vec(vec![90.0 * deg, -90.0 * deg, 90.0 * deg]);
+    let mut stack = TaskStack::default();
+    for t in cfg.priority {
+        let mut axes = [false; 6];
+        axes[match t {
+            ArmTask::Px => 0,
+            ArmTask::Py => 1,
+            ArmTask::Theta => 5,
+        }] = true;
+        stack.push(
+            t.name(),
+            vec![Task::Frame(FrameTask::new(
+                &robot,
+                "tip",
+                Axes(axes),
+                cfg.gains,
+            )?)],
+        );
+    }
+    let mut eqs = stack.equations(&robot);
+    let dims: Vec<usize> = eqs.iter().map(|e| e.dim()).collect();
+    let mut solver = Solver::new(robot.nv(), &dims, cfg.solver)?;
+    let limits = JointLimits::new(
+        robot
+            .dof_limits()
+            .iter()
+            .map(|l| DofLimits {
+                position_min: l.lower,
+                position_max: l.upper,
+                velocity_max: l.velocity,
+                acceleration_max: l.acceleration,
+            })
+            .collect(),
+    )?;
+    let mut bx = AccelerationBox::new(robot.nv());
+    let mut kin = Kinematics::new(&robot, &state)?;
+    let mut qdd = DVector::zeros(robot.nv());
+    let mut pos = vec![0.0; robot.nv()];
+    let n_steps = (cfg.duration / cfg.dt).round() as usize;
+    let mut steps = Vec::with_capacity(n_steps);
+    let tip = robot.frame_id("tip")?;
+    for k in 0..n_steps {
+        let t = k as f64 * cfg.dt;
+        let (x, xd, xdd) = reference(t);
+        let start = Instant::now();
+        kin.update(&robot, &state)?;
+        let pose = Isometry3::from_parts(
+            Translation3::new(x[0], x[1], 0.0),
+            UnitQuaternion::from_axis_angle(&Vector3::z_axis(), x[2]),
+        );
+        let r = FrameReference {
+            pose,
+            velocity: Vector6::new(xd[0], xd[1], 0.0, 0.0, 0.0, xd[2]),
+            acceleration: Vector6::new(xdd[0], xdd[1], 0.0, 0.0, 0.0, xdd[2]),
+        };
+        for level in stack.levels.iter_mut() {
+            for task in level.tasks.iter_mut() {
+                if let Task::Frame(f) = task {
+                    f.set_reference(r)?;
+                }
+            }
+        }
+        stack.linearize(&robot, &kin, &state, &mut eqs)?;
+        state.dof_positions(&robot, &mut pos)?;
+        compute_box(
+            &limits,
+            &cfg.bounds,
+            &pos,
+            state.qd.as_slice(),
+            cfg.dt,
+            &mut bx,
+        )?;
+        let rep = solver.solve(cfg.method, &eqs, &bx, &mut qdd)?;
+        let tick_us = start.elapsed().as_secs_f64() * 1e6;
+        let tp = kin.frame_pose(&robot, tip)?;
+        let value = [
+            tp.translation.x,
+            tp.translation.y,
+            state.q[0] + state.q[1] + state.q[2],
+        ];
+        let mut correction = [0.0; 3];
+        for (lvl, t) in cfg.priority.iter().enumerate() {
+            correction[t.index()] = rep.corrections[lvl][0];
+        }
+        steps.push(Planar3rStep {
+            t,
+            q: [state.q[0], state.q[1], state.q[2]],
+            qd: [state.qd[0], state.qd[1], state.qd[2]],
+            qdd: [qdd[0], qdd[1], qdd[2]],
+            box_lower: [bx.lower[0], bx.lower[1], bx.lower[2]],
+            box_upper: [bx.upper[0], bx.upper[1], bx.upper[2]],
+            reference: x,
+            value,
+            error: [x[0] - value[0], x[1] - value[1], x[2] - value[2]],
+            correction,
+            corrected_from: rep.corrected_from.map_or(0, |l| l + 1),
+            qp_solves: rep.qp_solves,
+            empty_dofs: rep.empty_box_dofs,
+            tick_us,
+        });
+        state.integrate(&robot, &qdd, cfg.dt)?;
+    }
+    let summary = summarize(cfg, &robot, &steps);
+    Ok(Planar3rRun { steps, summary })
+}
+
+fn summarize(
+    cfg: &Planar3rConfig,
+    robot: &crate::model::Robot,
+    steps: &[Planar3rStep],
+) -> Planar3rSummary {
+    let lims = robot.dof_limits();
+    let margins: Vec<DofMargins> = (0..3)
+        .map(|j| {
+            let q: Vec<f64> = steps.iter().map(|s| s.q[j]).collect();
+            let qd: Vec<f64> = steps.iter().map(|s| s.qd[j]).collect();
+            let qdd: Vec<f64> = steps.iter().map(|s| s.qdd[j]).collect();
+            dof_margins(j, &q, &qd, &qdd, cfg.dt, &lims[j])
+        })
+        .collect();
+    let mut max_error = [0.0f64; 3];
+    for s in steps {
+        for k in 0..3 {
+            max_error[k] = max_error[k].max(s.error[k].abs());
+        }
+    }
+    let ticks: Vec<f64> = steps.iter().map(|s| s.tick_us).collect();
+    let nt = cfg.priority.len();
+    Planar3rSummary {
+        solver: cfg.method.name().into(),
+        bounds: match cfg.bounds {
+            BoundMethod::Paper => "paper".into(),
+            BoundMethod::Viable(_) => "viable".into(),
+        },
+        dt: cfg.dt,
+        priority: cfg.priority.iter().map(|t| t.name().to_string()).collect(),
+        worst_position_margin: margins
+            .iter()
+            .map(|m| m.position)
+            .fold(f64::NEG_INFINITY, f64::max),
+        worst_velocity_margin: margins
+            .iter()
+            .map(|m| m.velocity)
+            .fold(f64::NEG_INFINITY, f64::max),
+        worst_acceleration_margin: margins
+            .iter()
+            .map(|m| m.acceleration)
+            .fold(f64::NEG_INFINITY, f64::max),
+        margins,
+        empty_box_steps: steps.iter().filter(|s| s.empty_dofs > 0).count(),
+        final_error: steps.last().map_or([0.0; 3], |s| s.error),
+        max_error,
+        min_q1: steps.iter().map(|s| s.q[0]).fold(f64::INFINITY, f64::min),
+        qp_per_step_mean: steps.iter().map(|s| s.qp_solves as f64).sum::<f64>()
+            / steps.len().max(1) as f64,
+        qp_per_step_max: steps.iter().map(|s| s.qp_solves).max().unwrap_or(0),
+        corrected_steps: steps.iter().filter(|s| s.corrected_from > 0).count(),
+        climbed_steps: steps
+            .iter()
+            .filter(|s| s.corrected_from > 0 && s.corrected_from < nt)
+            .count(),
+        tick_median_us: median(&ticks),
+    }
+}

@@ -1,0 +1,402 @@
+//! The prioritized solution (paper eqs. 5–9) and the correction map G (eqs. 19–21, Algorithm 1).
+//!
+//! ## Method
+//!
+//! For level i with Jacobian J_i (m_i × n) and right-hand side h_i:
+//!
+//! q̈_i = q̈_{i−1} + J̄_i^{λ+} (h_i − J_i q̈_{i−1}),  J̄_i = J_i N_{i−1}  (eqs. 5–7),
+//!
+//! where N_{i−1} projects onto the null space of the levels above. Instead of n × n projectors
+//! we keep an orthonormal basis Z (n × k) of that null space, N_{i−1} = Z Zᵀ. Then
+//! J̄_i = (J_i Z) Zᵀ and, with the column-pivoted QR (J_i Z)ᵀ Π = Q R of rank r (pivots
+//! |R_jj| above the rank threshold), J_i Z = Π R_rᵀ Q_rᵀ, so
+//!
+//! J̄_i^{λ+} = Z Q_r (R_r R_rᵀ + λ² I)⁻¹ R_r Πᵀ,
+//!
+//! which is the Moore–Penrose inverse for λ = 0 (eq. 4) and the damped least-squares inverse
+//! (eqs. 8–9) otherwise. The next basis is Z Q_{r+1..k}. Cost O(n k m) per level: no n × n
+//! product, no SVD.
+//!
+//! Algorithm 1 builds G = [g_1 … g_{n_T}] with g_i = (Π_{k>i} (I − J̄_k^{λ+} J_k)) J̄_i^{λ+},
+//! so that adding corrections Δh to the right-hand sides changes the solution by G Δh (eq. 20).
+
+use nalgebra::{DMatrix, DVector};
+
+use super::settings::{Damping, SolverSettings};
+use crate::error::{check_dim, Error, Result};
+use crate::task::TaskEquation;
+
+/// Workspace of the prioritized recursion, sized once for given level dimensions.
+#[derive(Debug, Clone)]
+pub struct Hierarchy {
+    n: usize,
+    dims: Vec<usize>,
+    offsets: Vec<usize>,
+    /// J̄_i^{λ+}, n × m_i per level.
+    pinv: Vec<DMatrix<f64>>,
+    /// Rank kept per level.
+    ranks: Vec<usize>,
+    /// G, n × Σm_i, blocks in level order; columns of level i valid once built.
+    g: DMatrix<f64>,
+    /// Null-space basis Z (first k columns valid) and its product with Q.
+    z: DMatrix<f64>,
+    zq: DMatrix<f64>,
+    k: usize,
+    /// (J Z)ᵀ in place → R (upper part), Householder vectors.
+    a: DMatrix<f64>,
+    v: DMatrix<f64>,
+    tau: Vec<f64>,
+    perm: Vec<usize>,
+    colnorm: Vec<f64>,
+    /// Small r × r system and r × m result.
+    s: DMatrix<f64>,
+    t: DMatrix<f64>,
+    tmp_n: DVector<f64>,
+    tmp_m: DVector<f64>,
+    residual: DVector<f64>,
+}
+
+impl Hierarchy {
+    /// A workspace for `n` velocity coordinates and levels of the given sizes.
+    pub fn new(n: usize, dims: &[usize]) -> Self {
+        let mmax = dims.iter().copied().max().unwrap_or(0).max(1);
+        let total: usize = dims.iter().sum();
+        let mut offsets = Vec::with_capacity(dims.len());
+        let mut o = 0;
+        for d in dims {
+            offsets.push(o);
+            o += d;
+        }
+        Self {
+            n,
+            dims: dims.to_vec(),
+            offsets,
+            pinv: dims.iter().map(|&m| DMatrix::zeros(n, m)).collect(),
+            ranks: vec![0; dims.len()],
+            g: DMatrix::zeros(n, total.max(1)),
+            z: DMatrix::zeros(n, n),
+            zq: DMatrix::zeros(n, n),
+            k: n,
+            a: DMatrix::zeros(n.max(1), mmax),
+            v: DMatrix::zeros(n.max(1), mmax),
+            tau: vec![0.0; mmax],
+            perm: vec![0; mmax],
+            colnorm: vec![0.0; mmax],
+            s: DMatrix::zeros(mmax, mmax),
+            t: DMatrix::zeros(mmax, mmax),
+            tmp_n: DVector::zeros(n),
+            tmp_m: DVector::zeros(mmax),
+            residual: DVector::zeros(mmax),
+        }
+    }
+
+    /// Number of velocity coordinates n.
+    pub fn n(&self) -> usize {
+        self.n
+    }
+
+    /// Level sizes m_i.
+    pub fn dims(&self) -> &[usize] {
+        &self.dims
+    }
+
+    /// Column offset of level i in G.
+    pub fn offset(&self, i: usize) -> usize {
+        self.offsets[i]
+    }
+
+    /// Rank kept at each level by the last [`Hierarchy::solve`].
+    pub fn ranks(&self) -> &[usize] {
+        &self.ranks
+    }
+
+    /// J̄_i^{λ+} of level i (n × m_i), from the last solve.
+    pub fn pinv(&self, i: usize) -> &DMatrix<f64> {
+        &self.pinv[i]
+    }
+
+    /// G (n × Σm_i); the blocks of levels ≥ `from` are valid after
+    /// [`Hierarchy::build_g`]`(…, from)`.
+    pub fn g(&self) -> &DMatrix<f64> {
+        &self.g
+    }
+
+    /// Checks that `levels` match the sizes this workspace was made for.
+    pub fn check(&self, levels: &[TaskEquation]) -> Result<()> {
+        check_dim("number of levels", self.dims.len(), levels.len())?;
+        for (l, &m) in levels.iter().zip(&self.dims) {
+            if l.dim() != m || l.nv() != self.n {
+                return Err(Error::DimensionMismatch {
+                    what: format!("rows of level `{}` (columns must be {})", l.name, self.n),
+                    expected: m,
+                    got: l.dim(),
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Runs the recursion (eq. 5) and writes the prioritized solution q̈_{n_T} into `qdd`.
+    /// Allocates nothing.
+    pub fn solve(
+        &mut self,
+        levels: &[TaskEquation],
+        settings: &SolverSettings,
+        qdd: &mut DVector<f64>,
+    ) -> Result<()> {
+        self.check(levels)?;
+        check_dim("q̈", self.n, qdd.len())?;
+        let n = self.n;
+        qdd.fill(0.0);
+        self.z.fill(0.0);
+        for d in 0..n {
+            self.z[(d, d)] = 1.0;
+        }
+        self.k = n;
+        for (i, lvl) in levels.iter().enumerate() {
+            let m = self.dims[i];
+            self.level_inverse(i, &lvl.jacobian, settings);
+            // residual = h_i − J_i q̈_{i−1};  q̈ += J̄⁺ residual.
+            for r in 0..m {
+                let mut s = lvl.rhs[r];
+                for c in 0..n {
+                    s -= lvl.jacobian[(r, c)] * qdd[c];
+                }
+                self.residual[r] = s;
+            }
+            let p = &self.pinv[i];
+            for c in 0..m {
+                let rc = self.residual[c];
+                if rc != 0.0 {
+                    for d in 0..n {
+                        qdd[d] += p[(d, c)] * rc;
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// J̄_i^{λ+} for level i from the current basis Z, then Z ← basis of null(J_i Z) within Z.
+    fn level_inverse(&mut self, i: usize, j: &DMatrix<f64>, settings: &SolverSettings) {
+        let (n, m, k) = (self.n, self.dims[i], self.k);
+        self.pinv[i].fill(0.0);
+        if m == 0 {
+            self.ranks[i] = 0;
+            return;
+        }
+        if k == 0 {
+            self.ranks[i] = 0;
+            return;
+        }
+        // A = (J Z)ᵀ, k × m.
+        for c in 0..m {
+            for a in 0..k {
+                let mut s = 0.0;
+                for d in 0..n {
+                    s += j[(c, d)] * self.z[(d, a)];
+                }
+                self.a[(a, c)] = s;
+            }
+        }
+        // Householder QR with column pivoting of A (k × m).
+        let steps = k.min(m);
+        for c in 0..m {
+            self.perm[c] = c;
+        }
+        let mut rank = 0;
+        for st in 0..steps {
+            // Pivot: the remaining column of largest norm (rows st..k).
+            for c in st..m {
+                let mut s = 0.0;
+                for a in st..k {
+                    s += self.a[(a, c)] * self.a[(a, c)];
+                }
+                self.colnorm[c] = s;
+            }
+            let mut best = st;
+            for c in st + 1..m {
+                if self.colnorm[c] > self.colnorm[best] {
+                    best = c;
+                }
+            }
+            if best != st {
+                self.a.swap_columns(st, best);
+                self.perm.swap(st, best);
+            }
+            let norm = self.colnorm[st].sqrt();
+            if norm <= settings.rank_threshold {
+                break;
+            }
+            // v = x − α e1 with α = −sign(x0)‖x‖; H = I − τ v vᵀ, τ = 2 / vᵀv.
+            let x0 = self.a[(st, st)];
+            let alpha = if x0 >= 0.0 { -norm } else { norm };
+            for a in 0..k {
+                self.v[(a, st)] = if a < st { 0.0 } else { self.a[(a, st)] };
+            }
+            self.v[(st, st)] = x0 - alpha;
+            let mut vv = 0.0;
+            for a in st..k {
+                vv += self.v[(a, st)] * self.v[(a, st)];
+            }
+            let tau = if vv > 0.0 { 2.0 / vv } else { 0.0 };
+            self.tau[st] = tau;
+            // Apply H to the remaining columns of A.
+            for c in st..m {
+                let mut s = 0.0;
+                for a in st..k {
+                    s += self.v[(a, st)] * self.a[(a, c)];
+                }
+                s *= tau;
+                for a in st..k {
+                    self.a[(a, c)] -= s * self.v[(a, st)];
+                }
+            }
+            rank = st + 1;
+        }
+        self.ranks[i] = rank;
+        // ZQ = Z H_1 … H_rank (n × k).
+        for a in 0..k {
+            for d in 0..n {
+                self.zq[(d, a)] = self.z[(d, a)];
+            }
+        }
+        for st in 0..rank {
+            let tau = self.tau[st];
+            for d in 0..n {
+                let mut s = 0.0;
+                for a in st..k {
+                    s += self.zq[(d, a)] * self.v[(a, st)];
+                }
+                s *= tau;
+                for a in st..k {
+                    self.zq[(d, a)] -= s * self.v[(a, st)];
+                }
+            }
+        }
+        if rank > 0 {
+            // λ² from the damping rule; σ_min estimated by the last kept pivot |R_rr|.
+            let sigma = self.a[(rank - 1, rank - 1)].abs();
+            let lambda2 = match settings.damping {
+                Damping::None => 0.0,
+                Damping::Fixed(l) => l * l,
+                Damping::Adaptive { max, threshold } => {
+                    if sigma < threshold {
+                        (1.0 - (sigma / threshold).powi(2)) * max * max
+                    } else {
+                        0.0
+                    }
+                }
+            };
+            // S = R_r R_rᵀ + λ² I (r × r), R_r = rows 0..r of R (upper trapezoidal, r × m).
+            for p in 0..rank {
+                for q in 0..=p {
+                    let mut s = 0.0;
+                    for c in p.max(q)..m {
+                        s += self.a[(p, c)] * self.a[(q, c)];
+                    }
+                    if p == q {
+                        s += lambda2;
+                    }
+                    self.s[(p, q)] = s;
+                    self.s[(q, p)] = s;
+                }
+            }
+            // Cholesky S = L Lᵀ in place (lower). S is SPD: R_r has full row rank r.
+            for p in 0..rank {
+                let mut d = self.s[(p, p)];
+                for q in 0..p {
+                    d -= self.s[(p, q)] * self.s[(p, q)];
+                }
+                let l = d.max(f64::MIN_POSITIVE).sqrt();
+                self.s[(p, p)] = l;
+                for r in p + 1..rank {
+                    let mut x = self.s[(r, p)];
+                    for q in 0..p {
+                        x -= self.s[(r, q)] * self.s[(p, q)];
+                    }
+                    self.s[(r, p)] = x / l;
+                }
+            }
+            // T = S⁻¹ R_r (r × m), column by column (R entries below the diagonal are zero).
+            for c in 0..m {
+                for p in 0..rank {
+                    self.tmp_m[p] = if p <= c { self.a[(p, c)] } else { 0.0 };
+                }
+                for p in 0..rank {
+                    let mut x = self.tmp_m[p];
+                    for q in 0..p {
+                        x -= self.s[(p, q)] * self.tmp_m[q];
+                    }
+                    self.tmp_m[p] = x / self.s[(p, p)];
+                }
+                for p in (0..rank).rev() {
+                    let mut x = self.tmp_m[p];
+                    for q in p + 1..rank {
+                        x -= self.s[(q, p)] * self.tmp_m[q];
+                    }
+                    self.tmp_m[p] = x / self.s[(p, p)];
+                }
+                for p in 0..rank {
+                    self.t[(p, c)] = self.tmp_m[p];
+                }
+            }
+            // J̄⁺ column perm[c] = ZQ_r · T[:, c].
+            let p = &mut self.pinv[i];
+            for c in 0..m {
+                let col = self.perm[c];
+                for d in 0..n {
+                    let mut s = 0.0;
+                    for q in 0..rank {
+                        s += self.zq[(d, q)] * self.t[(q, c)];
+                    }
+                    p[(d, col)] = s;
+                }
+            }
+        }
+        // Z ← ZQ[:, rank..k].
+        let newk = k - rank;
+        for a in 0..newk {
+            for d in 0..n {
+                self.z[(d, a)] = self.zq[(d, rank + a)];
+            }
+        }
+        self.k = newk;
+    }
+
+    /// Builds the block g_i of G (Algorithm 1), using the inverses of the last
+    /// [`Hierarchy::solve`]. Allocates nothing.
+    pub fn build_g_level(&mut self, levels: &[TaskEquation], i: usize) {
+        let n = self.n;
+        {
+            let off = self.offsets[i];
+            for c in 0..self.dims[i] {
+                for d in 0..n {
+                    self.tmp_n[d] = self.pinv[i][(d, c)];
+                }
+                // ψ ← (I − J̄_k⁺ J_k) ψ for k = i+1..n_T.
+                for (k, lvl) in levels.iter().enumerate().skip(i + 1) {
+                    let mk = self.dims[k];
+                    for r in 0..mk {
+                        let mut s = 0.0;
+                        for d in 0..n {
+                            s += lvl.jacobian[(r, d)] * self.tmp_n[d];
+                        }
+                        self.tmp_m[r] = s;
+                    }
+                    for r in 0..mk {
+                        let s = self.tmp_m[r];
+                        if s != 0.0 {
+                            for d in 0..n {
+                                self.tmp_n[d] -= self.pinv[k][(d, r)] * s;
+                            }
+                        }
+                    }
+                }
+                for d in 0..n {
+                    self.g[(d, off + c)] = self.tmp_n[d];
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,91 @@
+//! Settings of the prioritized solvers (IKTC, cascade, clamp).
+
+use super::qp::QpSettings;
+use crate::error::{Error, Result};
+
+/// Damping of the least-squares inverses (paper Section 2.2, eqs. 8–10).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Damping {
+    /// Plain pseudo-inverse (λ = 0); rank loss is handled by the rank threshold alone.
+    None,
+    /// A constant damping factor λ [task unit / joint unit, i.e. the unit of a singular value
+    /// of J]: bounds the gain of each inverse by 1/(2λ) at the price of a bias of order λ²/σ².
+    Fixed(f64),
+    /// Damping only near a singularity (Nakamura & Hanafusa; Chiaverini): with σ the smallest
+    /// kept singular value (estimated by the last pivot of the pivoted QR),
+    /// λ² = (1 − (σ/ε)²) λ_max² when σ < ε, else 0.
+    Adaptive {
+        /// λ_max: the damping reached at the singularity.
+        max: f64,
+        /// ε: the size of the singular region.
+        threshold: f64,
+    },
+}
+
+/// Settings of [`Solver`](super::Solver). Every threshold is documented with what it trades.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SolverSettings {
+    /// Damping of each level's inverse J̄_i^{λ+}. Default: none (the paper's 3R experiment).
+    pub damping: Damping,
+    /// A pivot |R_jj| of the pivoted QR of a task-consistent Jacobian below this counts as a lost
+    /// rank [unit of a singular value of J, ≈ 1 for metres and radians]. Larger values drop
+    /// nearly dependent rows sooner (robust, less tracking); smaller ones keep them and amplify
+    /// noise near singularities. Default 1e-9.
+    pub rank_threshold: f64,
+    /// A q̈ violating the box by at most this is inside it [rad/s²]. Default 1e-9: far below
+    /// any physical acceleration, above the QP's rounding.
+    pub box_tolerance: f64,
+    /// Regularisation ε of each cascade (GF) QP, min ½‖J_k q̈ − h_k‖² + ½ε‖q̈‖², which makes its
+    /// Hessian positive definite and picks the least-norm solution, as the pseudo-inverse does
+    /// [–]. Larger values bias the cascade towards small q̈; smaller ones make its Hessian
+    /// ill-conditioned. Default 1e-8.
+    pub cascade_regularization: f64,
+    /// Settings of the QPs.
+    pub qp: QpSettings,
+}
+
+impl Default for SolverSettings {
+    fn default() -> Self {
+        Self {
+            damping: Damping::None,
+            rank_threshold: 1e-9,
+            box_tolerance: 1e-9,
+            cascade_regularization: 1e-8,
+            qp: QpSettings::default(),
+        }
+    }
+}
+
+fn positive(name: &str, v: f64, allow_zero: bool) -> Result<()> {
+    if v.is_finite() && (v > 0.0 || (allow_zero && v == 0.0)) {
+        Ok(())
+    } else {
+        Err(Error::InvalidSetting {
+            name: name.into(),
+            value: v.to_string(),
+            expected: if allow_zero {
+                "a finite number ≥ 0".into()
+            } else {
+                "a finite number > 0".into()
+            },
+        })
+    }
+}
+
+impl SolverSettings {
+    /// Checks every field.
+    pub fn validate(&self) -> Result<()> {
+        match self.damping {
+            Damping::None => {}
+            Damping::Fixed(l) => positive("damping λ", l, true)?,
+            Damping::Adaptive { max, threshold } => {
+                positive("adaptive damping λ_max", max, true)?;
+                positive("adaptive damping threshold ε", threshold, false)?;
+            }
+        }
+        positive("rank_threshold", self.rank_threshold, false)?;
+        positive("box_tolerance", self.box_tolerance, true)?;
+        positive("cascade_regularization", self.cascade_regularization, false)?;
+        self.qp.validate()
+    }
+}

@@ -1,0 +1,294 @@
+//! The solvers: prioritized, IKTC (Section 3.2), cascade (GF) and clamp, behind one workspace.
+
+use nalgebra::{DMatrix, DVector};
+
+use super::hierarchy::Hierarchy;
+use super::qp::{Hessian, QpProblem, QpStatus, QpWorkspace};
+use super::report::{Fallback, Method, SolveReport};
+use super::settings::SolverSettings;
+use crate::error::{check_dim, Result};
+use crate::limits::AccelerationBox;
+use crate::task::TaskEquation;
+
+/// Solves a task hierarchy under an acceleration box. Made once for given level sizes; each
+/// [`Solver::solve`] allocates nothing.
+#[derive(Debug, Clone)]
+pub struct Solver {
+    settings: SolverSettings,
+    hierarchy: Hierarchy,
+    qp: QpWorkspace,
+    report: SolveReport,
+    q0: DVector<f64>,
+    lo: Vec<f64>,
+    hi: Vec<f64>,
+    qp_lo: Vec<f64>,
+    qp_hi: Vec<f64>,
+    zeros: Vec<f64>,
+    /// QP solution buffers: one per IKTC level (size Σ_{k≥i} m_k), then one of size n.
+    xs: Vec<DVector<f64>>,
+    // Cascade buffers.
+    h: DMatrix<f64>,
+    c: Vec<f64>,
+    a_eq: DMatrix<f64>,
+    b_eq: Vec<f64>,
+    eye: DMatrix<f64>,
+}
+
+impl Solver {
+    /// A solver for `nv` velocity coordinates and levels of sizes `dims` (priority order).
+    pub fn new(nv: usize, dims: &[usize], settings: SolverSettings) -> Result<Self> {
+        settings.validate()?;
+        let total: usize = dims.iter().sum();
+        Ok(Self {
+            settings,
+            hierarchy: Hierarchy::new(nv, dims),
+            qp: QpWorkspace::new(total.max(nv), total, nv),
+            report: SolveReport::new(dims),
+            q0: DVector::zeros(nv),
+            lo: vec![0.0; nv],
+            hi: vec![0.0; nv],
+            qp_lo: vec![0.0; nv],
+            qp_hi: vec![0.0; nv],
+            zeros: vec![0.0; total.max(nv)],
+            xs: {
+                let mut v: Vec<DVector<f64>> = (0..dims.len())
+                    .map(|i| DVector::zeros(dims[i..].iter().sum()))
+                    .collect();
+                v.push(DVector::zeros(nv));
+                v
+            },
+            h: DMatrix::zeros(nv, nv),
+            c: vec![0.0; nv],
+            a_eq: DMatrix::zeros(total.max(1), nv),
+            b_eq: vec![0.0; total.max(1)],
+            eye: DMatrix::identity(nv, nv),
+        })
+    }
+
+    /// The settings.
+    pub fn settings(&self) -> &SolverSettings {
+        &self.settings
+    }
+
+    /// The report of the last solve.
+    pub fn report(&self) -> &SolveReport {
+        &self.report
+    }
+
+    /// Solves `levels` (priority order) under `bounds` with `method`, writing q̈ into `qdd`.
+    ///
+    /// Bad input (sizes, NaN) is an error; a hard problem (an empty box, an infeasible
+    /// correction) is reported in [`Solver::report`] with the fallback taken.
+    pub fn solve(
+        &mut self,
+        method: Method,
+        levels: &[TaskEquation],
+        bounds: &AccelerationBox,
+        qdd: &mut DVector<f64>,
+    ) -> Result<&SolveReport> {
+        let n = self.hierarchy.n();
+        check_dim("q̈", n, qdd.len())?;
+        check_dim("acceleration box", n, bounds.nv())?;
+        for l in levels {
+            l.validate()?;
+        }
+        self.report.reset(method);
+        self.hierarchy.solve(levels, &self.settings, &mut self.q0)?;
+        self.report.ranks.copy_from_slice(self.hierarchy.ranks());
+        // The box, with empty dofs relaxed to their midpoint (the least possible violation).
+        let mut empty = 0;
+        for d in 0..n {
+            let (l, u) = (bounds.lower[d], bounds.upper[d]);
+            if l.is_nan() || u.is_nan() {
+                return Err(crate::Error::NonFinite {
+                    what: format!("acceleration box of dof {d}"),
+                    value: f64::NAN,
+                });
+            }
+            if l > u {
+                empty += 1;
+                let mid = 0.5 * (l + u);
+                self.lo[d] = mid;
+                self.hi[d] = mid;
+            } else {
+                self.lo[d] = l;
+                self.hi[d] = u;
+            }
+        }
+        self.report.empty_box_dofs = empty;
+        self.report.violation_before = self.violation(&self.q0);
+        match method {
+            Method::Prioritized => qdd.copy_from(&self.q0),
+            Method::Clamp => self.clamp(qdd),
+            Method::Iktc => self.iktc(levels, qdd)?,
+            Method::Cascade => self.cascade(levels, qdd)?,
+        }
+        self.report.violation = self.violation(qdd);
+        for (i, l) in levels.iter().enumerate() {
+            let e = &mut self.report.task_errors[i];
+            for r in 0..l.dim() {
+                let mut s = -l.rhs[r];
+                for c in 0..n {
+                    s += l.jacobian[(r, c)] * qdd[c];
+                }
+                e[r] = s;
+            }
+            self.report.task_error_norms[i] = e.norm();
+        }
+        Ok(&self.report)
+    }
+
+    fn violation(&self, q: &DVector<f64>) -> f64 {
+        let mut v: f64 = 0.0;
+        for d in 0..q.len() {
+            v = v.max(self.lo[d] - q[d]).max(q[d] - self.hi[d]);
+        }
+        v
+    }
+
+    fn clamp(&self, qdd: &mut DVector<f64>) {
+        for d in 0..qdd.len() {
+            qdd[d] = self.q0[d].clamp(self.lo[d], self.hi[d]);
+        }
+    }
+
+    /// IKTC (Algorithms 1–2, eqs. 23–25): if the prioritized q̈ leaves the box, find the least
+    /// correction of levels i..n_T, min ½‖Δh^a_i‖² s.t. b_l − q̈ ≤ g^a_i Δh^a_i ≤ b_u − q̈, from
+    /// i = n_T upwards until the QP is feasible; q̈* = q̈ + g^a_i Δh^a_i.
+    fn iktc(&mut self, levels: &[TaskEquation], qdd: &mut DVector<f64>) -> Result<()> {
+        qdd.copy_from(&self.q0);
+        if self.report.violation_before <= self.settings.box_tolerance {
+            return Ok(());
+        }
+        let n = self.hierarchy.n();
+        let nt = levels.len();
+        let total: usize = self.hierarchy.dims().iter().sum();
+        for d in 0..n {
+            self.qp_lo[d] = self.lo[d] - self.q0[d];
+            self.qp_hi[d] = self.hi[d] - self.q0[d];
+        }
+        for i in (0..nt).rev() {
+            self.hierarchy.build_g_level(levels, i);
+            let off = self.hierarchy.offset(i);
+            let ma = total - off;
+            if ma == 0 {
+                continue;
+            }
+            let g = self.hierarchy.g().columns(off, ma);
+            let problem = QpProblem {
+                hessian: Hessian::Identity,
+                c: &self.zeros[..ma],
+                a_eq: self.a_eq.rows(0, 0),
+                b_eq: &[],
+                a_in: g,
+                lower: &self.qp_lo,
+                upper: &self.qp_hi,
+            };
+            let rep = self
+                .qp
+                .solve(&problem, &self.settings.qp, &mut self.xs[i])?;
+            self.report.qp_solves += 1;
+            self.report.qp_iterations += rep.iterations;
+            if rep.status == QpStatus::Optimal {
+                self.report.corrected_from = Some(i);
+                let g = self.hierarchy.g();
+                let x = &self.xs[i];
+                for c in 0..ma {
+                    let dh = x[c];
+                    if dh != 0.0 {
+                        for d in 0..n {
+                            qdd[d] += g[(d, off + c)] * dh;
+                        }
+                    }
+                }
+                let mut c = 0;
+                for corr in self.report.corrections.iter_mut().skip(i) {
+                    for r in 0..corr.len() {
+                        corr[r] = x[c];
+                        c += 1;
+                    }
+                }
+                return Ok(());
+            }
+            self.report.qp_infeasible += 1;
+        }
+        self.report.fallback = Some(Fallback::ClampedToBox);
+        self.clamp(qdd);
+        Ok(())
+    }
+
+    /// GF (Kanoun et al.): for k = 1..n_T, min ½‖J_k q̈ − h_k‖² + ½ε‖q̈‖² subject to the box
+    /// and J_j q̈ = J_j q̈*_j for every j < k (the optimal slack of each higher level frozen).
+    fn cascade(&mut self, levels: &[TaskEquation], qdd: &mut DVector<f64>) -> Result<()> {
+        let n = self.hierarchy.n();
+        let eps = self.settings.cascade_regularization;
+        let mut rows = 0;
+        let mut have = false;
+        for (k, l) in levels.iter().enumerate() {
+            let m = l.dim();
+            // H = JᵀJ + εI, c = −Jᵀh.
+            for a in 0..n {
+                for b in 0..=a {
+                    let mut s = 0.0;
+                    for r in 0..m {
+                        s += l.jacobian[(r, a)] * l.jacobian[(r, b)];
+                    }
+                    if a == b {
+                        s += eps;
+                    }
+                    self.h[(a, b)] = s;
+                    self.h[(b, a)] = s;
+                }
+                let mut s = 0.0;
+                for r in 0..m {
+                    s -= l.jacobian[(r, a)] * l.rhs[r];
+                }
+                self.c[a] = s;
+            }
+            let problem = QpProblem {
+                hessian: Hessian::Dense(self.h.view((0, 0), (n, n))),
+                c: &self.c,
+                a_eq: self.a_eq.rows(0, rows),
+                b_eq: &self.b_eq[..rows],
+                a_in: self.eye.view((0, 0), (n, n)),
+                lower: &self.lo,
+                upper: &self.hi,
+            };
+            let nt = levels.len();
+            let rep = self
+                .qp
+                .solve(&problem, &self.settings.qp, &mut self.xs[nt])?;
+            self.report.qp_solves += 1;
+            self.report.qp_iterations += rep.iterations;
+            if rep.status != QpStatus::Optimal {
+                self.report.qp_infeasible += 1;
+                self.report.fallback = Some(Fallback::CascadeStoppedAtLevel(k));
+                if !have {
+                    qdd.copy_from(&self.q0);
+                }
+                self.clamp_in_place(qdd);
+                return Ok(());
+            }
+            qdd.copy_from(&self.xs[levels.len()]);
+            have = true;
+            // Freeze this level: J_k q̈ = J_k q̈*_k.
+            for r in 0..m {
+                let mut s = 0.0;
+                for c in 0..n {
+                    let v = l.jacobian[(r, c)];
+                    self.a_eq[(rows + r, c)] = v;
+                    s += v * qdd[c];
+                }
+                self.b_eq[rows + r] = s;
+            }
+            rows += m;
+        }
+        Ok(())
+    }
+
+    fn clamp_in_place(&self, qdd: &mut DVector<f64>) {
+        for d in 0..qdd.len() {
+            qdd[d] = qdd[d].clamp(self.lo[d], self.hi[d]);
+        }
+    }
+}
