@@ -110,7 +110,10 @@ fn paper_bound_empties_and_overshoots_as_the_errata_says() {
         let lib = run_library(&BoundMethod::Paper, dt, true);
         let (plain_empty, plain_overshoot) = run_plain_paper(dt, true);
         let empty = lib.first_empty.expect("the paper's box must empty");
-        assert!((0.31..=0.34).contains(&empty), "Δt={dt}: empties at {empty}");
+        assert!(
+            (0.31..=0.34).contains(&empty),
+            "Δt={dt}: empties at {empty}"
+        );
         assert_eq!(plain_empty, lib.first_empty, "Δt={dt}");
         assert!(
             (low..=high).contains(&lib.overshoot),
@@ -132,7 +135,10 @@ fn paper_bound_unsaturated_breaks_the_acceleration_limit_and_still_overshoots() 
         let lib = run_library(&BoundMethod::Paper, dt, false);
         let (plain_empty, plain_overshoot) = run_plain_paper(dt, false);
         assert_eq!(plain_empty, lib.first_empty);
-        assert!(lib.most_negative_command < -A_MAX * 1.01, "Δt={dt}: {lib:?}");
+        assert!(
+            lib.most_negative_command < -A_MAX * 1.01,
+            "Δt={dt}: {lib:?}"
+        );
         assert!(lib.overshoot > 1e-5, "Δt={dt}: {lib:?}");
         assert!((plain_overshoot - lib.overshoot).abs() < 1e-6);
     }

@@ -122,10 +122,7 @@ fn check_step(c: &Case, q: f64, qd: f64, u: f64) -> Result<(f64, f64), TestCaseE
     );
     let (q1, qd1) = integrate_constant_acceleration(q, qd, qdd, c.dt);
     prop_assert!(qd1.abs() <= c.limits.velocity_max + VELOCITY_SLACK);
-    prop_assert!(
-        c.is_viable(q1, qd1),
-        "next state ({q1}, {qd1}) not viable"
-    );
+    prop_assert!(c.is_viable(q1, qd1), "next state ({q1}, {qd1}) not viable");
     Ok((q1, qd1))
 }
 
@@ -202,18 +199,20 @@ fn multi_dof_box_under_a_pushing_policy() {
     for step in 0..2000 {
         compute_box(&limits, &method, &q, &qd, dt, &mut bounds).unwrap();
         assert!(!bounds.is_empty() && !bounds.any_dropped(), "step {step}");
-        for i in 0..nv {
-            // Push toward the upper limit for 400 steps, then the lower one, and so on.
-            qdd[i] = if (step / 400) % 2 == 0 {
-                bounds.upper[i]
-            } else {
-                bounds.lower[i]
-            };
-        }
+        // Push toward the upper limit for 400 steps, then the lower one, and so on.
+        let side = if (step / 400) % 2 == 0 {
+            &bounds.upper
+        } else {
+            &bounds.lower
+        };
+        qdd.copy_from_slice(side.as_slice());
         assert!(bounds.contains(&qdd, 0.0).unwrap());
         for i in 0..nv {
             let peak = peak_in_step(q[i], qd[i], qdd[i], dt);
-            assert!(dofs[i].excursion(peak) <= POSITION_SLACK, "dof {i} step {step}");
+            assert!(
+                dofs[i].excursion(peak) <= POSITION_SLACK,
+                "dof {i} step {step}"
+            );
             (q[i], qd[i]) = integrate_constant_acceleration(q[i], qd[i], qdd[i], dt);
             assert!(qd[i].abs() <= dofs[i].velocity_max + VELOCITY_SLACK);
         }

@@ -3,9 +3,8 @@
 
 use approx::assert_relative_eq;
 use iktc::limits::{
-    compute_box, compute_dof, intersect, paper, peak_in_step, viable, AccelerationBox,
-    BoundMethod, BoundSource, DofBoundSources, DofLimits, JointLimits, SourceBounds,
-    ViableSettings,
+    compute_box, compute_dof, intersect, paper, peak_in_step, viable, AccelerationBox, BoundMethod,
+    BoundSource, DofBoundSources, DofLimits, JointLimits, SourceBounds, ViableSettings,
 };
 use iktc::Error;
 
@@ -36,8 +35,16 @@ fn paper_sources_by_hand_far_from_the_limit() {
     assert_eq!(s.lower.acceleration, -8.0);
     assert_relative_eq!(s.upper.velocity, 20.0, epsilon = 1e-12); // (3 − 1)/0.1
     assert_relative_eq!(s.lower.velocity, -40.0, epsilon = 1e-12); // (−3 − 1)/0.1
-    assert_relative_eq!(s.upper.position, (8.0_f64.sqrt() - 1.0) / 0.1, epsilon = 1e-12); // √(2·8·0.5)
-    assert_relative_eq!(s.lower.position, (-24.0_f64.sqrt() - 1.0) / 0.1, epsilon = 1e-12); // √(2·8·1.5)
+    assert_relative_eq!(
+        s.upper.position,
+        (8.0_f64.sqrt() - 1.0) / 0.1,
+        epsilon = 1e-12
+    ); // √(2·8·0.5)
+    assert_relative_eq!(
+        s.lower.position,
+        (-24.0_f64.sqrt() - 1.0) / 0.1,
+        epsilon = 1e-12
+    ); // √(2·8·1.5)
     assert_eq!(s.upper.viability, INF);
     assert_eq!(s.lower.viability, -INF);
     assert_eq!((b.lower, b.upper), (-8.0, 8.0));
@@ -99,7 +106,11 @@ fn viable_position_bound_in_step_peak_case() {
     let bound = viable::position_upper(0.98, 1.0, 1.0, 0.1);
     assert_relative_eq!(bound, -25.0, epsilon = 1e-9);
     // The peak at the bound touches the limit; the end-of-step bound −16 would overshoot.
-    assert_relative_eq!(peak_in_step(0.98, 1.0, bound, 0.1).max, 1.0, epsilon = 1e-12);
+    assert_relative_eq!(
+        peak_in_step(0.98, 1.0, bound, 0.1).max,
+        1.0,
+        epsilon = 1e-12
+    );
     assert!(peak_in_step(0.98, 1.0, -16.0, 0.1).max > 1.0 + 1e-3);
     // Mirror on the lower side.
     assert_relative_eq!(
@@ -296,7 +307,15 @@ fn box_reports_empty_dofs_and_violation() {
     // step: −q̇²/(2d) = −4500) conflicts with velocity ((−3.2 − 3)/0.01 = −620).
     let limits = JointLimits::new(vec![joint(1.0, 5.0, 30.0), joint(1.0, 3.2, 30.0)]).unwrap();
     let mut out = AccelerationBox::new(2);
-    compute_box(&limits, &viable_half(), &[0.0, 0.999], &[0.0, 3.0], 0.01, &mut out).unwrap();
+    compute_box(
+        &limits,
+        &viable_half(),
+        &[0.0, 0.999],
+        &[0.0, 3.0],
+        0.01,
+        &mut out,
+    )
+    .unwrap();
     assert!(out.is_empty());
     assert_eq!(out.empty_dofs().collect::<Vec<_>>(), vec![1]);
     assert!(out.any_dropped());
@@ -456,7 +475,7 @@ fn peak_in_step_by_hand() {
     let e = peak_in_step(0.0, 1.0, -25.0, 0.1);
     assert_relative_eq!(e.max, 0.02, epsilon = 1e-15);
     assert_relative_eq!(e.min, 0.1 - 0.125, epsilon = 1e-15); // end point −0.025
-    // No turn inside the step: the end points.
+                                                              // No turn inside the step: the end points.
     let e = peak_in_step(0.0, 1.0, -5.0, 0.1);
     assert_eq!(e.min, 0.0);
     assert_relative_eq!(e.max, 0.1 - 0.025, epsilon = 1e-15);
