@@ -199,14 +199,13 @@ fn multi_dof_box_under_a_pushing_policy() {
     for step in 0..2000 {
         compute_box(&limits, &method, &q, &qd, dt, &mut bounds).unwrap();
         assert!(!bounds.is_empty() && !bounds.any_dropped(), "step {step}");
-        for i in 0..nv {
-            // Push toward the upper limit for 400 steps, then the lower one, and so on.
-            qdd[i] = if (step / 400) % 2 == 0 {
-                bounds.upper[i]
-            } else {
-                bounds.lower[i]
-            };
-        }
+        // Push toward the upper limit for 400 steps, then the lower one, and so on.
+        let side = if (step / 400) % 2 == 0 {
+            &bounds.upper
+        } else {
+            &bounds.lower
+        };
+        qdd.copy_from_slice(side.as_slice());
         assert!(bounds.contains(&qdd, 0.0).unwrap());
         for i in 0..nv {
             let peak = peak_in_step(q[i], qd[i], qdd[i], dt);

@@ -18,10 +18,10 @@ use super::source::{BoundSource, DofBoundSources, DroppedSources};
 /// error.
 #[derive(Debug, Clone, PartialEq)]
 pub struct AccelerationBox {
-    /// `b_l` [rad/s²] (or [m/s²] for prismatic and base translation dofs); `-inf` when
+    /// `b_l` \[rad/s²\] (or \[m/s²\] for prismatic and base translation dofs); `-inf` when
     /// unbounded.
     pub lower: DVector<f64>,
-    /// `b_u` [rad/s²]; `+inf` when unbounded.
+    /// `b_u` \[rad/s²\]; `+inf` when unbounded.
     pub upper: DVector<f64>,
     /// Which source gives each entry of `lower`, after conflict resolution.
     pub lower_source: Vec<BoundSource>,
@@ -29,7 +29,7 @@ pub struct AccelerationBox {
     pub upper_source: Vec<BoundSource>,
     /// Which sources were dropped for each dof to resolve a conflict.
     pub dropped: Vec<DroppedSources>,
-    /// The value of every source of each dof before intersection [rad/s²].
+    /// The value of every source of each dof before intersection \[rad/s²\].
     pub sources: Vec<DofBoundSources>,
 }
 
@@ -82,7 +82,7 @@ impl AccelerationBox {
         })
     }
 
-    /// The largest amount by which `qdd` leaves the box [rad/s²]:
+    /// The largest amount by which `qdd` leaves the box \[rad/s²\]:
     /// `max_i max(b_l,i − q̈_i, q̈_i − b_u,i, 0)`. Positive for every `qdd` when the box is
     /// empty.
     ///
@@ -101,7 +101,7 @@ impl AccelerationBox {
 
     /// Whether `b_l − tol ≤ q̈ ≤ b_u + tol` for every dof.
     ///
-    /// `tolerance` [rad/s²] ≥ 0 is explicit because what is acceptable depends on the caller
+    /// `tolerance` \[rad/s²\] ≥ 0 is explicit because what is acceptable depends on the caller
     /// (a QP solution carries its own residual; a test of exact arithmetic wants rounding only).
     ///
     /// # Errors

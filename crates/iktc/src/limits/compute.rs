@@ -19,10 +19,10 @@ use super::viable::viable_sources;
 /// side and the dropped sources. An empty box is a status ([`AccelerationBox::is_empty`]), not
 /// an error. Allocates nothing.
 ///
-/// * `position`: `q` per velocity dof [rad] or [m], length `nv` (for a floating base, any
+/// * `position`: `q` per velocity dof \[rad\] or \[m\], length `nv` (for a floating base, any
 ///   finite value: its limits are infinite);
-/// * `velocity`: `q̇` [rad/s] or [m/s], length `nv`;
-/// * `dt`: the control period `Δt` [s], finite and positive; the bounds assume the
+/// * `velocity`: `q̇` \[rad/s\] or \[m/s\], length `nv`;
+/// * `dt`: the control period `Δt` \[s\], finite and positive; the bounds assume the
 ///   constant-acceleration integrator
 ///   ([`integrate_constant_acceleration`](super::integrate_constant_acceleration)) over `Δt`.
 ///
@@ -57,7 +57,7 @@ pub fn compute_box(
 /// The sources and the resolved interval of a single dof; the one-dof version of
 /// [`compute_box`], for tests, reports and single-joint studies.
 ///
-/// `q` [rad], `qd` [rad/s], `dt` [s]. The limits are validated here as well.
+/// `q` \[rad\], `qd` \[rad/s\], `dt` \[s\]. The limits are validated here as well.
 ///
 /// # Errors
 /// As [`compute_box`], and the errors of [`DofLimits::validate`].

@@ -13,14 +13,14 @@
 /// q⁺ = q + Δt q̇ + ½ Δt² q̈,   q̇⁺ = q̇ + Δt q̈
 /// ```
 ///
-/// `q` [rad] or [m], `qd` [rad/s], `qdd` [rad/s²], `dt` = `Δt` [s]. This is the integrator
+/// `q` \[rad\] or \[m\], `qd` \[rad/s\], `qdd` \[rad/s²\], `dt` = `Δt` \[s\]. This is the integrator
 /// every bound of [`compute_box`](super::compute_box) is derived for (errata §2.1 and §3.1);
 /// the exact solution of `q̈ = const` over the step.
 pub fn integrate_constant_acceleration(q: f64, qd: f64, qdd: f64, dt: f64) -> (f64, f64) {
     (q + dt * qd + 0.5 * dt * dt * qdd, qd + dt * qdd)
 }
 
-/// The smallest and largest position reached during one step [rad] or [m].
+/// The smallest and largest position reached during one step \[rad\] or \[m\].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StepExtremes {
     /// The smallest position over `t ∈ [0, Δt]`.
@@ -37,7 +37,7 @@ pub struct StepExtremes {
 /// the turning point `q(t*) = q − q̇²/(2 q̈)`. A bound that only checks `q⁺` misses that
 /// turning point; see [`viable`](super::viable) for the bound that does not.
 ///
-/// `q` [rad] or [m], `qd` [rad/s], `qdd` [rad/s²], `dt` [s]. With a non-positive or
+/// `q` \[rad\] or \[m\], `qd` \[rad/s\], `qdd` \[rad/s²\], `dt` \[s\]. With a non-positive or
 /// non-finite `dt` the result is not meaningful (no panic).
 pub fn peak_in_step(q: f64, qd: f64, qdd: f64, dt: f64) -> StepExtremes {
     let (end, _) = integrate_constant_acceleration(q, qd, qdd, dt);

@@ -3,12 +3,12 @@
 use super::method::BoundMethod;
 use super::source::{BoundSource, DofBoundSources, DroppedSources, SourceBounds};
 
-/// The acceleration interval of one dof after intersection and conflict resolution [rad/s²].
+/// The acceleration interval of one dof after intersection and conflict resolution \[rad/s²\].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DofBounds {
-    /// Lower bound `b_l` on `q̈` [rad/s²]; `-inf` when nothing bounds it.
+    /// Lower bound `b_l` on `q̈` \[rad/s²\]; `-inf` when nothing bounds it.
     pub lower: f64,
-    /// Upper bound `b_u` on `q̈` [rad/s²]; `+inf` when nothing bounds it.
+    /// Upper bound `b_u` on `q̈` \[rad/s²\]; `+inf` when nothing bounds it.
     pub upper: f64,
     /// The source that gives `lower`.
     pub lower_source: BoundSource,

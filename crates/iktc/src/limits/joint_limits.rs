@@ -12,13 +12,13 @@ use super::integrator::StepExtremes;
 /// struct literal or [`DofLimits::unlimited`]; [`JointLimits::new`] validates it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DofLimits {
-    /// Lower end of the position range, `q_min` [rad] or [m]; `-inf` for none.
+    /// Lower end of the position range, `q_min` \[rad\] or \[m\]; `-inf` for none.
     pub position_min: f64,
-    /// Upper end of the position range, `q_max` [rad] or [m]; `+inf` for none.
+    /// Upper end of the position range, `q_max` \[rad\] or \[m\]; `+inf` for none.
     pub position_max: f64,
-    /// Largest speed in either direction, `v_max > 0` [rad/s] or [m/s]; `+inf` for none.
+    /// Largest speed in either direction, `v_max > 0` \[rad/s\] or \[m/s\]; `+inf` for none.
     pub velocity_max: f64,
-    /// Largest acceleration in either direction, `a_max > 0` [rad/s²] or [m/s²]; `+inf` for
+    /// Largest acceleration in either direction, `a_max > 0` \[rad/s²\] or \[m/s²\]; `+inf` for
     /// none.
     pub acceleration_max: f64,
 }
@@ -82,7 +82,7 @@ impl DofLimits {
     }
 
     /// How far the position range `[q_min, q_max]` is left by a motion whose extreme positions
-    /// are `extremes` (see [`peak_in_step`](super::peak_in_step)) [rad] or [m]:
+    /// are `extremes` (see [`peak_in_step`](super::peak_in_step)) \[rad\] or \[m\]:
     /// `max(0, extremes.max − q_max, q_min − extremes.min)`. Zero when the motion stays inside.
     pub fn excursion(&self, extremes: StepExtremes) -> f64 {
         let above = extremes.max - self.position_max;

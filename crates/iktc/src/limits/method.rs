@@ -47,7 +47,7 @@ impl BoundMethod {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ViableSettings {
     /// The braking acceleration assumed by the viability bound, as a fraction of the joint's
-    /// acceleration limit: `a_stop = braking_fraction · a_max` [–], in `(0, 1]`.
+    /// acceleration limit: `a_stop = braking_fraction · a_max` \[–\], in `(0, 1]`.
     ///
     /// Default 0.5 (errata §3.1). The viability bound keeps the next state able to stop before
     /// the range ends while braking at `a_stop`. At `a_stop = a_max` a joint that sits on its

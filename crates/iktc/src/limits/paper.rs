@@ -21,14 +21,14 @@ use super::joint_limits::DofLimits;
 use super::source::{DofBoundSources, SourceBounds};
 use super::velocity::{velocity_lower, velocity_upper};
 
-/// The third term of eq. (14), upper side [rad/s²]:
+/// The third term of eq. (14), upper side \[rad/s²\]:
 /// `(√(2 a_max max(q_max − q, 0)) − q̇)/Δt`.
 ///
 /// `+inf` when `q_max = +inf`, or when `a_max = +inf` and `q < q_max`. At or beyond the limit
 /// the square root is taken as 0 (see the module documentation).
 ///
-/// `q` [rad], `qd` [rad/s], `position_max` = `q_max` [rad], `acceleration_max` = `a_max`
-/// [rad/s²], `dt` [s].
+/// `q` \[rad\], `qd` \[rad/s\], `position_max` = `q_max` \[rad\], `acceleration_max` = `a_max`
+/// \[rad/s²\], `dt` \[s\].
 pub fn position_term_upper(
     q: f64,
     qd: f64,
@@ -52,7 +52,7 @@ pub fn position_term_upper(
     }
 }
 
-/// The third term of eq. (14), lower side [rad/s²]:
+/// The third term of eq. (14), lower side \[rad/s²\]:
 /// `(−√(2 a_max max(q − q_min, 0)) − q̇)/Δt`, the mirror of [`position_term_upper`].
 pub fn position_term_lower(
     q: f64,
@@ -64,11 +64,11 @@ pub fn position_term_lower(
     -position_term_upper(-q, -qd, -position_min, acceleration_max, dt)
 }
 
-/// All sources of eq. (14) for one dof [rad/s²]: acceleration `±a_max`, velocity
+/// All sources of eq. (14) for one dof \[rad/s²\]: acceleration `±a_max`, velocity
 /// `(±v_max − q̇)/Δt` and the position term; no viability source (infinite).
 ///
 /// Inputs are not validated here; [`compute_box`](super::compute_box) does that.
-/// `q` [rad], `qd` [rad/s], `dt` [s].
+/// `q` \[rad\], `qd` \[rad/s\], `dt` \[s\].
 pub fn paper_sources(limits: &DofLimits, q: f64, qd: f64, dt: f64) -> DofBoundSources {
     let a_max = limits.acceleration_max;
     DofBoundSources {

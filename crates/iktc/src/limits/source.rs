@@ -41,7 +41,7 @@ impl DroppedSources {
     }
 }
 
-/// The value of every source of bound on one side of one dof [rad/s²].
+/// The value of every source of bound on one side of one dof \[rad/s²\].
 ///
 /// On the upper side each entry is an upper bound on `q̈` (`+inf` when that limit does not
 /// apply); on the lower side a lower bound (`-inf` when it does not apply). A source that the
@@ -75,7 +75,7 @@ impl SourceBounds {
     }
 }
 
-/// Every source of bound of one dof, before intersection [rad/s²].
+/// Every source of bound of one dof, before intersection \[rad/s²\].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DofBoundSources {
     /// Lower bounds on `q̈`, one per source.

@@ -16,10 +16,12 @@
 //! included), keeps `|q̇⁺| ≤ v_max` and leads to a viable state, because the position,
 //! velocity and viability bounds are exact for the integrator. The box is then non-empty
 //! without dropping any source provided the time step is fine compared with the limits
-//! (tested for `q_max − q_min ≥ a_max Δt²`, `v_max ≥ a_max Δt` and `a_stop ≤ 0.95 a_max`;
-//! at `a_stop = a_max` rounding alone can make the acceleration limit conflict on the braking
-//! curve, where exactly `a_max` is needed). Coarser steps can make position and velocity
-//! bounds conflict; that is reported, not hidden.
+//! (property-tested for `q_max − q_min ≥ 5 a_max Δt²`, `v_max ≥ a_max Δt` and
+//! `a_stop ≤ 0.95 a_max`; a random exploration found conflicts only for ranges narrower than
+//! about `a_max Δt²` or `v_max` below about `a_max Δt`). At `a_stop = a_max` rounding alone
+//! can make the acceleration limit conflict on the braking curve, where exactly `a_max` is
+//! needed; it is then dropped. Coarser steps can make position and velocity bounds conflict;
+//! that is reported, not hidden.
 //!
 //! **Beyond the range** (a state that is not viable, e.g. an initial posture outside a
 //! narrowed range), the range is widened to the current position on that side
@@ -31,7 +33,7 @@ use super::method::ViableSettings;
 use super::source::{DofBoundSources, SourceBounds};
 use super::velocity::{velocity_lower, velocity_upper};
 
-/// Upper position bound including the in-step peak [rad/s²].
+/// Upper position bound including the in-step peak \[rad/s²\].
 ///
 /// With `d = max(q_max − q, 0)`:
 ///
@@ -48,7 +50,7 @@ use super::velocity::{velocity_lower, velocity_upper};
 /// `p = −2q̇/Δt` (`q⁺` back at the start, the peak `q̇Δt/4` beyond it). The same fallback is
 /// used if `−q̇²/(2d)` overflows. `+inf` when `q_max = +inf`.
 ///
-/// `q` [rad], `qd` [rad/s], `position_max` [rad], `dt` [s].
+/// `q` \[rad\], `qd` \[rad/s\], `position_max` \[rad\], `dt` \[s\].
 pub fn position_upper(q: f64, qd: f64, position_max: f64, dt: f64) -> f64 {
     if position_max == f64::INFINITY {
         return f64::INFINITY;
@@ -65,13 +67,13 @@ pub fn position_upper(q: f64, qd: f64, position_max: f64, dt: f64) -> f64 {
     end_of_step
 }
 
-/// Lower position bound including the in-step peak [rad/s²], the mirror of
+/// Lower position bound including the in-step peak \[rad/s²\], the mirror of
 /// [`position_upper`]: `−position_upper(−q, −q̇, −q_min, Δt)`.
 pub fn position_lower(q: f64, qd: f64, position_min: f64, dt: f64) -> f64 {
     -position_upper(-q, -qd, -position_min, dt)
 }
 
-/// Upper viability bound [rad/s²]: the next state can still stop before `q_max` braking at
+/// Upper viability bound \[rad/s²\]: the next state can still stop before `q_max` braking at
 /// `a_stop`.
 ///
 /// The condition `q̇⁺ ≤ √(2 a_stop (q_max − q⁺))` matters only when `q̇⁺ ≥ 0`, where squaring
@@ -90,8 +92,8 @@ pub fn position_lower(q: f64, qd: f64, position_min: f64, dt: f64) -> f64 {
 /// exactly: the integrator is exact for constant braking. `d = max(q_max − q, 0)` as in
 /// [`position_upper`]; `+inf` when `q_max = +inf` or `a_stop = +inf`.
 ///
-/// `q` [rad], `qd` [rad/s], `position_max` [rad], `braking_acceleration` = `a_stop`
-/// [rad/s²], `dt` [s].
+/// `q` \[rad\], `qd` \[rad/s\], `position_max` \[rad\], `braking_acceleration` = `a_stop`
+/// \[rad/s²\], `dt` \[s\].
 pub fn viability_upper(
     q: f64,
     qd: f64,
@@ -121,7 +123,7 @@ pub fn viability_upper(
     larger.max(stop_in_step)
 }
 
-/// Lower viability bound [rad/s²], the mirror of [`viability_upper`]:
+/// Lower viability bound \[rad/s²\], the mirror of [`viability_upper`]:
 /// `−viability_upper(−q, −q̇, −q_min, a_stop, Δt)`.
 pub fn viability_lower(
     q: f64,
@@ -133,12 +135,12 @@ pub fn viability_lower(
     -viability_upper(-q, -qd, -position_min, braking_acceleration, dt)
 }
 
-/// All sources of the viable bounds for one dof [rad/s²]: acceleration `±a_max`, velocity
+/// All sources of the viable bounds for one dof \[rad/s²\]: acceleration `±a_max`, velocity
 /// `(±v_max − q̇)/Δt`, position with in-step peak, viability with
 /// `a_stop = braking_fraction · a_max`.
 ///
 /// Inputs are not validated here; [`compute_box`](super::compute_box) does that.
-/// `q` [rad], `qd` [rad/s], `dt` [s].
+/// `q` \[rad\], `qd` \[rad/s\], `dt` \[s\].
 pub fn viable_sources(
     limits: &DofLimits,
     settings: &ViableSettings,
