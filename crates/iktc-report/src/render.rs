@@ -216,6 +216,8 @@ where
         .y_label_formatter(&y_fmt)
         .x_labels(10)
         .y_labels(7)
+        .x_max_light_lines(2)
+        .y_max_light_lines(2)
         .label_style((FONT_FAMILY, 13))
         .axis_desc_style((FONT_FAMILY, 15))
         .bold_line_style(RGBColor(215, 215, 215))
