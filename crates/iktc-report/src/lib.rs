@@ -8,6 +8,7 @@
 #![warn(missing_docs)]
 
 mod csv;
+mod decimate;
 mod error;
 mod figure;
 mod font;

@@ -6,6 +6,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
+use crate::decimate::decimate;
 use crate::error::ReportError;
 use crate::figure::{Figure, LineStyle, Panel, Series};
 use crate::font::FONT_FAMILY;
@@ -39,6 +40,20 @@ const Y_LABEL_AREA: u32 = 78;
 const LINE_WIDTH: u32 = 2;
 /// Marker radius of point series [px].
 const POINT_RADIUS: u32 = 3;
+
+/// Axis ranges and pixel geometry of one chart.
+struct View<'a> {
+    /// x-axis range, in the panel's x unit.
+    x_range: (f64, f64),
+    /// y-axis range, in the panel's y unit.
+    y_range: (f64, f64),
+    /// Width of the plotting area [px].
+    columns: usize,
+    /// Maps an x value to its pixel column.
+    to_col: &'a dyn Fn(f64) -> f64,
+    /// Whether any finite point exists.
+    has_data: bool,
+}
 
 fn err<E: std::fmt::Display>(context: &str) -> impl FnOnce(E) -> ReportError + '_ {
     move |e| ReportError::plot(context, e)
@@ -123,6 +138,10 @@ fn draw_panel<DB: DrawingBackend>(
     let yb = finite_bounds(pts().map(|p| p.1).chain(panel.hlines.iter().map(|h| h.y)));
     let has_data = xb.is_some();
     let mut y_range = linear_range(yb);
+    let (area_w, area_h) = area.dim_in_pixel();
+    let plot_w = f64::from(area_w) - f64::from(2 * MARGIN + MARGIN_RIGHT + Y_LABEL_AREA);
+    let plot_h = f64::from(area_h) - f64::from(2 * MARGIN + X_LABEL_AREA);
+    let columns = plot_w.max(1.0) as usize;
     let mut builder = ChartBuilder::on(&area);
     builder
         .margin(MARGIN)
@@ -134,27 +153,34 @@ fn draw_panel<DB: DrawingBackend>(
         let mut chart = builder
             .build_cartesian_2d((x_range.0..x_range.1).log_scale(), y_range.0..y_range.1)
             .map_err(err("building a log-x chart"))?;
-        fill_chart(
-            &mut chart,
-            panel,
+        let (l0, l1) = (x_range.0.ln(), x_range.1.ln());
+        let to_col = move |x: f64| (x.ln() - l0) / (l1 - l0) * columns as f64;
+        let view = View {
             x_range,
             y_range,
-            &log_formatter,
+            columns,
+            to_col: &to_col,
             has_data,
-        )
+        };
+        fill_chart(&mut chart, panel, &view, &log_formatter)
     } else {
         let mut x_range = linear_range(xb);
         if panel.equal_aspect {
-            let (w, h) = area.dim_in_pixel();
-            let plot_w = f64::from(w) - f64::from(2 * MARGIN + MARGIN_RIGHT + Y_LABEL_AREA);
-            let plot_h = f64::from(h) - f64::from(2 * MARGIN + X_LABEL_AREA);
             (x_range, y_range) = equalize(x_range, y_range, plot_w, plot_h);
         }
         let mut chart = builder
             .build_cartesian_2d(x_range.0..x_range.1, y_range.0..y_range.1)
             .map_err(err("building a chart"))?;
         let x_fmt = linear_formatter(x_range);
-        fill_chart(&mut chart, panel, x_range, y_range, &x_fmt, has_data)
+        let to_col = move |x: f64| (x - x_range.0) / (x_range.1 - x_range.0) * columns as f64;
+        let view = View {
+            x_range,
+            y_range,
+            columns,
+            to_col: &to_col,
+            has_data,
+        };
+        fill_chart(&mut chart, panel, &view, &x_fmt)
     }
 }
 
@@ -198,15 +224,14 @@ fn legend_corner(panel: &Panel, x: (f64, f64), y: (f64, f64)) -> SeriesLabelPosi
 fn fill_chart<'a, DB, X>(
     chart: &mut ChartContext<'a, DB, Cartesian2d<X, RangedCoordf64>>,
     panel: &Panel,
-    x_range: (f64, f64),
-    y_range: (f64, f64),
+    view: &View<'_>,
     x_fmt: &dyn Fn(&f64) -> String,
-    has_data: bool,
 ) -> Result<(), ReportError>
 where
     DB: DrawingBackend + 'a,
     X: Ranged<ValueType = f64> + ValueFormatter<f64>,
 {
+    let (x_range, y_range) = (view.x_range, view.y_range);
     let y_fmt = linear_formatter(y_range);
     chart
         .configure_mesh()
@@ -253,8 +278,25 @@ where
         let color = PALETTE[i % PALETTE.len()];
         let line = color.stroke_width(LINE_WIDTH);
         let segs = segments(s, panel.log_x);
+        let segs: Vec<Vec<(f64, f64)>> = segs
+            .iter()
+            .map(|seg| match s.style {
+                LineStyle::Points => seg.clone(),
+                _ => decimate(seg, view.columns, view.to_col),
+            })
+            .collect();
         let ctx = format!("drawing series '{}'", s.label);
         for seg in &segs {
+            if seg.len() == 1 && s.style != LineStyle::Points {
+                // An isolated finite sample of a line has no segment to draw: mark it with a dot.
+                chart
+                    .draw_series(
+                        seg.iter()
+                            .map(|&p| Circle::new(p, LINE_WIDTH + 1, color.filled())),
+                    )
+                    .map_err(err(&ctx))?;
+                continue;
+            }
             match s.style {
                 LineStyle::Solid => {
                     chart
@@ -303,7 +345,7 @@ where
         }
     }
 
-    if !has_data {
+    if !view.has_data {
         let area = chart.plotting_area();
         let (w, h) = area.dim_in_pixel();
         let style = TextStyle::from((FONT_FAMILY, 16).into_font())
