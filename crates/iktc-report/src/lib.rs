@@ -13,6 +13,7 @@ mod error;
 mod figure;
 mod font;
 mod html;
+mod legend;
 mod range;
 mod render;
 

@@ -10,6 +10,7 @@ use crate::decimate::decimate;
 use crate::error::ReportError;
 use crate::figure::{Figure, LineStyle, Panel, Series};
 use crate::font::FONT_FAMILY;
+use crate::legend::{draw_legend, LegendEntry, Marker};
 use crate::range::{
     equalize, finite_bounds, linear_formatter, linear_range, log_formatter, log_range,
 };
@@ -184,43 +185,6 @@ fn draw_panel<DB: DrawingBackend>(
     }
 }
 
-/// Which corner of the plot holds the fewest data points (there the legend hides least).
-fn legend_corner(panel: &Panel, x: (f64, f64), y: (f64, f64)) -> SeriesLabelPosition {
-    let nx = |v: f64| {
-        if panel.log_x {
-            (v.ln() - x.0.ln()) / (x.1.ln() - x.0.ln())
-        } else {
-            (v - x.0) / (x.1 - x.0)
-        }
-    };
-    let ny = |v: f64| (v - y.0) / (y.1 - y.0);
-    // upper-right, upper-left, lower-right, lower-left
-    let mut counts = [0usize; 4];
-    for p in panel
-        .series
-        .iter()
-        .flat_map(series_points)
-        .filter(|p| valid(*p, panel.log_x))
-    {
-        let (u, v) = (nx(p.0), ny(p.1));
-        let right = u > 0.55;
-        let left = u < 0.45;
-        let up = v > 0.5;
-        let down = v < 0.5;
-        counts[0] += usize::from(right && up);
-        counts[1] += usize::from(left && up);
-        counts[2] += usize::from(right && down);
-        counts[3] += usize::from(left && down);
-    }
-    let best = (0..4).min_by_key(|&i| counts[i]).unwrap_or(0);
-    match best {
-        1 => SeriesLabelPosition::UpperLeft,
-        2 => SeriesLabelPosition::LowerRight,
-        3 => SeriesLabelPosition::LowerLeft,
-        _ => SeriesLabelPosition::UpperRight,
-    }
-}
-
 fn fill_chart<'a, DB, X>(
     chart: &mut ChartContext<'a, DB, Cartesian2d<X, RangedCoordf64>>,
     panel: &Panel,
@@ -251,11 +215,15 @@ where
         .draw()
         .map_err(err("drawing axes"))?;
 
-    let mut entries = 0usize;
-    let mut seen_limit_labels: Vec<&str> = Vec::new();
+    let origin = {
+        let (xr, yr) = chart.plotting_area().get_pixel_range();
+        (xr.start, yr.start)
+    };
+    let mut occupied: Vec<(i32, i32)> = Vec::new();
+    let mut entries: Vec<LegendEntry> = Vec::new();
     for h in panel.hlines.iter().filter(|h| h.y.is_finite()) {
         let style = LIMIT_COLOR.stroke_width(LINE_WIDTH);
-        let anno = chart
+        chart
             .draw_series(DashedLineSeries::new(
                 vec![(x_range.0, h.y), (x_range.1, h.y)],
                 10,
@@ -263,13 +231,16 @@ where
                 style,
             ))
             .map_err(err("drawing a limit line"))?;
-        if !h.label.is_empty() && !seen_limit_labels.contains(&h.label.as_str()) {
-            seen_limit_labels.push(&h.label);
-            entries += 1;
-            anno.label(h.label.as_str()).legend(move |(x, y)| {
-                EmptyElement::at((x, y))
-                    + PathElement::new(vec![(0, 0), (8, 0)], style)
-                    + PathElement::new(vec![(13, 0), (21, 0)], style)
+        let (_, py) = chart.backend_coord(&(x_range.0, h.y));
+        occupied.extend(
+            (0..view.columns as i32)
+                .step_by(4)
+                .map(|px| (px, py - origin.1)),
+        );
+        if !h.label.is_empty() && !entries.iter().any(|e| e.label == h.label) {
+            entries.push(LegendEntry {
+                label: h.label.clone(),
+                marker: Marker::Dashed(LIMIT_COLOR),
             });
         }
     }
@@ -277,8 +248,7 @@ where
     for (i, s) in panel.series.iter().enumerate() {
         let color = PALETTE[i % PALETTE.len()];
         let line = color.stroke_width(LINE_WIDTH);
-        let segs = segments(s, panel.log_x);
-        let segs: Vec<Vec<(f64, f64)>> = segs
+        let segs: Vec<Vec<(f64, f64)>> = segments(s, panel.log_x)
             .iter()
             .map(|seg| match s.style {
                 LineStyle::Points => seg.clone(),
@@ -287,6 +257,10 @@ where
             .collect();
         let ctx = format!("drawing series '{}'", s.label);
         for seg in &segs {
+            occupied.extend(seg.iter().map(|p| {
+                let (px, py) = chart.backend_coord(p);
+                (px - origin.0, py - origin.1)
+            }));
             if seg.len() == 1 && s.style != LineStyle::Points {
                 // An isolated finite sample of a line has no segment to draw: mark it with a dot.
                 chart
@@ -318,57 +292,35 @@ where
                 }
             }
         }
-        if s.label.is_empty() {
-            continue;
-        }
-        entries += 1;
-        let anno = chart
-            .draw_series(std::iter::empty::<PathElement<(f64, f64)>>())
-            .map_err(err(&ctx))?;
-        let anno = anno.label(s.label.as_str());
-        match s.style {
-            LineStyle::Solid => {
-                anno.legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 21, y)], line));
-            }
-            LineStyle::Dashed => {
-                anno.legend(move |(x, y)| {
-                    EmptyElement::at((x, y))
-                        + PathElement::new(vec![(0, 0), (8, 0)], line)
-                        + PathElement::new(vec![(13, 0), (21, 0)], line)
-                });
-            }
-            LineStyle::Points => {
-                anno.legend(move |(x, y)| {
-                    Circle::new((x + 10, y), POINT_RADIUS + 1, color.filled())
-                });
-            }
+        if !s.label.is_empty() {
+            let marker = match s.style {
+                LineStyle::Solid => Marker::Line(color),
+                LineStyle::Dashed => Marker::Dashed(color),
+                LineStyle::Points => Marker::Dot(color),
+            };
+            entries.push(LegendEntry {
+                label: s.label.clone(),
+                marker,
+            });
         }
     }
 
+    let plot = chart.plotting_area().strip_coord_spec();
     if !view.has_data {
-        let area = chart.plotting_area();
-        let (w, h) = area.dim_in_pixel();
+        let (w, h) = plot.dim_in_pixel();
         let style = TextStyle::from((FONT_FAMILY, 16).into_font())
             .color(&RGBColor(120, 120, 120))
             .pos(Pos::new(HPos::Center, VPos::Center));
-        area.strip_coord_spec()
-            .draw(&Text::new(
-                "no finite data",
-                ((w / 2) as i32, (h / 2) as i32),
-                style,
-            ))
-            .map_err(err("drawing the no-data note"))?;
+        plot.draw(&Text::new(
+            "no finite data",
+            ((w / 2) as i32, (h / 2) as i32),
+            style,
+        ))
+        .map_err(err("drawing the no-data note"))?;
     }
 
-    if entries > 1 {
-        chart
-            .configure_series_labels()
-            .position(legend_corner(panel, x_range, y_range))
-            .background_style(WHITE.mix(0.85))
-            .border_style(RGBColor(160, 160, 160))
-            .label_font((FONT_FAMILY, 13))
-            .draw()
-            .map_err(err("drawing the legend"))?;
+    if entries.len() > 1 {
+        draw_legend(&plot, &entries, &occupied)?;
     }
     Ok(())
 }
