@@ -4,7 +4,7 @@
 /// lowest, highest and last point of each column, in their original order).
 ///
 /// `to_column` maps an x value to its horizontal pixel position; `columns` is the plot width
-/// [px]. Lines drawn through the result cover the same pixels as lines through all points, so
+/// \[px\]. Lines drawn through the result cover the same pixels as lines through all points, so
 /// the figure looks the same while SVG files stay small. Runs that are short (at most
 /// `4 * columns` points) or whose x is not sorted (x-y paths) are returned unchanged.
 pub(crate) fn decimate(

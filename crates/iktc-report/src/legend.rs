@@ -8,19 +8,19 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 use crate::error::ReportError;
 use crate::font::FONT_FAMILY;
 
-/// Height of one legend row [px].
+/// Height of one legend row \[px\].
 const ROW_H: i32 = 17;
-/// Padding inside the legend box [px].
+/// Padding inside the legend box \[px\].
 const PAD: i32 = 6;
-/// Length of the line sample left of each label [px].
+/// Length of the line sample left of each label \[px\].
 const SAMPLE_W: i32 = 24;
-/// Gap between the sample and the label [px].
+/// Gap between the sample and the label \[px\].
 const GAP: i32 = 6;
-/// Gap between legend columns [px].
+/// Gap between legend columns \[px\].
 const COL_GAP: i32 = 14;
-/// Distance of the legend box from the plot frame [px].
+/// Distance of the legend box from the plot frame \[px\].
 const INSET: i32 = 6;
-/// Legend text size [px].
+/// Legend text size \[px\].
 const FONT_SIZE: u32 = 13;
 
 /// How an entry's sample is drawn.

@@ -29,17 +29,17 @@ const PALETTE: [RGBColor; 9] = [
 ];
 /// Colour of horizontal reference (limit) lines.
 const LIMIT_COLOR: RGBColor = RGBColor(200, 30, 30);
-/// Space around each chart [px].
+/// Space around each chart \[px\].
 const MARGIN: u32 = 8;
-/// Extra space right of each chart so the last tick label fits [px].
+/// Extra space right of each chart so the last tick label fits \[px\].
 const MARGIN_RIGHT: u32 = 20;
-/// Height reserved for x tick labels and the x-axis label [px].
+/// Height reserved for x tick labels and the x-axis label \[px\].
 const X_LABEL_AREA: u32 = 42;
-/// Width reserved for y tick labels and the y-axis label [px].
+/// Width reserved for y tick labels and the y-axis label \[px\].
 const Y_LABEL_AREA: u32 = 78;
-/// Line width of series [px].
+/// Line width of series \[px\].
 const LINE_WIDTH: u32 = 2;
-/// Marker radius of point series [px].
+/// Marker radius of point series \[px\].
 const POINT_RADIUS: u32 = 3;
 
 /// Axis ranges and pixel geometry of one chart.
@@ -48,7 +48,7 @@ struct View<'a> {
     x_range: (f64, f64),
     /// y-axis range, in the panel's y unit.
     y_range: (f64, f64),
-    /// Width of the plotting area [px].
+    /// Width of the plotting area \[px\].
     columns: usize,
     /// Maps an x value to its pixel column.
     to_col: &'a dyn Fn(f64) -> f64,

@@ -38,7 +38,7 @@ fn numbers_round_trip_exactly() {
     let rows = vec![
         vec![0.0, 0.1 + 0.2, -1.0 / 3.0],
         vec![1e-300, 6.02214076e23, f64::MIN_POSITIVE],
-        vec![-0.0, f64::MAX, 123456789.123456789],
+        vec![-0.0, f64::MAX, 123_456_789.123_456_79],
         vec![f64::INFINITY, f64::NEG_INFINITY, std::f64::consts::PI],
     ];
     write_csv(&path, &header, &rows).unwrap();
