@@ -8,9 +8,9 @@ use crate::error::ReportError;
 use crate::font::ensure_font;
 use crate::render::draw_figure;
 
-/// Default width of one panel [px].
+/// Default width of one panel \[px\].
 pub const DEFAULT_PANEL_WIDTH: u32 = 800;
-/// Default height of one panel [px].
+/// Default height of one panel \[px\].
 pub const DEFAULT_PANEL_HEIGHT: u32 = 300;
 
 /// How a [`Series`] is drawn.
@@ -151,9 +151,9 @@ pub struct Figure {
     pub panels: Vec<Panel>,
     /// Number of grid columns (at least 1; default 1).
     pub columns: usize,
-    /// Width of one panel [px] (default [`DEFAULT_PANEL_WIDTH`]).
+    /// Width of one panel \[px\] (default [`DEFAULT_PANEL_WIDTH`]).
     pub panel_width: u32,
-    /// Height of one panel [px] (default [`DEFAULT_PANEL_HEIGHT`]).
+    /// Height of one panel \[px\] (default [`DEFAULT_PANEL_HEIGHT`]).
     pub panel_height: u32,
 }
 
@@ -181,7 +181,7 @@ impl Figure {
         self
     }
 
-    /// Sets the size of one panel [px].
+    /// Sets the size of one panel \[px\].
     pub fn panel_size(mut self, width: u32, height: u32) -> Self {
         self.panel_width = width;
         self.panel_height = height;
@@ -193,7 +193,7 @@ impl Figure {
         self.panels.len().div_ceil(self.columns.max(1))
     }
 
-    /// Height of the title row [px] (0 when the title is empty).
+    /// Height of the title row \[px\] (0 when the title is empty).
     pub(crate) fn title_height(&self) -> u32 {
         if self.title.trim().is_empty() {
             0
@@ -202,7 +202,7 @@ impl Figure {
         }
     }
 
-    /// Total size of the rendered figure [px].
+    /// Total size of the rendered figure \[px\].
     pub fn size(&self) -> (u32, u32) {
         let cols = self.columns.max(1).min(self.panels.len().max(1));
         let w = self.panel_width.saturating_mul(cols as u32);

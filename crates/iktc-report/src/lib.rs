@@ -8,10 +8,12 @@
 #![warn(missing_docs)]
 
 mod csv;
+mod decimate;
 mod error;
 mod figure;
 mod font;
 mod html;
+mod legend;
 mod range;
 mod render;
 

@@ -86,7 +86,7 @@ pub(crate) fn linear_formatter(range: (f64, f64)) -> impl Fn(&f64) -> String {
         if *v == 0.0 || v.abs() < span * 1e-9 {
             "0".to_string()
         } else if scientific {
-            format!("{v:.2e}")
+            trim_mantissa(format!("{v:.2e}"))
         } else {
             trim_decimals(format!("{v:.decimals$}"))
         }
@@ -100,6 +100,15 @@ pub(crate) fn log_formatter(v: &f64) -> String {
         trim_decimals(format!("{v:.4}"))
     } else {
         format!("{v:.0e}")
+    }
+}
+
+/// Removes trailing zeros from the mantissa of a number in scientific notation (`2.50e-8` ->
+/// `2.5e-8`).
+fn trim_mantissa(s: String) -> String {
+    match s.split_once('e') {
+        Some((m, e)) => format!("{}e{e}", trim_decimals(m.to_string())),
+        None => s,
     }
 }
 
@@ -154,7 +163,8 @@ mod tests {
         let f = linear_formatter((0.0, 1.0));
         assert_eq!(f(&0.30000000000000004), "0.3");
         let f = linear_formatter((0.0, 1e-7));
-        assert_eq!(f(&5e-8), "5.00e-8");
+        assert_eq!(f(&5e-8), "5e-8");
+        assert_eq!(f(&2.5e-8), "2.5e-8");
         assert_eq!(log_formatter(&100.0), "100");
         assert_eq!(log_formatter(&1e6), "1e6");
     }

@@ -6,9 +6,11 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
+use crate::decimate::decimate;
 use crate::error::ReportError;
 use crate::figure::{Figure, LineStyle, Panel, Series};
 use crate::font::FONT_FAMILY;
+use crate::legend::{draw_legend, LegendEntry, Marker};
 use crate::range::{
     equalize, finite_bounds, linear_formatter, linear_range, log_formatter, log_range,
 };
@@ -27,18 +29,32 @@ const PALETTE: [RGBColor; 9] = [
 ];
 /// Colour of horizontal reference (limit) lines.
 const LIMIT_COLOR: RGBColor = RGBColor(200, 30, 30);
-/// Space around each chart [px].
+/// Space around each chart \[px\].
 const MARGIN: u32 = 8;
-/// Extra space right of each chart so the last tick label fits [px].
+/// Extra space right of each chart so the last tick label fits \[px\].
 const MARGIN_RIGHT: u32 = 20;
-/// Height reserved for x tick labels and the x-axis label [px].
+/// Height reserved for x tick labels and the x-axis label \[px\].
 const X_LABEL_AREA: u32 = 42;
-/// Width reserved for y tick labels and the y-axis label [px].
+/// Width reserved for y tick labels and the y-axis label \[px\].
 const Y_LABEL_AREA: u32 = 78;
-/// Line width of series [px].
+/// Line width of series \[px\].
 const LINE_WIDTH: u32 = 2;
-/// Marker radius of point series [px].
+/// Marker radius of point series \[px\].
 const POINT_RADIUS: u32 = 3;
+
+/// Axis ranges and pixel geometry of one chart.
+struct View<'a> {
+    /// x-axis range, in the panel's x unit.
+    x_range: (f64, f64),
+    /// y-axis range, in the panel's y unit.
+    y_range: (f64, f64),
+    /// Width of the plotting area \[px\].
+    columns: usize,
+    /// Maps an x value to its pixel column.
+    to_col: &'a dyn Fn(f64) -> f64,
+    /// Whether any finite point exists.
+    has_data: bool,
+}
 
 fn err<E: std::fmt::Display>(context: &str) -> impl FnOnce(E) -> ReportError + '_ {
     move |e| ReportError::plot(context, e)
@@ -123,6 +139,10 @@ fn draw_panel<DB: DrawingBackend>(
     let yb = finite_bounds(pts().map(|p| p.1).chain(panel.hlines.iter().map(|h| h.y)));
     let has_data = xb.is_some();
     let mut y_range = linear_range(yb);
+    let (area_w, area_h) = area.dim_in_pixel();
+    let plot_w = f64::from(area_w) - f64::from(2 * MARGIN + MARGIN_RIGHT + Y_LABEL_AREA);
+    let plot_h = f64::from(area_h) - f64::from(2 * MARGIN + X_LABEL_AREA);
+    let columns = plot_w.max(1.0) as usize;
     let mut builder = ChartBuilder::on(&area);
     builder
         .margin(MARGIN)
@@ -134,79 +154,48 @@ fn draw_panel<DB: DrawingBackend>(
         let mut chart = builder
             .build_cartesian_2d((x_range.0..x_range.1).log_scale(), y_range.0..y_range.1)
             .map_err(err("building a log-x chart"))?;
-        fill_chart(
-            &mut chart,
-            panel,
+        let (l0, l1) = (x_range.0.ln(), x_range.1.ln());
+        let to_col = move |x: f64| (x.ln() - l0) / (l1 - l0) * columns as f64;
+        let view = View {
             x_range,
             y_range,
-            &log_formatter,
+            columns,
+            to_col: &to_col,
             has_data,
-        )
+        };
+        fill_chart(&mut chart, panel, &view, &log_formatter)
     } else {
         let mut x_range = linear_range(xb);
         if panel.equal_aspect {
-            let (w, h) = area.dim_in_pixel();
-            let plot_w = f64::from(w) - f64::from(2 * MARGIN + MARGIN_RIGHT + Y_LABEL_AREA);
-            let plot_h = f64::from(h) - f64::from(2 * MARGIN + X_LABEL_AREA);
             (x_range, y_range) = equalize(x_range, y_range, plot_w, plot_h);
         }
         let mut chart = builder
             .build_cartesian_2d(x_range.0..x_range.1, y_range.0..y_range.1)
             .map_err(err("building a chart"))?;
         let x_fmt = linear_formatter(x_range);
-        fill_chart(&mut chart, panel, x_range, y_range, &x_fmt, has_data)
-    }
-}
-
-/// Which corner of the plot holds the fewest data points (there the legend hides least).
-fn legend_corner(panel: &Panel, x: (f64, f64), y: (f64, f64)) -> SeriesLabelPosition {
-    let nx = |v: f64| {
-        if panel.log_x {
-            (v.ln() - x.0.ln()) / (x.1.ln() - x.0.ln())
-        } else {
-            (v - x.0) / (x.1 - x.0)
-        }
-    };
-    let ny = |v: f64| (v - y.0) / (y.1 - y.0);
-    // upper-right, upper-left, lower-right, lower-left
-    let mut counts = [0usize; 4];
-    for p in panel
-        .series
-        .iter()
-        .flat_map(series_points)
-        .filter(|p| valid(*p, panel.log_x))
-    {
-        let (u, v) = (nx(p.0), ny(p.1));
-        let right = u > 0.55;
-        let left = u < 0.45;
-        let up = v > 0.5;
-        let down = v < 0.5;
-        counts[0] += usize::from(right && up);
-        counts[1] += usize::from(left && up);
-        counts[2] += usize::from(right && down);
-        counts[3] += usize::from(left && down);
-    }
-    let best = (0..4).min_by_key(|&i| counts[i]).unwrap_or(0);
-    match best {
-        1 => SeriesLabelPosition::UpperLeft,
-        2 => SeriesLabelPosition::LowerRight,
-        3 => SeriesLabelPosition::LowerLeft,
-        _ => SeriesLabelPosition::UpperRight,
+        let to_col = move |x: f64| (x - x_range.0) / (x_range.1 - x_range.0) * columns as f64;
+        let view = View {
+            x_range,
+            y_range,
+            columns,
+            to_col: &to_col,
+            has_data,
+        };
+        fill_chart(&mut chart, panel, &view, &x_fmt)
     }
 }
 
 fn fill_chart<'a, DB, X>(
     chart: &mut ChartContext<'a, DB, Cartesian2d<X, RangedCoordf64>>,
     panel: &Panel,
-    x_range: (f64, f64),
-    y_range: (f64, f64),
+    view: &View<'_>,
     x_fmt: &dyn Fn(&f64) -> String,
-    has_data: bool,
 ) -> Result<(), ReportError>
 where
     DB: DrawingBackend + 'a,
     X: Ranged<ValueType = f64> + ValueFormatter<f64>,
 {
+    let (x_range, y_range) = (view.x_range, view.y_range);
     let y_fmt = linear_formatter(y_range);
     chart
         .configure_mesh()
@@ -216,6 +205,8 @@ where
         .y_label_formatter(&y_fmt)
         .x_labels(10)
         .y_labels(7)
+        .x_max_light_lines(2)
+        .y_max_light_lines(2)
         .label_style((FONT_FAMILY, 13))
         .axis_desc_style((FONT_FAMILY, 15))
         .bold_line_style(RGBColor(215, 215, 215))
@@ -224,11 +215,15 @@ where
         .draw()
         .map_err(err("drawing axes"))?;
 
-    let mut entries = 0usize;
-    let mut seen_limit_labels: Vec<&str> = Vec::new();
+    let origin = {
+        let (xr, yr) = chart.plotting_area().get_pixel_range();
+        (xr.start, yr.start)
+    };
+    let mut occupied: Vec<(i32, i32)> = Vec::new();
+    let mut entries: Vec<LegendEntry> = Vec::new();
     for h in panel.hlines.iter().filter(|h| h.y.is_finite()) {
         let style = LIMIT_COLOR.stroke_width(LINE_WIDTH);
-        let anno = chart
+        chart
             .draw_series(DashedLineSeries::new(
                 vec![(x_range.0, h.y), (x_range.1, h.y)],
                 10,
@@ -236,13 +231,16 @@ where
                 style,
             ))
             .map_err(err("drawing a limit line"))?;
-        if !h.label.is_empty() && !seen_limit_labels.contains(&h.label.as_str()) {
-            seen_limit_labels.push(&h.label);
-            entries += 1;
-            anno.label(h.label.as_str()).legend(move |(x, y)| {
-                EmptyElement::at((x, y))
-                    + PathElement::new(vec![(0, 0), (8, 0)], style)
-                    + PathElement::new(vec![(13, 0), (21, 0)], style)
+        let (_, py) = chart.backend_coord(&(x_range.0, h.y));
+        occupied.extend(
+            (0..view.columns as i32)
+                .step_by(4)
+                .map(|px| (px, py - origin.1)),
+        );
+        if !h.label.is_empty() && !entries.iter().any(|e| e.label == h.label) {
+            entries.push(LegendEntry {
+                label: h.label.clone(),
+                marker: Marker::Dashed(LIMIT_COLOR),
             });
         }
     }
@@ -250,9 +248,29 @@ where
     for (i, s) in panel.series.iter().enumerate() {
         let color = PALETTE[i % PALETTE.len()];
         let line = color.stroke_width(LINE_WIDTH);
-        let segs = segments(s, panel.log_x);
+        let segs: Vec<Vec<(f64, f64)>> = segments(s, panel.log_x)
+            .iter()
+            .map(|seg| match s.style {
+                LineStyle::Points => seg.clone(),
+                _ => decimate(seg, view.columns, view.to_col),
+            })
+            .collect();
         let ctx = format!("drawing series '{}'", s.label);
         for seg in &segs {
+            occupied.extend(seg.iter().map(|p| {
+                let (px, py) = chart.backend_coord(p);
+                (px - origin.0, py - origin.1)
+            }));
+            if seg.len() == 1 && s.style != LineStyle::Points {
+                // An isolated finite sample of a line has no segment to draw: mark it with a dot.
+                chart
+                    .draw_series(
+                        seg.iter()
+                            .map(|&p| Circle::new(p, LINE_WIDTH + 1, color.filled())),
+                    )
+                    .map_err(err(&ctx))?;
+                continue;
+            }
             match s.style {
                 LineStyle::Solid => {
                     chart
@@ -274,57 +292,35 @@ where
                 }
             }
         }
-        if s.label.is_empty() {
-            continue;
-        }
-        entries += 1;
-        let anno = chart
-            .draw_series(std::iter::empty::<PathElement<(f64, f64)>>())
-            .map_err(err(&ctx))?;
-        let anno = anno.label(s.label.as_str());
-        match s.style {
-            LineStyle::Solid => {
-                anno.legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 21, y)], line));
-            }
-            LineStyle::Dashed => {
-                anno.legend(move |(x, y)| {
-                    EmptyElement::at((x, y))
-                        + PathElement::new(vec![(0, 0), (8, 0)], line)
-                        + PathElement::new(vec![(13, 0), (21, 0)], line)
-                });
-            }
-            LineStyle::Points => {
-                anno.legend(move |(x, y)| {
-                    Circle::new((x + 10, y), POINT_RADIUS + 1, color.filled())
-                });
-            }
+        if !s.label.is_empty() {
+            let marker = match s.style {
+                LineStyle::Solid => Marker::Line(color),
+                LineStyle::Dashed => Marker::Dashed(color),
+                LineStyle::Points => Marker::Dot(color),
+            };
+            entries.push(LegendEntry {
+                label: s.label.clone(),
+                marker,
+            });
         }
     }
 
-    if !has_data {
-        let area = chart.plotting_area();
-        let (w, h) = area.dim_in_pixel();
+    let plot = chart.plotting_area().strip_coord_spec();
+    if !view.has_data {
+        let (w, h) = plot.dim_in_pixel();
         let style = TextStyle::from((FONT_FAMILY, 16).into_font())
             .color(&RGBColor(120, 120, 120))
             .pos(Pos::new(HPos::Center, VPos::Center));
-        area.strip_coord_spec()
-            .draw(&Text::new(
-                "no finite data",
-                ((w / 2) as i32, (h / 2) as i32),
-                style,
-            ))
-            .map_err(err("drawing the no-data note"))?;
+        plot.draw(&Text::new(
+            "no finite data",
+            ((w / 2) as i32, (h / 2) as i32),
+            style,
+        ))
+        .map_err(err("drawing the no-data note"))?;
     }
 
-    if entries > 1 {
-        chart
-            .configure_series_labels()
-            .position(legend_corner(panel, x_range, y_range))
-            .background_style(WHITE.mix(0.85))
-            .border_style(RGBColor(160, 160, 160))
-            .label_font((FONT_FAMILY, 13))
-            .draw()
-            .map_err(err("drawing the legend"))?;
+    if entries.len() > 1 {
+        draw_legend(&plot, &entries, &occupied)?;
     }
     Ok(())
 }

@@ -207,7 +207,7 @@ fn gallery_for_eyeballing() {
                 .hline(-45.0, "-45 deg"),
         );
     write_figure(&bode, &dir, "bode").unwrap();
-    let s = linspace(0.0, 6.283, 200);
+    let s = linspace(0.0, std::f64::consts::TAU, 200);
     let xy = Figure::new("Hand path seen from above").panel(
         Panel::new("Hand path", "x [m]", "y [m]")
             .equal_aspect()
