@@ -4,6 +4,8 @@
 use clap::{Parser, Subcommand};
 
 mod cmd_model;
+mod cmd_reproduce;
+mod cmd_run;
 mod robot_arg;
 
 #[derive(Parser)]
@@ -21,12 +23,18 @@ struct Cli {
 enum Command {
     /// Describe a robot model; with --config, its kinematics at a configuration.
     Model(cmd_model::Args),
+    /// Run a scenario (the 3R arm of Section 3.3) and write its trajectory, summary and figures.
+    Run(cmd_run::Args),
+    /// Run every experiment and write one offline report, DIR/index.html.
+    Reproduce(cmd_reproduce::Args),
 }
 
 fn main() -> std::process::ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
         Command::Model(a) => cmd_model::run(a),
+        Command::Run(a) => cmd_run::run(a),
+        Command::Reproduce(a) => cmd_reproduce::run(a),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,
