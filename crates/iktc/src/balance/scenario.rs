@@ -1,0 +1,1 @@
+//! The three balance scenarios (identify, design, push) as plain result structs.
