@@ -38,7 +38,7 @@ impl Default for SweepSettings {
     fn default() -> Self {
         Self {
             min_frequency: 0.2,
-            max_frequency: 20.0,
+            max_frequency: 10.0,
             count: 30,
             amplitude: 0.002,
             settle_time: 10.0,
