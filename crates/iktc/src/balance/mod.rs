@@ -45,3 +45,8 @@ pub use response::{analyse_response, ResponseMetrics, ResponseSettings};
 pub use sim::{NoiseSource, PlantParams, SimPlant, SimSettings};
 pub use sweep::{sine_sweep, SweepSettings};
 pub use zmp::{measure_zmp, Foot, FootSensor, ZmpMeasurement, ZmpSettings, ZmpStatus};
+pub use scenario::{
+    run_design, run_identify, run_push, BodeSeries, DesignResult, DesignScenario,
+    IdentifyResult, IdentifyScenario, ParameterComparison, PlanePushMetrics, PushResult,
+    PushScenario, RootLocus,
+};

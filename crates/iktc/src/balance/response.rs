@@ -5,9 +5,12 @@
 //! `y(t) ≈ e^{−ζ w τ} (a cos(w √(1−ζ²) τ) + b sin(w √(1−ζ²) τ))`, `τ = t − t₀`, by variable
 //! projection (`a`, `b` by linear least squares for each `(ζ, w)`): a coarse grid over
 //! `(ζ, w)` then [`levenberg_marquardt`] on `(logit ζ, ln w)`. The window starts a little
-//! after the push so that the fast modes (lag, delay, observer) have died out.
+//! after the push so that the fastest modes (lag, delay) have died out. With
+//! [`ResponseSettings::modes`] = 2 the sum of two such modes is fitted (the grid then moves the
+//! pair `(ζ, w)`, `(ζ, r w)` together before the free refinement) and the
+//! mode is reported: this is the closed loop's controller mode, the other its observer mode.
 
-use nalgebra::{DVector, Matrix2, Vector2};
+use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 
 use super::lm::{levenberg_marquardt, LmSettings};
@@ -34,6 +37,12 @@ pub struct ResponseSettings {
     pub grid_max_frequency: f64,
     /// …with this many points [–].
     pub grid_frequency: usize,
+    /// Number of damped modes fitted together [–], 1 or 2 (see the module documentation).
+    /// Fitting the observer's mode too keeps it from biasing the controller's.
+    pub modes: usize,
+    /// Frequency of the second mode as a multiple of the first's [–]: the observer's pole
+    /// scale, [`super::design::DiscreteSettings::observer_pole_scale`].
+    pub second_mode_ratio: f64,
     /// The refining solver.
     pub lm: LmSettings,
 }
@@ -45,10 +54,12 @@ impl Default for ResponseSettings {
             noise_sigmas: 5.0,
             fit_delay: 0.1,
             fit_window: 2.0,
-            grid_damping: 49,
+            grid_damping: 24,
             grid_min_frequency: 1.0,
             grid_max_frequency: 200.0,
-            grid_frequency: 80,
+            grid_frequency: 60,
+            modes: 1,
+            second_mode_ratio: 2.0,
             lm: LmSettings::default(),
         }
     }
@@ -88,6 +99,16 @@ impl ResponseSettings {
                 ">= 2",
             ));
         }
+        if !(self.modes == 1 || self.modes == 2) {
+            return Err(invalid("ResponseSettings::modes", self.modes as f64, "1 or 2"));
+        }
+        if !(self.second_mode_ratio.is_finite() && self.second_mode_ratio > 1.0) {
+            return Err(invalid(
+                "ResponseSettings::second_mode_ratio",
+                self.second_mode_ratio,
+                "> 1",
+            ));
+        }
         self.lm.validate()
     }
 }
@@ -104,9 +125,9 @@ pub struct ResponseMetrics {
     pub settling_time: Option<f64>,
     /// The settling band used [m].
     pub settle_band: f64,
-    /// Damping ratio of the fitted dominant mode [–].
+    /// Damping ratio of the fitted (first) mode [–].
     pub damping_ratio: f64,
-    /// Natural frequency of the fitted dominant mode [rad/s].
+    /// Natural frequency of the fitted (first) mode [rad/s].
     pub natural_frequency: f64,
     /// RMS of the fit residual over its window [m].
     pub fit_rms: f64,
@@ -157,7 +178,9 @@ pub fn analyse_response(
             ),
         });
     }
-    // Grid search.
+    // Grid search, then refinement.
+    let two = settings.modes == 2;
+    let ratio = settings.second_mode_ratio;
     let mut best = (f64::INFINITY, 0.5, 1.0);
     let (lw0, lw1) = (
         settings.grid_min_frequency.ln(),
@@ -167,22 +190,35 @@ pub fn analyse_response(
         let z = (i as f64 + 1.0) / (settings.grid_damping as f64 + 1.0);
         for j in 0..settings.grid_frequency {
             let w = (lw0 + (lw1 - lw0) * j as f64 / (settings.grid_frequency - 1) as f64).exp();
-            let c = mode_cost(&window, z, w);
+            let modes: &[(f64, f64)] = if two {
+                &[(z, w), (z, ratio * w)]
+            } else {
+                &[(z, w)]
+            };
+            let c = modes_cost(&window, modes);
             if c < best.0 {
                 best = (c, z, w);
             }
         }
     }
-    let x0 = DVector::from_vec(vec![(best.1 / (1.0 - best.1)).ln(), best.2.ln()]);
+    let logit = |z: f64| (z / (1.0 - z)).ln();
+    let x0 = vec![logit(best.1), best.2.ln()];
     let m = window.len();
+    let decode = |x: &DVector<f64>| -> Vec<(f64, f64)> {
+        let z = 1.0 / (1.0 + (-x[0]).exp());
+        let w = x[1].exp();
+        if two {
+            vec![(z, w), (z, ratio * w)]
+        } else {
+            vec![(z, w)]
+        }
+    };
     let fit = levenberg_marquardt(
         |x: &DVector<f64>, r: &mut DVector<f64>| {
-            let z = 1.0 / (1.0 + (-x[0]).exp());
-            let w = x[1].exp();
-            mode_residual(&window, z, w, r);
+            modes_residual(&window, &decode(x), r);
             Ok(())
         },
-        x0,
+        DVector::from_vec(x0),
         m,
         &settings.lm,
     )?;
@@ -205,33 +241,50 @@ fn basis(t: f64, z: f64, w: f64) -> (f64, f64) {
     (e * (wd * t).cos(), e * (wd * t).sin())
 }
 
-fn linear_coefficients(window: &[(f64, f64)], z: f64, w: f64) -> Vector2<f64> {
-    let mut n = Matrix2::zeros();
-    let mut r = Vector2::zeros();
+/// Least-squares coefficients of the modes' cosine and sine terms, and the fitted values.
+fn modes_fit(window: &[(f64, f64)], modes: &[(f64, f64)]) -> (DVector<f64>, Vec<f64>) {
+    let k = 2 * modes.len();
+    let mut n = DMatrix::<f64>::zeros(k, k);
+    let mut r = DVector::<f64>::zeros(k);
+    let mut phi = DVector::<f64>::zeros(k);
     for (t, y) in window {
-        let (c, s) = basis(*t, z, w);
-        let phi = Vector2::new(c, s);
-        n += phi * phi.transpose();
-        r += phi * *y;
+        fill(&mut phi, *t, modes);
+        n += &phi * phi.transpose();
+        r += &phi * *y;
     }
-    n.try_inverse().map_or(Vector2::zeros(), |inv| inv * r)
-}
-
-fn mode_residual(window: &[(f64, f64)], z: f64, w: f64, r: &mut DVector<f64>) {
-    let ab = linear_coefficients(window, z, w);
-    for (ri, (t, y)) in r.iter_mut().zip(window) {
-        let (c, s) = basis(*t, z, w);
-        *ri = ab[0] * c + ab[1] * s - y;
-    }
-}
-
-fn mode_cost(window: &[(f64, f64)], z: f64, w: f64) -> f64 {
-    let ab = linear_coefficients(window, z, w);
-    window
+    let coef = n
+        .cholesky()
+        .map_or(DVector::zeros(k), |c| c.solve(&r));
+    let fitted = window
         .iter()
-        .map(|(t, y)| {
-            let (c, s) = basis(*t, z, w);
-            (ab[0] * c + ab[1] * s - y).powi(2)
+        .map(|(t, _)| {
+            fill(&mut phi, *t, modes);
+            phi.dot(&coef)
         })
+        .collect();
+    (coef, fitted)
+}
+
+fn fill(phi: &mut DVector<f64>, t: f64, modes: &[(f64, f64)]) {
+    for (i, (z, w)) in modes.iter().enumerate() {
+        let (c, s) = basis(t, *z, *w);
+        phi[2 * i] = c;
+        phi[2 * i + 1] = s;
+    }
+}
+
+fn modes_residual(window: &[(f64, f64)], modes: &[(f64, f64)], r: &mut DVector<f64>) {
+    let (_, fitted) = modes_fit(window, modes);
+    for ((ri, f), (_, y)) in r.iter_mut().zip(fitted).zip(window) {
+        *ri = f - y;
+    }
+}
+
+fn modes_cost(window: &[(f64, f64)], modes: &[(f64, f64)]) -> f64 {
+    let (_, fitted) = modes_fit(window, modes);
+    fitted
+        .iter()
+        .zip(window)
+        .map(|(f, (_, y))| (f - y).powi(2))
         .sum()
 }
