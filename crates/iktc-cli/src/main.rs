@@ -1,6 +1,8 @@
 //! The `iktc` command-line tool: argument parsing and output files only; every algorithm lives
 //! in the `iktc` library.
 
+mod cmd_balance;
+
 use clap::{Parser, Subcommand};
 
 #[derive(Parser)]
@@ -15,9 +17,14 @@ struct Cli {
 }
 
 #[derive(Subcommand)]
-enum Command {}
+enum Command {
+    /// The ZMP damping controller of Section 4: identify, design, push.
+    Balance(cmd_balance::BalanceArgs),
+}
 
 fn main() -> anyhow::Result<()> {
     let cli = Cli::parse();
-    match cli.command {}
+    match cli.command {
+        Command::Balance(args) => cmd_balance::run(args),
+    }
 }
