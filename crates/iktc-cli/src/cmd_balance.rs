@@ -125,7 +125,10 @@ pub fn run(args: BalanceArgs) -> anyhow::Result<()> {
                     m.static_gain_closed
                 );
             }
-            println!("-> {}", out.join(format!("push-{}", phase.name())).display());
+            println!(
+                "-> {}",
+                out.join(format!("push-{}", phase.name())).display()
+            );
         }
     }
     Ok(())
@@ -255,7 +258,10 @@ pub fn balance_section(out_dir: &Path) -> anyhow::Result<Section> {
                     fmt_opt(m.open.settling_time),
                     fmt_opt(m.closed.settling_time)
                 ),
-                format!("{:.3} → {:.3}", m.open.damping_ratio, m.closed.damping_ratio),
+                format!(
+                    "{:.3} → {:.3}",
+                    m.open.damping_ratio, m.closed.damping_ratio
+                ),
                 format!("{:.2}", m.designed_damping_ratio),
                 format!(
                     "{:.4} / {:.4} / {:.4}",
@@ -266,13 +272,28 @@ pub fn balance_section(out_dir: &Path) -> anyhow::Result<Section> {
     }
     s = s.table(t);
     for (href, text) in [
-        ("balance/identify/summary.json", "identification summary (JSON)"),
+        (
+            "balance/identify/summary.json",
+            "identification summary (JSON)",
+        ),
         ("balance/identify/bode.csv", "measured Bode data (CSV)"),
         ("balance/design/summary.json", "design summary (JSON)"),
-        ("balance/push-dsp/summary.json", "push test DSP summary (JSON)"),
-        ("balance/push-dsp/zmp.csv", "push test DSP time series (CSV)"),
-        ("balance/push-ssp/summary.json", "push test SSP summary (JSON)"),
-        ("balance/push-ssp/zmp.csv", "push test SSP time series (CSV)"),
+        (
+            "balance/push-dsp/summary.json",
+            "push test DSP summary (JSON)",
+        ),
+        (
+            "balance/push-dsp/zmp.csv",
+            "push test DSP time series (CSV)",
+        ),
+        (
+            "balance/push-ssp/summary.json",
+            "push test SSP summary (JSON)",
+        ),
+        (
+            "balance/push-ssp/zmp.csv",
+            "push test SSP time series (CSV)",
+        ),
     ] {
         s = s.link(href, text);
     }
@@ -477,8 +498,16 @@ fn push(out: &Path, phase: Phase, seed: u64) -> anyhow::Result<PushResult> {
                 "time [s]",
                 format!("ZMP {axis} [mm]"),
             )
-            .with(Series::line("without controller", t.clone(), mm(&r.zmp_open[i])))
-            .with(Series::line("with controller", t.clone(), mm(&r.zmp_closed[i]))),
+            .with(Series::line(
+                "without controller",
+                t.clone(),
+                mm(&r.zmp_open[i]),
+            ))
+            .with(Series::line(
+                "with controller",
+                t.clone(),
+                mm(&r.zmp_closed[i]),
+            )),
         );
     }
     fig = fig.panel(

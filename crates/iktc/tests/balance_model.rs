@@ -27,10 +27,7 @@ fn assert_sets_close(a: Vec<Complex<f64>>, b: Vec<Complex<f64>>, tol: f64) {
     let (a, b) = (sorted(a), sorted(b));
     assert_eq!(a.len(), b.len());
     for (x, y) in a.iter().zip(&b) {
-        assert!(
-            (x - y).norm() <= tol * (1.0 + y.norm()),
-            "{a:?}\n vs {b:?}"
-        );
+        assert!((x - y).norm() <= tol * (1.0 + y.norm()), "{a:?}\n vs {b:?}");
     }
 }
 
@@ -84,10 +81,7 @@ fn state_space_matches_transfer_function() {
         let s = Complex::new(0.0, w);
         let a: Matrix4<Complex<f64>> = ss.a.map(|v| Complex::new(v, 0.0));
         let m = Matrix4::<Complex<f64>>::identity() * s - a;
-        let x = m
-            .lu()
-            .solve(&ss.b.map(|v| Complex::new(v, 0.0)))
-            .unwrap();
+        let x = m.lu().solve(&ss.b.map(|v| Complex::new(v, 0.0))).unwrap();
         let h_ss = ss.c.map(|v| Complex::new(v, 0.0)) * x;
         let h_tf = p.transfer_function().eval(s);
         let h_fr = p.frequency_response(w);
@@ -146,7 +140,11 @@ fn closed_loop_eigenvalues_and_static_gain() {
         assert_sets_close(eig, want, 1e-8);
         // Static gain of the closed loop: −C A_cl⁻¹ B N equals the open loop's.
         let g_cl = -(ss.c * acl.try_inverse().unwrap() * ss.b)[0] * d.feedforward;
-        assert!((g_cl - p.dc_gain()).abs() < 1e-9, "{g_cl} vs {}", p.dc_gain());
+        assert!(
+            (g_cl - p.dc_gain()).abs() < 1e-9,
+            "{g_cl} vs {}",
+            p.dc_gain()
+        );
     }
 }
 
@@ -163,10 +161,14 @@ fn discrete_closed_loop_with_observer_has_designed_eigenvalues() {
     let xbar_x = m * c;
     let xbar_xh = i4 - m * c;
     let mut big = DMatrix::<f64>::zeros(8, 8);
-    big.view_mut((0, 0), (4, 4)).copy_from(&(a - b * k * xbar_x));
-    big.view_mut((0, 4), (4, 4)).copy_from(&(-(b * k) * xbar_xh));
-    big.view_mut((4, 0), (4, 4)).copy_from(&((a - b * k) * xbar_x));
-    big.view_mut((4, 4), (4, 4)).copy_from(&((a - b * k) * xbar_xh));
+    big.view_mut((0, 0), (4, 4))
+        .copy_from(&(a - b * k * xbar_x));
+    big.view_mut((0, 4), (4, 4))
+        .copy_from(&(-(b * k) * xbar_xh));
+    big.view_mut((4, 0), (4, 4))
+        .copy_from(&((a - b * k) * xbar_x));
+    big.view_mut((4, 4), (4, 4))
+        .copy_from(&((a - b * k) * xbar_xh));
     let eig: Vec<_> = big.complex_eigenvalues().iter().copied().collect();
     let h = 0.005;
     let cont = place_poles(&p, &PoleSpec::default()).unwrap();

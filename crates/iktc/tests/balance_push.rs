@@ -2,8 +2,8 @@
 //! the closed loop with the true delay, and the smooth hand-over between support phases.
 
 use iktc::balance::{
-    run_push, BalanceController, BalanceSettings, CaseParams, PlantParams, PushScenario,
-    SimPlant, SimSettings, SupportPhase,
+    run_push, BalanceController, BalanceSettings, CaseParams, PlantParams, PushScenario, SimPlant,
+    SimSettings, SupportPhase,
 };
 use nalgebra::{DMatrix, Matrix4};
 
@@ -28,7 +28,11 @@ fn controller_damps_pushes_to_the_designed_ratio() {
             let r = run_push(&s).unwrap();
             for m in &r.metrics {
                 let z = m.closed.damping_ratio;
-                assert!((z - 0.72).abs() < 0.07, "{phase:?} {:?} seed {seed}: ζ = {z}", m.plane);
+                assert!(
+                    (z - 0.72).abs() < 0.07,
+                    "{phase:?} {:?} seed {seed}: ζ = {z}",
+                    m.plane
+                );
                 zetas.push(z);
                 assert!((m.open.damping_ratio - m.model_damping_ratio).abs() < 0.02);
                 let ts_open = m.open.settling_time.unwrap();
@@ -179,7 +183,11 @@ fn phase_hand_over_is_smooth() {
             plants[i].advance(out.u[i]).unwrap();
         }
     }
-    assert!(blends[100] < 0.1 && blends[130] == 1.0, "{:?}", &blends[95..135]);
+    assert!(
+        blends[100] < 0.1 && blends[130] == 1.0,
+        "{:?}",
+        &blends[95..135]
+    );
     assert!(
         max_step_switch < 2.0 * max_step_steady,
         "{max_step_switch} vs {max_step_steady}"
@@ -190,6 +198,8 @@ fn phase_hand_over_is_smooth() {
     }
     // Non-finite input is refused without changing the state.
     let before = ctrl.clone();
-    assert!(ctrl.step(SupportPhase::Single, [f64::NAN, 0.0], [0.0, 0.0]).is_err());
+    assert!(ctrl
+        .step(SupportPhase::Single, [f64::NAN, 0.0], [0.0, 0.0])
+        .is_err());
     assert_eq!(before, ctrl);
 }

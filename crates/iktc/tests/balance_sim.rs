@@ -17,8 +17,11 @@ fn model() -> FullModelParams {
 #[test]
 fn free_response_after_push_matches_closed_form() {
     let (m, j) = (45.0, 3.0);
-    let mut p = SimPlant::new(PlantParams::from_model(model(), m, 0.0), &SimSettings::default())
-        .unwrap();
+    let mut p = SimPlant::new(
+        PlantParams::from_model(model(), m, 0.0),
+        &SimSettings::default(),
+    )
+    .unwrap();
     p.push(j).unwrap();
     let (wn, z) = (TAU * 2.0, 0.05);
     let wd = wn * (1.0f64 - z * z).sqrt();

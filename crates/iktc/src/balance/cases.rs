@@ -115,7 +115,7 @@ pub struct BalanceSettings {
     pub poles: PoleSpec,
     /// Control period and observer speed.
     pub discrete: DiscreteSettings,
-    /// Duration of the cross-fade after a support-phase change [s]; 0 switches at once.
+    /// Duration of the cross-fade after a support-phase change \[s\]; 0 switches at once.
     /// Longer is smoother but keeps the wrong case's controller in the loop for longer.
     pub blend_time: f64,
 }
@@ -149,13 +149,13 @@ impl BalanceSettings {
 /// What one tick of the two-plane controller returns; arrays are `[x̃z̃, ỹz̃]`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct BalanceOutput {
-    /// Command angles `u` [rad].
+    /// Command angles `u` \[rad\].
     pub u: [f64; 2],
-    /// COM reference offsets `Δc = l (u − u_ref)` [m] in the local frame.
+    /// COM reference offsets `Δc = l (u − u_ref)` \[m\] in the local frame.
     pub com_offset: [f64; 2],
     /// The support phase whose controllers are (becoming) active.
     pub phase: SupportPhase,
-    /// Weight of the active phase's controllers in the command [–]: 1 when settled, below 1
+    /// Weight of the active phase's controllers in the command \[–\]: 1 when settled, below 1
     /// during a hand-over.
     pub blend: f64,
 }
@@ -178,7 +178,11 @@ pub struct BalanceController {
 
 impl BalanceController {
     /// Designs the four controllers; starts in `phase`, at rest.
-    pub fn new(cases: &CaseParams, settings: &BalanceSettings, phase: SupportPhase) -> Result<Self> {
+    pub fn new(
+        cases: &CaseParams,
+        settings: &BalanceSettings,
+        phase: SupportPhase,
+    ) -> Result<Self> {
         settings.validate()?;
         cases.validate()?;
         let d = |plane, ph| -> Result<DampingController> {
@@ -208,8 +212,8 @@ impl BalanceController {
         &self.controllers[plane.index()][phase.index()]
     }
 
-    /// One control tick in support phase `phase`, with references `u_ref` [rad] and measured
-    /// ZMP deviations `zmp` [m], both `[x̃, ỹ]` in that phase's local frame. Allocates nothing.
+    /// One control tick in support phase `phase`, with references `u_ref` \[rad\] and measured
+    /// ZMP deviations `zmp` \[m\], both `[x̃, ỹ]` in that phase's local frame. Allocates nothing.
     /// Errors (state unchanged) on non-finite input.
     pub fn step(
         &mut self,
@@ -251,8 +255,7 @@ impl BalanceController {
                     pair[from].predict(&old_x, u);
                     BalanceCommand {
                         u,
-                        com_offset: (1.0 - alpha) * old_cmd.com_offset
-                            + alpha * new_cmd.com_offset,
+                        com_offset: (1.0 - alpha) * old_cmd.com_offset + alpha * new_cmd.com_offset,
                         estimate: new_cmd.estimate,
                     }
                 }

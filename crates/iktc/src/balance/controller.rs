@@ -10,19 +10,19 @@ use crate::error::{check_finite, Result};
 /// What one controller tick returns.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct BalanceCommand {
-    /// Command angle `u` [rad] sent to the plant (through the COM reference).
+    /// Command angle `u` \[rad\] sent to the plant (through the COM reference).
     pub u: f64,
-    /// COM reference offset `Δc = l (u − u_ref)` [m] for the kinematic controller.
+    /// COM reference offset `Δc = l (u − u_ref)` \[m\] for the kinematic controller.
     pub com_offset: f64,
-    /// Filtered state estimate `x̄ = [θ, θ̇, z, p]` [rad, rad/s, m, m].
+    /// Filtered state estimate `x̄ = [θ, θ̇, z, p]` \[rad, rad/s, m, m\].
     pub estimate: [f64; 4],
 }
 
 /// One plane's damping controller: current-estimator observer and state feedback
 /// ([`DiscreteDesign`]). All state is fixed-size; [`DampingController::step`] allocates nothing.
 ///
-/// Inputs are deviations from the nominal posture: `u_ref` [rad] is the reference COM offset
-/// divided by `l`, `y` [m] the measured ZMP minus its nominal value, both in the case's local
+/// Inputs are deviations from the nominal posture: `u_ref` \[rad\] is the reference COM offset
+/// divided by `l`, `y` \[m\] the measured ZMP minus its nominal value, both in the case's local
 /// frame (Figure 11).
 #[derive(Debug, Clone, PartialEq)]
 pub struct DampingController {
@@ -45,7 +45,7 @@ impl DampingController {
         &self.design
     }
 
-    /// The predicted state `x̂(k | k−1)` [rad, rad/s, m, m].
+    /// The predicted state `x̂(k | k−1)` \[rad, rad/s, m, m\].
     pub fn predicted_state(&self) -> [f64; 4] {
         self.predicted.into()
     }
@@ -60,7 +60,7 @@ impl DampingController {
         self.predicted = Vector4::zeros();
     }
 
-    /// One tick: correct with `y` [m], command `u = N_d u_ref − K_d x̄` [rad], predict with
+    /// One tick: correct with `y` \[m\], command `u = N_d u_ref − K_d x̄` \[rad\], predict with
     /// the same `u`. Errors (state unchanged) if an input is not finite.
     pub fn step(&mut self, u_ref: f64, y: f64) -> Result<BalanceCommand> {
         let (cmd, filtered) = self.correct(u_ref, y)?;

@@ -17,9 +17,9 @@ use crate::error::{Error, Result};
 /// Desired IPCJ pole pair, eq. (33).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct PoleSpec {
-    /// Desired damping ratio `ζ_d` [–], in (0, 1). The paper uses 0.72.
+    /// Desired damping ratio `ζ_d` \[–\], in (0, 1). The paper uses 0.72.
     pub damping_ratio: f64,
-    /// Desired natural frequency `w_d` [rad/s]; `None` keeps the open-loop `w_n`, so only
+    /// Desired natural frequency `w_d` \[rad/s\]; `None` keeps the open-loop `w_n`, so only
     /// damping is added and `N = 1`.
     pub natural_frequency: Option<f64>,
 }
@@ -52,15 +52,15 @@ impl PoleSpec {
 /// A continuous-time pole-placement design.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct ContinuousDesign {
-    /// State-feedback gain `K_f = [k₁, k₂]` on `[θ, θ̇]` [–, s].
+    /// State-feedback gain `K_f = [k₁, k₂]` on `[θ, θ̇]` \[–, s\].
     pub gain: [f64; 2],
-    /// Feed-forward `N` on `u_ref` that keeps the static gain [–].
+    /// Feed-forward `N` on `u_ref` that keeps the static gain \[–\].
     pub feedforward: f64,
-    /// Desired natural frequency used `w_d` [rad/s].
+    /// Desired natural frequency used `w_d` \[rad/s\].
     pub natural_frequency: f64,
-    /// Desired damping ratio used `ζ_d` [–].
+    /// Desired damping ratio used `ζ_d` \[–\].
     pub damping_ratio: f64,
-    /// Designed closed-loop poles (eq. 33) `[re, im]` [rad/s]: IPCJ pair, `−1/τ_s`, `−1/T`.
+    /// Designed closed-loop poles (eq. 33) `[re, im]` \[rad/s\]: IPCJ pair, `−1/τ_s`, `−1/T`.
     pub closed_loop_poles: [[f64; 2]; 4],
 }
 
@@ -99,9 +99,9 @@ pub fn place_poles(params: &FullModelParams, spec: &PoleSpec) -> Result<Continuo
 /// Settings of the discrete controller design.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct DiscreteSettings {
-    /// Control period `Δt` [s]; the paper's lower body runs at 200 Hz (0.005 s).
+    /// Control period `Δt` \[s\]; the paper's lower body runs at 200 Hz (0.005 s).
     pub control_period: f64,
-    /// The observer's continuous poles are this multiple of the closed-loop poles [–] (> 1).
+    /// The observer's continuous poles are this multiple of the closed-loop poles \[–\] (> 1).
     /// Faster observers follow pushes sooner but pass more sensor noise into the command.
     pub observer_pole_scale: f64,
 }
@@ -150,7 +150,7 @@ pub struct DiscreteDesign {
     pub params: FullModelParams,
     /// The continuous design it discretises.
     pub continuous: ContinuousDesign,
-    /// Control period [s].
+    /// Control period \[s\].
     pub control_period: f64,
     /// `A_d`.
     pub ad: Matrix4<f64>,

@@ -3,7 +3,7 @@
 //! Nonlinear least squares over `x = ln[l, K/m, b/m, τ_s, T]` (logarithms keep every
 //! parameter positive and make the steps relative) with the residual
 //! `rᵢ = H(jωᵢ; x) / Hᵢ − 1` split into real and imaginary parts: for small errors it is the
-//! relative magnitude error and the phase error [rad], equally weighted at every frequency and
+//! relative magnitude error and the phase error \[rad\], equally weighted at every frequency and
 //! insensitive to ±2π phase wrapping. Solved with [`levenberg_marquardt`].
 //!
 //! The initial guess is automatic, from the shape of the data:
@@ -27,14 +27,14 @@ use crate::error::{check_finite, Error, Result};
 /// Measured frequency response `y/u` at a set of angular frequencies.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FrequencyData {
-    /// Angular frequencies [rad/s], positive, any order.
+    /// Angular frequencies \[rad/s\], positive, any order.
     pub omega: Vec<f64>,
-    /// Complex response `y/u (jω)` [m/rad], one per frequency.
+    /// Complex response `y/u (jω)` \[m/rad\], one per frequency.
     pub response: Vec<Complex<f64>>,
 }
 
 impl FrequencyData {
-    /// From Bode data: magnitudes [m/rad] and phases [rad] at angular frequencies [rad/s].
+    /// From Bode data: magnitudes \[m/rad\] and phases \[rad\] at angular frequencies \[rad/s\].
     /// Errors if the lengths differ or a value is not finite.
     pub fn from_bode(omega: &[f64], magnitude: &[f64], phase: &[f64]) -> Result<Self> {
         crate::error::check_dim("FrequencyData magnitude", omega.len(), magnitude.len())?;
@@ -96,21 +96,21 @@ impl FrequencyData {
 /// Settings of the identification.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct IdentifySettings {
-    /// Gravity [m/s²], known, not identified.
+    /// Gravity \[m/s²\], known, not identified.
     pub gravity: f64,
-    /// Fewest distinct frequencies accepted [–] (≥ 3: five parameters, two numbers a point).
+    /// Fewest distinct frequencies accepted \[–\] (≥ 3: five parameters, two numbers a point).
     /// More makes the fit better determined and the residual a meaningful check.
     pub min_points: usize,
-    /// Points above this multiple of the resonance frequency set the initial `τ_s`, `T` [–].
+    /// Points above this multiple of the resonance frequency set the initial `τ_s`, `T` \[–\].
     /// Higher keeps the IPCJ's own phase out of the estimate but leaves fewer points.
     pub high_frequency_factor: f64,
-    /// Initial `τ_s` when no point lies above the resonance [s].
+    /// Initial `τ_s` when no point lies above the resonance \[s\].
     pub fallback_lag: f64,
-    /// Initial `T` when no point lies above the resonance [s].
+    /// Initial `T` when no point lies above the resonance \[s\].
     pub fallback_pade: f64,
-    /// Initial `l` when the low-frequency magnitude gives none [m].
+    /// Initial `l` when the low-frequency magnitude gives none \[m\].
     pub fallback_length: f64,
-    /// Initial damping ratio when the peak gives none [–].
+    /// Initial damping ratio when the peak gives none \[–\].
     pub fallback_damping_ratio: f64,
     /// The least-squares solver.
     pub lm: LmSettings,
@@ -142,7 +142,10 @@ impl IdentifySettings {
             ),
             ("IdentifySettings::fallback_lag [s]", self.fallback_lag),
             ("IdentifySettings::fallback_pade [s]", self.fallback_pade),
-            ("IdentifySettings::fallback_length [m]", self.fallback_length),
+            (
+                "IdentifySettings::fallback_length [m]",
+                self.fallback_length,
+            ),
             (
                 "IdentifySettings::fallback_damping_ratio",
                 self.fallback_damping_ratio,
@@ -172,7 +175,7 @@ pub struct ParameterEstimate {
     pub unit: &'static str,
     /// Estimated value.
     pub value: f64,
-    /// One-sigma standard error from the fit's Jacobian and residual (linearised) [unit].
+    /// One-sigma standard error from the fit's Jacobian and residual (linearised) \[unit\].
     pub std_error: f64,
 }
 
@@ -185,11 +188,11 @@ pub struct Identification {
     pub initial_guess: FullModelParams,
     /// The parameters with units and standard errors, in the order l, K/m, b/m, τ_s, T.
     pub estimates: Vec<ParameterEstimate>,
-    /// RMS of `|H_model/H_measured − 1|` over the frequencies [–].
+    /// RMS of `|H_model/H_measured − 1|` over the frequencies \[–\].
     pub rms_relative_error: f64,
-    /// RMS magnitude error [dB].
+    /// RMS magnitude error \[dB\].
     pub rms_magnitude_error_db: f64,
-    /// RMS phase error [deg].
+    /// RMS phase error \[deg\].
     pub rms_phase_error_deg: f64,
     /// Solver iterations of the kept start.
     pub iterations: usize,
@@ -301,14 +304,21 @@ pub fn initial_guess(data: &FrequencyData, settings: &IdentifySettings) -> Resul
     let (wn, peak) = pts
         .iter()
         .map(|(w, h)| (*w, h.norm()))
-        .fold((0.0, 0.0), |acc, (w, m)| if m > acc.1 { (w, m) } else { acc });
+        .fold(
+            (0.0, 0.0),
+            |acc, (w, m)| if m > acc.1 { (w, m) } else { acc },
+        );
     let (w0, h0) = pts.first().map_or((wn, peak), |(w, h)| (*w, h.norm()));
     let mut zeta = settings.fallback_damping_ratio;
     let mut length = settings.fallback_length;
     let mut km = length * length * wn * wn + g * length;
     for _ in 0..3 {
         let den = Complex::new(wn * wn - w0 * w0, 2.0 * zeta * wn * w0).norm();
-        let (qa, qb, qc) = (wn * wn * w0 * w0, g * (wn * wn + w0 * w0), g * g - g * h0 * den);
+        let (qa, qb, qc) = (
+            wn * wn * w0 * w0,
+            g * (wn * wn + w0 * w0),
+            g * g - g * h0 * den,
+        );
         let disc = qb * qb - 4.0 * qa * qc;
         if qc < 0.0 && disc > 0.0 && qa > 0.0 {
             length = (-qb + disc.sqrt()) / (2.0 * qa);

@@ -15,22 +15,22 @@ use crate::error::Result;
 /// Settings of the Levenberg–Marquardt solver.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct LmSettings {
-    /// Most iterations (accepted or rejected steps) [–]. More costs time, fewer may stop early.
+    /// Most iterations (accepted or rejected steps) \[–\]. More costs time, fewer may stop early.
     pub max_iterations: usize,
-    /// Initial damping `λ` [–]; large values start like gradient descent, small like Gauss–Newton.
+    /// Initial damping `λ` \[–\]; large values start like gradient descent, small like Gauss–Newton.
     pub initial_lambda: f64,
     /// Factor `λ` is multiplied by after a rejected step and divided by after an accepted
-    /// one [–] (> 1).
+    /// one \[–\] (> 1).
     pub lambda_factor: f64,
-    /// Stop when the relative decrease of the cost in an accepted step is below this [–].
+    /// Stop when the relative decrease of the cost in an accepted step is below this \[–\].
     /// Smaller is more precise but takes more iterations.
     pub relative_cost_tolerance: f64,
-    /// Stop when the step's largest component is below this [parameter units].
+    /// Stop when the step's largest component is below this \[parameter units\].
     pub step_tolerance: f64,
-    /// Give up (status [`LmStatus::NoImprovement`]) when `λ` exceeds this [–]: the step is then
+    /// Give up (status [`LmStatus::NoImprovement`]) when `λ` exceeds this \[–\]: the step is then
     /// a tiny gradient step that still fails, i.e. a minimum to working precision.
     pub max_lambda: f64,
-    /// Central finite-difference step for the Jacobian [parameter units]. Too small loses
+    /// Central finite-difference step for the Jacobian \[parameter units\]. Too small loses
     /// digits to round-off, too large to truncation; √ε·scale ≈ 1e-6 suits O(1) parameters.
     pub jacobian_step: f64,
 }

@@ -17,7 +17,7 @@
 //!   (identify, design, push).
 //!
 //! Sign conventions: `θ` and `u` are positive toward `+x̃` (`+ỹ`); `y` is the ZMP deviation
-//! from nominal [m]; the feedback is `u = N u_ref − K_f x`.
+//! from nominal \[m\]; the feedback is `u = N u_ref − K_f x`.
 
 pub mod cases;
 pub mod controller;
@@ -32,21 +32,22 @@ pub mod sim;
 pub mod sweep;
 pub mod zmp;
 
-pub use cases::{BalanceController, BalanceOutput, BalanceSettings, CaseParams, Plane, SupportPhase};
+pub use cases::{
+    BalanceController, BalanceOutput, BalanceSettings, CaseParams, Plane, SupportPhase,
+};
 pub use controller::{BalanceCommand, DampingController};
 pub use design::{
     design_discrete, place_poles, ContinuousDesign, DiscreteDesign, DiscreteSettings, PoleSpec,
 };
-pub use identify::{identify, initial_guess, FrequencyData, IdentifySettings, Identification};
+pub use identify::{identify, initial_guess, FrequencyData, Identification, IdentifySettings};
 pub use lm::{levenberg_marquardt, LmResult, LmSettings, LmStatus};
 pub use model::{Bode, FullModelParams, IpcjParams, Modal, TransferFunction, STANDARD_GRAVITY};
 pub use poly::Polynomial;
 pub use response::{analyse_response, ResponseMetrics, ResponseSettings};
+pub use scenario::{
+    run_design, run_identify, run_push, BodeSeries, DesignResult, DesignScenario, IdentifyResult,
+    IdentifyScenario, ParameterComparison, PlanePushMetrics, PushResult, PushScenario, RootLocus,
+};
 pub use sim::{NoiseSource, PlantParams, SimPlant, SimSettings};
 pub use sweep::{sine_sweep, SweepSettings};
 pub use zmp::{measure_zmp, Foot, FootSensor, ZmpMeasurement, ZmpSettings, ZmpStatus};
-pub use scenario::{
-    run_design, run_identify, run_push, BodeSeries, DesignResult, DesignScenario,
-    IdentifyResult, IdentifyScenario, ParameterComparison, PlanePushMetrics, PushResult,
-    PushScenario, RootLocus,
-};

@@ -12,34 +12,34 @@ use serde::{Deserialize, Serialize};
 use super::poly::Polynomial;
 use crate::error::{check_finite, Error, Result};
 
-/// Standard gravity [m/s²], the default of [`IpcjParams::gravity`].
+/// Standard gravity \[m/s²\], the default of [`IpcjParams::gravity`].
 pub const STANDARD_GRAVITY: f64 = 9.81;
 
 /// Physical parameters of one IPCJ (eq. 26), per unit mass.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct IpcjParams {
-    /// Pendulum length `l` [m]: from the compliant joint (ankle) to the centre of mass.
+    /// Pendulum length `l` \[m\]: from the compliant joint (ankle) to the centre of mass.
     pub length: f64,
-    /// Joint stiffness per unit mass `K/m` [N·m/(rad·kg)] = [m²/(s²·rad)].
+    /// Joint stiffness per unit mass `K/m` \[N·m/(rad·kg)\] = \[m²/(s²·rad)\].
     pub stiffness_per_mass: f64,
-    /// Joint damping per unit mass `b/m` [N·m·s/(rad·kg)] = [m²/(s·rad)].
+    /// Joint damping per unit mass `b/m` \[N·m·s/(rad·kg)\] = \[m²/(s·rad)\].
     pub damping_per_mass: f64,
-    /// Gravity `g` [m/s²].
+    /// Gravity `g` \[m/s²\].
     pub gravity: f64,
 }
 
 /// Natural frequency and damping ratio of the IPCJ pole pair (errata eq. 32).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Modal {
-    /// `w_n = √(K/(m l²) − g/l)` [rad/s].
+    /// `w_n = √(K/(m l²) − g/l)` \[rad/s\].
     pub natural_frequency: f64,
-    /// `ζ = b / (2 w_n m l²)` [–].
+    /// `ζ = b / (2 w_n m l²)` \[–\].
     pub damping_ratio: f64,
 }
 
 impl IpcjParams {
-    /// Parameters from the pendulum length `l` [m], the open-loop natural frequency `w_n`
-    /// [rad/s] and damping ratio `ζ` [–] of the pole pair (inverse of errata eq. 32):
+    /// Parameters from the pendulum length `l` \[m\], the open-loop natural frequency `w_n`
+    /// \[rad/s\] and damping ratio `ζ` \[–\] of the pole pair (inverse of errata eq. 32):
     /// `K/m = l² (w_n² + g/l)`, `b/m = 2 ζ w_n l²`.
     pub fn from_modal(
         length: f64,
@@ -79,12 +79,12 @@ impl IpcjParams {
         Ok(())
     }
 
-    /// `K/(m l²)` [1/s²].
+    /// `K/(m l²)` \[1/s²\].
     pub fn stiffness_term(&self) -> f64 {
         self.stiffness_per_mass / (self.length * self.length)
     }
 
-    /// `b/(m l²)` [1/s].
+    /// `b/(m l²)` \[1/s\].
     pub fn damping_term(&self) -> f64 {
         self.damping_per_mass / (self.length * self.length)
     }
@@ -97,7 +97,10 @@ impl IpcjParams {
             return Err(invalid(
                 "IpcjParams::stiffness_per_mass [m²/(s²·rad)]",
                 self.stiffness_per_mass,
-                &format!("> g·l = {} (a stiffer joint than gravity)", self.gravity * self.length),
+                &format!(
+                    "> g·l = {} (a stiffer joint than gravity)",
+                    self.gravity * self.length
+                ),
             ));
         }
         let wn = wn2.sqrt();
@@ -107,8 +110,8 @@ impl IpcjParams {
         })
     }
 
-    /// State space of the corrected eqs. (27)–(28), state `[θ, θ̇]` [rad, rad/s], input `u`
-    /// [rad], output ZMP `y` [m]:
+    /// State space of the corrected eqs. (27)–(28), state `[θ, θ̇]` \[rad, rad/s\], input `u`
+    /// \[rad\], output ZMP `y` \[m\]:
     /// `A = [[0, 1], [g/l − K/(m l²), −b/(m l²)]]`, `B = [0, K/(m l²)]ᵀ`,
     /// `C = [K/(m g), b/(m g)]`, `D = −K/(m g)`.
     pub fn state_space(&self) -> StateSpace2 {
@@ -141,7 +144,7 @@ impl IpcjParams {
         }
     }
 
-    /// The two poles [rad/s], roots of `s² + (b/(m l²)) s + K/(m l²) − g/l`, the one with the
+    /// The two poles \[rad/s\], roots of `s² + (b/(m l²)) s + K/(m l²) − g/l`, the one with the
     /// non-negative imaginary part first.
     pub fn poles(&self) -> [Complex<f64>; 2] {
         let half = 0.5 * self.damping_term();
@@ -159,22 +162,21 @@ impl IpcjParams {
         }
     }
 
-    /// The two zeros `±√(g/l)` [rad/s]; the positive one makes the plant non-minimum phase.
+    /// The two zeros `±√(g/l)` \[rad/s\]; the positive one makes the plant non-minimum phase.
     pub fn zeros(&self) -> [f64; 2] {
         let z = (self.gravity / self.length).sqrt();
         [z, -z]
     }
 
-    /// Static gain `y/u` at `s = 0`: `K l / (K − m g l)` [m/rad].
+    /// Static gain `y/u` at `s = 0`: `K l / (K − m g l)` \[m/rad\].
     pub fn dc_gain(&self) -> f64 {
         let km = self.stiffness_per_mass;
         km * self.length / (km - self.gravity * self.length)
     }
 
-    /// Frequency response `y/u (jω)` at the angular frequency `omega` [rad/s] [m/rad].
+    /// Frequency response `y/u (jω)` at the angular frequency `omega` \[rad/s\] \[m/rad\].
     pub fn frequency_response(&self, omega: f64) -> Complex<f64> {
-        self.transfer_function()
-            .eval(Complex::new(0.0, omega))
+        self.transfer_function().eval(Complex::new(0.0, omega))
     }
 }
 
@@ -187,9 +189,9 @@ impl IpcjParams {
 pub struct FullModelParams {
     /// The pendulum with compliant joint.
     pub ipcj: IpcjParams,
-    /// Time constant `τ_s` of the lag [s].
+    /// Time constant `τ_s` of the lag \[s\].
     pub lag: f64,
-    /// Padé parameter `T` [s]; the delay it approximates is `2T`.
+    /// Padé parameter `T` \[s\]; the delay it approximates is `2T`.
     pub pade: f64,
 }
 
@@ -201,7 +203,7 @@ impl FullModelParams {
         positive("FullModelParams::pade T [s]", self.pade)
     }
 
-    /// Four-state realisation of eq. (31), state `[θ, θ̇, z, p]` [rad, rad/s, m, m]: the IPCJ
+    /// Four-state realisation of eq. (31), state `[θ, θ̇, z, p]` \[rad, rad/s, m, m\]: the IPCJ
     /// (27); the lag `ż = (C x + D u − z)/τ_s` driven by the IPCJ's ZMP; the Padé term as
     /// `ṗ = (2 z − p)/T`, output `y = p − z`, since `(−s + a)/(s + a) = −1 + 2a/(s + a)` with
     /// `a = 1/T`. `D = 0`: the lag removes the feed-through.
@@ -237,7 +239,7 @@ impl FullModelParams {
         }
     }
 
-    /// The four poles [rad/s] (errata eq. 32): the IPCJ pair, `−1/τ_s`, `−1/T`.
+    /// The four poles \[rad/s\] (errata eq. 32): the IPCJ pair, `−1/τ_s`, `−1/T`.
     pub fn poles(&self) -> [Complex<f64>; 4] {
         let [p1, p2] = self.ipcj.poles();
         [
@@ -248,26 +250,26 @@ impl FullModelParams {
         ]
     }
 
-    /// The three zeros [rad/s]: `±√(g/l)` and the Padé zero `+1/T`.
+    /// The three zeros \[rad/s\]: `±√(g/l)` and the Padé zero `+1/T`.
     pub fn zeros(&self) -> [f64; 3] {
         let [z1, z2] = self.ipcj.zeros();
         [z1, z2, 1.0 / self.pade]
     }
 
-    /// Static gain [m/rad], the IPCJ's: the lag and the Padé term have unit static gain.
+    /// Static gain \[m/rad\], the IPCJ's: the lag and the Padé term have unit static gain.
     pub fn dc_gain(&self) -> f64 {
         self.ipcj.dc_gain()
     }
 
-    /// Frequency response `y/u (jω)` [m/rad] at one angular frequency [rad/s].
+    /// Frequency response `y/u (jω)` \[m/rad\] at one angular frequency \[rad/s\].
     pub fn frequency_response(&self, omega: f64) -> Complex<f64> {
         let s = Complex::new(0.0, omega);
         let a = 1.0 / self.pade;
         self.ipcj.frequency_response(omega) / (s * self.lag + 1.0) * (a - s) / (s + a)
     }
 
-    /// Bode data at the given angular frequencies [rad/s]: magnitude [m/rad] and *unwrapped*
-    /// phase [rad], the phase being the sum of the factors' phases (no ±2π jumps):
+    /// Bode data at the given angular frequencies \[rad/s\]: magnitude \[m/rad\] and *unwrapped*
+    /// phase \[rad\], the phase being the sum of the factors' phases (no ±2π jumps):
     /// `−atan2(b ω/(m l²), K/(m l²) − g/l − ω²) − atan(τ_s ω) − 2 atan(T ω)`.
     pub fn bode(&self, omegas: &[f64]) -> Bode {
         let mut out = Bode {
@@ -290,11 +292,11 @@ impl FullModelParams {
 /// Bode data: magnitude and phase at a set of angular frequencies.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Bode {
-    /// Angular frequencies [rad/s].
+    /// Angular frequencies \[rad/s\].
     pub omega: Vec<f64>,
-    /// Magnitudes `|y/u|` [m/rad].
+    /// Magnitudes `|y/u|` \[m/rad\].
     pub magnitude: Vec<f64>,
-    /// Phases [rad].
+    /// Phases \[rad\].
     pub phase: Vec<f64>,
 }
 
@@ -308,17 +310,17 @@ pub struct TransferFunction {
 }
 
 impl TransferFunction {
-    /// Value at a complex point `s` [rad/s].
+    /// Value at a complex point `s` \[rad/s\].
     pub fn eval(&self, s: Complex<f64>) -> Complex<f64> {
         self.numerator.eval(s) / self.denominator.eval(s)
     }
 
-    /// Poles: roots of the denominator [rad/s].
+    /// Poles: roots of the denominator \[rad/s\].
     pub fn poles(&self) -> Vec<Complex<f64>> {
         self.denominator.roots()
     }
 
-    /// Zeros: roots of the numerator [rad/s].
+    /// Zeros: roots of the numerator \[rad/s\].
     pub fn zeros(&self) -> Vec<Complex<f64>> {
         self.numerator.roots()
     }
@@ -327,13 +329,13 @@ impl TransferFunction {
 /// Continuous state space of the IPCJ: `ẋ = A x + B u`, `y = C x + D u`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StateSpace2 {
-    /// `A` [1/s, 1/s²].
+    /// `A` \[1/s, 1/s²\].
     pub a: Matrix2<f64>,
     /// `B`.
     pub b: Vector2<f64>,
-    /// `C` [m/rad, m·s/rad].
+    /// `C` \[m/rad, m·s/rad\].
     pub c: RowVector2<f64>,
-    /// `D` [m/rad].
+    /// `D` \[m/rad\].
     pub d: f64,
 }
 
@@ -346,7 +348,7 @@ pub struct StateSpace4 {
     pub b: Vector4<f64>,
     /// `C`.
     pub c: RowVector4<f64>,
-    /// `D` [m/rad].
+    /// `D` \[m/rad\].
     pub d: f64,
 }
 

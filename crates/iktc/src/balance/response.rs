@@ -20,27 +20,27 @@ use crate::error::{check_dim, check_finite, Error, Result};
 /// Settings of the response analysis.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct ResponseSettings {
-    /// The response has settled when it stays within this fraction of its peak [–].
+    /// The response has settled when it stays within this fraction of its peak \[–\].
     pub settle_fraction: f64,
-    /// … or within this many noise standard deviations, whichever is larger [–]; keeps noise
+    /// … or within this many noise standard deviations, whichever is larger \[–\]; keeps noise
     /// spikes from counting as not settled (5σ: about one false alarm in 3·10⁶ samples).
     pub noise_sigmas: f64,
-    /// Start of the fit window after the push [s]; long enough for the fast modes to vanish.
+    /// Start of the fit window after the push \[s\]; long enough for the fast modes to vanish.
     pub fit_delay: f64,
-    /// Length of the fit window [s]; a few periods of the slowest mode expected.
+    /// Length of the fit window \[s\]; a few periods of the slowest mode expected.
     pub fit_window: f64,
-    /// Grid of damping ratios tried before refining [–]: this many points in (0, 1).
+    /// Grid of damping ratios tried before refining \[–\]: this many points in (0, 1).
     pub grid_damping: usize,
-    /// Grid of natural frequencies tried [rad/s]: log-spaced between these two…
+    /// Grid of natural frequencies tried \[rad/s\]: log-spaced between these two…
     pub grid_min_frequency: f64,
-    /// …and this [rad/s].
+    /// …and this \[rad/s\].
     pub grid_max_frequency: f64,
-    /// …with this many points [–].
+    /// …with this many points \[–\].
     pub grid_frequency: usize,
-    /// Number of damped modes fitted together [–], 1 or 2 (see the module documentation).
+    /// Number of damped modes fitted together \[–\], 1 or 2 (see the module documentation).
     /// Fitting the observer's mode too keeps it from biasing the controller's.
     pub modes: usize,
-    /// Frequency of the second mode as a multiple of the first's [–]: the observer's pole
+    /// Frequency of the second mode as a multiple of the first's \[–\]: the observer's pole
     /// scale, [`super::design::DiscreteSettings::observer_pole_scale`].
     pub second_mode_ratio: f64,
     /// The refining solver.
@@ -100,7 +100,11 @@ impl ResponseSettings {
             ));
         }
         if !(self.modes == 1 || self.modes == 2) {
-            return Err(invalid("ResponseSettings::modes", self.modes as f64, "1 or 2"));
+            return Err(invalid(
+                "ResponseSettings::modes",
+                self.modes as f64,
+                "1 or 2",
+            ));
         }
         if !(self.second_mode_ratio.is_finite() && self.second_mode_ratio > 1.0) {
             return Err(invalid(
@@ -116,25 +120,25 @@ impl ResponseSettings {
 /// Metrics of one response.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct ResponseMetrics {
-    /// Largest `|y|` after the event [m].
+    /// Largest `|y|` after the event \[m\].
     pub peak: f64,
-    /// Time of the peak after the event [s].
+    /// Time of the peak after the event \[s\].
     pub peak_time: f64,
-    /// Time after the event from which `|y|` stays within the band [s]; `None` if it never
+    /// Time after the event from which `|y|` stays within the band \[s\]; `None` if it never
     /// does within the data.
     pub settling_time: Option<f64>,
-    /// The settling band used [m].
+    /// The settling band used \[m\].
     pub settle_band: f64,
-    /// Damping ratio of the fitted (first) mode [–].
+    /// Damping ratio of the fitted (first) mode \[–\].
     pub damping_ratio: f64,
-    /// Natural frequency of the fitted (first) mode [rad/s].
+    /// Natural frequency of the fitted (first) mode \[rad/s\].
     pub natural_frequency: f64,
-    /// RMS of the fit residual over its window [m].
+    /// RMS of the fit residual over its window \[m\].
     pub fit_rms: f64,
 }
 
-/// Analyses the response `y` [m] sampled at times `t` [s] (increasing) after an event at
-/// `t_event` [s]; `noise_std` [m] is the sensor noise's standard deviation (0 if none).
+/// Analyses the response `y` \[m\] sampled at times `t` \[s\] (increasing) after an event at
+/// `t_event` \[s\]; `noise_std` \[m\] is the sensor noise's standard deviation (0 if none).
 pub fn analyse_response(
     t: &[f64],
     y: &[f64],
@@ -154,9 +158,13 @@ pub fn analyse_response(
         .filter(|(ti, _)| **ti >= t_event)
         .map(|(ti, yi)| (*ti - t_event, *yi))
         .collect();
-    let (peak_time, peak) = after
-        .iter()
-        .fold((0.0, 0.0), |acc, (ti, yi)| if yi.abs() > acc.1 { (*ti, yi.abs()) } else { acc });
+    let (peak_time, peak) = after.iter().fold((0.0, 0.0), |acc, (ti, yi)| {
+        if yi.abs() > acc.1 {
+            (*ti, yi.abs())
+        } else {
+            acc
+        }
+    });
     let band = (settings.settle_fraction * peak).max(settings.noise_sigmas * noise_std);
     let last_out = after.iter().rposition(|(_, yi)| yi.abs() > band);
     let settling_time = match last_out {
@@ -166,7 +174,9 @@ pub fn analyse_response(
     };
     let window: Vec<(f64, f64)> = after
         .iter()
-        .filter(|(ti, _)| *ti >= settings.fit_delay && *ti <= settings.fit_delay + settings.fit_window)
+        .filter(|(ti, _)| {
+            *ti >= settings.fit_delay && *ti <= settings.fit_delay + settings.fit_window
+        })
         .map(|(ti, yi)| (*ti - settings.fit_delay, *yi))
         .collect();
     if window.len() < 8 {
@@ -252,9 +262,7 @@ fn modes_fit(window: &[(f64, f64)], modes: &[(f64, f64)]) -> (DVector<f64>, Vec<
         n += &phi * phi.transpose();
         r += &phi * *y;
     }
-    let coef = n
-        .cholesky()
-        .map_or(DVector::zeros(k), |c| c.solve(&r));
+    let coef = n.cholesky().map_or(DVector::zeros(k), |c| c.solve(&r));
     let fitted = window
         .iter()
         .map(|(t, _)| {

@@ -13,21 +13,21 @@ use serde::Serialize;
 
 use super::cases::{BalanceController, BalanceSettings, CaseParams, Plane, SupportPhase};
 use super::design::{design_discrete, place_poles, ContinuousDesign, DiscreteSettings, PoleSpec};
-use super::identify::{identify, IdentifySettings, Identification};
+use super::identify::{identify, Identification, IdentifySettings};
 use super::model::{invalid, Bode, FullModelParams, Modal};
 use super::response::{analyse_response, ResponseMetrics, ResponseSettings};
 use super::sim::{PlantParams, SimPlant, SimSettings};
 use super::sweep::{sine_sweep, SweepSettings};
 use crate::error::Result;
 
-/// Bode data for plotting: frequency [Hz], magnitude [dB re 1 m/rad], phase [deg].
+/// Bode data for plotting: frequency \[Hz\], magnitude \[dB re 1 m/rad\], phase \[deg\].
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct BodeSeries {
-    /// Frequencies [Hz].
+    /// Frequencies \[Hz\].
     pub frequency_hz: Vec<f64>,
-    /// Magnitudes `20 log₁₀ |y/u|` [dB].
+    /// Magnitudes `20 log₁₀ |y/u|` \[dB\].
     pub magnitude_db: Vec<f64>,
-    /// Phases [deg], unwrapped.
+    /// Phases \[deg\], unwrapped.
     pub phase_deg: Vec<f64>,
 }
 
@@ -52,7 +52,7 @@ pub struct IdentifyScenario {
     pub sweep: SweepSettings,
     /// The fit.
     pub identify: IdentifySettings,
-    /// Points of the model curves [–].
+    /// Points of the model curves \[–\].
     pub curve_points: usize,
 }
 
@@ -98,7 +98,7 @@ pub struct ParameterComparison {
     pub identified: f64,
     /// Its one-sigma standard error.
     pub std_error: f64,
-    /// `(identified − true)/true` [–].
+    /// `(identified − true)/true` \[–\].
     pub relative_error: f64,
 }
 
@@ -193,9 +193,9 @@ pub struct DesignScenario {
     pub poles: PoleSpec,
     /// Discretisation and observer.
     pub discrete: DiscreteSettings,
-    /// Points of the root locus per decade of gain [–].
+    /// Points of the root locus per decade of gain \[–\].
     pub locus_points_per_decade: usize,
-    /// Largest output-feedback gain of the root locus, as a multiple of `1/|G(0)|` [–].
+    /// Largest output-feedback gain of the root locus, as a multiple of `1/|G(0)|` \[–\].
     pub locus_max_gain: f64,
 }
 
@@ -219,7 +219,7 @@ impl Default for DesignScenario {
 pub struct RootLocus {
     /// The gains, increasing from 0.
     pub gains: Vec<f64>,
-    /// One branch per pole: `[re, im]` [rad/s] at each gain.
+    /// One branch per pole: `[re, im]` \[rad/s\] at each gain.
     pub branches: Vec<Vec<[f64; 2]>>,
 }
 
@@ -230,11 +230,11 @@ pub struct DesignResult {
     pub params: FullModelParams,
     /// Open-loop natural frequency and damping ratio of the IPCJ pair.
     pub open_loop_modal: Modal,
-    /// Static gain `y/u` [m/rad].
+    /// Static gain `y/u` \[m/rad\].
     pub dc_gain: f64,
-    /// Open-loop poles `[re, im]` [rad/s] (eq. 32).
+    /// Open-loop poles `[re, im]` \[rad/s\] (eq. 32).
     pub open_loop_poles: [[f64; 2]; 4],
-    /// Zeros [rad/s].
+    /// Zeros \[rad/s\].
     pub zeros: [f64; 3],
     /// The continuous design: `K_f`, `N`, closed-loop poles (eq. 33).
     pub continuous: ContinuousDesign,
@@ -244,7 +244,7 @@ pub struct DesignResult {
     pub discrete_feedforward: f64,
     /// Discrete observer gain `M` (current estimator).
     pub observer_gain: [f64; 4],
-    /// Continuous-equivalent observer poles `[re, im]` [rad/s].
+    /// Continuous-equivalent observer poles `[re, im]` \[rad/s\].
     pub observer_poles: [[f64; 2]; 4],
     /// Classic root locus of `1 + k G(s)` (output feedback `u = −k y`), `k ≥ 0` (Figure 13).
     pub root_locus: RootLocus,
@@ -257,8 +257,7 @@ pub fn run_design(s: &DesignScenario) -> Result<DesignResult> {
     let p = &s.params;
     let continuous = place_poles(p, &s.poles)?;
     let disc = design_discrete(p, &s.poles, &s.discrete)?;
-    if s.locus_points_per_decade == 0 || !(s.locus_max_gain.is_finite() && s.locus_max_gain > 0.0)
-    {
+    if s.locus_points_per_decade == 0 || !(s.locus_max_gain.is_finite() && s.locus_max_gain > 0.0) {
         return Err(invalid(
             "DesignScenario::locus_points_per_decade / locus_max_gain",
             s.locus_max_gain,
@@ -278,11 +277,17 @@ pub fn run_design(s: &DesignScenario) -> Result<DesignResult> {
     let kappas: Vec<f64> = (0..=200).map(|i| i as f64 / 200.0).collect();
     let design_path = track(&kappas, |kappa| {
         let k = RowVector4::new(continuous.gain[0], continuous.gain[1], 0.0, 0.0) * kappa;
-        (ss.a - ss.b * k).complex_eigenvalues().iter().copied().collect()
+        (ss.a - ss.b * k)
+            .complex_eigenvalues()
+            .iter()
+            .copied()
+            .collect()
     });
     let h = s.discrete.control_period;
     let pair = |c: Complex<f64>| [c.re, c.im];
-    let observer_poles = disc.observer_poles.map(|z| pair(Complex::new(z[0], z[1]).ln() / h));
+    let observer_poles = disc
+        .observer_poles
+        .map(|z| pair(Complex::new(z[0], z[1]).ln() / h));
     Ok(DesignResult {
         params: *p,
         open_loop_modal: p.ipcj.modal()?,
@@ -336,19 +341,19 @@ pub struct PushScenario {
     pub phase: SupportPhase,
     /// The robot's four cases (true plant = model, with a true delay `2T`).
     pub cases: CaseParams,
-    /// Robot mass [kg].
+    /// Robot mass \[kg\].
     pub mass: f64,
-    /// ZMP sensor noise, standard deviation [m].
+    /// ZMP sensor noise, standard deviation \[m\].
     pub noise_std: f64,
     /// The controller.
     pub controller: BalanceSettings,
     /// Simulation (substeps, seed); its control period must equal the controller's.
     pub sim: SimSettings,
-    /// Time of the push [s].
+    /// Time of the push \[s\].
     pub push_time: f64,
-    /// Length of the run [s].
+    /// Length of the run \[s\].
     pub duration: f64,
-    /// The push: horizontal impulse on the COM `[x̃, ỹ]` [N·s].
+    /// The push: horizontal impulse on the COM `[x̃, ỹ]` \[N·s\].
     pub impulse: [f64; 2],
     /// Analysis of the responses without the controller (one mode).
     pub response: ResponseSettings,
@@ -356,9 +361,9 @@ pub struct PushScenario {
     /// the fit starts 0.05 s after the push, where the signal is strong: a later start leaves
     /// less of the quickly damped response above the noise).
     pub closed_loop_response: ResponseSettings,
-    /// Step of `u_ref` for the static-gain test [rad].
+    /// Step of `u_ref` for the static-gain test \[rad\].
     pub static_step: f64,
-    /// Length of the static-gain runs [s]; the gain is the mean over their last third.
+    /// Length of the static-gain runs \[s\]; the gain is the mean over their last third.
     pub static_duration: f64,
 }
 
@@ -441,17 +446,17 @@ pub struct PlanePushMetrics {
     pub open: ResponseMetrics,
     /// With the controller.
     pub closed: ResponseMetrics,
-    /// Designed damping ratio `ζ_d` [–].
+    /// Designed damping ratio `ζ_d` \[–\].
     pub designed_damping_ratio: f64,
-    /// Designed natural frequency `w_d` [rad/s].
+    /// Designed natural frequency `w_d` \[rad/s\].
     pub designed_natural_frequency: f64,
-    /// Open-loop damping ratio of the model [–].
+    /// Open-loop damping ratio of the model \[–\].
     pub model_damping_ratio: f64,
-    /// Static COM→ZMP gain of the model, `K l/(K − m g l)` [m/rad].
+    /// Static COM→ZMP gain of the model, `K l/(K − m g l)` \[m/rad\].
     pub static_gain_model: f64,
-    /// Static gain measured without the controller [m/rad].
+    /// Static gain measured without the controller \[m/rad\].
     pub static_gain_open: f64,
-    /// Static gain measured with the controller [m/rad].
+    /// Static gain measured with the controller \[m/rad\].
     pub static_gain_closed: f64,
 }
 
@@ -460,13 +465,13 @@ pub struct PlanePushMetrics {
 pub struct PushResult {
     /// The scenario.
     pub scenario: PushScenario,
-    /// Sample times [s].
+    /// Sample times \[s\].
     pub time: Vec<f64>,
-    /// Measured ZMP without the controller, `[x̃, ỹ]` [m].
+    /// Measured ZMP without the controller, `[x̃, ỹ]` \[m\].
     pub zmp_open: [Vec<f64>; 2],
-    /// Measured ZMP with the controller [m].
+    /// Measured ZMP with the controller \[m\].
     pub zmp_closed: [Vec<f64>; 2],
-    /// The controller's COM reference offset `Δc` [m].
+    /// The controller's COM reference offset `Δc` \[m\].
     pub com_offset: [Vec<f64>; 2],
     /// Per-plane metrics `[x̃z̃, ỹz̃]`.
     pub metrics: [PlanePushMetrics; 2],
@@ -540,12 +545,13 @@ pub fn run_push(s: &PushScenario) -> Result<PushResult> {
             static_gain_closed: g_closed,
         });
     }
-    let metrics: [PlanePushMetrics; 2] = metrics.try_into().map_err(|_| {
-        crate::Error::InsufficientData {
-            what: "push metrics".into(),
-            message: "two planes expected".into(),
-        }
-    })?;
+    let metrics: [PlanePushMetrics; 2] =
+        metrics
+            .try_into()
+            .map_err(|_| crate::Error::InsufficientData {
+                what: "push metrics".into(),
+                message: "two planes expected".into(),
+            })?;
     Ok(PushResult {
         scenario: *s,
         time,

@@ -5,7 +5,7 @@
 //! `h = Δt / substeps` with the command held (zero-order hold). The lag output `z` goes
 //! through a delay line sampled every `h` and read by linear interpolation, so any delay is
 //! possible; Gaussian noise is added to the delayed ZMP. A push is a horizontal force impulse
-//! `J` [N·s] at the COM: the angular momentum `m l² θ̇` about the joint jumps by `J l`, so
+//! `J` \[N·s\] at the COM: the angular momentum `m l² θ̇` about the joint jumps by `J l`, so
 //! `θ̇ += J / (m l)`.
 //!
 //! Noise comes from [`NoiseSource`], a small deterministic generator (SplitMix64, Steele et
@@ -23,16 +23,16 @@ use crate::error::{check_finite, Result};
 pub struct PlantParams {
     /// IPCJ, lag `τ_s` and Padé `T` (the Padé term itself is *not* simulated).
     pub model: FullModelParams,
-    /// Robot mass `m` [kg]; only the push needs it.
+    /// Robot mass `m` \[kg\]; only the push needs it.
     pub mass: f64,
-    /// True output delay [s]; `2T` is the delay the Padé term of the model approximates.
+    /// True output delay \[s\]; `2T` is the delay the Padé term of the model approximates.
     pub delay: f64,
-    /// Standard deviation of the ZMP sensor noise [m].
+    /// Standard deviation of the ZMP sensor noise \[m\].
     pub noise_std: f64,
 }
 
 impl PlantParams {
-    /// The plant the model describes: delay `2T`, with the given mass [kg] and noise [m].
+    /// The plant the model describes: delay `2T`, with the given mass \[kg\] and noise \[m\].
     pub fn from_model(model: FullModelParams, mass: f64, noise_std: f64) -> Self {
         Self {
             model,
@@ -63,9 +63,9 @@ impl PlantParams {
 /// Settings of the simulation.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct SimSettings {
-    /// Control period `Δt` [s]: one [`SimPlant::advance`] call.
+    /// Control period `Δt` \[s\]: one [`SimPlant::advance`] call.
     pub control_period: f64,
-    /// Integration substeps per control period [–] (≥ 1); they set the delay line's
+    /// Integration substeps per control period \[–\] (≥ 1); they set the delay line's
     /// resolution `Δt/substeps`. The integration itself is exact at any value.
     pub substeps: usize,
     /// Seed of the sensor noise.
@@ -159,17 +159,17 @@ impl SimPlant {
         &self.params
     }
 
-    /// Simulated time [s].
+    /// Simulated time \[s\].
     pub fn time(&self) -> f64 {
         self.time
     }
 
-    /// True state `[θ, θ̇, z]` [rad, rad/s, m].
+    /// True state `[θ, θ̇, z]` \[rad, rad/s, m\].
     pub fn state(&self) -> [f64; 3] {
         self.state.into()
     }
 
-    /// The ZMP at the sensor now, delayed and without noise [m].
+    /// The ZMP at the sensor now, delayed and without noise \[m\].
     pub fn delayed_zmp(&self) -> f64 {
         let steps = self.params.delay / self.h;
         let k = steps.floor();
@@ -179,12 +179,12 @@ impl SimPlant {
         (1.0 - frac) * a + frac * b
     }
 
-    /// The measured ZMP now: delayed, plus noise [m].
+    /// The measured ZMP now: delayed, plus noise \[m\].
     pub fn measure(&mut self) -> f64 {
         self.delayed_zmp() + self.params.noise_std * self.noise.gaussian()
     }
 
-    /// Advances one control period with the command `u` [rad] held. Errors (nothing changed)
+    /// Advances one control period with the command `u` \[rad\] held. Errors (nothing changed)
     /// if `u` is not finite.
     pub fn advance(&mut self, u: f64) -> Result<()> {
         check_finite(|| "plant command u [rad]".into(), u)?;
@@ -199,7 +199,7 @@ impl SimPlant {
         Ok(())
     }
 
-    /// A horizontal force impulse `J` [N·s] on the COM: `θ̇ += J/(m l)`.
+    /// A horizontal force impulse `J` \[N·s\] on the COM: `θ̇ += J/(m l)`.
     pub fn push(&mut self, impulse: f64) -> Result<()> {
         check_finite(|| "push impulse [N·s]".into(), impulse)?;
         self.state.y += impulse / (self.params.mass * self.params.model.ipcj.length);

@@ -17,20 +17,20 @@ use crate::error::{Error, Result};
 /// Settings of the sine sweep.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct SweepSettings {
-    /// Lowest frequency [Hz].
+    /// Lowest frequency \[Hz\].
     pub min_frequency: f64,
-    /// Highest frequency [Hz]; below the Nyquist frequency of the control rate.
+    /// Highest frequency \[Hz\]; below the Nyquist frequency of the control rate.
     pub max_frequency: f64,
-    /// Number of frequencies, log-spaced [–] (≥ 2).
+    /// Number of frequencies, log-spaced \[–\] (≥ 2).
     pub count: usize,
-    /// Command amplitude `A` [rad]. Larger beats the noise; the model is linear anyway.
+    /// Command amplitude `A` \[rad\]. Larger beats the noise; the model is linear anyway.
     pub amplitude: f64,
-    /// Time let pass before measuring at each frequency [s]; ≳ 5/(ζ w_n) removes the
+    /// Time let pass before measuring at each frequency \[s\]; ≳ 5/(ζ w_n) removes the
     /// transient of the lightly damped pendulum.
     pub settle_time: f64,
-    /// Least number of periods measured [–].
+    /// Least number of periods measured \[–\].
     pub min_cycles: usize,
-    /// Least measuring time [s]; longer averages more noise away.
+    /// Least measuring time \[s\]; longer averages more noise away.
     pub min_measure_time: f64,
 }
 
@@ -81,7 +81,7 @@ impl SweepSettings {
         Ok(())
     }
 
-    /// The log-spaced frequencies [Hz].
+    /// The log-spaced frequencies \[Hz\].
     pub fn frequencies(&self) -> Vec<f64> {
         let (a, b) = (self.min_frequency.ln(), self.max_frequency.ln());
         let n = self.count.max(2) - 1;
@@ -137,13 +137,14 @@ pub fn sine_sweep(
             }
             p.advance(settings.amplitude * (w * t).sin())?;
         }
-        let coef = normal
-            .cholesky()
-            .map(|c| c.solve(&rhs))
-            .ok_or_else(|| Error::InsufficientData {
-                what: "sine sweep".into(),
-                message: format!("too few samples at {f} Hz"),
-            })?;
+        let coef =
+            normal
+                .cholesky()
+                .map(|c| c.solve(&rhs))
+                .ok_or_else(|| Error::InsufficientData {
+                    what: "sine sweep".into(),
+                    message: format!("too few samples at {f} Hz"),
+                })?;
         let s = Complex::new(0.0, w * dt);
         let zoh = (Complex::new(1.0, 0.0) - (-s).exp()) / s;
         omega.push(w);

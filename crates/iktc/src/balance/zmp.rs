@@ -19,12 +19,12 @@ use super::model::invalid;
 /// One foot's force/torque sensor reading and where the sensor is.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FootSensor {
-    /// Position of the sensor's measuring point in the local frame [m]; `z` is its height above
+    /// Position of the sensor's measuring point in the local frame \[m\]; `z` is its height above
     /// the sole (0 for sensors at sole level).
     pub position: Vector3<f64>,
-    /// Force the ground exerts on the foot, local axes [N]; `z` is the normal force.
+    /// Force the ground exerts on the foot, local axes \[N\]; `z` is the normal force.
     pub force: Vector3<f64>,
-    /// Torque about the measuring point, local axes [N·m].
+    /// Torque about the measuring point, local axes \[N·m\].
     pub torque: Vector3<f64>,
 }
 
@@ -51,7 +51,7 @@ pub enum ZmpStatus {
 /// Settings of the ZMP computation.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct ZmpSettings {
-    /// A foot whose normal force is at most this is unloaded and left out [N]. Higher values
+    /// A foot whose normal force is at most this is unloaded and left out \[N\]. Higher values
     /// reject sensor offset and noise of a lifted foot; lower values keep a lightly loaded foot.
     pub min_normal_force: f64,
 }
@@ -82,11 +82,11 @@ impl ZmpSettings {
 /// A measured ZMP.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct ZmpMeasurement {
-    /// `[x̃, ỹ]` of the ZMP in the local frame [m]; `None` when [`ZmpStatus::NoContact`].
+    /// `[x̃, ỹ]` of the ZMP in the local frame \[m\]; `None` when [`ZmpStatus::NoContact`].
     pub position: Option<[f64; 2]>,
     /// Which feet were used.
     pub status: ZmpStatus,
-    /// Sum of the used feet's normal forces [N].
+    /// Sum of the used feet's normal forces \[N\].
     pub normal_force: f64,
 }
 
