@@ -20,6 +20,8 @@ pub fn run(a: &Args) -> Result<()> {
         .intro("<p>Every figure below was computed by this run of <code>iktc reproduce</code>; the numbers in the tables come from the runs' <code>summary.json</code> files. The printed equations of the paper are used with the corrections of the project's errata.</p>");
     eprintln!("running the 3R experiment (Section 3.3)…");
     report = report.section(crate::cmd_run::planar3r_section(&a.out)?);
+    eprintln!("running the damping-controller experiments (Sections 4 and 5.2)…");
+    report = report.section(crate::cmd_balance::balance_section(&a.out)?);
     let path = write_report(&report, &a.out)?;
     println!("report: {}", path.display());
     Ok(())

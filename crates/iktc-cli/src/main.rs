@@ -3,6 +3,7 @@
 
 use clap::{Parser, Subcommand};
 
+mod cmd_balance;
 mod cmd_model;
 mod cmd_reproduce;
 mod cmd_run;
@@ -27,14 +28,17 @@ enum Command {
     Run(cmd_run::Args),
     /// Run every experiment and write one offline report, DIR/index.html.
     Reproduce(cmd_reproduce::Args),
+    /// The ZMP damping controller of Section 4: identify, design, push.
+    Balance(cmd_balance::BalanceArgs),
 }
 
 fn main() -> std::process::ExitCode {
     let cli = Cli::parse();
-    let result = match &cli.command {
-        Command::Model(a) => cmd_model::run(a),
-        Command::Run(a) => cmd_run::run(a),
-        Command::Reproduce(a) => cmd_reproduce::run(a),
+    let result = match cli.command {
+        Command::Model(a) => cmd_model::run(&a),
+        Command::Run(a) => cmd_run::run(&a),
+        Command::Reproduce(a) => cmd_reproduce::run(&a),
+        Command::Balance(a) => cmd_balance::run(a),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,
