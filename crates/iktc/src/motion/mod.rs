@@ -1,14 +1,28 @@
 //! Captured motion: clips, readers and writers, and the rotation decomposition used to retarget
 //! captured joint rotations onto robot joints.
 //!
+//! * [`Clip`] — plain data: a [`Skeleton`] (named joints, parents, rest offsets [m], spherical /
+//!   hinge / fixed / root), frame times [s] and one [`Pose`] per frame (root position [m], root
+//!   orientation, local joint rotations); sampling at any time (slerp) and forward kinematics.
+//! * [`read_deepmimic`], [`builtin_clip`] — DeepMimic motion files on the DeepMimic humanoid
+//!   (Y-up; convert with [`Clip::to_z_up`] / [`y_up_to_z_up`]).
 //! * [`decompose_rotation`] — a rotation as a product of rotations about 1–3 given joint axes
 //!   (generalised Euler / Davenport angles in closed form, least squares otherwise).
 
 mod angles;
+mod clip;
 mod decompose;
+mod deepmimic;
+mod skeleton;
 
 pub use angles::{nearest_equivalent, unwrap_track, wrap_to_pi};
+pub use clip::{y_up_to_z_up, Clip, Pose, UpAxis};
 pub use decompose::{
-    compose_rotation, decompose_rotation, decompose_rotation_with, rotation_angle, DecomposeSettings,
-    Decomposition, DecompositionMethod, MAX_DECOMPOSITION_AXES,
+    compose_rotation, decompose_rotation, decompose_rotation_with, rotation_angle,
+    DecomposeSettings, Decomposition, DecompositionMethod, MAX_DECOMPOSITION_AXES,
 };
+pub use deepmimic::{
+    builtin_clip, deepmimic_skeleton, read_deepmimic, read_deepmimic_with, DeepMimicSettings,
+    BUILTIN_CLIP_NAMES, DEEPMIMIC_FRAME_LEN, DEEPMIMIC_URDF, DEEPMIMIC_URDF_SCALE,
+};
+pub use skeleton::{JointKind, Skeleton, SkeletonJoint};
