@@ -6,16 +6,23 @@
 //!   orientation, local joint rotations); sampling at any time (slerp) and forward kinematics.
 //! * [`read_deepmimic`], [`builtin_clip`] — DeepMimic motion files on the DeepMimic humanoid
 //!   (Y-up; convert with [`Clip::to_z_up`] / [`y_up_to_z_up`]).
+//! * [`read_bvh`], [`write_bvh`], [`BvhClip`] — Biovision hierarchy files with any hierarchy
+//!   and channel order, in centimetres, metres or any length unit.
 //! * [`decompose_rotation`] — a rotation as a product of rotations about 1–3 given joint axes
 //!   (generalised Euler / Davenport angles in closed form, least squares otherwise).
 
 mod angles;
+mod bvh;
 mod clip;
 mod decompose;
 mod deepmimic;
 mod skeleton;
 
 pub use angles::{nearest_equivalent, unwrap_track, wrap_to_pi};
+pub use bvh::{
+    bvh_rotation, read_bvh, write_bvh, BvhChannel, BvhClip, BvhExportOptions, BvhJoint,
+    BvhReadOptions, BvhWriteOptions, LengthUnit, RotationOrder,
+};
 pub use clip::{y_up_to_z_up, Clip, Pose, UpAxis};
 pub use decompose::{
     compose_rotation, decompose_rotation, decompose_rotation_with, rotation_angle,
