@@ -10,7 +10,10 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 fn metres() -> BvhReadOptions {
-    BvhReadOptions { length_unit: LengthUnit::Metres, up_axis: UpAxis::Y }
+    BvhReadOptions {
+        length_unit: LengthUnit::Metres,
+        up_axis: UpAxis::Y,
+    }
 }
 
 /// A two-joint chain with an end site; `order` is the root's rotation channel list.
@@ -53,31 +56,47 @@ fn close(a: Vector3<f64>, b: Vector3<f64>) -> bool {
 #[test]
 fn euler_channels_compose_in_the_listed_order() {
     // ZXY with (90, 90, 0): R = Rz·Rx·Ry, R·y = Rz(Rx y) = Rz z = z.
-    let c = read_bvh(&chain("Zrotation Xrotation Yrotation", &["0 0 0 90 90 0 0 0 0"]), "zxy", &metres())
-        .unwrap()
-        .to_clip()
-        .unwrap();
+    let c = read_bvh(
+        &chain("Zrotation Xrotation Yrotation", &["0 0 0 90 90 0 0 0 0"]),
+        "zxy",
+        &metres(),
+    )
+    .unwrap()
+    .to_clip()
+    .unwrap();
     let p = positions(&c, 0);
     assert!(close(p[1], Vector3::new(0.0, 0.0, 1.0)), "{:?}", p[1]);
     assert!(close(p[2], Vector3::new(0.0, 0.0, 2.0)));
     // XYZ with (90, 0, 90): R·y = Rx(Rz y) = Rx(−x) = −x.
-    let c = read_bvh(&chain("Xrotation Yrotation Zrotation", &["0 0 0 90 0 90 0 0 0"]), "xyz", &metres())
-        .unwrap()
-        .to_clip()
-        .unwrap();
+    let c = read_bvh(
+        &chain("Xrotation Yrotation Zrotation", &["0 0 0 90 0 90 0 0 0"]),
+        "xyz",
+        &metres(),
+    )
+    .unwrap()
+    .to_clip()
+    .unwrap();
     assert!(close(positions(&c, 0)[1], Vector3::new(-1.0, 0.0, 0.0)));
     // YXZ with (90, 90, 0): R·y = Ry(Rx y) = Ry z = x.
-    let c = read_bvh(&chain("Yrotation Xrotation Zrotation", &["0 0 0 90 90 0 0 0 0"]), "yxz", &metres())
-        .unwrap()
-        .to_clip()
-        .unwrap();
+    let c = read_bvh(
+        &chain("Yrotation Xrotation Zrotation", &["0 0 0 90 90 0 0 0 0"]),
+        "yxz",
+        &metres(),
+    )
+    .unwrap()
+    .to_clip()
+    .unwrap();
     assert!(close(positions(&c, 0)[1], Vector3::new(1.0, 0.0, 0.0)));
     // The child's own rotation applies to its children only: Chest Xrotation 90 moves the end
     // site from +y to +z relative to the chest.
-    let c = read_bvh(&chain("Zrotation Xrotation Yrotation", &["1 2 3 0 0 0 90 0 0"]), "child", &metres())
-        .unwrap()
-        .to_clip()
-        .unwrap();
+    let c = read_bvh(
+        &chain("Zrotation Xrotation Yrotation", &["1 2 3 0 0 0 90 0 0"]),
+        "child",
+        &metres(),
+    )
+    .unwrap()
+    .to_clip()
+    .unwrap();
     let p = positions(&c, 0);
     assert!(close(p[0], Vector3::new(1.0, 2.0, 3.0)));
     assert!(close(p[1], Vector3::new(1.0, 3.0, 3.0)));
@@ -91,7 +110,14 @@ fn bvh_rotation_matches_matrix_products() {
     let rx = |a: f64| Matrix3::new(1.0, 0.0, 0.0, 0.0, a.cos(), -a.sin(), 0.0, a.sin(), a.cos());
     let ry = |a: f64| Matrix3::new(a.cos(), 0.0, a.sin(), 0.0, 1.0, 0.0, -a.sin(), 0.0, a.cos());
     let rz = |a: f64| Matrix3::new(a.cos(), -a.sin(), 0.0, a.sin(), a.cos(), 0.0, 0.0, 0.0, 1.0);
-    for order in [RotationOrder::Xyz, RotationOrder::Xzy, RotationOrder::Yxz, RotationOrder::Yzx, RotationOrder::Zxy, RotationOrder::Zyx] {
+    for order in [
+        RotationOrder::Xyz,
+        RotationOrder::Xzy,
+        RotationOrder::Yxz,
+        RotationOrder::Yzx,
+        RotationOrder::Zxy,
+        RotationOrder::Zyx,
+    ] {
         let ch = order.channels();
         let v: Vec<f64> = (0..3).map(|_| rng.random_range(-3.0..3.0)).collect();
         let m = |c: BvhChannel, a: f64| match c {
@@ -132,19 +158,34 @@ Frame Time: 0.01
     let p = positions(&c, 0);
     // Root at (0.1, 0.2, 0) m rotated by Rz(90°): the arm at root + Rz(90)·(0.5, 1.0, 0) m.
     assert!(close(p[0], Vector3::new(0.1, 0.2, 0.0)));
-    assert!(close(p[1], Vector3::new(0.1 - 1.0, 0.2 + 0.5, 0.0)), "{:?}", p[1]);
+    assert!(
+        close(p[1], Vector3::new(0.1 - 1.0, 0.2 + 0.5, 0.0)),
+        "{:?}",
+        p[1]
+    );
     assert!(close(p[2], p[1] + Vector3::new(0.0, 0.0, 0.1)));
-    assert!(close(c.frame(0).unwrap().translations[1], Vector3::new(0.5, 0.0, 0.0)));
+    assert!(close(
+        c.frame(0).unwrap().translations[1],
+        Vector3::new(0.5, 0.0, 0.0)
+    ));
     // One rotation channel: a hinge about z.
     assert_eq!(c.skeleton().joints()[0].kind, JointKind::Root);
     assert_eq!(c.skeleton().joints()[1].kind, JointKind::Spherical);
     assert_eq!(c.skeleton().joints()[2].kind, JointKind::Fixed);
     assert_eq!(c.skeleton().joints()[2].name, "arm_end");
     // The writer keeps position channels on the arm, and reading back gives the same poses.
-    let again = read_bvh(&write_bvh(&BvhClip::from_clip(&c, &BvhExportOptions::default()).unwrap(), &BvhWriteOptions::default()).unwrap(), "again", &BvhReadOptions::default())
-        .unwrap()
-        .to_clip()
-        .unwrap();
+    let again = read_bvh(
+        &write_bvh(
+            &BvhClip::from_clip(&c, &BvhExportOptions::default()).unwrap(),
+            &BvhWriteOptions::default(),
+        )
+        .unwrap(),
+        "again",
+        &BvhReadOptions::default(),
+    )
+    .unwrap()
+    .to_clip()
+    .unwrap();
     for (a, b) in positions(&again, 0).iter().zip(&p) {
         assert!((a - b).norm() < 1e-12);
     }
@@ -152,11 +193,32 @@ Frame Time: 0.01
 
 #[test]
 fn length_units_scale_offsets_and_positions() {
-    let text = chain("Zrotation Xrotation Yrotation", &["10 20 30 0 0 0 0 0 0", "1 2 3 0 0 0 0 0 0"]);
+    let text = chain(
+        "Zrotation Xrotation Yrotation",
+        &["10 20 30 0 0 0 0 0 0", "1 2 3 0 0 0 0 0 0"],
+    );
     let m = read_bvh(&text, "m", &metres()).unwrap();
     let cm = read_bvh(&text, "cm", &BvhReadOptions::default()).unwrap();
-    let inch = read_bvh(&text, "in", &BvhReadOptions { length_unit: LengthUnit::Inches, ..metres() }).unwrap();
-    let custom = read_bvh(&text, "c", &BvhReadOptions { length_unit: LengthUnit::Custom { metres_per_unit: 0.0254 }, ..metres() }).unwrap();
+    let inch = read_bvh(
+        &text,
+        "in",
+        &BvhReadOptions {
+            length_unit: LengthUnit::Inches,
+            ..metres()
+        },
+    )
+    .unwrap();
+    let custom = read_bvh(
+        &text,
+        "c",
+        &BvhReadOptions {
+            length_unit: LengthUnit::Custom {
+                metres_per_unit: 0.0254,
+            },
+            ..metres()
+        },
+    )
+    .unwrap();
     assert_eq!(inch.values(), custom.values());
     assert_eq!(cm.joints()[1].offset, Vector3::new(0.0, 0.01, 0.0));
     assert_eq!(m.joints()[1].offset, Vector3::new(0.0, 1.0, 0.0));
@@ -166,8 +228,21 @@ fn length_units_scale_offsets_and_positions() {
         assert!((a * 0.01 - b).norm() < 1e-15);
     }
     // Rotations are not scaled.
-    assert_eq!(m.track(0, BvhChannel::Zrotation), cm.track(0, BvhChannel::Zrotation));
-    assert!(read_bvh(&text, "bad", &BvhReadOptions { length_unit: LengthUnit::Custom { metres_per_unit: -1.0 }, ..metres() }).is_err());
+    assert_eq!(
+        m.track(0, BvhChannel::Zrotation),
+        cm.track(0, BvhChannel::Zrotation)
+    );
+    assert!(read_bvh(
+        &text,
+        "bad",
+        &BvhReadOptions {
+            length_unit: LengthUnit::Custom {
+                metres_per_unit: -1.0
+            },
+            ..metres()
+        }
+    )
+    .is_err());
     assert!((m.duration() - 0.5).abs() < 1e-15);
 }
 
@@ -177,9 +252,17 @@ fn length_units_scale_offsets_and_positions() {
 fn angle_tracks_are_unwrapped_through_180_degrees() {
     let file: [f64; 7] = [170.0, 179.0, -179.0, -170.0, 175.0, -185.0, 539.0];
     let unwrapped: [f64; 7] = [170.0, 179.0, 181.0, 190.0, 175.0, 175.0, 179.0];
-    let frames: Vec<String> = file.iter().map(|y| format!("0 0 0 0 0 {y} 0 0 0")).collect();
+    let frames: Vec<String> = file
+        .iter()
+        .map(|y| format!("0 0 0 0 0 {y} 0 0 0"))
+        .collect();
     let frames: Vec<&str> = frames.iter().map(|s| s.as_str()).collect();
-    let bvh = read_bvh(&chain("Zrotation Xrotation Yrotation", &frames), "wrap", &metres()).unwrap();
+    let bvh = read_bvh(
+        &chain("Zrotation Xrotation Yrotation", &frames),
+        "wrap",
+        &metres(),
+    )
+    .unwrap();
     let track = bvh.track(0, BvhChannel::Yrotation).unwrap();
     for (t, u) in track.iter().zip(&unwrapped) {
         assert!((t - u.to_radians()).abs() < 1e-12, "{track:?}");
@@ -232,14 +315,26 @@ Frame Time: 0.0083333
     let mut rng = ChaCha8Rng::seed_from_u64(42);
     let mut full = text.to_string();
     for _ in 0..30 {
-        let row: Vec<String> = (0..14).map(|_| format!("{}", rng.random_range(-400.0..400.0))).collect();
+        let row: Vec<String> = (0..14)
+            .map(|_| format!("{}", rng.random_range(-400.0..400.0)))
+            .collect();
         full.push_str(&row.join(" "));
         full.push('\n');
     }
     for unit in [LengthUnit::Centimetres, LengthUnit::Metres] {
-        let read_opts = BvhReadOptions { length_unit: unit, up_axis: UpAxis::Y };
+        let read_opts = BvhReadOptions {
+            length_unit: unit,
+            up_axis: UpAxis::Y,
+        };
         let x = read_bvh(&full, "x", &read_opts).unwrap();
-        let written = write_bvh(&x, &BvhWriteOptions { length_unit: unit, decimals: None }).unwrap();
+        let written = write_bvh(
+            &x,
+            &BvhWriteOptions {
+                length_unit: unit,
+                decimals: None,
+            },
+        )
+        .unwrap();
         let y = read_bvh(&written, "x", &read_opts).unwrap();
         assert_eq!(x.joints().len(), y.joints().len());
         for (a, b) in x.joints().iter().zip(y.joints()) {
@@ -253,10 +348,19 @@ Frame Time: 0.0083333
         }
         assert_eq!(x.frame_time(), y.frame_time());
         // Six decimals: equal to 1e-6 file units.
-        let written = write_bvh(&x, &BvhWriteOptions { length_unit: unit, decimals: Some(6) }).unwrap();
+        let written = write_bvh(
+            &x,
+            &BvhWriteOptions {
+                length_unit: unit,
+                decimals: Some(6),
+            },
+        )
+        .unwrap();
         let z = read_bvh(&written, "x", &read_opts).unwrap();
         for (a, b) in x.values().iter().zip(z.values()) {
-            assert!((a - b).abs() <= 1e-6_f64.to_radians().max(1e-6 * unit.metres_per_unit()) * 1.01);
+            assert!(
+                (a - b).abs() <= 1e-6_f64.to_radians().max(1e-6 * unit.metres_per_unit()) * 1.01
+            );
         }
     }
 }
@@ -268,7 +372,10 @@ fn clip_round_trip_through_bvh() {
     for name in ["humanoid3d_walk", "humanoid3d_dance_b"] {
         let clip = builtin_clip(name).unwrap();
         for order in [RotationOrder::Zxy, RotationOrder::Xyz, RotationOrder::Yzx] {
-            let opts = BvhExportOptions { rotation_order: order, ..BvhExportOptions::default() };
+            let opts = BvhExportOptions {
+                rotation_order: order,
+                ..BvhExportOptions::default()
+            };
             let bvh = BvhClip::from_clip(&clip, &opts).unwrap();
             let knee = bvh.joint_index("right_knee").unwrap();
             assert_eq!(bvh.joints()[knee].channels, vec![BvhChannel::Zrotation]);
@@ -276,14 +383,25 @@ fn clip_round_trip_through_bvh() {
             for f in 1..bvh.frame_count() {
                 let (a, b) = (bvh.frame(f - 1).unwrap(), bvh.frame(f).unwrap());
                 for c in 0..n {
-                    assert!((a[c] - b[c]).abs() < std::f64::consts::PI, "{name} {order:?} frame {f} channel {c}");
+                    assert!(
+                        (a[c] - b[c]).abs() < std::f64::consts::PI,
+                        "{name} {order:?} frame {f} channel {c}"
+                    );
                 }
             }
             let text = write_bvh(&bvh, &BvhWriteOptions::default()).unwrap();
-            let back = read_bvh(&text, name, &BvhReadOptions::default()).unwrap().to_clip().unwrap();
+            let back = read_bvh(&text, name, &BvhReadOptions::default())
+                .unwrap()
+                .to_clip()
+                .unwrap();
             assert_eq!(back.frame_count(), clip.frame_count());
             assert!((back.duration() - clip.duration()).abs() < 1e-6);
-            for (a, b) in back.skeleton().joints().iter().zip(clip.skeleton().joints()) {
+            for (a, b) in back
+                .skeleton()
+                .joints()
+                .iter()
+                .zip(clip.skeleton().joints())
+            {
                 if a.kind != JointKind::Fixed {
                     assert_eq!(a.name, b.name);
                 }
@@ -302,6 +420,9 @@ fn irregular_frame_times_are_refused() {
     let text = "{\"Frames\": [[0.03,0,0.85,0,1,0,0,0,1,0,0,0,1,0,0,0,1,0,0,0,0,1,0,0,0,1,0,0,0,0,1,0,0,0,0,1,0,0,0,1,0,0,0,0],\n[0.05,0,0.85,0,1,0,0,0,1,0,0,0,1,0,0,0,1,0,0,0,0,1,0,0,0,1,0,0,0,0,1,0,0,0,0,1,0,0,0,1,0,0,0,0],\n[0.03,0,0.85,0,1,0,0,0,1,0,0,0,1,0,0,0,1,0,0,0,0,1,0,0,0,1,0,0,0,0,1,0,0,0,0,1,0,0,0,1,0,0,0,0]]}";
     let clip = iktc::motion::read_deepmimic(text, "irregular").unwrap();
     assert!(BvhClip::from_clip(&clip, &BvhExportOptions::default()).is_err());
-    let loose = BvhExportOptions { frame_time_tolerance: 0.02, ..BvhExportOptions::default() };
+    let loose = BvhExportOptions {
+        frame_time_tolerance: 0.02,
+        ..BvhExportOptions::default()
+    };
     assert!((BvhClip::from_clip(&clip, &loose).unwrap().frame_time() - 0.04).abs() < 1e-15);
 }

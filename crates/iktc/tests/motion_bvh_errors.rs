@@ -6,26 +6,26 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 const BASE: [&str; 20] = [
-    "HIERARCHY",                                                             // 1
-    "ROOT Hips",                                                             // 2
-    "{",                                                                     // 3
-    "\tOFFSET 0 0 0",                                                        // 4
+    "HIERARCHY",                                                                // 1
+    "ROOT Hips",                                                                // 2
+    "{",                                                                        // 3
+    "\tOFFSET 0 0 0",                                                           // 4
     "\tCHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation", // 5
-    "\tJOINT Chest",                                                         // 6
-    "\t{",                                                                   // 7
-    "\t\tOFFSET 0 10 0",                                                     // 8
-    "\t\tCHANNELS 3 Zrotation Xrotation Yrotation",                          // 9
-    "\t\tEnd Site",                                                          // 10
-    "\t\t{",                                                                 // 11
-    "\t\t\tOFFSET 0 10 0",                                                   // 12
-    "\t\t}",                                                                 // 13
-    "\t}",                                                                   // 14
-    "}",                                                                     // 15
-    "MOTION",                                                                // 16
-    "Frames: 2",                                                             // 17
-    "Frame Time: 0.0333",                                                    // 18
-    "0 0 0 0 0 0 0 0 0",                                                     // 19
-    "1 1 1 1 1 1 1 1 1",                                                     // 20
+    "\tJOINT Chest",                                                            // 6
+    "\t{",                                                                      // 7
+    "\t\tOFFSET 0 10 0",                                                        // 8
+    "\t\tCHANNELS 3 Zrotation Xrotation Yrotation",                             // 9
+    "\t\tEnd Site",                                                             // 10
+    "\t\t{",                                                                    // 11
+    "\t\t\tOFFSET 0 10 0",                                                      // 12
+    "\t\t}",                                                                    // 13
+    "\t}",                                                                      // 14
+    "}",                                                                        // 15
+    "MOTION",                                                                   // 16
+    "Frames: 2",                                                                // 17
+    "Frame Time: 0.0333",                                                       // 18
+    "0 0 0 0 0 0 0 0 0",                                                        // 19
+    "1 1 1 1 1 1 1 1 1",                                                        // 20
 ];
 
 fn text(lines: &[&str]) -> String {
@@ -55,7 +55,11 @@ fn inserted(n: usize, line: &str) -> String {
 
 fn error_line(t: &str) -> (usize, String) {
     match read_bvh(t, "test.bvh", &BvhReadOptions::default()) {
-        Err(Error::Parse { line, message, source_name }) => {
+        Err(Error::Parse {
+            line,
+            message,
+            source_name,
+        }) => {
             assert_eq!(source_name, "test.bvh");
             (line, message)
         }
@@ -66,7 +70,10 @@ fn error_line(t: &str) -> (usize, String) {
 fn assert_error(t: &str, line: usize, words: &str) {
     let (l, message) = error_line(t);
     assert_eq!(l, line, "{message}");
-    assert!(message.contains(words), "`{message}` should contain `{words}`");
+    assert!(
+        message.contains(words),
+        "`{message}` should contain `{words}`"
+    );
 }
 
 #[test]
@@ -75,14 +82,29 @@ fn the_base_file_is_valid_also_with_crlf_and_blank_lines() {
     assert_eq!(clip.frame_count(), 2);
     assert_eq!(clip.channel_count(), 9);
     let crlf = BASE.join("\r\n") + "\r\n";
-    assert_eq!(read_bvh(&crlf, "base", &BvhReadOptions::default()).unwrap().values(), clip.values());
+    assert_eq!(
+        read_bvh(&crlf, "base", &BvhReadOptions::default())
+            .unwrap()
+            .values(),
+        clip.values()
+    );
     let blank = inserted(19, "   ");
-    assert_eq!(read_bvh(&blank, "base", &BvhReadOptions::default()).unwrap().values(), clip.values());
+    assert_eq!(
+        read_bvh(&blank, "base", &BvhReadOptions::default())
+            .unwrap()
+            .values(),
+        clip.values()
+    );
     // `{` on the header line.
     let mut l = BASE.to_vec();
     l[5] = "\tJOINT Chest {";
     l.remove(6);
-    assert_eq!(read_bvh(&text(&l), "b", &BvhReadOptions::default()).unwrap().values(), clip.values());
+    assert_eq!(
+        read_bvh(&text(&l), "b", &BvhReadOptions::default())
+            .unwrap()
+            .values(),
+        clip.values()
+    );
 }
 
 #[test]
@@ -97,14 +119,42 @@ fn missing_braces() {
 #[test]
 fn bad_hierarchy_lines() {
     assert_error(&replaced(1, "HIERARCHIE"), 1, "expected `HIERARCHY`");
-    assert_error(&replaced(9, "\t\tCHANNELS 3 Zrotation Xrotation Wrotation"), 9, "unknown channel `Wrotation`");
-    assert_error(&replaced(9, "\t\tCHANNELS 4 Zrotation Xrotation Yrotation"), 9, "declares 4 channels but lists 3");
-    assert_error(&replaced(9, "\t\tCHANNELS three Zrotation Xrotation Yrotation"), 9, "not a number");
-    assert_error(&replaced(9, "\t\tCHANNELS 3 Zrotation Xrotation Zrotation"), 9, "listed twice");
-    assert_error(&replaced(8, "\t\tOFFSET 0 ten 0"), 8, "`ten` is not a number");
+    assert_error(
+        &replaced(9, "\t\tCHANNELS 3 Zrotation Xrotation Wrotation"),
+        9,
+        "unknown channel `Wrotation`",
+    );
+    assert_error(
+        &replaced(9, "\t\tCHANNELS 4 Zrotation Xrotation Yrotation"),
+        9,
+        "declares 4 channels but lists 3",
+    );
+    assert_error(
+        &replaced(9, "\t\tCHANNELS three Zrotation Xrotation Yrotation"),
+        9,
+        "not a number",
+    );
+    assert_error(
+        &replaced(9, "\t\tCHANNELS 3 Zrotation Xrotation Zrotation"),
+        9,
+        "listed twice",
+    );
+    assert_error(
+        &replaced(8, "\t\tOFFSET 0 ten 0"),
+        8,
+        "`ten` is not a number",
+    );
     assert_error(&replaced(8, "\t\tOFFSET 0 10"), 8, "OFFSET needs 3 numbers");
-    assert_error(&replaced(8, "\t\tOFFSETT 0 10 0"), 8, "unexpected `OFFSETT`");
-    assert_error(&inserted(13, "\t\t\tCHANNELS 1 Xrotation"), 13, "End Site cannot have CHANNELS");
+    assert_error(
+        &replaced(8, "\t\tOFFSETT 0 10 0"),
+        8,
+        "unexpected `OFFSETT`",
+    );
+    assert_error(
+        &inserted(13, "\t\t\tCHANNELS 1 Xrotation"),
+        13,
+        "End Site cannot have CHANNELS",
+    );
     assert_error(&replaced(10, "\t\tEnd Sight"), 10, "expected `End Site`");
     assert_error(&replaced(6, "\tJOINT Hips"), 6, "used twice");
     assert_error(&replaced(6, "\tJOINT"), 6, "needs a name");
@@ -113,24 +163,52 @@ fn bad_hierarchy_lines() {
 
 #[test]
 fn bad_motion_lines() {
-    assert_error(&replaced(20, "1 1 1 1 1 1 1 1"), 20, "fewer than the 9 channels");
-    assert_error(&replaced(19, "0 0 0 0 0 0 0 0 0 0"), 19, "more than the 9 channels");
-    assert_error(&replaced(20, "1 1 1 1 x 1 1 1 1"), 20, "`x` is not a number");
+    assert_error(
+        &replaced(20, "1 1 1 1 1 1 1 1"),
+        20,
+        "fewer than the 9 channels",
+    );
+    assert_error(
+        &replaced(19, "0 0 0 0 0 0 0 0 0 0"),
+        19,
+        "more than the 9 channels",
+    );
+    assert_error(
+        &replaced(20, "1 1 1 1 x 1 1 1 1"),
+        20,
+        "`x` is not a number",
+    );
     assert_error(&replaced(20, "1 1 1 1 nan 1 1 1 1"), 20, "not finite");
     assert_error(&replaced(17, "Frames: 0"), 17, "zero frames");
     assert_error(&replaced(17, "Frames: many"), 17, "not a frame count");
     assert_error(&replaced(17, "Frame: 2"), 17, "expected `Frames: <number>`");
     assert_error(&replaced(18, "Frame Time: 0"), 18, "expected > 0");
     assert_error(&replaced(18, "Frame Time: -0.1"), 18, "expected > 0");
-    assert_error(&replaced(18, "Frame Time:"), 18, "expected `Frame Time: <number>`");
-    assert_error(&inserted(21, "2 2 2 2 2 2 2 2 2"), 21, "more frame lines than the 2 declared");
+    assert_error(
+        &replaced(18, "Frame Time:"),
+        18,
+        "expected `Frame Time: <number>`",
+    );
+    assert_error(
+        &inserted(21, "2 2 2 2 2 2 2 2 2"),
+        21,
+        "more frame lines than the 2 declared",
+    );
     assert_error(&replaced(16, "MOTIONS"), 16, "expected `MOTION`");
 }
 
 #[test]
 fn truncated_files() {
-    assert_error(&text(&BASE[..19]), 19, "truncated file: 2 frames declared at line 17, 1 found");
-    assert_error(&text(&BASE[..18]), 18, "truncated file: 2 frames declared at line 17, 0 found");
+    assert_error(
+        &text(&BASE[..19]),
+        19,
+        "truncated file: 2 frames declared at line 17, 1 found",
+    );
+    assert_error(
+        &text(&BASE[..18]),
+        18,
+        "truncated file: 2 frames declared at line 17, 0 found",
+    );
     assert_error(&text(&BASE[..17]), 17, "`Frame Time:` (truncated file)");
     assert_error(&text(&BASE[..16]), 16, "`Frames:` (truncated file)");
     assert_error(&text(&BASE[..15]), 15, "before `MOTION` (truncated file)");
@@ -147,9 +225,10 @@ fn never_panics_on_corrupt_input() {
     for end in 0..=base.len() {
         let _ = read_bvh(&base[..end], "prefix", &BvhReadOptions::default());
     }
-    let alphabet: Vec<char> = "{}0123456789-.eE \n\tXYZpositionrtJOINTEndSiteROOTMOTIONFrames:Time9"
-        .chars()
-        .collect();
+    let alphabet: Vec<char> =
+        "{}0123456789-.eE \n\tXYZpositionrtJOINTEndSiteROOTMOTIONFrames:Time9"
+            .chars()
+            .collect();
     let mut rng = ChaCha8Rng::seed_from_u64(1234);
     let mut ok = 0;
     for _ in 0..3000 {

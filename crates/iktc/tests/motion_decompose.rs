@@ -65,8 +65,18 @@ fn wrapped_diff(a: f64, b: f64) -> f64 {
 fn closed_form_recovers_random_angles_for_all_orders() {
     let mut rng = ChaCha8Rng::seed_from_u64(7);
     let orders: Vec<[usize; 3]> = vec![
-        [0, 1, 2], [0, 2, 1], [1, 0, 2], [1, 2, 0], [2, 0, 1], [2, 1, 0],
-        [0, 1, 0], [0, 2, 0], [1, 0, 1], [1, 2, 1], [2, 0, 2], [2, 1, 2],
+        [0, 1, 2],
+        [0, 2, 1],
+        [1, 0, 2],
+        [1, 2, 0],
+        [2, 0, 1],
+        [2, 1, 0],
+        [0, 1, 0],
+        [0, 2, 0],
+        [1, 0, 1],
+        [1, 2, 1],
+        [2, 0, 2],
+        [2, 1, 2],
     ];
     let mut checked = 0;
     for trial in 0..600 {
@@ -84,21 +94,36 @@ fn closed_form_recovers_random_angles_for_all_orders() {
             rng.random_range(-PI..PI),
         ];
         // Distance of θ2 from the singular values λ, λ + π.
-        let lambda = axes[0].dot(&axes[1].cross(&axes[2])).atan2(axes[0].dot(&axes[2]));
+        let lambda = axes[0]
+            .dot(&axes[1].cross(&axes[2]))
+            .atan2(axes[0].dot(&axes[2]));
         if (truth[1] - lambda).sin().abs() < 0.1 {
             continue;
         }
         let r = compose_rotation(&axes, &truth).unwrap();
-        let previous: Vec<f64> = truth.iter().map(|t| t + rng.random_range(-0.05..0.05)).collect();
+        let previous: Vec<f64> = truth
+            .iter()
+            .map(|t| t + rng.random_range(-0.05..0.05))
+            .collect();
         let mut out = [0.0; 3];
         let rep = decompose_rotation(&r, &axes, Some(&previous), &mut out).unwrap();
-        assert_eq!(rep.method, DecompositionMethod::ClosedForm { singular: false });
+        assert_eq!(
+            rep.method,
+            DecompositionMethod::ClosedForm { singular: false }
+        );
         for (o, t) in out.iter().zip(&truth) {
-            assert!((o - t).abs() < 1e-9, "trial {trial} order {order:?}: {out:?} vs {truth:?}");
+            assert!(
+                (o - t).abs() < 1e-9,
+                "trial {trial} order {order:?}: {out:?} vs {truth:?}"
+            );
         }
         assert!(rep.residual < 1e-12);
         // The closed form is exact: the Gauss–Newton polish has (almost) nothing to do.
-        assert!(rep.iterations <= 1, "trial {trial}: {} polish iterations", rep.iterations);
+        assert!(
+            rep.iterations <= 1,
+            "trial {trial}: {} polish iterations",
+            rep.iterations
+        );
 
         let rep = decompose_rotation(&r, &axes, None, &mut out).unwrap();
         assert!(misfit(&r, &axes, &out) < 1e-9, "trial {trial}: misfit");
@@ -157,8 +182,13 @@ fn continuity_through_gimbal_lock() {
         }
         assert!(misfit(&r, &axes, &out) < 1e-9, "frame {i}");
         if let Some(p) = prev {
-            let step = ((out[0] - p[0]).powi(2) + (out[1] - p[1]).powi(2) + (out[2] - p[2]).powi(2)).sqrt();
-            assert!(step < 2.0 * max_true_step, "frame {i}: jump {step} {out:?} {p:?}");
+            let step =
+                ((out[0] - p[0]).powi(2) + (out[1] - p[1]).powi(2) + (out[2] - p[2]).powi(2))
+                    .sqrt();
+            assert!(
+                step < 2.0 * max_true_step,
+                "frame {i}: jump {step} {out:?} {p:?}"
+            );
         } else {
             for (o, t) in out.iter().zip(&th) {
                 assert!((o - t).abs() < 1e-9);
@@ -166,7 +196,10 @@ fn continuity_through_gimbal_lock() {
         }
         prev = Some(out);
     }
-    assert!(saw_singular, "the middle frame must be detected as gimbal-locked");
+    assert!(
+        saw_singular,
+        "the middle frame must be detected as gimbal-locked"
+    );
     let last = prev.unwrap();
     for (o, t) in last.iter().zip(&truth(n - 1)) {
         assert!((o - t).abs() < 1e-6, "{last:?}");
@@ -180,9 +213,15 @@ fn gimbal_lock_without_previous_puts_everything_on_the_first_axis() {
     let r = compose_rotation(&axes, &[0.4, FRAC_PI_2, 0.3]).unwrap();
     let mut out = [0.0; 3];
     let rep = decompose_rotation(&r, &axes, None, &mut out).unwrap();
-    assert_eq!(rep.method, DecompositionMethod::ClosedForm { singular: true });
+    assert_eq!(
+        rep.method,
+        DecompositionMethod::ClosedForm { singular: true }
+    );
     // Rz(a)·Ry(π/2)·Rx(c) = Rz(a − c)·Ry(π/2): θ1 = 0.4 − 0.3, θ3 = 0.
-    assert!((out[0] - 0.1).abs() < 1e-9 && (out[1] - FRAC_PI_2).abs() < 1e-9 && out[2].abs() < 1e-9, "{out:?}");
+    assert!(
+        (out[0] - 0.1).abs() < 1e-9 && (out[1] - FRAC_PI_2).abs() < 1e-9 && out[2].abs() < 1e-9,
+        "{out:?}"
+    );
 }
 
 /// Random non-orthogonal axes (1, 2 or 3 of them): representable rotations come back exactly,
@@ -199,18 +238,31 @@ fn least_squares_recovers_random_axes() {
         }
         let truth: Vec<f64> = (0..k).map(|_| rng.random_range(-2.5..2.5)).collect();
         let r = compose_rotation(&axes, &truth).unwrap();
-        let prev: Vec<f64> = truth.iter().map(|t| t + rng.random_range(-0.1..0.1)).collect();
+        let prev: Vec<f64> = truth
+            .iter()
+            .map(|t| t + rng.random_range(-0.1..0.1))
+            .collect();
         let mut out = vec![0.0; k];
         let rep = decompose_rotation(&r, &axes, Some(&prev), &mut out).unwrap();
-        assert!(rep.residual < 1e-10, "trial {trial}: residual {}", rep.residual);
+        assert!(
+            rep.residual < 1e-10,
+            "trial {trial}: residual {}",
+            rep.residual
+        );
         assert!(misfit(&r, &axes, &out) < 1e-9);
         for (o, t) in out.iter().zip(&truth) {
-            assert!((o - t).abs() < 1e-7, "trial {trial} k {k}: {out:?} vs {truth:?}");
+            assert!(
+                (o - t).abs() < 1e-7,
+                "trial {trial} k {k}: {out:?} vs {truth:?}"
+            );
         }
         if k <= 2 {
             decompose_rotation(&r, &axes, None, &mut out).unwrap();
             for (o, t) in out.iter().zip(&truth) {
-                assert!(wrapped_diff(*o, *t) < 1e-7, "trial {trial} k {k}: {out:?} vs {truth:?}");
+                assert!(
+                    wrapped_diff(*o, *t) < 1e-7,
+                    "trial {trial} k {k}: {out:?} vs {truth:?}"
+                );
             }
         }
     }
@@ -289,7 +341,10 @@ fn bad_input_is_an_error() {
         decompose_rotation(&nan_q, &axes, None, &mut out3),
         Err(Error::NonFinite { .. })
     ));
-    let bad = DecomposeSettings { damping: 0.0, ..DecomposeSettings::default() };
+    let bad = DecomposeSettings {
+        damping: 0.0,
+        ..DecomposeSettings::default()
+    };
     assert!(decompose_rotation_with(&r, &axes, None, &bad, &mut out3).is_err());
     assert!(DecomposeSettings::default().validate().is_ok());
     assert!(compose_rotation(&axes, &[0.0]).is_err());

@@ -32,7 +32,11 @@ fn all_builtin_clips_load_with_the_stated_durations_and_rates() {
         let clip = builtin_clip(name).unwrap();
         let text = file_text(name);
         assert_eq!(clip.frame_count(), bracket_frames(&text), "{name}");
-        assert!((clip.duration() - duration).abs() < 0.01, "{name}: {}", clip.duration());
+        assert!(
+            (clip.duration() - duration).abs() < 0.01,
+            "{name}: {}",
+            clip.duration()
+        );
         let measured = clip.mean_frame_rate().unwrap();
         assert!((measured - rate).abs() < 0.01, "{name}: {measured} Hz");
         assert_eq!(clip.times()[0], 0.0);
@@ -40,8 +44,14 @@ fn all_builtin_clips_load_with_the_stated_durations_and_rates() {
         // Same as reading the file from disk.
         assert_eq!(read_deepmimic(&text, name).unwrap(), clip);
     }
-    assert_eq!(builtin_clip("humanoid3d_dance_a").unwrap().frame_count(), 98);
-    assert_eq!(builtin_clip("humanoid3d_dance_b").unwrap().frame_count(), 153);
+    assert_eq!(
+        builtin_clip("humanoid3d_dance_a").unwrap().frame_count(),
+        98
+    );
+    assert_eq!(
+        builtin_clip("humanoid3d_dance_b").unwrap().frame_count(),
+        153
+    );
     assert_eq!(builtin_clip("humanoid3d_punch").unwrap().frame_count(), 65);
     assert_eq!(builtin_clip("humanoid3d_walk").unwrap().frame_count(), 39);
 }
@@ -111,13 +121,19 @@ fn walk_has_human_proportions_after_z_up() {
     );
     assert!((1.5..1.9).contains(&height), "height {height}");
     assert!(floor.abs() < 0.1, "the feet are near the floor: {floor}");
-    assert!(at("left_hip").y > at("right_hip").y, "left is +y after Y-up → Z-up");
+    assert!(
+        at("left_hip").y > at("right_hip").y,
+        "left is +y after Y-up → Z-up"
+    );
     assert!(at("neck").z > at("chest").z && at("chest").z > at("root").z);
     // Rigid links: the thigh is 0.25 × 1.686184 m long in every frame of every clip.
     for name in BUILTIN_CLIP_NAMES {
         let c = builtin_clip(name).unwrap();
         let s = c.skeleton();
-        let (h, k) = (s.index_of("left_hip").unwrap(), s.index_of("left_knee").unwrap());
+        let (h, k) = (
+            s.index_of("left_hip").unwrap(),
+            s.index_of("left_knee").unwrap(),
+        );
         for f in 0..c.frame_count() {
             let p = c.world_positions(f).unwrap();
             assert!(((p[k] - p[h]).norm() - 0.25 * 1.686184).abs() < 1e-12);
@@ -187,7 +203,13 @@ const ZERO_FRAME: &str = "0.0333,0,0.85,0, 1,0,0,0, 1,0,0,0, 1,0,0,0, 1,0,0,0, -
 
 fn small_file(frames: &[String]) -> String {
     let mut s = String::from("{\n\"Loop\": \"wrap\",\n\"Frames\":\n[\n");
-    s.push_str(&frames.iter().map(|f| format!("[{f}]")).collect::<Vec<_>>().join(",\n"));
+    s.push_str(
+        &frames
+            .iter()
+            .map(|f| format!("[{f}]"))
+            .collect::<Vec<_>>()
+            .join(",\n"),
+    );
     s.push_str("\n]\n}\n");
     s
 }
@@ -208,12 +230,19 @@ fn a_small_file_reads_and_bad_ones_name_frame_line_and_field() {
 
     // Frame 1 (line 6) with 43 numbers.
     let short = ZERO_FRAME.rsplit_once(',').unwrap().0.to_string();
-    let (line, msg) = parse_error(read_deepmimic(&small_file(&[ZERO_FRAME.into(), short]), "f"));
+    let (line, msg) = parse_error(read_deepmimic(
+        &small_file(&[ZERO_FRAME.into(), short]),
+        "f",
+    ));
     assert_eq!(line, 6);
     assert!(msg.contains("frame 1") && msg.contains("43"), "{msg}");
 
     // Neck quaternion of zero norm in frame 0 (line 5).
-    let zero_neck = ZERO_FRAME.replacen(" 1,0,0,0, 1,0,0,0, 1,0,0,0,", " 1,0,0,0, 1,0,0,0, 0,0,0,0,", 1);
+    let zero_neck = ZERO_FRAME.replacen(
+        " 1,0,0,0, 1,0,0,0, 1,0,0,0,",
+        " 1,0,0,0, 1,0,0,0, 0,0,0,0,",
+        1,
+    );
     let (line, msg) = parse_error(read_deepmimic(&small_file(&[zero_neck]), "f"));
     assert_eq!(line, 5);
     assert!(msg.contains("frame 0") && msg.contains("`neck`"), "{msg}");
@@ -227,7 +256,10 @@ fn a_small_file_reads_and_bad_ones_name_frame_line_and_field() {
     let (_, msg) = parse_error(read_deepmimic("{\"Frames\": []}", "f"));
     assert!(msg.contains("zero frames"));
     let zero_dt = ZERO_FRAME.replacen("0.0333", "0", 1);
-    let (line, msg) = parse_error(read_deepmimic(&small_file(&[zero_dt, ZERO_FRAME.into()]), "f"));
+    let (line, msg) = parse_error(read_deepmimic(
+        &small_file(&[zero_dt, ZERO_FRAME.into()]),
+        "f",
+    ));
     assert_eq!(line, 5);
     assert!(msg.contains("duration"));
     assert!(read_deepmimic("{\"Loop\": 1}", "f").is_err());
@@ -239,7 +271,9 @@ fn a_small_file_reads_and_bad_ones_name_frame_line_and_field() {
 #[test]
 fn quaternion_norm_tolerance_is_a_setting() {
     let text = file_text("humanoid3d_punch");
-    let strict = DeepMimicSettings { max_quaternion_norm_error: 0.05 };
+    let strict = DeepMimicSettings {
+        max_quaternion_norm_error: 0.05,
+    };
     let (line, msg) = parse_error(read_deepmimic_with(&text, "punch", &strict));
     assert!(msg.contains("frame 57") && msg.contains("`neck`"), "{msg}");
     // The first frame is on line 5 of the file, one frame per line.
@@ -250,5 +284,9 @@ fn quaternion_norm_tolerance_is_a_setting() {
             assert!((q.norm() - 1.0).abs() < 1e-12);
         }
     }
-    assert!(DeepMimicSettings { max_quaternion_norm_error: 1.5 }.validate().is_err());
+    assert!(DeepMimicSettings {
+        max_quaternion_norm_error: 1.5
+    }
+    .validate()
+    .is_err());
 }

@@ -2,7 +2,7 @@
 
 use std::f64::consts::{PI, TAU};
 
-/// Wraps an angle [rad] into (−π, π].
+/// Wraps an angle \[rad\] into (−π, π].
 ///
 /// Non-finite input is returned unchanged (the callers check finiteness first).
 pub fn wrap_to_pi(angle: f64) -> f64 {
@@ -16,7 +16,7 @@ pub fn wrap_to_pi(angle: f64) -> f64 {
     a
 }
 
-/// The angle equivalent to `angle` modulo 2π that is nearest to `reference` [rad]:
+/// The angle equivalent to `angle` modulo 2π that is nearest to `reference` \[rad\]:
 /// `angle + 2πk` with the integer `k` minimising `|angle + 2πk − reference|`.
 pub fn nearest_equivalent(angle: f64, reference: f64) -> f64 {
     if !angle.is_finite() || !reference.is_finite() {

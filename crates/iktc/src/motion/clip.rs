@@ -24,19 +24,19 @@ pub enum UpAxis {
 /// zero.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Pose {
-    /// Position of the root joint in the world [m].
+    /// Position of the root joint in the world \[m\].
     pub root_position: Vector3<f64>,
     /// Orientation of the root joint's frame in the world.
     pub root_orientation: UnitQuaternion<f64>,
     /// Local rotation of every joint relative to its parent's frame (a hinge's is a rotation
     /// about its axis; a fixed joint's is the identity).
     pub rotations: Vec<UnitQuaternion<f64>>,
-    /// Extra local translation of every joint [m], added to its rest offset (BVH position
+    /// Extra local translation of every joint \[m\], added to its rest offset (BVH position
     /// channels on non-root joints); zero for most joints.
     pub translations: Vec<Vector3<f64>>,
 }
 
-/// A captured motion: a [`Skeleton`], the time of every frame [s] and one [`Pose`] per frame.
+/// A captured motion: a [`Skeleton`], the time of every frame \[s\] and one [`Pose`] per frame.
 ///
 /// Invariants (checked by [`Clip::new`]): at least one frame; times finite and strictly
 /// increasing; every pose sized for the skeleton and finite.
@@ -120,7 +120,7 @@ impl Clip {
         &self.skeleton
     }
 
-    /// Time of every frame [s], strictly increasing (the first is 0 for the built-in readers).
+    /// Time of every frame \[s\], strictly increasing (the first is 0 for the built-in readers).
     pub fn times(&self) -> &[f64] {
         &self.times
     }
@@ -145,7 +145,7 @@ impl Clip {
         self.frames.len()
     }
 
-    /// Duration [s]: time of the last frame minus time of the first.
+    /// Duration \[s\]: time of the last frame minus time of the first.
     pub fn duration(&self) -> f64 {
         match (self.times.first(), self.times.last()) {
             (Some(a), Some(b)) => b - a,
@@ -153,20 +153,20 @@ impl Clip {
         }
     }
 
-    /// Mean frame rate [Hz], `(n − 1) / duration`; `None` for a single frame.
+    /// Mean frame rate \[Hz\], `(n − 1) / duration`; `None` for a single frame.
     pub fn mean_frame_rate(&self) -> Option<f64> {
         let d = self.duration();
         (self.frames.len() > 1 && d > 0.0).then(|| (self.frames.len() - 1) as f64 / d)
     }
 
-    /// The pose at time `t` [s]; see [`Clip::sample_into`].
+    /// The pose at time `t` \[s\]; see [`Clip::sample_into`].
     pub fn sample(&self, t: f64) -> Result<Pose> {
         let mut pose = self.skeleton.rest_pose();
         self.sample_into(t, &mut pose)?;
         Ok(pose)
     }
 
-    /// Writes the pose at time `t` [s] into `pose` (resized if needed, so no allocation when it
+    /// Writes the pose at time `t` \[s\] into `pose` (resized if needed, so no allocation when it
     /// already fits).
     ///
     /// Between frames `i` and `i+1`, with `α = (t − t_i)/(t_{i+1} − t_i)`: positions and
@@ -215,14 +215,17 @@ impl Clip {
         Ok(())
     }
 
-    /// World positions of all joints at frame `index` [m] (forward kinematics, see
+    /// World positions of all joints at frame `index` \[m\] (forward kinematics, see
     /// [`Skeleton::world_transforms`]).
     pub fn world_positions(&self, index: usize) -> Result<Vec<Vector3<f64>>> {
-        let pose = self.frames.get(index).ok_or_else(|| Error::InvalidSetting {
-            name: "frame index".to_string(),
-            value: index.to_string(),
-            expected: format!("an index below the frame count {}", self.frames.len()),
-        })?;
+        let pose = self
+            .frames
+            .get(index)
+            .ok_or_else(|| Error::InvalidSetting {
+                name: "frame index".to_string(),
+                value: index.to_string(),
+                expected: format!("an index below the frame count {}", self.frames.len()),
+            })?;
         self.skeleton.world_positions(pose)
     }
 

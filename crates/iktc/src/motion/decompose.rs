@@ -1,54 +1,5 @@
 //! Decomposition of a rotation into rotations about given joint axes, for retargeting a captured
-//! joint rotation onto a robot's 1–3 revolute joints.
-//!
-//! Given a rotation `R` and an ordered list of unit axes `a_1 … a_k` (k = 1, 2 or 3), find angles
-//! `θ_1 … θ_k` [rad] such that
-//!
-//! ```text
-//! R ≈ Rot(a_1, θ_1) · Rot(a_2, θ_2) · … · Rot(a_k, θ_k)
-//! ```
-//!
-//! where `Rot(a, θ)` is the right-handed rotation by `θ` about `a` and the product acts on column
-//! vectors (the rightmost factor is applied first to a vector; read left to right it is a sequence
-//! of *intrinsic* rotations: first about `a_1`, then about the moved `a_2`, …). The axes are
-//! expressed in the frame `R` maps *from* is expressed in before any rotation, i.e. the joint axes
-//! of a serial chain at zero angles.
-//!
-//! Three cases:
-//!
-//! * **k = 3 with `a_1 ⊥ a_2` and `a_2 ⊥ a_3`** (all Tait–Bryan and proper Euler orders and their
-//!   generalisation, the *Davenport angles*): closed form (Shuster & Markley, "Generalization of
-//!   Euler angles", J. Astronaut. Sci. 51(2), 2003). With `λ = atan2(a_1·(a_2×a_3), a_1·a_3)`:
-//!   `a_1ᵀ R a_3 = cos(θ_2 − λ)`, so `θ_2 = λ ± β` with `β = atan2(‖w − (a_1·w)a_1‖, a_1·w)`,
-//!   `w = R a_3`; then `θ_1` is the angle about `a_1` taking `Rot(a_2, θ_2) a_3` to `R a_3`, and
-//!   `θ_3` the angle about `a_3` taking `Rᵀ a_1` to `Rot(a_2, θ_2)ᵀ a_1`. Every rotation is
-//!   represented. The result is polished by the Gauss–Newton iteration below (normally 0–1 steps).
-//! * **k = 1**: the *twist* of the swing–twist decomposition, `θ = 2·atan2(v·a, w)` for
-//!   `R = (w, v)` as a unit quaternion. It is the exact least-squares answer: it minimises the
-//!   angle of the residual rotation `R · Rot(a, θ)ᵀ`.
-//! * **k = 2, or 3 axes that are not consecutively orthogonal**: seeds from projections (for two
-//!   axes, `θ_1` turns `a_2` about `a_1` towards `R a_2`, then `θ_2` is the twist of the remainder
-//!   about `a_2`; sequential twists for three), the previous angles if given, then damped
-//!   Gauss–Newton on the residual rotation vector `e(θ) = log(R · R(θ)ᵀ)` (spatial frame) with the
-//!   Jacobian columns `J_i = Rot(a_1,θ_1)⋯Rot(a_{i−1},θ_{i−1}) a_i`:
-//!   `(JᵀJ + μI) δ = Jᵀe`, `θ ← θ + δ` with step halving while the residual does not decrease.
-//!   The result is a local least-squares solution (the smallest residual over the seeds); it is
-//!   exact whenever `R` is representable and a seed lies in the basin of the solution.
-//!
-//! **Choice among equivalent solutions.** Angles are defined modulo 2π, and three-axis
-//! decompositions have two branches (`θ_2 = λ ± β`). Without `previous`, every angle is wrapped
-//! into (−π, π] and the branch with the smaller `|θ_2|` is taken (for the Tait–Bryan orders this is
-//! `θ_2 ∈ [−π/2, π/2]`; for proper Euler orders, `θ_2 ∈ [0, π]`). With `previous`, the branch and
-//! the 2π-equivalent of every angle that are nearest (in Euclidean distance) to the previous angles
-//! are taken, so a track decomposed frame after frame stays continuous and may leave (−π, π].
-//!
-//! **Singular case (gimbal lock).** When `a_1` and `Rot(a_2, θ_2) a_3` are parallel
-//! (`|sin(θ_2 − λ)|` below [`DecomposeSettings::singularity_tolerance`]), only
-//! `φ = θ_1 + σθ_3` is determined (`σ = ±1`, the sign of `cos(θ_2 − λ)`). Then `φ` is split so that
-//! `(θ_1, θ_3)` is nearest to the previous angles: `θ_1 = p_1 + d/2`, `θ_3 = p_3 + σd/2` with
-//! `d = φ − (p_1 + σp_3)` (φ taken modulo 2π nearest to `p_1 + σp_3`); without `previous`,
-//! `θ_3 = 0`. The same rule applies to one axis when the twist is undefined (`R` a half turn about
-//! an axis perpendicular to `a`): the previous angle, or 0, is kept.
+//! joint rotation onto a robot's 1–3 revolute joints (see [`decompose_rotation`]).
 
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 
@@ -61,33 +12,33 @@ pub const MAX_DECOMPOSITION_AXES: usize = 3;
 /// Thresholds of [`decompose_rotation_with`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DecomposeSettings {
-    /// Largest `|a_i · a_j|` [–] for which consecutive axes count as orthogonal, so that three
+    /// Largest `|a_i · a_j|` \[–\] for which consecutive axes count as orthogonal, so that three
     /// axes are decomposed in closed form. Larger values send nearly orthogonal axes to the closed
     /// form, whose small error the Gauss–Newton polish then removes; smaller values send them to
     /// the slower iterative path. Default 1e-9.
     pub orthogonality_tolerance: f64,
-    /// `|sin(θ_2 − λ)|` [–] below which a three-axis decomposition is treated as gimbal-locked
+    /// `|sin(θ_2 − λ)|` \[–\] below which a three-axis decomposition is treated as gimbal-locked
     /// (and, for one axis, the norm of the quaternion's part `(w, v·a)` below which the twist is
     /// undefined). Larger values give smoother tracks near the singularity at the price of a
     /// Gauss–Newton polish over a wider band; smaller values let rounding noise of `R`, amplified
     /// by `1/|sin(θ_2 − λ)|`, reach `θ_1` and `θ_3`. Default 1e-7.
     pub singularity_tolerance: f64,
-    /// Largest number of Gauss–Newton iterations per seed [–]. More iterations polish harder
+    /// Largest number of Gauss–Newton iterations per seed \[–\]. More iterations polish harder
     /// cases (far seeds, non-orthogonal axes) at a proportional cost. Default 50.
     pub max_iterations: usize,
-    /// Largest number of step halvings per Gauss–Newton iteration [–] before the iteration stops
+    /// Largest number of step halvings per Gauss–Newton iteration \[–\] before the iteration stops
     /// for lack of progress. Default 30.
     pub max_step_halvings: usize,
-    /// Gauss–Newton stops when the accepted step is shorter than this [rad]. Smaller values
+    /// Gauss–Newton stops when the accepted step is shorter than this \[rad\]. Smaller values
     /// polish to the last digits at the cost of an extra iteration or two. Default 1e-12.
     pub step_tolerance: f64,
-    /// Levenberg damping `μ` [–] added to the diagonal of `JᵀJ`: keeps the step bounded at
+    /// Levenberg damping `μ` \[–\] added to the diagonal of `JᵀJ`: keeps the step bounded at
     /// singular configurations (where it also keeps the angles near their seed) and costs
     /// convergence speed when too large. Default 1e-9.
     pub damping: f64,
-    /// Smallest accepted norm of a given axis [–] (axes are normalised). Default 1e-9.
+    /// Smallest accepted norm of a given axis \[–\] (axes are normalised). Default 1e-9.
     pub min_axis_norm: f64,
-    /// Solutions whose residual angles differ by less than this [rad] count as equally good; among
+    /// Solutions whose residual angles differ by less than this \[rad\] count as equally good; among
     /// them the one nearest to `previous` wins. Larger values favour continuity over the last
     /// digits of the fit. Default 1e-9.
     pub equivalence_tolerance: f64,
@@ -172,17 +123,67 @@ pub enum DecompositionMethod {
 pub struct Decomposition {
     /// Which path produced the angles.
     pub method: DecompositionMethod,
-    /// Angle of the residual rotation `R · R(θ)ᵀ` [rad]: 0 (to rounding) when `R` is represented
+    /// Angle of the residual rotation `R · R(θ)ᵀ` \[rad\]: 0 (to rounding) when `R` is represented
     /// exactly by the axes, otherwise the least-squares misfit.
     pub residual: f64,
-    /// Gauss–Newton iterations carried out in total (over all seeds) [–].
+    /// Gauss–Newton iterations carried out in total (over all seeds) \[–\].
     pub iterations: usize,
 }
 
 /// Decomposes `r` into rotations about `axes` (1 to 3 of them) with the default
-/// [`DecomposeSettings`]; see the [module documentation](self) for the equations and conventions.
+/// [`DecomposeSettings`].
 ///
-/// `out` receives `θ_1 … θ_k` [rad] and must have the length of `axes`; `previous`, if given,
+/// Given a rotation `R` and an ordered list of unit axes `a_1 … a_k` (k = 1, 2 or 3), find angles
+/// `θ_1 … θ_k` \[rad\] such that
+///
+/// ```text
+/// R ≈ Rot(a_1, θ_1) · Rot(a_2, θ_2) · … · Rot(a_k, θ_k)
+/// ```
+///
+/// where `Rot(a, θ)` is the right-handed rotation by `θ` about `a` and the product acts on column
+/// vectors (the rightmost factor is applied first to a vector; read left to right it is a sequence
+/// of *intrinsic* rotations: first about `a_1`, then about the moved `a_2`, …). Each axis is
+/// given in its own joint frame at zero angle, which for a serial chain of joints sharing one
+/// origin frame (a robot's shoulder pitch–roll–yaw at zero) is the parent frame of `R`: the
+/// axes of the chain at its zero configuration.
+///
+/// Three cases:
+///
+/// * **k = 3 with `a_1 ⊥ a_2` and `a_2 ⊥ a_3`** (all Tait–Bryan and proper Euler orders and their
+///   generalisation, the *Davenport angles*): closed form (Shuster & Markley, "Generalization of
+///   Euler angles", J. Astronaut. Sci. 51(2), 2003). With `λ = atan2(a_1·(a_2×a_3), a_1·a_3)`:
+///   `a_1ᵀ R a_3 = cos(θ_2 − λ)`, so `θ_2 = λ ± β` with `β = atan2(‖w − (a_1·w)a_1‖, a_1·w)`,
+///   `w = R a_3`; then `θ_1` is the angle about `a_1` taking `Rot(a_2, θ_2) a_3` to `R a_3`, and
+///   `θ_3` the angle about `a_3` taking `Rᵀ a_1` to `Rot(a_2, θ_2)ᵀ a_1`. Every rotation is
+///   represented. The result is polished by the Gauss–Newton iteration below (normally 0–1 steps).
+/// * **k = 1**: the *twist* of the swing–twist decomposition, `θ = 2·atan2(v·a, w)` for
+///   `R = (w, v)` as a unit quaternion. It is the exact least-squares answer: it minimises the
+///   angle of the residual rotation `R · Rot(a, θ)ᵀ`.
+/// * **k = 2, or 3 axes that are not consecutively orthogonal**: seeds from projections (for two
+///   axes, `θ_1` turns `a_2` about `a_1` towards `R a_2`, then `θ_2` is the twist of the remainder
+///   about `a_2`; sequential twists for three), the previous angles if given, then damped
+///   Gauss–Newton on the residual rotation vector `e(θ) = log(R · R(θ)ᵀ)` (spatial frame) with the
+///   Jacobian columns `J_i = Rot(a_1,θ_1)⋯Rot(a_{i−1},θ_{i−1}) a_i`:
+///   `(JᵀJ + μI) δ = Jᵀe`, `θ ← θ + δ` with step halving while the residual does not decrease.
+///   The result is a local least-squares solution (the smallest residual over the seeds); it is
+///   exact whenever `R` is representable and a seed lies in the basin of the solution.
+///
+/// **Choice among equivalent solutions.** Angles are defined modulo 2π, and three-axis
+/// decompositions have two branches (`θ_2 = λ ± β`). Without `previous`, every angle is wrapped
+/// into (−π, π] and the branch with the smaller `|θ_2|` is taken (for the Tait–Bryan orders this is
+/// `θ_2 ∈ \[−π/2, π/2\]`; for proper Euler orders, `θ_2 ∈ \[0, π\]`). With `previous`, the branch and
+/// the 2π-equivalent of every angle that are nearest (in Euclidean distance) to the previous angles
+/// are taken, so a track decomposed frame after frame stays continuous and may leave (−π, π].
+///
+/// **Singular case (gimbal lock).** When `a_1` and `Rot(a_2, θ_2) a_3` are parallel
+/// (`|sin(θ_2 − λ)|` below [`DecomposeSettings::singularity_tolerance`]), only
+/// `φ = θ_1 + σθ_3` is determined (`σ = ±1`, the sign of `cos(θ_2 − λ)`). Then `φ` is split so that
+/// `(θ_1, θ_3)` is nearest to the previous angles: `θ_1 = p_1 + d/2`, `θ_3 = p_3 + σd/2` with
+/// `d = φ − (p_1 + σp_3)` (φ taken modulo 2π nearest to `p_1 + σp_3`); without `previous`,
+/// `θ_3 = 0`. The same rule applies to one axis when the twist is undefined (`R` a half turn about
+/// an axis perpendicular to `a`): the previous angle, or 0, is kept.
+///
+/// `out` receives `θ_1 … θ_k` \[rad\] and must have the length of `axes`; `previous`, if given,
 /// too. Errors: 0 or more than [`MAX_DECOMPOSITION_AXES`] axes, a length mismatch, a non-finite
 /// input, an axis of (near) zero length. Allocates nothing.
 pub fn decompose_rotation(
@@ -297,12 +298,12 @@ fn axis_rotation(n: &Vector3<f64>, angle: f64) -> UnitQuaternion<f64> {
     UnitQuaternion::from_scaled_axis(n * angle)
 }
 
-/// Angle [rad] of a rotation, in [0, π], computed without the loss of precision of `acos`.
+/// Angle \[rad\] of a rotation, in \[0, π\], computed without the loss of precision of `acos`.
 pub fn rotation_angle(q: &UnitQuaternion<f64>) -> f64 {
     2.0 * q.imag().norm().atan2(q.w.abs())
 }
 
-/// Rotation vector (axis × angle, angle in [0, π]) of a unit quaternion, precise near identity.
+/// Rotation vector (axis × angle, angle in \[0, π\]) of a unit quaternion, precise near identity.
 fn log(q: &UnitQuaternion<f64>) -> Vector3<f64> {
     let (w, v) = if q.w < 0.0 {
         (-q.w, -q.imag())
@@ -316,7 +317,7 @@ fn log(q: &UnitQuaternion<f64>) -> Vector3<f64> {
     v * (2.0 * s.atan2(w) / s)
 }
 
-/// Signed angle [rad] about the unit `axis` that turns the projection of `from` onto the plane
+/// Signed angle \[rad\] about the unit `axis` that turns the projection of `from` onto the plane
 /// normal to `axis` onto the projection of `to` (0 if either projection vanishes).
 fn signed_angle(axis: &Vector3<f64>, from: &Vector3<f64>, to: &Vector3<f64>) -> f64 {
     let y = axis.dot(&from.cross(to));
@@ -468,17 +469,17 @@ impl Problem<'_> {
         let mut s1 = [0.0; MAX_DECOMPOSITION_AXES];
         s1[0] = signed_angle(&self.n[0], &self.n[1], &(r * self.n[1]));
         let mut rest = axis_rotation(&self.n[0], s1[0]).inverse() * r;
-        for i in 1..self.k {
-            s1[i] = twist_angle(&rest, &self.n[i]);
-            rest = axis_rotation(&self.n[i], s1[i]).inverse() * rest;
+        for (t, n) in s1.iter_mut().zip(self.n.iter()).take(self.k).skip(1) {
+            *t = twist_angle(&rest, n);
+            rest = axis_rotation(n, *t).inverse() * rest;
         }
         seeds[0] = Some(s1);
         // Seed 2: sequential twists.
         let mut s2 = [0.0; MAX_DECOMPOSITION_AXES];
         let mut rest = r;
-        for i in 0..self.k {
-            s2[i] = twist_angle(&rest, &self.n[i]);
-            rest = axis_rotation(&self.n[i], s2[i]).inverse() * rest;
+        for (t, n) in s2.iter_mut().zip(self.n.iter()).take(self.k) {
+            *t = twist_angle(&rest, n);
+            rest = axis_rotation(n, *t).inverse() * rest;
         }
         seeds[1] = Some(s2);
         // Seed 3: the previous angles.
@@ -496,14 +497,16 @@ impl Problem<'_> {
                 None => true,
                 Some((_, best_res, best_dist)) => {
                     let tol = self.settings.equivalence_tolerance;
-                    residual < best_res - tol || (residual <= best_res + tol && distance < best_dist)
+                    residual < best_res - tol
+                        || (residual <= best_res + tol && distance < best_dist)
                 }
             };
             if better {
                 best = Some((theta, residual, distance));
             }
         }
-        let (theta, residual) = best.map_or(([0.0; MAX_DECOMPOSITION_AXES], f64::NAN), |b| (b.0, b.1));
+        let (theta, residual) =
+            best.map_or(([0.0; MAX_DECOMPOSITION_AXES], f64::NAN), |b| (b.0, b.1));
         (
             theta,
             Decomposition {
@@ -561,7 +564,7 @@ impl Problem<'_> {
     }
 }
 
-/// Twist angle of `q` about the unit axis `a` [rad] (0 where undefined).
+/// Twist angle of `q` about the unit axis `a` \[rad\] (0 where undefined).
 fn twist_angle(q: &UnitQuaternion<f64>, a: &Vector3<f64>) -> f64 {
     let p = q.imag().dot(a);
     if p == 0.0 && q.w == 0.0 {

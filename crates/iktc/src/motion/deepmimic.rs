@@ -1,9 +1,9 @@
 //! Reader of DeepMimic motion files and the DeepMimic humanoid skeleton.
 //!
 //! File format (see `data/NOTICE.md`): JSON with a `"Frames"` array; each frame holds 44
-//! numbers: `[duration of the frame [s], root position (3) [m], root orientation (w, x, y, z),
-//! chest (w, x, y, z), neck, right hip, right knee angle [rad], right ankle, right shoulder,
-//! right elbow angle [rad], left hip, left knee angle, left ankle, left shoulder, left elbow
+//! numbers: `[duration of the frame \[s\], root position (3) \[m\], root orientation (w, x, y, z),
+//! chest (w, x, y, z), neck, right hip, right knee angle \[rad\], right ankle, right shoulder,
+//! right elbow angle \[rad\], left hip, left knee angle, left ankle, left shoulder, left elbow
 //! angle]`; the world is Y-up. Quaternions are local rotations of a joint's frame relative to its
 //! parent's; the angles are rotations about the hinge axes of `deepmimic_humanoid.urdf`.
 //!
@@ -23,7 +23,7 @@ use crate::error::{Error, Result};
 pub const DEEPMIMIC_URDF: &str =
     include_str!("../../../../data/motions/deepmimic/deepmimic_humanoid.urdf");
 
-/// Length of one URDF unit of [`DEEPMIMIC_URDF`] in metres [m/unit].
+/// Length of one URDF unit of [`DEEPMIMIC_URDF`] in metres \[m/unit\].
 ///
 /// pybullet loads that file with `globalScaling = 0.25`; the motion files' root heights confirm it:
 /// in the first frame of `humanoid3d_walk` the pelvis is 0.848 m above the floor, and the scaled
@@ -52,7 +52,7 @@ pub const DEEPMIMIC_FRAME_LEN: usize = 44;
 /// Settings of [`read_deepmimic_with`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DeepMimicSettings {
-    /// Largest accepted `|‖q‖ − 1|` [–] of a quaternion in the file before it is normalised.
+    /// Largest accepted `|‖q‖ − 1|` \[–\] of a quaternion in the file before it is normalised.
     /// Larger values accept sloppier files (whose rotations are then only what the normalised
     /// quaternion says); smaller values reject them. Default 0.1: the shipped `humanoid3d_punch`
     /// has neck quaternions of norm down to 0.917 (frames 55–64); the other clips are unit to
@@ -167,16 +167,15 @@ fn skeleton_from_urdf(text: &str, scale: f64) -> Result<Skeleton> {
             (Some(_), urdf_rs::JointType::Fixed) => JointKind::Fixed,
             (Some(_), urdf_rs::JointType::Revolute | urdf_rs::JointType::Continuous) => {
                 let axis = Vector3::from(*uj.axis.xyz);
-                let axis = Unit::try_new(axis, 0.0).ok_or_else(|| {
-                    urdf_error(format!("joint `{}` has a zero axis", uj.name))
-                })?;
+                let axis = Unit::try_new(axis, 0.0)
+                    .ok_or_else(|| urdf_error(format!("joint `{}` has a zero axis", uj.name)))?;
                 JointKind::Hinge { axis }
             }
             (Some(_), other) => {
                 return Err(urdf_error(format!(
-                    "joint `{}` has type {other:?}; expected spherical, revolute, continuous or fixed",
-                    uj.name
-                )))
+                "joint `{}` has type {other:?}; expected spherical, revolute, continuous or fixed",
+                uj.name
+            )))
             }
         };
         let index = joints.len();
@@ -212,9 +211,13 @@ fn skeleton_from_urdf(text: &str, scale: f64) -> Result<Skeleton> {
     Skeleton::new(joints)
 }
 
-/// Offset of an end site in the frame of `link` [URDF units].
+/// Offset of an end site in the frame of `link` \[URDF units\].
 fn end_site_offset(robot: &urdf_rs::Robot, link: &str) -> Result<Vector3<f64>> {
-    let missing = || urdf_error(format!("link `{link}` has no collision geometry for an end site"));
+    let missing = || {
+        urdf_error(format!(
+            "link `{link}` has no collision geometry for an end site"
+        ))
+    };
     let collision = robot
         .links
         .iter()

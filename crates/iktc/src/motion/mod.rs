@@ -1,8 +1,8 @@
 //! Captured motion: clips, readers and writers, and the rotation decomposition used to retarget
 //! captured joint rotations onto robot joints.
 //!
-//! * [`Clip`] — plain data: a [`Skeleton`] (named joints, parents, rest offsets [m], spherical /
-//!   hinge / fixed / root), frame times [s] and one [`Pose`] per frame (root position [m], root
+//! * [`Clip`] — plain data: a [`Skeleton`] (named joints, parents, rest offsets \[m\], spherical /
+//!   hinge / fixed / root), frame times \[s\] and one [`Pose`] per frame (root position \[m\], root
 //!   orientation, local joint rotations); sampling at any time (slerp) and forward kinematics.
 //! * [`read_deepmimic`], [`builtin_clip`] — DeepMimic motion files on the DeepMimic humanoid
 //!   (Y-up; convert with [`Clip::to_z_up`] / [`y_up_to_z_up`]).

@@ -19,7 +19,7 @@ pub enum JointKind {
     /// A revolute joint: its local rotation is a rotation about `axis` (a unit vector in the
     /// joint's frame, which at zero angle coincides with the parent's frame).
     Hinge {
-        /// The rotation axis [–], unit length.
+        /// The rotation axis \[–\], unit length.
         axis: Unit<Vector3<f64>>,
     },
     /// A rigid attachment (an end site, a wrist): its local rotation is the identity.
@@ -33,7 +33,7 @@ pub struct SkeletonJoint {
     pub name: String,
     /// Index of the parent joint (smaller than this joint's index), `None` for the root.
     pub parent: Option<usize>,
-    /// Rest offset [m]: position of this joint's origin in its parent's frame when the parent's
+    /// Rest offset \[m\]: position of this joint's origin in its parent's frame when the parent's
     /// rotation is applied (for the root: its rest position in the world, unused by the forward
     /// kinematics, which place the root at the frame's root position).
     pub offset: Vector3<f64>,
@@ -156,7 +156,7 @@ impl Skeleton {
     /// Forward kinematics: the pose of every joint frame in the world.
     ///
     /// `T_0 = (root_position, root_orientation)`; for a joint `j` with parent `p`,
-    /// `p_j = p_p + R_p (offset_j + translation_j)` [m] and `R_j = R_p · rotation_j`.
+    /// `p_j = p_p + R_p (offset_j + translation_j)` \[m\] and `R_j = R_p · rotation_j`.
     /// `out` must have one entry per joint. Allocates nothing.
     pub fn world_transforms(&self, pose: &Pose, out: &mut [Isometry3<f64>]) -> Result<()> {
         self.check_pose(pose)?;
@@ -182,7 +182,7 @@ impl Skeleton {
         Ok(())
     }
 
-    /// World positions of all joints [m] (see [`Skeleton::world_transforms`]).
+    /// World positions of all joints \[m\] (see [`Skeleton::world_transforms`]).
     pub fn world_positions(&self, pose: &Pose) -> Result<Vec<Vector3<f64>>> {
         let mut transforms = vec![Isometry3::identity(); self.joints.len()];
         self.world_transforms(pose, &mut transforms)?;
@@ -192,7 +192,11 @@ impl Skeleton {
     /// Checks that `pose` has one rotation and one translation per joint.
     pub fn check_pose(&self, pose: &Pose) -> Result<()> {
         check_dim("pose rotations", self.joints.len(), pose.rotations.len())?;
-        check_dim("pose translations", self.joints.len(), pose.translations.len())
+        check_dim(
+            "pose translations",
+            self.joints.len(),
+            pose.translations.len(),
+        )
     }
 }
 

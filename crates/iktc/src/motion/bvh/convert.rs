@@ -4,9 +4,7 @@ use nalgebra::{Unit, UnitQuaternion, Vector3};
 
 use super::types::{BvhChannel, BvhClip, BvhExportOptions, BvhJoint};
 use crate::error::{Error, Result};
-use crate::motion::{
-    decompose_rotation_with, Clip, JointKind, Pose, Skeleton, SkeletonJoint,
-};
+use crate::motion::{decompose_rotation_with, Clip, JointKind, Pose, Skeleton, SkeletonJoint};
 
 /// The rotation of a joint from its rotation channels, in the BVH convention: for channels
 /// listed `c_1 c_2 c_3` with angles `θ_1 θ_2 θ_3`, `R = Rot(c_1, θ_1) · Rot(c_2, θ_2) ·
@@ -24,7 +22,7 @@ pub fn bvh_rotation(channels: &[BvhChannel], values: &[f64]) -> UnitQuaternion<f
     q
 }
 
-/// The translation of a joint from its position channels [m] (their vector sum).
+/// The translation of a joint from its position channels \[m\] (their vector sum).
 fn bvh_translation(channels: &[BvhChannel], values: &[f64]) -> Vector3<f64> {
     channels
         .iter()
@@ -49,8 +47,12 @@ impl BvhClip {
             .iter()
             .enumerate()
             .map(|(i, j)| {
-                let rotations: Vec<BvhChannel> =
-                    j.channels.iter().copied().filter(|c| c.is_rotation()).collect();
+                let rotations: Vec<BvhChannel> = j
+                    .channels
+                    .iter()
+                    .copied()
+                    .filter(|c| c.is_rotation())
+                    .collect();
                 let kind = match (i, rotations.as_slice()) {
                     (0, _) => JointKind::Root,
                     (_, []) => JointKind::Fixed,
@@ -133,10 +135,11 @@ impl BvhClip {
             let sj = &skeleton.joints()[old];
             let is_root = sj.parent.is_none();
             let translates = !is_root
-                && clip
-                    .frames()
-                    .iter()
-                    .any(|p| p.translations.get(old).is_some_and(|t| *t != Vector3::zeros()));
+                && clip.frames().iter().any(|p| {
+                    p.translations
+                        .get(old)
+                        .is_some_and(|t| *t != Vector3::zeros())
+                });
             let has_children = skeleton.children(old).next().is_some();
             let mut channels = Vec::new();
             if is_root || translates {
@@ -204,7 +207,10 @@ impl BvhClip {
                 let here = values.len() - frame_start;
                 let previous: Option<Vec<f64>> = (f > 0).then(|| {
                     let start = frame_start - channel_count + here;
-                    values.get(start..start + k).map(|s| s.to_vec()).unwrap_or_default()
+                    values
+                        .get(start..start + k)
+                        .map(|s| s.to_vec())
+                        .unwrap_or_default()
                 });
                 let out = angles.get_mut(..k).unwrap_or(&mut []);
                 decompose_rotation_with(&q, axes, previous.as_deref(), &options.decompose, out)?;

@@ -12,7 +12,7 @@ mod write;
 pub use convert::bvh_rotation;
 pub use read::read_bvh;
 pub use types::{
-    BvhChannel, BvhClip, BvhExportOptions, BvhJoint, BvhReadOptions, BvhWriteOptions,
-    LengthUnit, RotationOrder,
+    BvhChannel, BvhClip, BvhExportOptions, BvhJoint, BvhReadOptions, BvhWriteOptions, LengthUnit,
+    RotationOrder,
 };
 pub use write::write_bvh;

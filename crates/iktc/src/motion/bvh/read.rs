@@ -127,7 +127,10 @@ impl<'a> Reader<'a> {
                 }
             }
             Some(("ROOT", l)) => {
-                return Err(self.error(l, "a second `ROOT` is not supported (one skeleton per file)"))
+                return Err(self.error(
+                    l,
+                    "a second `ROOT` is not supported (one skeleton per file)",
+                ))
             }
             Some((t, l)) => return Err(self.error(l, format!("expected `MOTION`, found `{t}`"))),
             None => {
@@ -135,16 +138,22 @@ impl<'a> Reader<'a> {
             }
         }
         let (frames_line, frame_count) = self.read_header_number("Frames")?;
-        let frame_count = frame_count
-            .parse::<usize>()
-            .map_err(|_| self.error(frames_line, format!("`Frames: {frame_count}` is not a frame count")))?;
+        let frame_count = frame_count.parse::<usize>().map_err(|_| {
+            self.error(
+                frames_line,
+                format!("`Frames: {frame_count}` is not a frame count"),
+            )
+        })?;
         if frame_count == 0 {
             return Err(self.error(frames_line, "zero frames"));
         }
         let (time_line, frame_time) = self.read_header_number("Frame Time")?;
         let frame_time = self.number(&frame_time, time_line, "Frame Time")?;
         if frame_time <= 0.0 {
-            return Err(self.error(time_line, format!("Frame Time {frame_time} s; expected > 0")));
+            return Err(self.error(
+                time_line,
+                format!("Frame Time {frame_time} s; expected > 0"),
+            ));
         }
         // Reserve no more than the text can hold (at least two bytes per value).
         let capacity = frame_count
@@ -156,11 +165,17 @@ impl<'a> Reader<'a> {
             if read == frame_count {
                 return Err(self.error(
                     line,
-                    format!("more frame lines than the {frame_count} declared at line {frames_line}"),
+                    format!(
+                        "more frame lines than the {frame_count} declared at line {frames_line}"
+                    ),
                 ));
             }
             if tokens.len() != channel_count {
-                let relation = if tokens.len() < channel_count { "fewer" } else { "more" };
+                let relation = if tokens.len() < channel_count {
+                    "fewer"
+                } else {
+                    "more"
+                };
                 return Err(self.error(
                     line,
                     format!(
@@ -193,7 +208,6 @@ impl<'a> Reader<'a> {
         )
     }
 
-
     /// Reads `<key>: value` (or `<key> : value`) on the next non-blank line.
     fn read_header_number(&mut self, key: &str) -> Result<(usize, String)> {
         let Some((tokens, line)) = self.next_line() else {
@@ -210,7 +224,10 @@ impl<'a> Reader<'a> {
             .map(str::trim);
         match value {
             Some(v) if !v.is_empty() => Ok((line, v.to_string())),
-            _ => Err(self.error(line, format!("expected `{key}: <number>`, found `{joined}`"))),
+            _ => Err(self.error(
+                line,
+                format!("expected `{key}: <number>`, found `{joined}`"),
+            )),
         }
     }
 
@@ -231,7 +248,9 @@ impl<'a> Reader<'a> {
                 });
             }
             Some((t, l)) => return Err(self.error(l, format!("expected `ROOT`, found `{t}`"))),
-            None => return Err(self.error(self.line, "the file ends before `ROOT` (truncated file)")),
+            None => {
+                return Err(self.error(self.line, "the file ends before `ROOT` (truncated file)"))
+            }
         }
         loop {
             let Some((token, line)) = self.next_token() else {
@@ -250,7 +269,9 @@ impl<'a> Reader<'a> {
                     let name = joints.get(index).map_or("", |j| j.name.as_str());
                     return Err(self.error(
                         line,
-                        format!("missing `{{` after `{name}` (line {header_line}), found `{token}`"),
+                        format!(
+                            "missing `{{` after `{name}` (line {header_line}), found `{token}`"
+                        ),
                     ));
                 }
                 pending = None;
@@ -305,7 +326,9 @@ impl<'a> Reader<'a> {
                         return Err(self.error(line, "an End Site cannot have CHANNELS"));
                     }
                     if open.has_children {
-                        return Err(self.error(line, "CHANNELS must come before the joint's children"));
+                        return Err(
+                            self.error(line, "CHANNELS must come before the joint's children")
+                        );
                     }
                     let channels = self.channels(line)?;
                     if let Some(j) = joints.get_mut(current) {
@@ -349,8 +372,8 @@ impl<'a> Reader<'a> {
                     return Err(self.error(
                         line,
                         format!(
-                            "unexpected `{other}`; expected OFFSET, CHANNELS, JOINT, End Site or `}}`"
-                        ),
+                        "unexpected `{other}`; expected OFFSET, CHANNELS, JOINT, End Site or `}}`"
+                    ),
                     ))
                 }
             }
@@ -426,7 +449,10 @@ impl<'a> Reader<'a> {
         if names.len() != count {
             return Err(self.error(
                 line,
-                format!("CHANNELS declares {count} channels but lists {}", names.len()),
+                format!(
+                    "CHANNELS declares {count} channels but lists {}",
+                    names.len()
+                ),
             ));
         }
         let mut channels: Vec<BvhChannel> = Vec::with_capacity(count);

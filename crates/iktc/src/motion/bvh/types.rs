@@ -10,13 +10,13 @@ use crate::motion::UpAxis;
 /// One BVH motion channel.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum BvhChannel {
-    /// Translation along the parent frame's x axis [m after reading].
+    /// Translation along the parent frame's x axis \[m after reading\].
     Xposition,
     /// Translation along y.
     Yposition,
     /// Translation along z.
     Zposition,
-    /// Rotation about x [rad after reading, degrees in the file].
+    /// Rotation about x \[rad after reading, degrees in the file\].
     Xrotation,
     /// Rotation about y.
     Yrotation,
@@ -86,13 +86,13 @@ pub enum LengthUnit {
     Inches,
     /// Any scale given by the caller.
     Custom {
-        /// Metres per file unit [m/unit], finite and > 0.
+        /// Metres per file unit \[m/unit\], finite and > 0.
         metres_per_unit: f64,
     },
 }
 
 impl LengthUnit {
-    /// Metres per file unit [m/unit].
+    /// Metres per file unit \[m/unit\].
     pub fn metres_per_unit(self) -> f64 {
         match self {
             LengthUnit::Metres => 1.0,
@@ -125,7 +125,7 @@ pub struct BvhJoint {
     pub name: String,
     /// Index of the parent joint, `None` for the root.
     pub parent: Option<usize>,
-    /// `OFFSET` [m]: the joint's origin in its parent's frame.
+    /// `OFFSET` \[m\]: the joint's origin in its parent's frame.
     pub offset: Vector3<f64>,
     /// `CHANNELS`, in file order (empty for end sites).
     pub channels: Vec<BvhChannel>,
@@ -243,7 +243,7 @@ impl BvhClip {
                 expected: "a frame time > 0 [s]".to_string(),
             });
         }
-        let expected = channel_count.checked_mul(frame_count).unwrap_or(usize::MAX);
+        let expected = channel_count.saturating_mul(frame_count);
         crate::error::check_dim("BVH channel values", expected, values.len())?;
         crate::error::check_all_finite("BVH channel values", &values)?;
         Ok(Self {
@@ -267,7 +267,7 @@ impl BvhClip {
         &self.joints
     }
 
-    /// `Frame Time` [s].
+    /// `Frame Time` \[s\].
     pub fn frame_time(&self) -> f64 {
         self.frame_time
     }
@@ -277,7 +277,7 @@ impl BvhClip {
         self.frame_count
     }
 
-    /// Duration [s]: `(frame_count − 1) · frame_time`.
+    /// Duration \[s\]: `(frame_count − 1) · frame_time`.
     pub fn duration(&self) -> f64 {
         (self.frame_count - 1) as f64 * self.frame_time
     }
@@ -292,12 +292,12 @@ impl BvhClip {
         self.values.len() / self.frame_count
     }
 
-    /// All values, frame-major [m, rad].
+    /// All values, frame-major \[m, rad\].
     pub fn values(&self) -> &[f64] {
         &self.values
     }
 
-    /// The channel values of frame `index` [m, rad].
+    /// The channel values of frame `index` \[m, rad\].
     pub fn frame(&self, index: usize) -> Option<&[f64]> {
         let c = self.channel_count();
         let start = index.checked_mul(c)?;
@@ -309,7 +309,7 @@ impl BvhClip {
         self.channel_starts.get(joint).copied()
     }
 
-    /// The track (one value per frame) of `channel` of joint `joint` [m or rad, unwrapped], or
+    /// The track (one value per frame) of `channel` of joint `joint` \[m or rad, unwrapped\], or
     /// `None` if the joint does not have that channel.
     pub fn track(&self, joint: usize, channel: BvhChannel) -> Option<Vec<f64>> {
         let j = self.joints.get(joint)?;
@@ -402,12 +402,12 @@ impl RotationOrder {
 pub struct BvhExportOptions {
     /// Euler order of ball joints and of the root (default ZXY).
     pub rotation_order: RotationOrder,
-    /// Largest deviation [s] of a frame interval from the mean interval; BVH has one frame time,
+    /// Largest deviation \[s\] of a frame interval from the mean interval; BVH has one frame time,
     /// so a clip with less regular times is refused (resample it first). Default 1e-6 s.
     pub frame_time_tolerance: f64,
-    /// Frame time written for a single-frame clip [s]. Default 1/30 s.
+    /// Frame time written for a single-frame clip \[s\]. Default 1/30 s.
     pub single_frame_time: f64,
-    /// A hinge whose axis is within this of a coordinate axis (`|a·e_k| ≥ 1 − tol`) [–] gets
+    /// A hinge whose axis is within this of a coordinate axis (`|a·e_k| ≥ 1 − tol`) \[–\] gets
     /// one rotation channel about that coordinate axis; otherwise three. Default 1e-9.
     pub axis_alignment_tolerance: f64,
     /// Settings of the Euler decomposition of every rotation.
@@ -430,9 +430,19 @@ impl BvhExportOptions {
     /// Checks that every value is finite and in range.
     pub fn validate(&self) -> Result<()> {
         let checks = [
-            ("frame_time_tolerance", self.frame_time_tolerance, 0.0, false),
+            (
+                "frame_time_tolerance",
+                self.frame_time_tolerance,
+                0.0,
+                false,
+            ),
             ("single_frame_time", self.single_frame_time, 0.0, true),
-            ("axis_alignment_tolerance", self.axis_alignment_tolerance, 0.0, false),
+            (
+                "axis_alignment_tolerance",
+                self.axis_alignment_tolerance,
+                0.0,
+                false,
+            ),
         ];
         for (name, value, low, strict) in checks {
             let ok = value.is_finite() && if strict { value > low } else { value >= low };

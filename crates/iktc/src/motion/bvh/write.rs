@@ -51,7 +51,13 @@ pub fn write_bvh(clip: &BvhClip, options: &BvhWriteOptions) -> Result<String> {
         };
         let _ = writeln!(out, "{indent}{header}\n{indent}{{");
         let o = joint.offset / scale;
-        let _ = writeln!(out, "{indent}\tOFFSET {} {} {}", num(o.x), num(o.y), num(o.z));
+        let _ = writeln!(
+            out,
+            "{indent}\tOFFSET {} {} {}",
+            num(o.x),
+            num(o.y),
+            num(o.z)
+        );
         if !joint.end_site {
             let mut line = format!("{indent}\tCHANNELS {}", joint.channels.len());
             for c in &joint.channels {
