@@ -15,4 +15,4 @@ pub use types::{
     BvhChannel, BvhClip, BvhExportOptions, BvhJoint, BvhReadOptions, BvhWriteOptions, LengthUnit,
     RotationOrder,
 };
-pub use write::write_bvh;
+pub use write::{write_bvh, write_clip_bvh};

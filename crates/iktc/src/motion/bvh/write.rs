@@ -93,3 +93,13 @@ pub fn write_bvh(clip: &BvhClip, options: &BvhWriteOptions) -> Result<String> {
     }
     Ok(out)
 }
+
+/// Writes a [`Clip`](crate::motion::Clip) as BVH text: [`BvhClip::from_clip`] then
+/// [`write_bvh`].
+pub fn write_clip_bvh(
+    clip: &crate::motion::Clip,
+    export: &super::BvhExportOptions,
+    options: &BvhWriteOptions,
+) -> Result<String> {
+    write_bvh(&BvhClip::from_clip(clip, export)?, options)
+}
