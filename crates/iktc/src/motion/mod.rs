@@ -1,1 +1,58 @@
-//! (module under construction in this session)
+//! Captured motion: clips, readers and writers, and the rotation decomposition used to retarget
+//! captured joint rotations onto robot joints.
+//!
+//! * [`Clip`] — plain data: a [`Skeleton`] (named joints, parents, rest offsets \[m\], spherical /
+//!   hinge / fixed / root), frame times \[s\] and one [`Pose`] per frame (root position \[m\], root
+//!   orientation, local joint rotations); sampling at any time (slerp) and forward kinematics.
+//! * [`read_deepmimic`], [`builtin_clip`] — DeepMimic motion files on the DeepMimic humanoid
+//!   (Y-up; convert with [`Clip::to_z_up`] / [`y_up_to_z_up`]).
+//! * [`read_bvh`], [`write_bvh`], [`BvhClip`] — Biovision hierarchy files with any hierarchy
+//!   and channel order, in centimetres, metres or any length unit.
+//! * [`decompose_rotation`] — a rotation as a product of rotations about 1–3 given joint axes
+//!   (generalised Euler / Davenport angles in closed form, least squares otherwise).
+//!
+//! ```
+//! use iktc::motion::{builtin_clip, decompose_rotation, write_clip_bvh, BvhExportOptions,
+//!     BvhWriteOptions};
+//! use nalgebra::Vector3;
+//!
+//! let clip = builtin_clip("humanoid3d_walk")?.to_z_up();
+//! assert_eq!(clip.frame_count(), 39);
+//! let pose = clip.sample(0.5)?; // slerp between frames 15 and 16
+//! let shoulder = clip.skeleton().index_of("right_shoulder")?;
+//! // The shoulder's rotation as three angles about the character's z, x, y axes [rad].
+//! let mut angles = [0.0; 3];
+//! let report = decompose_rotation(
+//!     &pose.rotations[shoulder],
+//!     &[Vector3::z(), Vector3::x(), Vector3::y()],
+//!     None,
+//!     &mut angles,
+//! )?;
+//! assert!(report.residual < 1e-9);
+//! let bvh_text = write_clip_bvh(&clip, &BvhExportOptions::default(), &BvhWriteOptions::default())?;
+//! assert!(bvh_text.starts_with("HIERARCHY"));
+//! # Ok::<(), iktc::Error>(())
+//! ```
+
+mod angles;
+mod bvh;
+mod clip;
+mod decompose;
+mod deepmimic;
+mod skeleton;
+
+pub use angles::{nearest_equivalent, unwrap_track, wrap_to_pi};
+pub use bvh::{
+    bvh_rotation, read_bvh, write_bvh, write_clip_bvh, BvhChannel, BvhClip, BvhExportOptions,
+    BvhJoint, BvhReadOptions, BvhWriteOptions, LengthUnit, RotationOrder,
+};
+pub use clip::{y_up_to_z_up, Clip, Pose, UpAxis};
+pub use decompose::{
+    compose_rotation, decompose_rotation, decompose_rotation_with, rotation_angle,
+    DecomposeSettings, Decomposition, DecompositionMethod, MAX_DECOMPOSITION_AXES,
+};
+pub use deepmimic::{
+    builtin_clip, deepmimic_skeleton, read_deepmimic, read_deepmimic_with, DeepMimicSettings,
+    BUILTIN_CLIP_NAMES, DEEPMIMIC_FRAME_LEN, DEEPMIMIC_URDF, DEEPMIMIC_URDF_SCALE,
+};
+pub use skeleton::{JointKind, Skeleton, SkeletonJoint};
