@@ -39,7 +39,14 @@ struct Givens {
 
 impl Givens {
     fn new(a: f64, b: f64) -> Self {
-        let h = a.hypot(b);
+        // √(a² + b²) directly when the squares neither overflow nor underflow (libm's hypot is
+        // several times slower), `hypot` otherwise.
+        let squares = a * a + b * b;
+        let h = if squares.is_finite() && squares >= f64::MIN_POSITIVE {
+            squares.sqrt()
+        } else {
+            a.hypot(b)
+        };
         Self {
             c: a / h,
             s: b / h,
@@ -193,9 +200,25 @@ impl ActiveBasis {
     }
 }
 
-/// `xᵀ y`.
+/// `xᵀ y` over the common length, with four partial sums (so that the compiler can use SIMD
+/// lanes; strict left-to-right summation cannot be vectorised).
 pub(crate) fn dot(x: &[f64], y: &[f64]) -> f64 {
-    x.iter().zip(y).map(|(a, b)| a * b).sum()
+    let len = x.len().min(y.len());
+    let (x, y) = (&x[..len], &y[..len]);
+    let mut acc = [0.0_f64; 4];
+    let (xc, yc) = (x.chunks_exact(4), y.chunks_exact(4));
+    let tail: f64 = xc
+        .remainder()
+        .iter()
+        .zip(yc.remainder())
+        .map(|(a, b)| a * b)
+        .sum();
+    for (a, b) in xc.zip(yc) {
+        for k in 0..4 {
+            acc[k] += a[k] * b[k];
+        }
+    }
+    (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
 }
 
 /// `y ← y + a x`.

@@ -444,9 +444,7 @@ impl QpWorkspace {
         }
         for (j, &xj) in x.iter().enumerate().take(n) {
             if xj != 0.0 {
-                for (acc, &a) in ax.iter_mut().zip(problem.a_in.column(j).iter()) {
-                    *acc += xj * a;
-                }
+                axpy(xj, problem.a_in.column(j).as_slice(), ax);
             }
         }
     }
@@ -516,7 +514,7 @@ impl QpWorkspace {
                 let hx = &mut self.hx.as_mut_slice()[..x.len()];
                 hx.fill(0.0);
                 for (j, &xj) in x.iter().enumerate() {
-                    axpy_iter(xj, h.column(j).iter(), hx);
+                    axpy(xj, h.column(j).as_slice(), hx);
                 }
                 dot(hx, x)
             }
@@ -536,14 +534,5 @@ impl QpWorkspace {
             worst = worst.max(l - ax).max(ax - u);
         }
         worst
-    }
-}
-
-/// `y ← y + a x` for an iterator `x`.
-fn axpy_iter<'a>(a: f64, x: impl Iterator<Item = &'a f64>, y: &mut [f64]) {
-    if a != 0.0 {
-        for (yi, &xi) in y.iter_mut().zip(x) {
-            *yi += a * xi;
-        }
     }
 }
