@@ -9,7 +9,6 @@
 //! Run: `cargo bench -p iktc --bench qp -- --warm-up-time 1 --measurement-time 3`.
 
 #[path = "../tests/qp_common/mod.rs"]
-#[allow(dead_code)]
 mod qp_common;
 
 use std::hint::black_box;
@@ -74,7 +73,9 @@ fn bench_shape(c: &mut Criterion, name: &str, p: &OwnedQp) {
     let settings = QpSettings::default();
     let mut ws = QpWorkspace::new(p.n(), p.a_eq.nrows(), p.a_in.nrows());
     let mut x = DVector::zeros(p.n());
-    let report = ws.solve(&p.view(), &settings, &mut x).expect("valid problem");
+    let report = ws
+        .solve(&p.view(), &settings, &mut x)
+        .expect("valid problem");
     assert_eq!(report.status, QpStatus::Optimal);
     if let Verdict::Solved { x: xo, .. } = clarabel_solve(p) {
         eprintln!(
@@ -95,7 +96,12 @@ fn bench_shape(c: &mut Criterion, name: &str, p: &OwnedQp) {
         })
     });
     c.bench_function(&format!("{name}/clarabel"), |b| {
-        b.iter(|| black_box(matches!(clarabel_solve(black_box(p)), Verdict::Solved { .. })))
+        b.iter(|| {
+            black_box(matches!(
+                clarabel_solve(black_box(p)),
+                Verdict::Solved { .. }
+            ))
+        })
     });
 }
 

@@ -79,7 +79,9 @@ fn length_of_b_eq_must_match_rows() {
     let mut d = Data::new();
     d.b_eq = vec![0.5, 1.0];
     let err = solve(&d.problem()).unwrap_err();
-    assert!(matches!(&err, Error::DimensionMismatch { what, expected: 1, got: 2 } if what.contains("b_eq")));
+    assert!(
+        matches!(&err, Error::DimensionMismatch { what, expected: 1, got: 2 } if what.contains("b_eq"))
+    );
 }
 
 #[test]
@@ -87,7 +89,9 @@ fn length_of_limits_must_match_rows() {
     let mut d = Data::new();
     d.u = vec![1.0];
     let err = solve(&d.problem()).unwrap_err();
-    assert!(matches!(&err, Error::DimensionMismatch { what, expected: 2, got: 1 } if what.contains("u")));
+    assert!(
+        matches!(&err, Error::DimensionMismatch { what, expected: 2, got: 1 } if what.contains("u"))
+    );
 }
 
 #[test]
@@ -98,7 +102,9 @@ fn length_of_x_must_be_n() {
     let err = ws
         .solve(&d.problem(), &QpSettings::default(), &mut x)
         .unwrap_err();
-    assert!(matches!(&err, Error::DimensionMismatch { what, expected: 2, got: 3 } if what.contains("x")));
+    assert!(
+        matches!(&err, Error::DimensionMismatch { what, expected: 2, got: 3 } if what.contains("x"))
+    );
 }
 
 #[test]
@@ -117,7 +123,9 @@ fn more_variables_than_the_workspace_is_an_error() {
     let err = ws
         .solve(&d.problem(), &QpSettings::default(), &mut x)
         .unwrap_err();
-    assert!(matches!(&err, Error::DimensionMismatch { what, expected: 1, got: 2 } if what.contains("variables")));
+    assert!(
+        matches!(&err, Error::DimensionMismatch { what, expected: 1, got: 2 } if what.contains("variables"))
+    );
 }
 
 #[test]
@@ -128,7 +136,9 @@ fn more_rows_than_the_workspace_is_an_error() {
     let err = ws
         .solve(&d.problem(), &QpSettings::default(), &mut x)
         .unwrap_err();
-    assert!(matches!(&err, Error::DimensionMismatch { what, expected: 1, got: 2 } if what.contains("inequality")));
+    assert!(
+        matches!(&err, Error::DimensionMismatch { what, expected: 1, got: 2 } if what.contains("inequality"))
+    );
 }
 
 #[test]
@@ -176,7 +186,9 @@ fn lower_above_upper_is_an_error() {
     let mut d = Data::new();
     d.l[0] = 1.5;
     let err = solve(&d.problem()).unwrap_err();
-    assert!(matches!(&err, Error::InvalidLimit { what, lower, upper } if what.contains("row 0") && *lower == 1.5 && *upper == 1.0));
+    assert!(
+        matches!(&err, Error::InvalidLimit { what, lower, upper } if what.contains("row 0") && *lower == 1.5 && *upper == 1.0)
+    );
 }
 
 #[test]
@@ -193,7 +205,9 @@ fn indefinite_hessian_is_an_error() {
     let mut d = Data::new();
     d.h = DMatrix::from_row_slice(2, 2, &[1.0, 2.0, 2.0, 1.0]);
     let err = solve(&d.problem()).unwrap_err();
-    assert!(matches!(&err, Error::InvalidSetting { name, expected, .. } if name.contains("H") && expected.contains("positive definite")));
+    assert!(
+        matches!(&err, Error::InvalidSetting { name, expected, .. } if name.contains("H") && expected.contains("positive definite"))
+    );
 }
 
 #[test]
@@ -201,7 +215,9 @@ fn singular_hessian_is_an_error() {
     let mut d = Data::new();
     d.h = DMatrix::from_row_slice(2, 2, &[1.0, 1.0, 1.0, 1.0]);
     let err = solve(&d.problem()).unwrap_err();
-    assert!(matches!(&err, Error::InvalidSetting { expected, .. } if expected.contains("positive definite")));
+    assert!(
+        matches!(&err, Error::InvalidSetting { expected, .. } if expected.contains("positive definite"))
+    );
 }
 
 #[test]
@@ -209,7 +225,9 @@ fn asymmetric_hessian_is_an_error() {
     let mut d = Data::new();
     d.h[(0, 1)] = 0.6;
     let err = solve(&d.problem()).unwrap_err();
-    assert!(matches!(&err, Error::InvalidSetting { expected, .. } if expected.contains("symmetric")));
+    assert!(
+        matches!(&err, Error::InvalidSetting { expected, .. } if expected.contains("symmetric"))
+    );
 }
 
 #[test]
@@ -248,4 +266,19 @@ fn nan_dependence_tolerance_is_an_error() {
 #[test]
 fn default_settings_are_valid() {
     assert!(QpSettings::default().validate().is_ok());
+}
+
+#[test]
+fn overflowing_data_is_an_error_not_a_panic() {
+    let mut d = Data::new();
+    d.h = DMatrix::identity(2, 2);
+    d.c = vec![1e308, 1e308];
+    d.b_eq = vec![1e308];
+    d.l = vec![-1e308, f64::NEG_INFINITY];
+    d.u = vec![1e308, 1e308];
+    let err = solve(&d.problem()).unwrap_err();
+    assert!(
+        matches!(&err, Error::NonFinite { what, .. } if what.contains("overflow")),
+        "{err:?}"
+    );
 }

@@ -41,7 +41,11 @@ fn unconstrained_minimum_is_minus_h_inverse_c() {
         let mut ws = QpWorkspace::new(n, 0, 0);
         let mut x = DVector::zeros(n);
         let rep = ws.solve(&p, &QpSettings::default(), &mut x).unwrap();
-        let expected = -h.clone().lu().solve(&DVector::from_column_slice(&c)).unwrap();
+        let expected = -h
+            .clone()
+            .lu()
+            .solve(&DVector::from_column_slice(&c))
+            .unwrap();
         assert_eq!(rep.status, QpStatus::Optimal);
         assert_eq!(rep.iterations, 0);
         assert!((&x - &expected).amax() <= CLOSED_FORM_TOL * (1.0 + expected.amax()));
@@ -248,7 +252,10 @@ fn identity_path_equals_dense_identity() {
         let (r2, x2, _, y2) = solve(&dense, &settings);
         assert_eq!(r1.status, r2.status, "seed {seed}");
         assert_eq!(r1.iterations, r2.iterations, "seed {seed}");
-        assert!((&x1 - &x2).amax() <= 1e-12 * (1.0 + x1.amax()), "seed {seed}");
+        assert!(
+            (&x1 - &x2).amax() <= 1e-12 * (1.0 + x1.amax()),
+            "seed {seed}"
+        );
         for (a, b) in y1.iter().zip(&y2) {
             assert!((a - b).abs() <= 1e-10 * (1.0 + a.abs()), "seed {seed}");
         }
@@ -273,11 +280,20 @@ fn kkt_conditions_hold_on_random_solutions() {
         let (rep, x, y_eq, y_in) = solve(&p, &settings);
         assert_eq!(rep.status, QpStatus::Optimal, "seed {seed}");
         let k = kkt(&p, &x, &y_eq, &y_in);
-        let ymax = y_in.iter().chain(&y_eq).fold(0.0_f64, |a, v| a.max(v.abs()));
+        let ymax = y_in
+            .iter()
+            .chain(&y_eq)
+            .fold(0.0_f64, |a, v| a.max(v.abs()));
         assert!(k.stationarity <= STATIONARITY_TOL, "seed {seed}: {k:?}");
-        assert!(k.primal <= settings.feasibility_tolerance + PRIMAL_SLACK, "seed {seed}: {k:?}");
+        assert!(
+            k.primal <= settings.feasibility_tolerance + PRIMAL_SLACK,
+            "seed {seed}: {k:?}"
+        );
         assert_eq!(k.dual_sign, 0.0, "seed {seed}: {k:?}");
-        assert!(k.complementarity <= PRIMAL_SLACK * (1.0 + ymax), "seed {seed}: {k:?}");
+        assert!(
+            k.complementarity <= PRIMAL_SLACK * (1.0 + ymax),
+            "seed {seed}: {k:?}"
+        );
         checked += 1;
     }
     assert_eq!(checked, 1200);
@@ -331,7 +347,10 @@ fn objective_scaling_scales_multipliers() {
         let (r2, x2, _, y2) = solve(&q, &settings);
         assert_eq!(r1.status, QpStatus::Optimal);
         assert_eq!(r2.status, QpStatus::Optimal);
-        assert!((&x1 - &x2).amax() <= 1e-10 * (1.0 + x1.amax()), "seed {seed}");
+        assert!(
+            (&x1 - &x2).amax() <= 1e-10 * (1.0 + x1.amax()),
+            "seed {seed}"
+        );
         for (a, b) in y1.iter().zip(&y2) {
             assert!((s * a - b).abs() <= 1e-8 * (1.0 + b.abs()), "seed {seed}");
         }

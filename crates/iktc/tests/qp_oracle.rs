@@ -6,8 +6,8 @@ mod qp_common;
 use iktc::solver::{QpConstraint, QpSettings, QpStatus};
 use nalgebra::DVector;
 use qp_common::{
-    clarabel_solve, kkt, random_problem_sized, scale_rows, solve, tight_rows, Kind, OwnedQp,
-    Sizes, Verdict, LARGE, SMALL,
+    clarabel_solve, kkt, random_problem_sized, scale_rows, solve, tight_rows, Kind, OwnedQp, Sizes,
+    Verdict, LARGE, SMALL,
 };
 
 /// Agreement of `x` with the oracle, relative to `1 + ‖x‖∞`. Clarabel stops at a relative
@@ -48,15 +48,33 @@ struct Stats {
 fn named_constraint_violated(p: &OwnedQp, x: &DVector<f64>, c: QpConstraint, tol: f64) -> bool {
     match c {
         QpConstraint::Equality { row } => {
-            let v: f64 = p.a_eq.row(row).iter().zip(x.iter()).map(|(a, b)| a * b).sum();
+            let v: f64 = p
+                .a_eq
+                .row(row)
+                .iter()
+                .zip(x.iter())
+                .map(|(a, b)| a * b)
+                .sum();
             (v - p.b_eq[row]).abs() > tol
         }
         QpConstraint::Lower { row } => {
-            let v: f64 = p.a_in.row(row).iter().zip(x.iter()).map(|(a, b)| a * b).sum();
+            let v: f64 = p
+                .a_in
+                .row(row)
+                .iter()
+                .zip(x.iter())
+                .map(|(a, b)| a * b)
+                .sum();
             p.l[row] - v > tol
         }
         QpConstraint::Upper { row } => {
-            let v: f64 = p.a_in.row(row).iter().zip(x.iter()).map(|(a, b)| a * b).sum();
+            let v: f64 = p
+                .a_in
+                .row(row)
+                .iter()
+                .zip(x.iter())
+                .map(|(a, b)| a * b)
+                .sum();
             v - p.u[row] > tol
         }
     }
@@ -105,7 +123,10 @@ fn run_with(kind: Kind, count: u64, seed0: u64, sizes: Sizes, scaled: bool) -> S
         match report.status {
             QpStatus::Optimal => {
                 let k = kkt(&p, &x, &y_eq, &y_in);
-                let ymax = y_in.iter().chain(&y_eq).fold(0.0_f64, |a, v| a.max(v.abs()));
+                let ymax = y_in
+                    .iter()
+                    .chain(&y_eq)
+                    .fold(0.0_f64, |a, v| a.max(v.abs()));
                 assert!(k.stationarity <= STATIONARITY_TOL, "{ctx}: {k:?}");
                 assert!(
                     k.primal <= settings.feasibility_tolerance + PRIMAL_SLACK,
@@ -118,7 +139,10 @@ fn run_with(kind: Kind, count: u64, seed0: u64, sizes: Sizes, scaled: bool) -> S
                 );
                 assert!((report.max_violation - k.primal).abs() <= 1e-12 * (1.0 + k.primal));
                 let f = p.objective(&x);
-                assert!((report.objective - f).abs() <= 1e-9 * (1.0 + f.abs()), "{ctx}");
+                assert!(
+                    (report.objective - f).abs() <= 1e-9 * (1.0 + f.abs()),
+                    "{ctx}"
+                );
                 st.max_stat = st.max_stat.max(k.stationarity);
                 if tight_rows(&p, &x, 1e-9) > report.active_count + report.redundant_equalities {
                     st.degenerate_optima += 1;

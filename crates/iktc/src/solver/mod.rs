@@ -3,6 +3,5 @@
 pub mod qp;
 
 pub use qp::{
-    ActiveConstraint, Hessian, QpConstraint, QpProblem, QpReport, QpSettings, QpStatus,
-    QpWorkspace,
+    ActiveConstraint, Hessian, QpConstraint, QpProblem, QpReport, QpSettings, QpStatus, QpWorkspace,
 };

@@ -2,10 +2,8 @@
 #![allow(dead_code)]
 
 use clarabel::algebra::CscMatrix;
-use clarabel::solver::{
-    DefaultSettings, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,
-};
-use iktc::solver::{Hessian, QpProblem, QpReport, QpStatus, QpWorkspace, QpSettings};
+use clarabel::solver::{DefaultSettings, DefaultSolver, IPSolver, SolverStatus, SupportedConeT};
+use iktc::solver::{Hessian, QpProblem, QpReport, QpSettings, QpStatus, QpWorkspace};
 use nalgebra::{DMatrix, DVector};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -43,7 +41,9 @@ impl OwnedQp {
     }
 
     pub fn h_dense(&self) -> DMatrix<f64> {
-        self.h.clone().unwrap_or_else(|| DMatrix::identity(self.n(), self.n()))
+        self.h
+            .clone()
+            .unwrap_or_else(|| DMatrix::identity(self.n(), self.n()))
     }
 
     pub fn objective(&self, x: &DVector<f64>) -> f64 {
@@ -336,7 +336,11 @@ fn dot(a: &[f64], x: &DVector<f64>) -> f64 {
     a.iter().zip(x.iter()).map(|(a, b)| a * b).sum()
 }
 
-fn combination(rng: &mut ChaCha8Rng, m: &DMatrix<f64>, k: usize) -> (Vec<usize>, Vec<f64>, Vec<f64>) {
+fn combination(
+    rng: &mut ChaCha8Rng,
+    m: &DMatrix<f64>,
+    k: usize,
+) -> (Vec<usize>, Vec<f64>, Vec<f64>) {
     let n = m.ncols();
     let mut idx = Vec::new();
     let mut w = Vec::new();
@@ -435,7 +439,15 @@ fn make_infeasible(rng: &mut ChaCha8Rng, p: &mut OwnedQp, xf: &DVector<f64>) {
         let a = random_row(rng, n);
         let l = dot(&a, xf) - uniform(rng, 0.0, 1.0);
         let w = uniform(rng, 0.2, 2.0);
-        p.push_in(&a, l, if rng.random_bool(0.5) { f64::INFINITY } else { l + 2.0 });
+        p.push_in(
+            &a,
+            l,
+            if rng.random_bool(0.5) {
+                f64::INFINITY
+            } else {
+                l + 2.0
+            },
+        );
         for (r, ai) in row.iter_mut().zip(&a) {
             *r += w * ai;
         }
@@ -504,7 +516,9 @@ pub fn tight_rows(p: &OwnedQp, x: &DVector<f64>, tol: f64) -> usize {
 pub fn solve(p: &OwnedQp, settings: &QpSettings) -> (QpReport, DVector<f64>, Vec<f64>, Vec<f64>) {
     let mut ws = QpWorkspace::new(p.n(), p.a_eq.nrows(), p.a_in.nrows());
     let mut x = DVector::zeros(p.n());
-    let report = ws.solve(&p.view(), settings, &mut x).expect("valid problem");
+    let report = ws
+        .solve(&p.view(), settings, &mut x)
+        .expect("valid problem");
     (
         report,
         x,

@@ -127,7 +127,7 @@ impl ActiveBasis {
 
     /// `‖d₂‖ = ‖(d_q, …, d_{n−1})‖`: the size of the new normal orthogonal to the active ones.
     pub(crate) fn orthogonal_norm(&self, d: &[f64]) -> f64 {
-        dot(&d[self.q..self.n], &d[self.q..self.n]).sqrt()
+        norm(&d[self.q..self.n])
     }
 
     /// `r = R⁻¹ d₁`: the dual step direction (minus the rate of change of the active
@@ -221,6 +221,20 @@ pub(crate) fn dot(x: &[f64], y: &[f64]) -> f64 {
     (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
 }
 
+/// `‖x‖₂`, without overflow or underflow of the squares: entries are scaled by the largest
+/// magnitude when it lies outside `[1e-150, 1e150]`.
+pub(crate) fn norm(x: &[f64]) -> f64 {
+    /// Magnitudes whose squares (summed over up to 1e6 entries) stay normal and finite.
+    const SAFE: std::ops::RangeInclusive<f64> = 1e-150..=1e150;
+    let largest = x.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    if largest == 0.0 || !largest.is_finite() || SAFE.contains(&largest) {
+        dot(x, x).sqrt()
+    } else {
+        let scaled: f64 = x.iter().map(|v| (v / largest) * (v / largest)).sum();
+        largest * scaled.sqrt()
+    }
+}
+
 /// `y ← y + a x`.
 pub(crate) fn axpy(a: f64, x: &[f64], y: &mut [f64]) {
     for (yi, &xi) in y.iter_mut().zip(x) {
@@ -244,7 +258,10 @@ mod tests {
     struct Lcg(u64);
     impl Lcg {
         fn next(&mut self) -> f64 {
-            self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            self.0 = self
+                .0
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             ((self.0 >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
         }
     }

@@ -59,8 +59,16 @@ impl QpProblem<'_> {
         let m_eq = self.a_eq.nrows();
         let m_in = self.a_in.nrows();
         check_capacity("number of variables (length of c)", capacity.n, n)?;
-        check_capacity("number of equality rows (rows of A_eq)", capacity.m_eq, m_eq)?;
-        check_capacity("number of inequality rows (rows of A_in)", capacity.m_in, m_in)?;
+        check_capacity(
+            "number of equality rows (rows of A_eq)",
+            capacity.m_eq,
+            m_eq,
+        )?;
+        check_capacity(
+            "number of inequality rows (rows of A_in)",
+            capacity.m_in,
+            m_in,
+        )?;
         if m_eq > 0 {
             check_dim("columns of A_eq", n, self.a_eq.ncols())?;
         }
@@ -68,8 +76,16 @@ impl QpProblem<'_> {
             check_dim("columns of A_in", n, self.a_in.ncols())?;
         }
         check_dim("length of b_eq", m_eq, self.b_eq.len())?;
-        check_dim("length of l (lower ends of A_in rows)", m_in, self.lower.len())?;
-        check_dim("length of u (upper ends of A_in rows)", m_in, self.upper.len())?;
+        check_dim(
+            "length of l (lower ends of A_in rows)",
+            m_in,
+            self.lower.len(),
+        )?;
+        check_dim(
+            "length of u (upper ends of A_in rows)",
+            m_in,
+            self.upper.len(),
+        )?;
         check_all_finite("c", self.c)?;
         check_all_finite("b_eq", self.b_eq)?;
         check_matrix_finite("A_eq", &self.a_eq)?;

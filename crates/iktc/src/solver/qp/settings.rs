@@ -72,9 +72,15 @@ impl QpSettings {
             ));
         }
         for (name, value) in [
-            ("linear_dependence_tolerance", self.linear_dependence_tolerance),
+            (
+                "linear_dependence_tolerance",
+                self.linear_dependence_tolerance,
+            ),
             ("hessian_pivot_tolerance", self.hessian_pivot_tolerance),
-            ("hessian_symmetry_tolerance", self.hessian_symmetry_tolerance),
+            (
+                "hessian_symmetry_tolerance",
+                self.hessian_symmetry_tolerance,
+            ),
         ] {
             if !(value.is_finite() && (0.0..1.0).contains(&value)) {
                 return Err(invalid(name, value, "a number in [0, 1)"));
