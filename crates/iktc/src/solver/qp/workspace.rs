@@ -184,7 +184,11 @@ impl QpWorkspace {
         let dims = problem.check(self.capacity, settings)?;
         check_dim("length of x", dims.n, x.len())?;
         let n = dims.n;
+        // forget the previous solve first, so that a failed factorisation leaves an empty
+        // active set and zero multipliers behind
         self.last = dims;
+        self.active.clear();
+        self.fill_multipliers();
         match problem.hessian {
             Hessian::Identity => self.basis.reset_identity(n),
             Hessian::Dense(h) => {
@@ -204,7 +208,6 @@ impl QpWorkspace {
         for v in x.iter_mut() {
             *v = -*v;
         }
-        self.active.clear();
         for (state, (&l, &u)) in self.states[..dims.m_in]
             .iter_mut()
             .zip(problem.lower.iter().zip(problem.upper))
