@@ -47,19 +47,34 @@ impl Givens {
         } else {
             a.hypot(b)
         };
+        let inv = 1.0 / h;
         Self {
-            c: a / h,
-            s: b / h,
+            c: a * inv,
+            s: b * inv,
             h,
         }
     }
 
-    /// `(x, y) ← (c x + s y, −s x + c y)` element-wise.
+    /// `(x, y) ← (c x + s y, −s x + c y)` element-wise (in blocks of four, which the compiler
+    /// turns into SIMD lanes).
     fn apply(self, x: &mut [f64], y: &mut [f64]) {
-        for (xi, yi) in x.iter_mut().zip(y.iter_mut()) {
+        let (c, s) = (self.c, self.s);
+        let len = x.len().min(y.len());
+        let (x, y) = (&mut x[..len], &mut y[..len]);
+        let mut xc = x.chunks_exact_mut(4);
+        let mut yc = y.chunks_exact_mut(4);
+        for (xb, yb) in (&mut xc).zip(&mut yc) {
+            let a = [xb[0], xb[1], xb[2], xb[3]];
+            let b = [yb[0], yb[1], yb[2], yb[3]];
+            for k in 0..4 {
+                xb[k] = c * a[k] + s * b[k];
+                yb[k] = c * b[k] - s * a[k];
+            }
+        }
+        for (xi, yi) in xc.into_remainder().iter_mut().zip(yc.into_remainder()) {
             let (a, b) = (*xi, *yi);
-            *xi = self.c * a + self.s * b;
-            *yi = -self.s * a + self.c * b;
+            *xi = c * a + s * b;
+            *yi = c * b - s * a;
         }
     }
 }
@@ -106,10 +121,25 @@ impl ActiveBasis {
         &self.j.as_slice()[k * self.ld..k * self.ld + self.n]
     }
 
-    /// `d = Jᵀ v` (all `n` entries).
+    /// `d = Jᵀ v` (all `n` entries): `n` dot products with the columns of `J`, or, when `v` has
+    /// few non-zeros (a box row, `v = ±e_i`), `d = Σ_{i: v_i ≠ 0} v_i J[i, :]`.
     pub(crate) fn project(&self, v: &[f64], d: &mut [f64]) {
-        for (k, dk) in d[..self.n].iter_mut().enumerate() {
-            *dk = dot(self.j_col(k), &v[..self.n]);
+        let (n, ld) = (self.n, self.ld);
+        let v = &v[..n];
+        let d = &mut d[..n];
+        let nonzeros = v.iter().filter(|vi| **vi != 0.0).count();
+        if 4 * nonzeros < n {
+            d.fill(0.0);
+            let j = self.j.as_slice();
+            for (i, &vi) in v.iter().enumerate().filter(|(_, vi)| **vi != 0.0) {
+                for (k, dk) in d.iter_mut().enumerate() {
+                    *dk += vi * j[k * ld + i];
+                }
+            }
+        } else {
+            for (k, dk) in d.iter_mut().enumerate() {
+                *dk = dot(self.j_col(k), v);
+            }
         }
     }
 
