@@ -426,7 +426,8 @@ impl QpWorkspace {
                     None if dependent => {
                         return Outcome::Infeasible(entry.constraint(sign, false));
                     }
-                    Some((k, partial_step)) if partial_step < full_step => {
+                    // a dependent normal is never added: only the dual step is possible
+                    Some((k, partial_step)) if dependent || partial_step < full_step => {
                         *iterations += 1;
                         self.step(x, partial_step, !dependent);
                         u_plus += partial_step;
