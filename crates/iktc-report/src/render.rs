@@ -12,7 +12,7 @@ use crate::figure::{Figure, LineStyle, Panel, Series};
 use crate::font::FONT_FAMILY;
 use crate::legend::{draw_legend, LegendEntry, Marker};
 use crate::range::{
-    equalize, finite_bounds, linear_formatter, linear_range, log_formatter, log_range,
+    equalize, finite_bounds, is_usable, linear_formatter, linear_range, log_formatter, log_range,
 };
 
 /// Series colours (Tableau-like, red left out: red is reserved for limit lines).
@@ -116,6 +116,31 @@ fn segments(s: &Series, log_x: bool) -> Vec<Vec<(f64, f64)>> {
     out
 }
 
+/// Pulls points lying far outside the axis ranges (beyond ten spans; possible only for values
+/// beyond `range::MAX_ABS`) to that distance, so that pixel coordinates cannot overflow.
+fn clamp_to_view(seg: &[(f64, f64)], view: &View<'_>, log_x: bool) -> Vec<(f64, f64)> {
+    let wide = |r: (f64, f64)| {
+        let span = r.1 - r.0;
+        (r.0 - 10.0 * span, r.1 + 10.0 * span)
+    };
+    let (x, y) = (view.x_range, view.y_range);
+    let xr = if log_x {
+        let ratio = (x.1 / x.0).powi(10);
+        (x.0 / ratio, x.1 * ratio)
+    } else {
+        wide(x)
+    };
+    let yr = wide(y);
+    let fit = |v: f64, r: (f64, f64)| {
+        if r.0.is_finite() && r.1.is_finite() && r.0 < r.1 {
+            v.clamp(r.0, r.1)
+        } else {
+            v
+        }
+    };
+    seg.iter().map(|&(a, b)| (fit(a, xr), fit(b, yr))).collect()
+}
+
 fn draw_panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     panel: &Panel,
@@ -149,8 +174,17 @@ fn draw_panel<DB: DrawingBackend>(
         .margin_right(MARGIN_RIGHT)
         .x_label_area_size(X_LABEL_AREA)
         .y_label_area_size(Y_LABEL_AREA);
+    let unusable = |x_range: (f64, f64), y_range: (f64, f64)| ReportError::Plot {
+        what: format!(
+            "panel '{}' has axis ranges x {x_range:?}, y {y_range:?} that cannot be drawn",
+            panel.title
+        ),
+    };
     if log_x {
         let x_range = log_range(xb);
+        if !is_usable(x_range) || !is_usable(y_range) {
+            return Err(unusable(x_range, y_range));
+        }
         let mut chart = builder
             .build_cartesian_2d((x_range.0..x_range.1).log_scale(), y_range.0..y_range.1)
             .map_err(err("building a log-x chart"))?;
@@ -168,6 +202,9 @@ fn draw_panel<DB: DrawingBackend>(
         let mut x_range = linear_range(xb);
         if panel.equal_aspect {
             (x_range, y_range) = equalize(x_range, y_range, plot_w, plot_h);
+        }
+        if !is_usable(x_range) || !is_usable(y_range) {
+            return Err(unusable(x_range, y_range));
         }
         let mut chart = builder
             .build_cartesian_2d(x_range.0..x_range.1, y_range.0..y_range.1)
@@ -223,15 +260,18 @@ where
     let mut entries: Vec<LegendEntry> = Vec::new();
     for h in panel.hlines.iter().filter(|h| h.y.is_finite()) {
         let style = LIMIT_COLOR.stroke_width(LINE_WIDTH);
+        let hy = clamp_to_view(&[(x_range.0, h.y)], view, panel.log_x)
+            .first()
+            .map_or(h.y, |p| p.1);
         chart
             .draw_series(DashedLineSeries::new(
-                vec![(x_range.0, h.y), (x_range.1, h.y)],
+                vec![(x_range.0, hy), (x_range.1, hy)],
                 10,
                 6,
                 style,
             ))
             .map_err(err("drawing a limit line"))?;
-        let (_, py) = chart.backend_coord(&(x_range.0, h.y));
+        let (_, py) = chart.backend_coord(&(x_range.0, hy));
         occupied.extend(
             (0..view.columns as i32)
                 .step_by(4)
@@ -250,9 +290,12 @@ where
         let line = color.stroke_width(LINE_WIDTH);
         let segs: Vec<Vec<(f64, f64)>> = segments(s, panel.log_x)
             .iter()
-            .map(|seg| match s.style {
-                LineStyle::Points => seg.clone(),
-                _ => decimate(seg, view.columns, view.to_col),
+            .map(|seg| {
+                let seg = clamp_to_view(seg, view, panel.log_x);
+                match s.style {
+                    LineStyle::Points => seg,
+                    _ => decimate(&seg, view.columns, view.to_col),
+                }
             })
             .collect();
         let ctx = format!("drawing series '{}'", s.label);
