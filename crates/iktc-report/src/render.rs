@@ -35,8 +35,12 @@ const MARGIN: u32 = 8;
 const MARGIN_RIGHT: u32 = 20;
 /// Height reserved for x tick labels and the x-axis label \[px\].
 const X_LABEL_AREA: u32 = 42;
-/// Width reserved for y tick labels and the y-axis label \[px\].
-const Y_LABEL_AREA: u32 = 78;
+/// Width reserved for the y-axis label and tick marks, besides the tick labels \[px\].
+const Y_DESC_AREA: u32 = 40;
+/// Smallest width reserved for y tick labels and the y-axis label \[px\].
+const MIN_Y_LABEL_AREA: u32 = 70;
+/// Tick-label text size \[px\].
+const TICK_FONT: u32 = 13;
 /// Line width of series \[px\].
 const LINE_WIDTH: u32 = 2;
 /// Marker radius of point series \[px\].
@@ -141,6 +145,23 @@ fn clamp_to_view(seg: &[(f64, f64)], view: &View<'_>, log_x: bool) -> Vec<(f64, 
     seg.iter().map(|&(a, b)| (fit(a, xr), fit(b, yr))).collect()
 }
 
+/// Width for the y tick labels and axis label \[px\]: the widest label that the formatter of
+/// `y_range` produces, plus room for the rotated axis label.
+fn y_label_area<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, y_range: (f64, f64)) -> u32 {
+    let fmt = linear_formatter(y_range);
+    let style = TextStyle::from((FONT_FAMILY, TICK_FONT).into_font());
+    let widest = (0..=20)
+        .map(|k| y_range.0 + (y_range.1 - y_range.0) * f64::from(k) / 20.0)
+        .map(|v| {
+            let label = fmt(&v);
+            area.estimate_text_size(&label, &style)
+                .map_or(8 * label.len() as u32, |(w, _)| w)
+        })
+        .max()
+        .unwrap_or(0);
+    (widest + Y_DESC_AREA).max(MIN_Y_LABEL_AREA)
+}
+
 fn draw_panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     panel: &Panel,
@@ -164,8 +185,9 @@ fn draw_panel<DB: DrawingBackend>(
     let yb = finite_bounds(pts().map(|p| p.1).chain(panel.hlines.iter().map(|h| h.y)));
     let has_data = xb.is_some();
     let mut y_range = linear_range(yb);
+    let y_label_area = y_label_area(&area, y_range);
     let (area_w, area_h) = area.dim_in_pixel();
-    let plot_w = f64::from(area_w) - f64::from(2 * MARGIN + MARGIN_RIGHT + Y_LABEL_AREA);
+    let plot_w = f64::from(area_w) - f64::from(2 * MARGIN + MARGIN_RIGHT + y_label_area);
     let plot_h = f64::from(area_h) - f64::from(2 * MARGIN + X_LABEL_AREA);
     let columns = plot_w.max(1.0) as usize;
     let mut builder = ChartBuilder::on(&area);
@@ -173,7 +195,7 @@ fn draw_panel<DB: DrawingBackend>(
         .margin(MARGIN)
         .margin_right(MARGIN_RIGHT)
         .x_label_area_size(X_LABEL_AREA)
-        .y_label_area_size(Y_LABEL_AREA);
+        .y_label_area_size(y_label_area);
     let unusable = |x_range: (f64, f64), y_range: (f64, f64)| ReportError::Plot {
         what: format!(
             "panel '{}' has axis ranges x {x_range:?}, y {y_range:?} that cannot be drawn",
@@ -244,7 +266,7 @@ where
         .y_labels(7)
         .x_max_light_lines(2)
         .y_max_light_lines(2)
-        .label_style((FONT_FAMILY, 13))
+        .label_style((FONT_FAMILY, TICK_FONT))
         .axis_desc_style((FONT_FAMILY, 15))
         .bold_line_style(RGBColor(215, 215, 215))
         .light_line_style(RGBColor(240, 240, 240))

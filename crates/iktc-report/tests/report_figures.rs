@@ -244,6 +244,25 @@ fn gallery_for_eyeballing() {
                     .collect(),
             )),
         );
+    let t = linspace(0.0, 1.0, 50);
+    let tiny = tiny
+        .panel(Panel::new("offset", "time [s]", "z [m]").with(Series::line(
+            "z",
+            t.clone(),
+            t.iter().map(|t| -1000.0 - 1e-3 * t).collect(),
+        )))
+        .panel(
+            Panel::new(
+                "long label",
+                "time since the start of the experiment [s]",
+                "joint torque tau_12 [N m]",
+            )
+            .with(Series::line(
+                "tau",
+                t.clone(),
+                t.iter().map(|t| -123.456 * t).collect(),
+            )),
+        );
     write_figure(&tiny, &dir, "scales").unwrap();
     write_csv(
         &dir.join("data/joint.csv"),
@@ -315,5 +334,45 @@ fn extreme_magnitudes_do_not_panic() {
             );
         let r = write_figure(&fig, &out_dir("extreme"), &format!("extreme{i}"));
         assert!(r.is_ok(), "case {i}: {r:?}");
+    }
+}
+
+/// Small deterministic generator (xorshift64*) so the sweep below needs no extra dependency.
+struct Xorshift(u64);
+impl Xorshift {
+    fn next_f64(&mut self) -> f64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+#[test]
+fn sweep_of_offsets_and_spans_draws_every_figure() {
+    // Offsets from 1e-12 to 1e12 with relative spans down to 1e-14: plotters' tick computation
+    // must neither hang nor fail on any of them.
+    let mut rng = Xorshift(0x1234_5678_9abc_def1);
+    let dir = out_dir("sweep");
+    for i in 0..60 {
+        let offset =
+            10f64.powf(-12.0 + 24.0 * rng.next_f64()) * if i % 2 == 0 { 1.0 } else { -1.0 };
+        let rel = 10f64.powf(-14.0 + 14.0 * rng.next_f64());
+        let span = offset.abs() * rel;
+        let x: Vec<f64> = (0..20)
+            .map(|k| offset + span * f64::from(k) / 19.0)
+            .collect();
+        let y: Vec<f64> = x.iter().map(|v| v * 0.5).collect();
+        let fig = Figure::new("")
+            .panel_size(300, 150)
+            .columns(2)
+            .panel(Panel::new("lin", "x", "y").with(Series::line("a", x.clone(), y.clone())))
+            .panel(Panel::new("log", "x", "y").log_x().with(Series::line(
+                "a",
+                x.iter().map(|v| v.abs()).collect(),
+                y,
+            )));
+        let r = write_figure(&fig, &dir, "sweep");
+        assert!(r.is_ok(), "offset {offset:e}, span {span:e}: {r:?}");
     }
 }
