@@ -243,9 +243,9 @@ pub fn write_run(r: &Planar3rRun, dir: &Path) -> Result<Vec<(String, String)>> {
                     .hline(lim.upper * DEG, "upper limit"),
             )
             .panel(
-                Panel::new(format!("q̇{}", j + 1), "t [s]", "q̇ [deg/s]")
+                Panel::new(format!("velocity dq{}/dt", j + 1), "t [s]", "dq/dt [deg/s]")
                     .with(Series::line(
-                        format!("q̇{}", j + 1),
+                        format!("dq{}/dt", j + 1),
                         t.clone(),
                         col(&|s| s.qd[j] * DEG),
                     ))
@@ -253,34 +253,38 @@ pub fn write_run(r: &Planar3rRun, dir: &Path) -> Result<Vec<(String, String)>> {
                     .hline(-lim.velocity * DEG, "−v_max"),
             )
             .panel(
-                Panel::new(format!("q̈{}", j + 1), "t [s]", "q̈ [deg/s²]")
-                    .with(Series::line(
-                        format!("q̈{}", j + 1),
-                        t.clone(),
-                        col(&|s| s.qdd[j] * DEG),
-                    ))
-                    .with(Series::dashed(
-                        "box lower b_l",
-                        t.clone(),
-                        col(&|s| s.box_lower[j].max(-3.0 * lim.acceleration) * DEG),
-                    ))
-                    .with(Series::dashed(
-                        "box upper b_u",
-                        t.clone(),
-                        col(&|s| s.box_upper[j].min(3.0 * lim.acceleration) * DEG),
-                    ))
-                    .hline(lim.acceleration * DEG, "+a_max")
-                    .hline(-lim.acceleration * DEG, "−a_max"),
+                Panel::new(
+                    format!("acceleration d²q{}/dt²", j + 1),
+                    "t [s]",
+                    "d²q/dt² [deg/s²]",
+                )
+                .with(Series::line(
+                    format!("d²q{}/dt²", j + 1),
+                    t.clone(),
+                    col(&|s| s.qdd[j] * DEG),
+                ))
+                .with(Series::dashed(
+                    "box lower b_l",
+                    t.clone(),
+                    col(&|s| s.box_lower[j].max(-3.0 * lim.acceleration) * DEG),
+                ))
+                .with(Series::dashed(
+                    "box upper b_u",
+                    t.clone(),
+                    col(&|s| s.box_upper[j].min(3.0 * lim.acceleration) * DEG),
+                ))
+                .hline(lim.acceleration * DEG, "+a_max")
+                .hline(-lim.acceleration * DEG, "−a_max"),
             );
         let stem = format!("fig{}_q{}", 5 + j, j + 1);
         write_figure(&fig, dir, &stem)?;
         figs.push((
             format!("{stem}.svg"),
             format!(
-                "Fig. {}: q{0}, q̇, q̈ with limits and the acceleration box ({tag})",
-                5 + j
-            )
-            .replace("q5", &format!("q{}", j + 1)),
+                "Fig. {}: position, velocity and acceleration of q{} with their limits and the acceleration box ({tag})",
+                5 + j,
+                j + 1
+            ),
         ));
     }
     // Fig. 8: task errors.
@@ -443,7 +447,7 @@ pub fn planar3r_section(out: &Path) -> Result<Section> {
                 .hline(60.0, "q1 lower limit"),
         )
         .panel(
-            Panel::new("q̈1", "t [s]", "q̈1 [deg/s²]")
+            Panel::new("acceleration of q1", "t [s]", "d²q1/dt² [deg/s²]")
                 .with(Series::line(
                     "viable",
                     t.clone(),
