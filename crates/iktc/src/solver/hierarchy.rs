@@ -223,6 +223,7 @@ impl Hierarchy {
             if best != st {
                 self.a.swap_columns(st, best);
                 self.perm.swap(st, best);
+                self.colnorm.swap(st, best);
             }
             let norm = self.colnorm[st].sqrt();
             if norm <= settings.rank_threshold {
