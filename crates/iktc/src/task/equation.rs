@@ -85,14 +85,28 @@ impl TaskEquation {
 
     /// Checks that sizes agree and every entry is finite.
     pub fn validate(&self) -> Result<()> {
+        // Messages are formatted only on failure: this runs every tick and must not allocate.
         let m = self.rhs.len();
-        crate::error::check_dim(
-            &format!("rows of J of `{}`", self.name),
-            m,
-            self.jacobian.nrows(),
-        )?;
-        crate::error::check_all_finite(&format!("J of `{}`", self.name), self.jacobian.as_slice())?;
-        crate::error::check_all_finite(&format!("h of `{}`", self.name), self.rhs.as_slice())
+        if self.jacobian.nrows() != m {
+            return crate::error::check_dim(
+                &format!("rows of J of `{}`", self.name),
+                m,
+                self.jacobian.nrows(),
+            );
+        }
+        if self.jacobian.iter().any(|v| !v.is_finite()) {
+            return crate::error::check_all_finite(
+                &format!("J of `{}`", self.name),
+                self.jacobian.as_slice(),
+            );
+        }
+        if self.rhs.iter().any(|v| !v.is_finite()) {
+            return crate::error::check_all_finite(
+                &format!("h of `{}`", self.name),
+                self.rhs.as_slice(),
+            );
+        }
+        Ok(())
     }
 }
 
