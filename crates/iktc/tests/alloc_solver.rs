@@ -36,16 +36,27 @@ fn solvers_allocate_nothing() {
     let levels = random_levels(&mut r, 38, &dims);
     let mut s = Solver::new(38, &dims, SolverSettings::default()).unwrap();
     let mut q0 = DVector::zeros(38);
-    s.solve(Method::Prioritized, &levels, &wide_box(38), &mut q0).unwrap();
+    s.solve(Method::Prioritized, &levels, &wide_box(38), &mut q0)
+        .unwrap();
     let bx = box_violated_by(&mut r, &q0, 5.0, 3, 0.5);
     let mut q = DVector::zeros(38);
-    for m in [Method::Iktc, Method::Cascade, Method::Clamp, Method::Prioritized] {
+    for m in [
+        Method::Iktc,
+        Method::Cascade,
+        Method::Clamp,
+        Method::Prioritized,
+    ] {
         s.solve(m, &levels, &bx, &mut q).unwrap();
         let before = ALLOCS.load(Ordering::SeqCst);
         let rep = s.solve(m, &levels, &bx, &mut q).unwrap();
         let qps = rep.qp_solves;
         let after = ALLOCS.load(Ordering::SeqCst);
-        assert_eq!(after - before, 0, "{m:?} allocated {} times", after - before);
+        assert_eq!(
+            after - before,
+            0,
+            "{m:?} allocated {} times",
+            after - before
+        );
         if m == Method::Iktc {
             assert!(qps >= 1, "the box must force a correction");
         }

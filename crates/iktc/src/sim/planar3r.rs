@@ -13,7 +13,7 @@ use serde::Serialize;
 
 use super::margins::{dof_margins, median, DofMargins};
 use crate::error::{Error, Result};
-use crate::limits::{compute_box, AccelerationBox, BoundMethod, DofLimits, JointLimits};
+use crate::limits::{compute_box, AccelerationBox, BoundMethod, JointLimits};
 use crate::model::{planar3r, Kinematics, State};
 use crate::solver::{Method, Solver, SolverSettings};
 use crate::task::{Axes, FrameReference, FrameTask, Gains, Task, TaskStack};
@@ -223,18 +223,7 @@ pub fn run_planar3r(cfg: &Planar3rConfig) -> Result<Planar3rRun> {
     let mut eqs = stack.equations(&robot);
     let dims: Vec<usize> = eqs.iter().map(|e| e.dim()).collect();
     let mut solver = Solver::new(robot.nv(), &dims, cfg.solver)?;
-    let limits = JointLimits::new(
-        robot
-            .dof_limits()
-            .iter()
-            .map(|l| DofLimits {
-                position_min: l.lower,
-                position_max: l.upper,
-                velocity_max: l.velocity,
-                acceleration_max: l.acceleration,
-            })
-            .collect(),
-    )?;
+    let limits = JointLimits::from_robot(&robot)?;
     let mut bx = AccelerationBox::new(robot.nv());
     let mut kin = Kinematics::new(&robot, &state)?;
     let mut qdd = DVector::zeros(robot.nv());
