@@ -35,15 +35,15 @@ pub struct Args {
 #[derive(Deserialize, Debug, Default)]
 #[serde(deny_unknown_fields)]
 pub struct ConfigFile {
-    /// Joint positions [rad or m] by name; missing joints stay at the neutral value.
+    /// Joint positions \[rad or m\] by name; missing joints stay at the neutral value.
     #[serde(default)]
     pub joints: BTreeMap<String, f64>,
     /// Floating-base pose.
     pub base: Option<BasePose>,
-    /// Joint rates [rad/s or m/s] by name.
+    /// Joint rates \[rad/s or m/s\] by name.
     #[serde(default)]
     pub velocities: BTreeMap<String, f64>,
-    /// Base body twist (vx, vy, vz [m/s], wx, wy, wz [rad/s], base axes).
+    /// Base body twist (vx, vy, vz \[m/s\], wx, wy, wz \[rad/s\], base axes).
     pub base_velocity: Option<[f64; 6]>,
 }
 
@@ -51,7 +51,7 @@ pub struct ConfigFile {
 #[derive(Deserialize, Debug)]
 #[serde(deny_unknown_fields)]
 pub struct BasePose {
-    /// Position [m].
+    /// Position \[m\].
     pub position: [f64; 3],
     /// Unit quaternion (x, y, z, w).
     #[serde(default = "identity_quat")]

@@ -69,7 +69,7 @@ pub struct Args {
     /// Joint bounds.
     #[arg(long, value_enum, default_value = "viable")]
     pub bounds: BoundsArg,
-    /// Control period [s].
+    /// Control period \[s\].
     #[arg(long, default_value_t = 0.005)]
     pub dt: f64,
     /// Priority order, highest first: a permutation of Px, Py, theta3.
@@ -93,13 +93,20 @@ fn parse_task(s: &str) -> Result<ArmTask> {
 pub fn run(a: &Args) -> Result<()> {
     let Scenario::Planar3r = a.scenario;
     if a.priority.len() != 3 {
-        anyhow::bail!("--priority needs the three tasks Px, Py, theta3 in some order, got {}", a.priority.len());
+        anyhow::bail!(
+            "--priority needs the three tasks Px, Py, theta3 in some order, got {}",
+            a.priority.len()
+        );
     }
     let cfg = Planar3rConfig {
         method: a.solver.method(),
         bounds: a.bounds.method(),
         dt: a.dt,
-        priority: [parse_task(&a.priority[0])?, parse_task(&a.priority[1])?, parse_task(&a.priority[2])?],
+        priority: [
+            parse_task(&a.priority[0])?,
+            parse_task(&a.priority[1])?,
+            parse_task(&a.priority[2])?,
+        ],
         ..Default::default()
     };
     let r = run_planar3r(&cfg)?;
@@ -134,22 +141,52 @@ pub fn write_run(r: &Planar3rRun, dir: &Path) -> Result<Vec<(String, String)>> {
             header.push(format!("{p}_{t}"));
         }
     }
-    header.extend(["corrected_from_level", "qp_solves", "empty_box_dofs", "tick_us"].map(String::from));
+    header.extend(
+        [
+            "corrected_from_level",
+            "qp_solves",
+            "empty_box_dofs",
+            "tick_us",
+        ]
+        .map(String::from),
+    );
     let rows: Vec<Vec<f64>> = r
         .steps
         .iter()
         .map(|s| {
             let mut v = vec![s.t];
-            for a in [s.q, s.qd, s.qdd, s.box_lower, s.box_upper, s.reference, s.value, s.error, s.correction] {
+            for a in [
+                s.q,
+                s.qd,
+                s.qdd,
+                s.box_lower,
+                s.box_upper,
+                s.reference,
+                s.value,
+                s.error,
+                s.correction,
+            ] {
                 v.extend(a);
             }
-            v.extend([s.corrected_from as f64, s.qp_solves as f64, s.empty_dofs as f64, s.tick_us]);
+            v.extend([
+                s.corrected_from as f64,
+                s.qp_solves as f64,
+                s.empty_dofs as f64,
+                s.tick_us,
+            ]);
             v
         })
         .collect();
     write_csv(&dir.join("trajectory.csv"), &header, &rows)?;
-    std::fs::write(dir.join("summary.json"), serde_json::to_string_pretty(&r.summary)?)?;
-    let tag = format!("{} / {} bounds", r.summary.solver.to_uppercase(), r.summary.bounds);
+    std::fs::write(
+        dir.join("summary.json"),
+        serde_json::to_string_pretty(&r.summary)?,
+    )?;
+    let tag = format!(
+        "{} / {} bounds",
+        r.summary.solver.to_uppercase(),
+        r.summary.bounds
+    );
     let t: Vec<f64> = r.steps.iter().map(|s| s.t).collect();
     let mut figs = Vec::new();
     // Fig. 4: the arm's motion and the desired tip path.
@@ -159,53 +196,121 @@ pub fn write_run(r: &Planar3rRun, dir: &Path) -> Result<Vec<(String, String)>> {
         let (a, b, c) = (s.q[0], s.q[0] + s.q[1], s.q[0] + s.q[1] + s.q[2]);
         let xs = vec![0.0, a.cos(), a.cos() + b.cos(), a.cos() + b.cos() + c.cos()];
         let ys = vec![0.0, a.sin(), a.sin() + b.sin(), a.sin() + b.sin() + c.sin()];
-        let label = if k == 0 { "arm (every 0.1 s)".to_string() } else { String::new() };
+        let label = if k == 0 {
+            "arm (every 0.1 s)".to_string()
+        } else {
+            String::new()
+        };
         p = p.with(Series::line(label, xs, ys));
     }
     p = p
-        .with(Series::points("desired tip path", r.steps.iter().map(|s| s.reference[0]).collect(), r.steps.iter().map(|s| s.reference[1]).collect()))
-        .with(Series::dashed("tip path", r.steps.iter().map(|s| s.value[0]).collect(), r.steps.iter().map(|s| s.value[1]).collect()));
-    write_figure(&Figure::new(format!("Fig. 4 — tracking under joint limits ({tag})")).panel(p).panel_size(700, 560), dir, "fig4_motion")?;
-    figs.push(("fig4_motion.svg".to_string(), format!("Fig. 4: arm motion and desired tip path ({tag})")));
+        .with(Series::points(
+            "desired tip path",
+            r.steps.iter().map(|s| s.reference[0]).collect(),
+            r.steps.iter().map(|s| s.reference[1]).collect(),
+        ))
+        .with(Series::dashed(
+            "tip path",
+            r.steps.iter().map(|s| s.value[0]).collect(),
+            r.steps.iter().map(|s| s.value[1]).collect(),
+        ));
+    write_figure(
+        &Figure::new(format!("Fig. 4 — tracking under joint limits ({tag})"))
+            .panel(p)
+            .panel_size(700, 560),
+        dir,
+        "fig4_motion",
+    )?;
+    figs.push((
+        "fig4_motion.svg".to_string(),
+        format!("Fig. 4: arm motion and desired tip path ({tag})"),
+    ));
     // Figs. 5–7: q, q̇, q̈ of each joint with limits.
     let robot = iktc::model::planar3r();
     for (j, lim) in robot.dof_limits().iter().enumerate() {
-        let col = |f: &dyn Fn(&iktc::sim::Planar3rStep) -> f64| r.steps.iter().map(f).collect::<Vec<f64>>();
+        let col = |f: &dyn Fn(&iktc::sim::Planar3rStep) -> f64| {
+            r.steps.iter().map(f).collect::<Vec<f64>>()
+        };
         let fig = Figure::new(format!("Fig. {} — joint q{} ({tag})", 5 + j, j + 1))
             .panel(
                 Panel::new(format!("q{}", j + 1), "t [s]", "q [deg]")
-                    .with(Series::line(format!("q{}", j + 1), t.clone(), col(&|s| s.q[j] * DEG)))
+                    .with(Series::line(
+                        format!("q{}", j + 1),
+                        t.clone(),
+                        col(&|s| s.q[j] * DEG),
+                    ))
                     .hline(lim.lower * DEG, "lower limit")
                     .hline(lim.upper * DEG, "upper limit"),
             )
             .panel(
-                Panel::new(format!("q̇{}", j + 1), "t [s]", "q̇ [deg/s]")
-                    .with(Series::line(format!("q̇{}", j + 1), t.clone(), col(&|s| s.qd[j] * DEG)))
+                Panel::new(format!("velocity dq{}/dt", j + 1), "t [s]", "dq/dt [deg/s]")
+                    .with(Series::line(
+                        format!("dq{}/dt", j + 1),
+                        t.clone(),
+                        col(&|s| s.qd[j] * DEG),
+                    ))
                     .hline(lim.velocity * DEG, "+v_max")
                     .hline(-lim.velocity * DEG, "−v_max"),
             )
             .panel(
-                Panel::new(format!("q̈{}", j + 1), "t [s]", "q̈ [deg/s²]")
-                    .with(Series::line(format!("q̈{}", j + 1), t.clone(), col(&|s| s.qdd[j] * DEG)))
-                    .with(Series::dashed("box lower b_l", t.clone(), col(&|s| s.box_lower[j].max(-3.0 * lim.acceleration) * DEG)))
-                    .with(Series::dashed("box upper b_u", t.clone(), col(&|s| s.box_upper[j].min(3.0 * lim.acceleration) * DEG)))
-                    .hline(lim.acceleration * DEG, "+a_max")
-                    .hline(-lim.acceleration * DEG, "−a_max"),
+                Panel::new(
+                    format!("acceleration d²q{}/dt²", j + 1),
+                    "t [s]",
+                    "d²q/dt² [deg/s²]",
+                )
+                .with(Series::line(
+                    format!("d²q{}/dt²", j + 1),
+                    t.clone(),
+                    col(&|s| s.qdd[j] * DEG),
+                ))
+                .with(Series::dashed(
+                    "box lower b_l",
+                    t.clone(),
+                    col(&|s| s.box_lower[j].max(-3.0 * lim.acceleration) * DEG),
+                ))
+                .with(Series::dashed(
+                    "box upper b_u",
+                    t.clone(),
+                    col(&|s| s.box_upper[j].min(3.0 * lim.acceleration) * DEG),
+                ))
+                .hline(lim.acceleration * DEG, "+a_max")
+                .hline(-lim.acceleration * DEG, "−a_max"),
             );
         let stem = format!("fig{}_q{}", 5 + j, j + 1);
         write_figure(&fig, dir, &stem)?;
-        figs.push((format!("{stem}.svg"), format!("Fig. {}: q{0}, q̇, q̈ with limits and the acceleration box ({tag})", 5 + j).replace("q5", &format!("q{}", j + 1))));
+        figs.push((
+            format!("{stem}.svg"),
+            format!(
+                "Fig. {}: position, velocity and acceleration of q{} with their limits and the acceleration box ({tag})",
+                5 + j,
+                j + 1
+            ),
+        ));
     }
     // Fig. 8: task errors.
     let mut fig = Figure::new(format!("Fig. 8 — task errors ({tag})"));
-    for (k, (name, unit, scale)) in [("Px", "m", 1.0), ("Py", "m", 1.0), ("θ3", "deg", DEG)].iter().enumerate() {
+    for (k, (name, unit, scale)) in [("Px", "m", 1.0), ("Py", "m", 1.0), ("θ3", "deg", DEG)]
+        .iter()
+        .enumerate()
+    {
         fig = fig.panel(
-            Panel::new(format!("error of {name}"), "t [s]", format!("{name} error [{unit}]"))
-                .with(Series::line(format!("{name}_d − {name}"), t.clone(), r.steps.iter().map(|s| s.error[k] * scale).collect())),
+            Panel::new(
+                format!("error of {name}"),
+                "t [s]",
+                format!("{name} error [{unit}]"),
+            )
+            .with(Series::line(
+                format!("{name}_d − {name}"),
+                t.clone(),
+                r.steps.iter().map(|s| s.error[k] * scale).collect(),
+            )),
         );
     }
     write_figure(&fig, dir, "fig8_errors")?;
-    figs.push(("fig8_errors.svg".to_string(), format!("Fig. 8: task errors ({tag})")));
+    figs.push((
+        "fig8_errors.svg".to_string(),
+        format!("Fig. 8: task errors ({tag})"),
+    ));
     Ok(figs)
 }
 
@@ -244,13 +349,29 @@ pub fn planar3r_section(out: &Path) -> Result<Section> {
     );
     let mut table = Table::new(
         "Summaries (margins in rad, rad/s, rad/s²; errors at t = 2 s)",
-        ["run", "position margin", "velocity margin", "accel. margin", "empty-box steps", "min q1 [deg]", "final Px / Py error [m]", "final θ3 error [deg]", "QPs per step (mean / max)", "corrected / climbed steps", "median tick [µs]"]
-            .map(String::from)
-            .to_vec(),
+        [
+            "run",
+            "position margin",
+            "velocity margin",
+            "accel. margin",
+            "empty-box steps",
+            "min q1 [deg]",
+            "final Px / Py error [m]",
+            "final θ3 error [deg]",
+            "QPs per step (mean / max)",
+            "corrected / climbed steps",
+            "median tick [µs]",
+        ]
+        .map(String::from)
+        .to_vec(),
     );
     let mut runs = Vec::new();
     for (name, method, bounds) in configs {
-        let r = run_planar3r(&Planar3rConfig { method, bounds, ..Default::default() })?;
+        let r = run_planar3r(&Planar3rConfig {
+            method,
+            bounds,
+            ..Default::default()
+        })?;
         let figs = write_run(&r, &base.join(name))?;
         table = table.row(summary_row(name, &r));
         if name == "iktc_viable" {
@@ -258,26 +379,50 @@ pub fn planar3r_section(out: &Path) -> Result<Section> {
                 sec = sec.figure(format!("planar3r/{name}/{f}"), c);
             }
         }
-        sec = sec.link(format!("planar3r/{name}/summary.json"), format!("{name}: summary.json"));
-        sec = sec.link(format!("planar3r/{name}/trajectory.csv"), format!("{name}: trajectory.csv"));
+        sec = sec.link(
+            format!("planar3r/{name}/summary.json"),
+            format!("{name}: summary.json"),
+        );
+        sec = sec.link(
+            format!("planar3r/{name}/trajectory.csv"),
+            format!("{name}: trajectory.csv"),
+        );
         runs.push((name, r));
     }
     // IKTC vs GF, and the paper's bound vs the viable bound.
     let t: Vec<f64> = runs[0].1.steps.iter().map(|s| s.t).collect();
-    let get = |i: usize, f: &dyn Fn(&iktc::sim::Planar3rStep) -> f64| runs[i].1.steps.iter().map(f).collect::<Vec<f64>>();
+    let get = |i: usize, f: &dyn Fn(&iktc::sim::Planar3rStep) -> f64| {
+        runs[i].1.steps.iter().map(f).collect::<Vec<f64>>()
+    };
     let cmp = Figure::new("IKTC and GF side by side (viable bounds)")
         .panel(
             Panel::new("q1", "t [s]", "q1 [deg]")
                 .with(Series::line("IKTC", t.clone(), get(0, &|s| s.q[0] * DEG)))
                 .with(Series::dashed("GF", t.clone(), get(1, &|s| s.q[0] * DEG)))
-                .with(Series::dashed("clamp", t.clone(), get(2, &|s| s.q[0] * DEG)))
+                .with(Series::dashed(
+                    "clamp",
+                    t.clone(),
+                    get(2, &|s| s.q[0] * DEG),
+                ))
                 .hline(60.0, "q1 lower limit"),
         )
         .panel(
             Panel::new("θ3 error", "t [s]", "θ3 error [deg]")
-                .with(Series::line("IKTC", t.clone(), get(0, &|s| s.error[2] * DEG)))
-                .with(Series::dashed("GF", t.clone(), get(1, &|s| s.error[2] * DEG)))
-                .with(Series::dashed("clamp", t.clone(), get(2, &|s| s.error[2] * DEG))),
+                .with(Series::line(
+                    "IKTC",
+                    t.clone(),
+                    get(0, &|s| s.error[2] * DEG),
+                ))
+                .with(Series::dashed(
+                    "GF",
+                    t.clone(),
+                    get(1, &|s| s.error[2] * DEG),
+                ))
+                .with(Series::dashed(
+                    "clamp",
+                    t.clone(),
+                    get(2, &|s| s.error[2] * DEG),
+                )),
         )
         .panel(
             Panel::new("P_x error", "t [s]", "Px error [m]")
@@ -286,22 +431,40 @@ pub fn planar3r_section(out: &Path) -> Result<Section> {
                 .with(Series::dashed("clamp", t.clone(), get(2, &|s| s.error[0]))),
         );
     write_figure(&cmp, &base, "iktc_vs_gf")?;
-    sec = sec.figure("planar3r/iktc_vs_gf.svg", "IKTC, GF and clamping: q1, θ3 error and Px error");
+    sec = sec.figure(
+        "planar3r/iktc_vs_gf.svg",
+        "IKTC, GF and clamping: q1, θ3 error and Px error",
+    );
     let bnd = Figure::new("The paper's bound (eq. 14) against the viable bound, IKTC")
         .panel(
             Panel::new("q1 near its lower limit", "t [s]", "q1 [deg]")
                 .with(Series::line("viable", t.clone(), get(0, &|s| s.q[0] * DEG)))
-                .with(Series::dashed("paper eq. (14)", t.clone(), get(3, &|s| s.q[0] * DEG)))
+                .with(Series::dashed(
+                    "paper eq. (14)",
+                    t.clone(),
+                    get(3, &|s| s.q[0] * DEG),
+                ))
                 .hline(60.0, "q1 lower limit"),
         )
         .panel(
-            Panel::new("q̈1", "t [s]", "q̈1 [deg/s²]")
-                .with(Series::line("viable", t.clone(), get(0, &|s| s.qdd[0] * DEG)))
-                .with(Series::dashed("paper eq. (14)", t.clone(), get(3, &|s| s.qdd[0] * DEG)))
+            Panel::new("acceleration of q1", "t [s]", "d²q1/dt² [deg/s²]")
+                .with(Series::line(
+                    "viable",
+                    t.clone(),
+                    get(0, &|s| s.qdd[0] * DEG),
+                ))
+                .with(Series::dashed(
+                    "paper eq. (14)",
+                    t.clone(),
+                    get(3, &|s| s.qdd[0] * DEG),
+                ))
                 .hline(1800.0, "+a_max")
                 .hline(-1800.0, "−a_max"),
         );
     write_figure(&bnd, &base, "paper_vs_viable")?;
-    sec = sec.figure("planar3r/paper_vs_viable.svg", "q1 and q̈1 under the paper's bound and the viable bound: eq. (14) lets q1 pass 60°");
+    sec = sec.figure(
+        "planar3r/paper_vs_viable.svg",
+        "q1 and q̈1 under the paper's bound and the viable bound: eq. (14) lets q1 pass 60°",
+    );
     Ok(sec.table(table))
 }

@@ -2,6 +2,11 @@
 
 /// Fraction of the data span added on each side of an axis so that curves do not touch the frame.
 const MARGIN_FRACTION: f64 = 0.05;
+/// Largest magnitude an axis end may have; data beyond is drawn off the chart. Keeps the span
+/// finite (plotters' tick computation does not terminate on an infinite span).
+pub(crate) const MAX_ABS: f64 = 1e300;
+/// Smallest positive axis end of a logarithmic axis.
+const MIN_POSITIVE: f64 = 1e-300;
 
 /// Finite minimum and maximum of `values` (`None` when no value is finite).
 pub(crate) fn finite_bounds(values: impl IntoIterator<Item = f64>) -> Option<(f64, f64)> {
@@ -16,20 +21,18 @@ pub(crate) fn finite_bounds(values: impl IntoIterator<Item = f64>) -> Option<(f6
 
 /// A linear axis range around `bounds` with a margin of [`MARGIN_FRACTION`] on each side.
 ///
-/// No data gives `[0, 1]`; a single value `v` (all values equal) is padded by `max(|v|/10, 1e-9)`
-/// on each side so the range never has zero width.
+/// No data gives `[0, 1]`; a single value `v` (all values equal) is padded by `|v|/10` (or 1
+/// when `v` is about 0) on each side so the range never has zero width. Bounds are clamped to
+/// `±MAX_ABS` so the span stays finite.
 pub(crate) fn linear_range(bounds: Option<(f64, f64)>) -> (f64, f64) {
     let Some((lo, hi)) = bounds else {
         return (0.0, 1.0);
     };
+    let (lo, hi) = (lo.clamp(-MAX_ABS, MAX_ABS), hi.clamp(-MAX_ABS, MAX_ABS));
     let span = hi - lo;
     let scale = lo.abs().max(hi.abs());
-    if !span.is_finite() {
-        // Values near ±f64::MAX: avoid overflow, keep the bounds themselves.
-        return (lo, hi);
-    }
-    if span <= scale * 1e-12 || span == 0.0 {
-        let pad = if scale > 0.0 { scale * 0.1 } else { 1.0 };
+    if span <= scale * 1e-12 || span < 1e-290 {
+        let pad = if scale > 1e-290 { scale * 0.1 } else { 1.0 };
         return (lo - pad, hi + pad);
     }
     let pad = span * MARGIN_FRACTION;
@@ -38,16 +41,26 @@ pub(crate) fn linear_range(bounds: Option<(f64, f64)>) -> (f64, f64) {
 
 /// A logarithmic axis range around positive `bounds`, padded by a small factor on each side.
 ///
-/// No positive data gives `[1, 10]`; a single value `v` gives `[v/2, 2v]`.
+/// No positive data gives `[1, 10]`; a single value `v` gives `[v/2, 2v]`. Ends are clamped to
+/// `[1e-300, MAX_ABS]`.
 pub(crate) fn log_range(bounds: Option<(f64, f64)>) -> (f64, f64) {
     let Some((lo, hi)) = bounds else {
         return (1.0, 10.0);
     };
-    if hi <= lo * (1.0 + 1e-12) {
-        return (lo / 2.0, hi * 2.0);
-    }
-    let ratio = (hi / lo).powf(MARGIN_FRACTION);
-    (lo / ratio, hi * ratio)
+    let (lo, hi) = (
+        lo.clamp(MIN_POSITIVE, MAX_ABS),
+        hi.clamp(MIN_POSITIVE, MAX_ABS),
+    );
+    let (l0, l1) = (lo.ln(), hi.ln());
+    let pad = if l1 - l0 < 1e-9 {
+        std::f64::consts::LN_2
+    } else {
+        (l1 - l0) * MARGIN_FRACTION
+    };
+    (
+        (l0 - pad).exp().clamp(MIN_POSITIVE, MAX_ABS),
+        (l1 + pad).exp().clamp(MIN_POSITIVE, MAX_ABS),
+    )
 }
 
 /// Widens the smaller of two ranges so that one data unit spans the same number of pixels on
@@ -63,11 +76,22 @@ pub(crate) fn equalize(
     }
     let per_px = ((x.1 - x.0) / plot_w).max((y.1 - y.0) / plot_h);
     let widen = |r: (f64, f64), px: f64| {
-        let c = 0.5 * (r.0 + r.1);
+        let c = 0.5 * r.0 + 0.5 * r.1;
         let half = 0.5 * per_px * px;
         (c - half, c + half)
     };
-    (widen(x, plot_w), widen(y, plot_h))
+    let (ex, ey) = (widen(x, plot_w), widen(y, plot_h));
+    if is_usable(ex) && is_usable(ey) {
+        (ex, ey)
+    } else {
+        (x, y)
+    }
+}
+
+/// Whether plotters can draw an axis over `r`: finite ends, a finite positive span.
+pub(crate) fn is_usable(r: (f64, f64)) -> bool {
+    let span = r.1 - r.0;
+    r.0.is_finite() && r.1.is_finite() && span.is_finite() && span > 0.0
 }
 
 /// A tick-label formatter for a linear axis spanning `range`: as many decimals as the tick step
@@ -146,7 +170,19 @@ mod tests {
         let (lo, hi) = linear_range(Some((0.0, 10.0)));
         assert!((lo + 0.5).abs() < 1e-12 && (hi - 10.5).abs() < 1e-12);
         let (lo, hi) = log_range(Some((3.0, 3.0)));
-        assert!(lo > 0.0 && hi > lo);
+        assert!((lo - 1.5).abs() < 1e-12 && (hi - 6.0).abs() < 1e-12);
+        for b in [
+            Some((-f64::MAX, f64::MAX)),
+            Some((f64::MAX, f64::MAX)),
+            Some((5e-324, 1e-323)),
+            Some((0.0, 5e-324)),
+        ] {
+            assert!(is_usable(linear_range(b)), "{b:?} -> {:?}", linear_range(b));
+        }
+        for b in [Some((5e-324, f64::MAX)), Some((f64::MAX, f64::MAX))] {
+            let r = log_range(b);
+            assert!(is_usable(r) && r.0 > 0.0, "{b:?} -> {r:?}");
+        }
     }
 
     #[test]

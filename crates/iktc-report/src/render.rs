@@ -12,7 +12,7 @@ use crate::figure::{Figure, LineStyle, Panel, Series};
 use crate::font::FONT_FAMILY;
 use crate::legend::{draw_legend, LegendEntry, Marker};
 use crate::range::{
-    equalize, finite_bounds, linear_formatter, linear_range, log_formatter, log_range,
+    equalize, finite_bounds, is_usable, linear_formatter, linear_range, log_formatter, log_range,
 };
 
 /// Series colours (Tableau-like, red left out: red is reserved for limit lines).
@@ -35,8 +35,12 @@ const MARGIN: u32 = 8;
 const MARGIN_RIGHT: u32 = 20;
 /// Height reserved for x tick labels and the x-axis label \[px\].
 const X_LABEL_AREA: u32 = 42;
-/// Width reserved for y tick labels and the y-axis label \[px\].
-const Y_LABEL_AREA: u32 = 78;
+/// Width reserved for the y-axis label and tick marks, besides the tick labels \[px\].
+const Y_DESC_AREA: u32 = 40;
+/// Smallest width reserved for y tick labels and the y-axis label \[px\].
+const MIN_Y_LABEL_AREA: u32 = 70;
+/// Tick-label text size \[px\].
+const TICK_FONT: u32 = 13;
 /// Line width of series \[px\].
 const LINE_WIDTH: u32 = 2;
 /// Marker radius of point series \[px\].
@@ -116,6 +120,48 @@ fn segments(s: &Series, log_x: bool) -> Vec<Vec<(f64, f64)>> {
     out
 }
 
+/// Pulls points lying far outside the axis ranges (beyond ten spans; possible only for values
+/// beyond `range::MAX_ABS`) to that distance, so that pixel coordinates cannot overflow.
+fn clamp_to_view(seg: &[(f64, f64)], view: &View<'_>, log_x: bool) -> Vec<(f64, f64)> {
+    let wide = |r: (f64, f64)| {
+        let span = r.1 - r.0;
+        (r.0 - 10.0 * span, r.1 + 10.0 * span)
+    };
+    let (x, y) = (view.x_range, view.y_range);
+    let xr = if log_x {
+        let ratio = (x.1 / x.0).powi(10);
+        (x.0 / ratio, x.1 * ratio)
+    } else {
+        wide(x)
+    };
+    let yr = wide(y);
+    let fit = |v: f64, r: (f64, f64)| {
+        if r.0.is_finite() && r.1.is_finite() && r.0 < r.1 {
+            v.clamp(r.0, r.1)
+        } else {
+            v
+        }
+    };
+    seg.iter().map(|&(a, b)| (fit(a, xr), fit(b, yr))).collect()
+}
+
+/// Width for the y tick labels and axis label \[px\]: the widest label that the formatter of
+/// `y_range` produces, plus room for the rotated axis label.
+fn y_label_area<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, y_range: (f64, f64)) -> u32 {
+    let fmt = linear_formatter(y_range);
+    let style = TextStyle::from((FONT_FAMILY, TICK_FONT).into_font());
+    let widest = (0..=20)
+        .map(|k| y_range.0 + (y_range.1 - y_range.0) * f64::from(k) / 20.0)
+        .map(|v| {
+            let label = fmt(&v);
+            area.estimate_text_size(&label, &style)
+                .map_or(8 * label.len() as u32, |(w, _)| w)
+        })
+        .max()
+        .unwrap_or(0);
+    (widest + Y_DESC_AREA).max(MIN_Y_LABEL_AREA)
+}
+
 fn draw_panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     panel: &Panel,
@@ -139,8 +185,9 @@ fn draw_panel<DB: DrawingBackend>(
     let yb = finite_bounds(pts().map(|p| p.1).chain(panel.hlines.iter().map(|h| h.y)));
     let has_data = xb.is_some();
     let mut y_range = linear_range(yb);
+    let y_label_area = y_label_area(&area, y_range);
     let (area_w, area_h) = area.dim_in_pixel();
-    let plot_w = f64::from(area_w) - f64::from(2 * MARGIN + MARGIN_RIGHT + Y_LABEL_AREA);
+    let plot_w = f64::from(area_w) - f64::from(2 * MARGIN + MARGIN_RIGHT + y_label_area);
     let plot_h = f64::from(area_h) - f64::from(2 * MARGIN + X_LABEL_AREA);
     let columns = plot_w.max(1.0) as usize;
     let mut builder = ChartBuilder::on(&area);
@@ -148,9 +195,18 @@ fn draw_panel<DB: DrawingBackend>(
         .margin(MARGIN)
         .margin_right(MARGIN_RIGHT)
         .x_label_area_size(X_LABEL_AREA)
-        .y_label_area_size(Y_LABEL_AREA);
+        .y_label_area_size(y_label_area);
+    let unusable = |x_range: (f64, f64), y_range: (f64, f64)| ReportError::Plot {
+        what: format!(
+            "panel '{}' has axis ranges x {x_range:?}, y {y_range:?} that cannot be drawn",
+            panel.title
+        ),
+    };
     if log_x {
         let x_range = log_range(xb);
+        if !is_usable(x_range) || !is_usable(y_range) {
+            return Err(unusable(x_range, y_range));
+        }
         let mut chart = builder
             .build_cartesian_2d((x_range.0..x_range.1).log_scale(), y_range.0..y_range.1)
             .map_err(err("building a log-x chart"))?;
@@ -168,6 +224,9 @@ fn draw_panel<DB: DrawingBackend>(
         let mut x_range = linear_range(xb);
         if panel.equal_aspect {
             (x_range, y_range) = equalize(x_range, y_range, plot_w, plot_h);
+        }
+        if !is_usable(x_range) || !is_usable(y_range) {
+            return Err(unusable(x_range, y_range));
         }
         let mut chart = builder
             .build_cartesian_2d(x_range.0..x_range.1, y_range.0..y_range.1)
@@ -207,7 +266,7 @@ where
         .y_labels(7)
         .x_max_light_lines(2)
         .y_max_light_lines(2)
-        .label_style((FONT_FAMILY, 13))
+        .label_style((FONT_FAMILY, TICK_FONT))
         .axis_desc_style((FONT_FAMILY, 15))
         .bold_line_style(RGBColor(215, 215, 215))
         .light_line_style(RGBColor(240, 240, 240))
@@ -223,15 +282,18 @@ where
     let mut entries: Vec<LegendEntry> = Vec::new();
     for h in panel.hlines.iter().filter(|h| h.y.is_finite()) {
         let style = LIMIT_COLOR.stroke_width(LINE_WIDTH);
+        let hy = clamp_to_view(&[(x_range.0, h.y)], view, panel.log_x)
+            .first()
+            .map_or(h.y, |p| p.1);
         chart
             .draw_series(DashedLineSeries::new(
-                vec![(x_range.0, h.y), (x_range.1, h.y)],
+                vec![(x_range.0, hy), (x_range.1, hy)],
                 10,
                 6,
                 style,
             ))
             .map_err(err("drawing a limit line"))?;
-        let (_, py) = chart.backend_coord(&(x_range.0, h.y));
+        let (_, py) = chart.backend_coord(&(x_range.0, hy));
         occupied.extend(
             (0..view.columns as i32)
                 .step_by(4)
@@ -250,9 +312,12 @@ where
         let line = color.stroke_width(LINE_WIDTH);
         let segs: Vec<Vec<(f64, f64)>> = segments(s, panel.log_x)
             .iter()
-            .map(|seg| match s.style {
-                LineStyle::Points => seg.clone(),
-                _ => decimate(seg, view.columns, view.to_col),
+            .map(|seg| {
+                let seg = clamp_to_view(seg, view, panel.log_x);
+                match s.style {
+                    LineStyle::Points => seg,
+                    _ => decimate(&seg, view.columns, view.to_col),
+                }
             })
             .collect();
         let ctx = format!("drawing series '{}'", s.label);

@@ -3,7 +3,10 @@
 
 use std::path::PathBuf;
 
-use iktc_report::{write_figure, Figure, Panel, ReportError, Series};
+use iktc_report::{
+    write_csv, write_figure, write_report, Figure, Panel, Report, ReportError, Section, Series,
+    Table,
+};
 
 fn out_dir(name: &str) -> PathBuf {
     let d = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
@@ -241,5 +244,135 @@ fn gallery_for_eyeballing() {
                     .collect(),
             )),
         );
+    let t = linspace(0.0, 1.0, 50);
+    let tiny = tiny
+        .panel(Panel::new("offset", "time [s]", "z [m]").with(Series::line(
+            "z",
+            t.clone(),
+            t.iter().map(|t| -1000.0 - 1e-3 * t).collect(),
+        )))
+        .panel(
+            Panel::new(
+                "long label",
+                "time since the start of the experiment [s]",
+                "joint torque tau_12 [N m]",
+            )
+            .with(Series::line(
+                "tau",
+                t.clone(),
+                t.iter().map(|t| -123.456 * t).collect(),
+            )),
+        );
     write_figure(&tiny, &dir, "scales").unwrap();
+    write_csv(
+        &dir.join("data/joint.csv"),
+        &["t [s]".to_string(), "q1 [rad]".to_string()],
+        &[vec![0.0, 0.0], vec![0.01, 0.015]],
+    )
+    .unwrap();
+    let report = Report::new("iktc gallery")
+        .intro("<p>Figures of every kind the experiments draw.</p>")
+        .section(
+            Section::new("Joint limits")
+                .intro("<p>Angles stay <b>inside</b> the dashed limits.</p>")
+                .figure(
+                    "joint.svg",
+                    "Joint angle and velocity; dashed red lines are limits",
+                )
+                .table(
+                    Table::new(
+                        "Summary",
+                        vec!["joint".into(), "max |q| [rad]".into(), "ok".into()],
+                    )
+                    .row(vec!["q1".into(), "1.2".into(), "no".into()])
+                    .row(vec!["q2 <left>".into(), "0.8".into(), "yes".into()]),
+                )
+                .link("data/joint.csv", "joint angles (CSV)"),
+        )
+        .section(Section::new("Frequency response").figure("bode.svg", "Bode plot"))
+        .section(
+            Section::new("Paths")
+                .figure("xy.svg", "Hand path, equal aspect")
+                .figure("scales.svg", "Very small and very large values"),
+        );
+    let index = write_report(&report, &dir).unwrap();
+    assert!(index.exists());
+}
+
+#[test]
+fn extreme_magnitudes_do_not_panic() {
+    let cases: Vec<(Vec<f64>, Vec<f64>)> = vec![
+        (vec![0.0, 1.0], vec![f64::MAX, -f64::MAX]),
+        (vec![0.0, 1.0], vec![1e300, -1e300]),
+        (vec![0.0, 1e-320], vec![5e-324, 1e-323]),
+        (vec![-f64::MAX, f64::MAX], vec![0.0, 1.0]),
+        (vec![1.0, 1.0 + 1e-15], vec![1e-9, 1e-9 + 1e-24]),
+    ];
+    let only: Option<usize> = std::env::var("EXTREME_CASE")
+        .ok()
+        .and_then(|v| v.parse().ok());
+    for (i, (x, y)) in cases.into_iter().enumerate() {
+        if only.is_some_and(|o| o != i) {
+            continue;
+        }
+        let fig = Figure::new("extreme")
+            .panel(
+                Panel::new("lin", "x [m]", "y [m]")
+                    .with(Series::line("a", x.clone(), y.clone()))
+                    .hline(f64::MAX, "max")
+                    .hline(-f64::MAX, "min"),
+            )
+            .panel(
+                Panel::new("eq", "x [m]", "y [m]")
+                    .equal_aspect()
+                    .with(Series::line("a", x.clone(), y.clone())),
+            )
+            .panel(
+                Panel::new("log", "x [m]", "y [m]")
+                    .log_x()
+                    .with(Series::points("a", x, y)),
+            );
+        let r = write_figure(&fig, &out_dir("extreme"), &format!("extreme{i}"));
+        assert!(r.is_ok(), "case {i}: {r:?}");
+    }
+}
+
+/// Small deterministic generator (xorshift64*) so the sweep below needs no extra dependency.
+struct Xorshift(u64);
+impl Xorshift {
+    fn next_f64(&mut self) -> f64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+#[test]
+fn sweep_of_offsets_and_spans_draws_every_figure() {
+    // Offsets from 1e-12 to 1e12 with relative spans down to 1e-14: plotters' tick computation
+    // must neither hang nor fail on any of them.
+    let mut rng = Xorshift(0x1234_5678_9abc_def1);
+    let dir = out_dir("sweep");
+    for i in 0..60 {
+        let offset =
+            10f64.powf(-12.0 + 24.0 * rng.next_f64()) * if i % 2 == 0 { 1.0 } else { -1.0 };
+        let rel = 10f64.powf(-14.0 + 14.0 * rng.next_f64());
+        let span = offset.abs() * rel;
+        let x: Vec<f64> = (0..20)
+            .map(|k| offset + span * f64::from(k) / 19.0)
+            .collect();
+        let y: Vec<f64> = x.iter().map(|v| v * 0.5).collect();
+        let fig = Figure::new("")
+            .panel_size(300, 150)
+            .columns(2)
+            .panel(Panel::new("lin", "x", "y").with(Series::line("a", x.clone(), y.clone())))
+            .panel(Panel::new("log", "x", "y").log_x().with(Series::line(
+                "a",
+                x.iter().map(|v| v.abs()).collect(),
+                y,
+            )));
+        let r = write_figure(&fig, &dir, "sweep");
+        assert!(r.is_ok(), "offset {offset:e}, span {span:e}: {r:?}");
+    }
 }

@@ -267,3 +267,18 @@ fn nan_dependence_tolerance_is_an_error() {
 fn default_settings_are_valid() {
     assert!(QpSettings::default().validate().is_ok());
 }
+
+#[test]
+fn overflowing_data_is_an_error_not_a_panic() {
+    let mut d = Data::new();
+    d.h = DMatrix::identity(2, 2);
+    d.c = vec![1e308, 1e308];
+    d.b_eq = vec![1e308];
+    d.l = vec![-1e308, f64::NEG_INFINITY];
+    d.u = vec![1e308, 1e308];
+    let err = solve(&d.problem()).unwrap_err();
+    assert!(
+        matches!(&err, Error::NonFinite { what, .. } if what.contains("overflow")),
+        "{err:?}"
+    );
+}

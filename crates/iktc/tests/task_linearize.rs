@@ -109,8 +109,8 @@ fn orientation_and_com_errors_follow_eq_12_on_jvrc1() {
         kin.update(&robot, &s).unwrap();
         stack.linearize(&robot, &kin, &s, &mut eqs).unwrap();
         let time = step as f64 * dt;
-        for k in 0..5 {
-            let want = closed_form(e0[k], 0.0, 100.0, time);
+        for (k, &e0k) in e0.iter().enumerate() {
+            let want = closed_form(e0k, 0.0, 100.0, time);
             // Rotation-vector errors compose non-linearly: allow a little more.
             assert!(
                 (eqs[0].error[k] - want).abs() < 2e-2 * e0[k].abs(),

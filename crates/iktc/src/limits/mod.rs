@@ -39,6 +39,7 @@
 
 mod acceleration_box;
 mod compute;
+mod from_robot;
 mod integrator;
 mod intersect;
 mod joint_limits;

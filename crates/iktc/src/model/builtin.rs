@@ -29,7 +29,7 @@ pub const JVRC1_FINGERS: &[&str] = &[
 ];
 
 /// The planar 3R arm of Section 3.3: three revolute joints about z, unit links along x, joint
-/// ranges q1 ∈ [60°, 180°], q2, q3 ∈ [−120°, 120°], 180°/s and 1800°/s² for every joint. Each
+/// ranges q1 ∈ \[60°, 180°\], q2, q3 ∈ \[−120°, 120°\], 180°/s and 1800°/s² for every joint. Each
 /// link has 1 kg at its middle. Frame `tip` is the end of the third link.
 pub fn planar3r() -> Robot {
     let deg = std::f64::consts::PI / 180.0;

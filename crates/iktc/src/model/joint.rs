@@ -5,13 +5,13 @@ use nalgebra::{Isometry3, Translation3, Unit, UnitQuaternion, Vector3};
 /// How a joint moves its child link relative to its parent.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum JointKind {
-    /// Rotation about a unit axis (in the joint frame) by q [rad]. URDF `revolute` and
+    /// Rotation about a unit axis (in the joint frame) by q \[rad\]. URDF `revolute` and
     /// `continuous` (a continuous joint has an infinite position range).
     Revolute {
         /// Unit rotation axis in the joint frame.
         axis: Unit<Vector3<f64>>,
     },
-    /// Translation along a unit axis (in the joint frame) by q [m].
+    /// Translation along a unit axis (in the joint frame) by q \[m\].
     Prismatic {
         /// Unit translation axis in the joint frame.
         axis: Unit<Vector3<f64>>,
@@ -21,7 +21,7 @@ pub enum JointKind {
 }
 
 impl JointKind {
-    /// The motion of the joint for coordinate `q` [rad] or [m], as a transform from the joint
+    /// The motion of the joint for coordinate `q` \[rad\] or \[m\], as a transform from the joint
     /// frame to the child link frame.
     #[inline]
     pub fn transform(&self, q: f64) -> Isometry3<f64> {
@@ -48,19 +48,19 @@ impl JointKind {
     }
 }
 
-/// Limits of one joint, in the joint's own unit ([rad] for revolute, [m] for prismatic).
+/// Limits of one joint, in the joint's own unit (\[rad\] for revolute, \[m\] for prismatic).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct JointLimit {
-    /// Lowest position [rad] or [m]; −∞ when unbounded (continuous joints).
+    /// Lowest position \[rad\] or \[m\]; −∞ when unbounded (continuous joints).
     pub lower: f64,
-    /// Highest position [rad] or [m]; +∞ when unbounded.
+    /// Highest position \[rad\] or \[m\]; +∞ when unbounded.
     pub upper: f64,
-    /// Largest speed [rad/s] or [m/s]; +∞ when unbounded.
+    /// Largest speed \[rad/s\] or \[m/s\]; +∞ when unbounded.
     pub velocity: f64,
-    /// Largest acceleration [rad/s²] or [m/s²]; URDF has none: it comes from
+    /// Largest acceleration \[rad/s²\] or \[m/s²\]; URDF has none: it comes from
     /// [`ModelOptions`](crate::model::ModelOptions).
     pub acceleration: f64,
-    /// Largest effort [N·m] or [N]; informative only (the IK is kinematic).
+    /// Largest effort \[N·m\] or \[N\]; informative only (the IK is kinematic).
     pub effort: f64,
 }
 
@@ -83,7 +83,7 @@ pub enum JointRole {
         /// Index of the joint's coordinate among the active joints (0-based).
         index: usize,
     },
-    /// The joint is held at a value [rad] or [m] and drops out of q.
+    /// The joint is held at a value \[rad\] or \[m\] and drops out of q.
     Locked {
         /// The value it is held at.
         value: f64,
@@ -94,7 +94,7 @@ pub enum JointRole {
         master: usize,
         /// Multiplier of the master's coordinate.
         multiplier: f64,
-        /// Offset [rad] or [m].
+        /// Offset \[rad\] or \[m\].
         offset: f64,
     },
     /// A fixed joint.

@@ -2,8 +2,8 @@
 //!
 //! ## Convention (one for every frame)
 //!
-//! A frame's velocity is the 6-vector (v, ω): v [m/s] the velocity of the frame's origin and
-//! ω [rad/s] its angular velocity, **both in world axes** (Pinocchio's `LOCAL_WORLD_ALIGNED`).
+//! A frame's velocity is the 6-vector (v, ω): v \[m/s\] the velocity of the frame's origin and
+//! ω \[rad/s\] its angular velocity, **both in world axes** (Pinocchio's `LOCAL_WORLD_ALIGNED`).
 //! The frame Jacobian J (6 × nv, rows v then ω) gives (v, ω) = J q̇, and the drift J̇q̇ is the
 //! frame's acceleration (p̈, ω̇) when q̈ = 0, so that (p̈, ω̇) = J q̈ + J̇q̇ (paper eq. 3).
 //!
@@ -101,8 +101,8 @@ impl Kinematics {
                 self.base_axes[k] = Motion::new(Vector3::zeros(), e);
                 self.base_axes[3 + k] = Motion::new(e, p.cross(&e));
             }
-            for k in 0..6 {
-                v += self.base_axes[k].scaled(qd[k]);
+            for (axis, rate) in self.base_axes.iter().zip(&qd[..6]) {
+                v += axis.scaled(*rate);
             }
             self.link_vel[root] = v;
         }
@@ -183,7 +183,7 @@ impl Kinematics {
         Ok(self.link_pose[fr.link] * fr.offset)
     }
 
-    /// Velocity (v [m/s], ω [rad/s]) of a frame, world axes: J q̇.
+    /// Velocity (v \[m/s\], ω \[rad/s\]) of a frame, world axes: J q̇.
     pub fn frame_velocity(&self, robot: &Robot, f: FrameId) -> Result<Vector6<f64>> {
         let fr = frame(robot, f)?;
         let p = (self.link_pose[fr.link] * fr.offset).translation.vector;
@@ -191,7 +191,7 @@ impl Kinematics {
         Ok(stack(&v.point_velocity(&p), &v.angular))
     }
 
-    /// Drift J̇q̇ of a frame (p̈ [m/s²], ω̇ [rad/s²], world axes): its acceleration when q̈ = 0.
+    /// Drift J̇q̇ of a frame (p̈ \[m/s²\], ω̇ \[rad/s²\], world axes): its acceleration when q̈ = 0.
     pub fn frame_drift(&self, robot: &Robot, f: FrameId) -> Result<Vector6<f64>> {
         let fr = frame(robot, f)?;
         let p = (self.link_pose[fr.link] * fr.offset).translation.vector;
@@ -229,22 +229,22 @@ impl Kinematics {
         Ok(())
     }
 
-    /// Centre of mass [m], world.
+    /// Centre of mass \[m\], world.
     pub fn com(&self) -> Vector3<f64> {
         self.com
     }
 
-    /// Velocity of the centre of mass [m/s], world.
+    /// Velocity of the centre of mass \[m/s\], world.
     pub fn com_velocity(&self) -> Vector3<f64> {
         self.com_vel
     }
 
-    /// Drift of the centre of mass [m/s²]: its acceleration when q̈ = 0.
+    /// Drift of the centre of mass \[m/s²\]: its acceleration when q̈ = 0.
     pub fn com_drift(&self) -> Vector3<f64> {
         self.com_drift
     }
 
-    /// Total mass [kg].
+    /// Total mass \[kg\].
     pub fn total_mass(&self) -> f64 {
         self.total_mass
     }

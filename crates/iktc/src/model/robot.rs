@@ -12,11 +12,11 @@ use crate::error::{Error, Result};
 pub struct Link {
     /// The link's name.
     pub name: String,
-    /// Mass [kg].
+    /// Mass \[kg\].
     pub mass: f64,
-    /// Centre of mass in the link frame [m].
+    /// Centre of mass in the link frame \[m\].
     pub com: Vector3<f64>,
-    /// Inertia about the centre of mass, in link axes [kg·m²].
+    /// Inertia about the centre of mass, in link axes \[kg·m²\].
     pub inertia: Matrix3<f64>,
 }
 
@@ -38,8 +38,8 @@ impl Link {
 pub enum BaseKind {
     /// The root link is fixed at the world origin.
     Fixed,
-    /// The root link is free: q starts with its position [m] and unit quaternion (x, y, z, w);
-    /// q̇ starts with its body twist: linear velocity [m/s] then angular velocity [rad/s], both
+    /// The root link is free: q starts with its position \[m\] and unit quaternion (x, y, z, w);
+    /// q̇ starts with its body twist: linear velocity \[m/s\] then angular velocity \[rad/s\], both
     /// in the root link's own axes (Pinocchio's free-flyer convention).
     Floating,
 }
@@ -72,16 +72,16 @@ pub enum MimicPolicy {
 pub struct ModelOptions {
     /// Fixed or floating root.
     pub base: BaseKind,
-    /// Joints held at a value [rad] or [m]: they drop out of q. Locking a mimic master also
+    /// Joints held at a value \[rad\] or \[m\]: they drop out of q. Locking a mimic master also
     /// locks its mimics.
     pub locked: Vec<(String, f64)>,
-    /// Acceleration limits [rad/s²] or [m/s²] by joint name (URDF has none).
+    /// Acceleration limits \[rad/s²\] or \[m/s²\] by joint name (URDF has none).
     pub acceleration_limits: Vec<(String, f64)>,
-    /// Default acceleration limit as a multiple of the joint's velocity limit [1/s]: the joint
+    /// Default acceleration limit as a multiple of the joint's velocity limit \[1/s\]: the joint
     /// reaches full speed from rest in 1/this seconds. Default 10 s⁻¹, the ratio of the paper's
     /// 3R arm (180°/s, 1800°/s²). Used for joints with no explicit acceleration limit.
     pub acceleration_per_velocity: f64,
-    /// Acceleration limit [rad/s²] for joints that have neither an acceleration nor a velocity
+    /// Acceleration limit \[rad/s²\] for joints that have neither an acceleration nor a velocity
     /// limit. Default +∞ (no limit).
     pub fallback_acceleration: f64,
     /// What to do with mimic joints.
@@ -591,7 +591,7 @@ impl Robot {
         &self.frames
     }
 
-    /// Total mass [kg].
+    /// Total mass \[kg\].
     pub fn total_mass(&self) -> f64 {
         self.total_mass
     }

@@ -1,13 +1,13 @@
 //! Spatial (6D) motion vectors in world axes and the SE(3) exponential.
 //!
 //! A [`Motion`] is a twist or a spatial acceleration expressed at the world origin in world axes
-//! (Featherstone's spatial notation): an angular part ω [rad/s] and a linear part v_O [m/s], the
+//! (Featherstone's spatial notation): an angular part ω \[rad/s\] and a linear part v_O \[m/s\], the
 //! velocity of the (possibly fictitious) body point that coincides with the world origin. The
-//! velocity of a body point at p [m] is then v_p = v_O + ω × p.
+//! velocity of a body point at p \[m\] is then v_p = v_O + ω × p.
 
 use nalgebra::{Isometry3, Matrix3, Translation3, UnitQuaternion, Vector3};
 
-/// A spatial motion vector (twist [rad/s, m/s] or spatial acceleration [rad/s², m/s²]) at the
+/// A spatial motion vector (twist \[rad/s, m/s\] or spatial acceleration \[rad/s², m/s²\]) at the
 /// world origin, in world axes.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Motion {
@@ -46,7 +46,7 @@ impl Motion {
         )
     }
 
-    /// Velocity [m/s] of the body point at `p` [m] (world): v_O + ω × p.
+    /// Velocity \[m/s\] of the body point at `p` \[m\] (world): v_O + ω × p.
     #[inline]
     pub fn point_velocity(&self, p: &Vector3<f64>) -> Vector3<f64> {
         self.linear + self.angular.cross(p)
@@ -74,11 +74,11 @@ pub fn skew(w: &Vector3<f64>) -> Matrix3<f64> {
     Matrix3::new(0.0, -w.z, w.y, w.z, 0.0, -w.x, -w.y, w.x, 0.0)
 }
 
-/// Below this rotation angle [rad] the SE(3) exponential uses Taylor series instead of the
+/// Below this rotation angle \[rad\] the SE(3) exponential uses Taylor series instead of the
 /// closed form, whose coefficients lose precision as θ → 0 (relative error ≈ ε/θ²).
 const SMALL_ANGLE: f64 = 1e-4;
 
-/// The SE(3) exponential of a body twist ξ = (v [m], ω [rad]) (a twist times a duration):
+/// The SE(3) exponential of a body twist ξ = (v \[m\], ω \[rad\]) (a twist times a duration):
 /// exp(ξ^) = (R, t) with R = exp(\[ω\]×) (Rodrigues) and
 /// t = (I + (1 − cos θ)/θ² \[ω\]× + (θ − sin θ)/θ³ \[ω\]×²) v, θ = ‖ω‖.
 pub fn se3_exp(v: &Vector3<f64>, w: &Vector3<f64>) -> Isometry3<f64> {
@@ -101,7 +101,7 @@ pub fn se3_exp(v: &Vector3<f64>, w: &Vector3<f64>) -> Isometry3<f64> {
     )
 }
 
-/// The SO(3) logarithm as a rotation vector [rad] (axis × angle, angle in [0, π]).
+/// The SO(3) logarithm as a rotation vector \[rad\] (axis × angle, angle in \[0, π\]).
 pub fn so3_log(r: &UnitQuaternion<f64>) -> Vector3<f64> {
     r.scaled_axis()
 }

@@ -14,11 +14,11 @@ pub const QUATERNION_NORM_TOLERANCE: f64 = 1e-3;
 /// Configuration and velocity, laid out as described in [`Robot`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct State {
-    /// Configuration, length `nq`: base position [m] and quaternion (x, y, z, w) if floating,
-    /// then active joint positions [rad] or [m].
+    /// Configuration, length `nq`: base position \[m\] and quaternion (x, y, z, w) if floating,
+    /// then active joint positions \[rad\] or \[m\].
     pub q: DVector<f64>,
-    /// Velocity, length `nv`: base body twist (linear [m/s], angular [rad/s], base axes) if
-    /// floating, then active joint rates [rad/s] or [m/s].
+    /// Velocity, length `nv`: base body twist (linear \[m/s\], angular \[rad/s\], base axes) if
+    /// floating, then active joint rates \[rad/s\] or \[m/s\].
     pub qd: DVector<f64>,
 }
 
@@ -86,12 +86,12 @@ impl State {
         Ok(())
     }
 
-    /// Position [rad] or [m] of the active joint `name`.
+    /// Position \[rad\] or \[m\] of the active joint `name`.
     pub fn joint(&self, robot: &Robot, name: &str) -> Result<f64> {
         Ok(self.q[robot.joint_q_index(name)?])
     }
 
-    /// Sets the position [rad] or [m] of the active joint `name`.
+    /// Sets the position \[rad\] or \[m\] of the active joint `name`.
     pub fn set_joint(&mut self, robot: &Robot, name: &str, value: f64) -> Result<()> {
         crate::error::check_finite(|| format!("value of joint `{name}`"), value)?;
         let i = robot.joint_q_index(name)?;
@@ -110,7 +110,7 @@ impl State {
         Ok(())
     }
 
-    /// Advances the state by `dt` [s] under a constant acceleration `qdd` (length nv):
+    /// Advances the state by `dt` \[s\] under a constant acceleration `qdd` (length nv):
     /// joints q⁺ = q + Δt q̇ + ½Δt² q̈, q̇⁺ = q̇ + Δt q̈ (exact); the floating base
     /// T⁺ = T · exp(Δt ν + ½Δt² ν̇) on SE(3) with the body twist ν⁺ = ν + Δt ν̇ (exact when
     /// ν̇ = 0, second order otherwise). This is the integrator the acceleration bounds assume.

@@ -9,16 +9,16 @@ pub struct DofMargins {
     /// Dof name.
     #[serde(skip)]
     pub index: usize,
-    /// max over the run of max(q − q_max, q_min − q), in-step peaks included [rad].
+    /// max over the run of max(q − q_max, q_min − q), in-step peaks included \[rad\].
     pub position: f64,
-    /// max of |q̇| − v_max [rad/s].
+    /// max of |q̇| − v_max \[rad/s\].
     pub velocity: f64,
-    /// max of |q̈| − a_max [rad/s²].
+    /// max of |q̈| − a_max \[rad/s²\].
     pub acceleration: f64,
 }
 
 /// Computes the margins of one dof from per-step samples: q_k, q̇_k at the start of step k and
-/// the constant q̈_k applied over it (duration `dt` [s]). Infinite limits give −∞ margins.
+/// the constant q̈_k applied over it (duration `dt` \[s\]). Infinite limits give −∞ margins.
 pub fn dof_margins(
     index: usize,
     q: &[f64],

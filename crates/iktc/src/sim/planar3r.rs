@@ -1,6 +1,6 @@
 //! The 3R planar arm experiment of Section 3.3 (errata 2.1).
 //!
-//! Three prioritized tasks on the tip of [`planar3r`](crate::model::planar3r): P_y, P_x and the
+//! Three prioritized tasks on the tip of [`crate::model::planar3r`]: P_y, P_x and the
 //! tip angle θ3 (default order 1 = P_y, 2 = P_x, 3 = θ3). References: P_y,d = 2, θ3,d = 90°,
 //! P_x,d(t) = 1.5 − 0.5 cos(πt) for t ≤ 1 s, then 2. CLIK gains k_p = 100 s⁻², k_v = 20 s⁻¹,
 //! Δt = 5 ms, 2 s, no DLS damping. From q = (90°, −90°, 90°), q1 falls to its 60° limit and
@@ -13,7 +13,7 @@ use serde::Serialize;
 
 use super::margins::{dof_margins, median, DofMargins};
 use crate::error::{Error, Result};
-use crate::limits::{compute_box, AccelerationBox, BoundMethod, DofLimits, JointLimits};
+use crate::limits::{compute_box, AccelerationBox, BoundMethod, JointLimits};
 use crate::model::{planar3r, Kinematics, State};
 use crate::solver::{Method, Solver, SolverSettings};
 use crate::task::{Axes, FrameReference, FrameTask, Gains, Task, TaskStack};
@@ -21,11 +21,11 @@ use crate::task::{Axes, FrameReference, FrameTask, Gains, Task, TaskStack};
 /// One of the three tasks of the experiment.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, serde::Deserialize)]
 pub enum ArmTask {
-    /// Tip x [m].
+    /// Tip x \[m\].
     Px,
-    /// Tip y [m].
+    /// Tip y \[m\].
     Py,
-    /// Tip angle θ3 = q1 + q2 + q3 [rad].
+    /// Tip angle θ3 = q1 + q2 + q3 \[rad\].
     Theta,
 }
 
@@ -55,9 +55,9 @@ pub struct Planar3rConfig {
     pub method: Method,
     /// Joint bounds.
     pub bounds: BoundMethod,
-    /// Control period Δt [s].
+    /// Control period Δt \[s\].
     pub dt: f64,
-    /// Duration [s].
+    /// Duration \[s\].
     pub duration: f64,
     /// Priority order, highest first.
     pub priority: [ArmTask; 3],
@@ -87,25 +87,25 @@ impl Default for Planar3rConfig {
 /// One recorded step (state at its start, command applied over it).
 #[derive(Debug, Clone, Serialize)]
 pub struct Planar3rStep {
-    /// Time [s].
+    /// Time \[s\].
     pub t: f64,
-    /// Joint positions [rad].
+    /// Joint positions \[rad\].
     pub q: [f64; 3],
-    /// Joint rates [rad/s].
+    /// Joint rates \[rad/s\].
     pub qd: [f64; 3],
-    /// Joint accelerations commanded [rad/s²].
+    /// Joint accelerations commanded \[rad/s²\].
     pub qdd: [f64; 3],
-    /// Acceleration box lower / upper [rad/s²].
+    /// Acceleration box lower / upper \[rad/s²\].
     pub box_lower: [f64; 3],
-    /// Upper side of the box [rad/s²].
+    /// Upper side of the box \[rad/s²\].
     pub box_upper: [f64; 3],
-    /// References (P_x [m], P_y [m], θ3 [rad]).
+    /// References (P_x \[m\], P_y \[m\], θ3 \[rad\]).
     pub reference: [f64; 3],
     /// Values (P_x, P_y, θ3).
     pub value: [f64; 3],
     /// Errors reference − value.
     pub error: [f64; 3],
-    /// IKTC corrections Δh of (P_x, P_y, θ3) [m/s², rad/s²].
+    /// IKTC corrections Δh of (P_x, P_y, θ3) \[m/s², rad/s²\].
     pub correction: [f64; 3],
     /// Level (1-based, priority order) the correction started from; 0 = none.
     pub corrected_from: usize,
@@ -113,7 +113,7 @@ pub struct Planar3rStep {
     pub qp_solves: usize,
     /// Dofs with an empty box.
     pub empty_dofs: usize,
-    /// Time of the tick (kinematics, tasks, bounds, solve) [µs].
+    /// Time of the tick (kinematics, tasks, bounds, solve) \[µs\].
     pub tick_us: f64,
 }
 
@@ -124,25 +124,25 @@ pub struct Planar3rSummary {
     pub solver: String,
     /// Bound method name.
     pub bounds: String,
-    /// Δt [s].
+    /// Δt \[s\].
     pub dt: f64,
     /// Priority order, highest first.
     pub priority: Vec<String>,
     /// Margins per joint (q1, q2, q3).
     pub margins: Vec<DofMargins>,
-    /// Largest position excursion over all joints [rad] (≤ 0: no limit exceeded).
+    /// Largest position excursion over all joints \[rad\] (≤ 0: no limit exceeded).
     pub worst_position_margin: f64,
-    /// Largest velocity excursion [rad/s].
+    /// Largest velocity excursion \[rad/s\].
     pub worst_velocity_margin: f64,
-    /// Largest acceleration excursion [rad/s²].
+    /// Largest acceleration excursion \[rad/s²\].
     pub worst_acceleration_margin: f64,
     /// Steps with an empty box.
     pub empty_box_steps: usize,
-    /// Final error of (P_x [m], P_y [m], θ3 [rad]).
+    /// Final error of (P_x \[m\], P_y \[m\], θ3 \[rad\]).
     pub final_error: [f64; 3],
     /// Largest |error| of each task over the run.
     pub max_error: [f64; 3],
-    /// Lowest q1 reached [rad].
+    /// Lowest q1 reached \[rad\].
     pub min_q1: f64,
     /// Mean and largest number of QPs per step.
     pub qp_per_step_mean: f64,
@@ -152,7 +152,7 @@ pub struct Planar3rSummary {
     pub corrected_steps: usize,
     /// Steps where the correction had to climb above the lowest level.
     pub climbed_steps: usize,
-    /// Median tick time [µs].
+    /// Median tick time \[µs\].
     pub tick_median_us: f64,
 }
 
@@ -165,7 +165,7 @@ pub struct Planar3rRun {
     pub summary: Planar3rSummary,
 }
 
-/// The reference (P_x, P_y, θ3) and its first two derivatives at time t [s].
+/// The reference (P_x, P_y, θ3) and its first two derivatives at time t \[s\].
 pub fn reference(t: f64) -> ([f64; 3], [f64; 3], [f64; 3]) {
     let pi = std::f64::consts::PI;
     let theta = 0.5 * pi;
@@ -223,18 +223,7 @@ pub fn run_planar3r(cfg: &Planar3rConfig) -> Result<Planar3rRun> {
     let mut eqs = stack.equations(&robot);
     let dims: Vec<usize> = eqs.iter().map(|e| e.dim()).collect();
     let mut solver = Solver::new(robot.nv(), &dims, cfg.solver)?;
-    let limits = JointLimits::new(
-        robot
-            .dof_limits()
-            .iter()
-            .map(|l| DofLimits {
-                position_min: l.lower,
-                position_max: l.upper,
-                velocity_max: l.velocity,
-                acceleration_max: l.acceleration,
-            })
-            .collect(),
-    )?;
+    let limits = JointLimits::from_robot(&robot)?;
     let mut bx = AccelerationBox::new(robot.nv());
     let mut kin = Kinematics::new(&robot, &state)?;
     let mut qdd = DVector::zeros(robot.nv());
@@ -323,8 +312,8 @@ fn summarize(
         .collect();
     let mut max_error = [0.0f64; 3];
     for s in steps {
-        for k in 0..3 {
-            max_error[k] = max_error[k].max(s.error[k].abs());
+        for (m, e) in max_error.iter_mut().zip(s.error) {
+            *m = m.max(e.abs());
         }
     }
     let ticks: Vec<f64> = steps.iter().map(|s| s.tick_us).collect();

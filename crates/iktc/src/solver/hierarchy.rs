@@ -17,7 +17,7 @@
 //! (eqs. 8–9) otherwise. The next basis is Z Q_{r+1..k}. Cost O(n k m) per level: no n × n
 //! product, no SVD.
 //!
-//! Algorithm 1 builds G = [g_1 … g_{n_T}] with g_i = (Π_{k>i} (I − J̄_k^{λ+} J_k)) J̄_i^{λ+},
+//! Algorithm 1 builds G = \[g_1 … g_{n_T}\] with g_i = (Π_{k>i} (I − J̄_k^{λ+} J_k)) J̄_i^{λ+},
 //! so that adding corrections Δh to the right-hand sides changes the solution by G Δh (eq. 20).
 
 use nalgebra::{DMatrix, DVector};
@@ -116,7 +116,7 @@ impl Hierarchy {
     }
 
     /// G (n × Σm_i); the blocks of levels ≥ `from` are valid after
-    /// [`Hierarchy::build_g`]`(…, from)`.
+    /// [`Hierarchy::build_g_level`].
     pub fn g(&self) -> &DMatrix<f64> {
         &self.g
     }
@@ -223,6 +223,7 @@ impl Hierarchy {
             if best != st {
                 self.a.swap_columns(st, best);
                 self.perm.swap(st, best);
+                self.colnorm.swap(st, best);
             }
             let norm = self.colnorm[st].sqrt();
             if norm <= settings.rank_threshold {

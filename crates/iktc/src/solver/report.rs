@@ -47,9 +47,9 @@ pub struct SolveReport {
     /// IKTC: the highest-priority level (0-based) whose correction was needed; `None` when the
     /// prioritized solution was inside the box (or another method ran).
     pub corrected_from: Option<usize>,
-    /// IKTC's correction Δh_i of each level [task unit/s²] (zero where uncorrected).
+    /// IKTC's correction Δh_i of each level \[task unit/s²\] (zero where uncorrected).
     pub corrections: Vec<DVector<f64>>,
-    /// J_i q̈ − h_i of each level at the returned q̈ [task unit/s²]: what the level lost.
+    /// J_i q̈ − h_i of each level at the returned q̈ \[task unit/s²\]: what the level lost.
     pub task_errors: Vec<DVector<f64>>,
     /// ‖J_i q̈ − h_i‖ per level.
     pub task_error_norms: Vec<f64>,
@@ -65,9 +65,9 @@ pub struct SolveReport {
     /// Dofs whose box was empty (b_l > b_u); they were given the midpoint, the least possible
     /// violation.
     pub empty_box_dofs: usize,
-    /// Largest violation of the box by the prioritized solution [rad/s²].
+    /// Largest violation of the box by the prioritized solution \[rad/s²\].
     pub violation_before: f64,
-    /// Largest violation of the (midpoint-relaxed) box by the returned q̈ [rad/s²].
+    /// Largest violation of the (midpoint-relaxed) box by the returned q̈ \[rad/s²\].
     pub violation: f64,
     /// The fallback taken, if any.
     pub fallback: Option<Fallback>,

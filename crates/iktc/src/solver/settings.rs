@@ -28,16 +28,16 @@ pub struct SolverSettings {
     /// Damping of each level's inverse J̄_i^{λ+}. Default: none (the paper's 3R experiment).
     pub damping: Damping,
     /// A pivot |R_jj| of the pivoted QR of a task-consistent Jacobian below this counts as a lost
-    /// rank [unit of a singular value of J, ≈ 1 for metres and radians]. Larger values drop
+    /// rank \[unit of a singular value of J, ≈ 1 for metres and radians\]. Larger values drop
     /// nearly dependent rows sooner (robust, less tracking); smaller ones keep them and amplify
     /// noise near singularities. Default 1e-9.
     pub rank_threshold: f64,
-    /// A q̈ violating the box by at most this is inside it [rad/s²]. Default 1e-9: far below
+    /// A q̈ violating the box by at most this is inside it \[rad/s²\]. Default 1e-9: far below
     /// any physical acceleration, above the QP's rounding.
     pub box_tolerance: f64,
     /// Regularisation ε of each cascade (GF) QP, min ½‖J_k q̈ − h_k‖² + ½ε‖q̈‖², which makes its
     /// Hessian positive definite and picks the least-norm solution, as the pseudo-inverse does
-    /// [–]. Larger values bias the cascade towards small q̈; smaller ones make its Hessian
+    /// \[–\]. Larger values bias the cascade towards small q̈; smaller ones make its Hessian
     /// ill-conditioned. Default 1e-8.
     pub cascade_regularization: f64,
     /// Settings of the QPs.

@@ -6,14 +6,14 @@ use super::equation::{write_row, Gains, TaskEquation};
 use crate::error::{check_all_finite, check_dim, Error, Result};
 use crate::model::{Kinematics, Robot, State};
 
-/// Desired COM position [m], velocity [m/s] and acceleration [m/s²], world axes.
+/// Desired COM position \[m\], velocity \[m/s\] and acceleration \[m/s²\], world axes.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ComReference {
-    /// c_d [m].
+    /// c_d \[m\].
     pub position: Vector3<f64>,
-    /// ċ_d [m/s].
+    /// ċ_d \[m/s\].
     pub velocity: Vector3<f64>,
-    /// c̈_d [m/s²].
+    /// c̈_d \[m/s²\].
     pub acceleration: Vector3<f64>,
 }
 
@@ -29,7 +29,7 @@ pub struct ComTask {
 }
 
 impl ComTask {
-    /// A COM task on the selected world axes (x, y, z); e.g. `[true, true, false]` for the
+    /// A COM task on the selected world axes (x, y, z); e.g. `\[true, true, false\]` for the
     /// horizontal plane of Table 1.
     pub fn new(robot: &Robot, axes: [bool; 3], gains: Gains) -> Result<Self> {
         gains.validate()?;

@@ -7,14 +7,14 @@ use crate::error::{check_finite, Error, Result};
 /// CLIK gains of a task (paper eq. 11): ẍ = ẍ_d + k_v (ẋ_d − ẋ) + k_p (x_d − x).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Gains {
-    /// Position gain k_p [1/s²].
+    /// Position gain k_p \[1/s²\].
     pub kp: f64,
-    /// Velocity gain k_v [1/s].
+    /// Velocity gain k_v \[1/s\].
     pub kv: f64,
 }
 
 impl Gains {
-    /// Critically damped gains for a given k_p [1/s²]: k_v = 2 √k_p. The paper's 3R
+    /// Critically damped gains for a given k_p \[1/s²\]: k_v = 2 √k_p. The paper's 3R
     /// experiment uses k_p = 100 s⁻², k_v = 20 s⁻¹.
     pub fn critical(kp: f64) -> Self {
         Self {
@@ -53,11 +53,11 @@ pub struct TaskEquation {
     pub name: String,
     /// J, m × nv.
     pub jacobian: DMatrix<f64>,
-    /// h, length m [task unit/s²].
+    /// h, length m \[task unit/s²\].
     pub rhs: DVector<f64>,
-    /// x_d − x, length m [task unit] (rotation vector [rad] for orientations).
+    /// x_d − x, length m \[task unit\] (rotation vector \[rad\] for orientations).
     pub error: DVector<f64>,
-    /// ẋ_d − ẋ, length m [task unit/s].
+    /// ẋ_d − ẋ, length m \[task unit/s\].
     pub error_rate: DVector<f64>,
 }
 
@@ -85,14 +85,28 @@ impl TaskEquation {
 
     /// Checks that sizes agree and every entry is finite.
     pub fn validate(&self) -> Result<()> {
+        // Messages are formatted only on failure: this runs every tick and must not allocate.
         let m = self.rhs.len();
-        crate::error::check_dim(
-            &format!("rows of J of `{}`", self.name),
-            m,
-            self.jacobian.nrows(),
-        )?;
-        crate::error::check_all_finite(&format!("J of `{}`", self.name), self.jacobian.as_slice())?;
-        crate::error::check_all_finite(&format!("h of `{}`", self.name), self.rhs.as_slice())
+        if self.jacobian.nrows() != m {
+            return crate::error::check_dim(
+                &format!("rows of J of `{}`", self.name),
+                m,
+                self.jacobian.nrows(),
+            );
+        }
+        if self.jacobian.iter().any(|v| !v.is_finite()) {
+            return crate::error::check_all_finite(
+                &format!("J of `{}`", self.name),
+                self.jacobian.as_slice(),
+            );
+        }
+        if self.rhs.iter().any(|v| !v.is_finite()) {
+            return crate::error::check_all_finite(
+                &format!("h of `{}`", self.name),
+                self.rhs.as_slice(),
+            );
+        }
+        Ok(())
     }
 }
 

@@ -31,9 +31,9 @@ impl Axes {
 pub struct FrameReference {
     /// Desired pose x_d.
     pub pose: Isometry3<f64>,
-    /// Desired (v [m/s], ω [rad/s]) ẋ_d, world axes.
+    /// Desired (v \[m/s\], ω \[rad/s\]) ẋ_d, world axes.
     pub velocity: Vector6<f64>,
-    /// Desired (v̇ [m/s²], ω̇ [rad/s²]) ẍ_d, world axes.
+    /// Desired (v̇ \[m/s²\], ω̇ \[rad/s²\]) ẍ_d, world axes.
     pub acceleration: Vector6<f64>,
 }
 
@@ -50,7 +50,7 @@ impl FrameReference {
 
 /// Frame task: the selected rows of J q̈ = ẍ_d + k_v(ẋ_d − ẋ) + k_p e − J̇q̇, with the position
 /// error e = p_d − p in world axes and the orientation error e = log(R_d Rᵀ) as a rotation
-/// vector in world axes [rad].
+/// vector in world axes \[rad\].
 #[derive(Debug, Clone)]
 pub struct FrameTask {
     frame: FrameId,

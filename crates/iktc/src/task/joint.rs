@@ -15,11 +15,11 @@ pub struct JointTask {
     q_index: Vec<usize>,
     /// CLIK gains.
     pub gains: Gains,
-    /// Desired positions [rad] or [m], one per selected joint.
+    /// Desired positions \[rad\] or \[m\], one per selected joint.
     pub position: DVector<f64>,
-    /// Desired rates [rad/s].
+    /// Desired rates \[rad/s\].
     pub velocity: DVector<f64>,
-    /// Desired accelerations [rad/s²].
+    /// Desired accelerations \[rad/s²\].
     pub acceleration: DVector<f64>,
 }
 
@@ -67,11 +67,16 @@ impl JointTask {
         self.names.len()
     }
 
-    /// Sets the reference (positions [rad], rates [rad/s], accelerations [rad/s²]).
+    /// Sets the reference (positions \[rad\], rates \[rad/s\], accelerations \[rad/s²\]).
     pub fn set_reference(&mut self, q: &[f64], qd: &[f64], qdd: &[f64]) -> Result<()> {
         for (what, v) in [("position", q), ("velocity", qd), ("acceleration", qdd)] {
-            check_dim(&format!("joint task reference {what}"), self.dim(), v.len())?;
-            check_all_finite(&format!("joint task reference {what}"), v)?;
+            // Formatted only on failure: references are set every tick.
+            if v.len() != self.dim() {
+                check_dim(&format!("joint task reference {what}"), self.dim(), v.len())?;
+            }
+            if v.iter().any(|x| !x.is_finite()) {
+                check_all_finite(&format!("joint task reference {what}"), v)?;
+            }
         }
         self.position.copy_from_slice(q);
         self.velocity.copy_from_slice(qd);

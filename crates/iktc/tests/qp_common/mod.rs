@@ -418,8 +418,9 @@ fn add_degenerate_rows(rng: &mut ChaCha8Rng, p: &mut OwnedQp, xf: &DVector<f64>)
 /// `Σ w_i l_i` by a margin (Farkas: infeasible), or an inconsistent equality.
 fn make_infeasible(rng: &mut ChaCha8Rng, p: &mut OwnedQp, xf: &DVector<f64>) {
     let n = p.n();
-    let margin = 10f64.powf(uniform(rng, -2.0, 0.0));
-    let choice = rng.random_range(0..3);
+    // margins from 1e-6 (far above the 1e-9 feasibility tolerance, but a thin gap) to 1
+    let margin = 10f64.powf(uniform(rng, -6.0, 0.0));
+    let choice = rng.random_range(0..4);
     if choice == 0 && p.a_eq.nrows() > 0 {
         let k = rng.random_range(1..=2);
         let (idx, w, row) = combination(rng, &p.a_eq.clone(), k);
@@ -431,10 +432,20 @@ fn make_infeasible(rng: &mut ChaCha8Rng, p: &mut OwnedQp, xf: &DVector<f64>) {
         }
         return;
     }
-    // rows with lower ends: make some if needed
+    // rows with lower ends (new ones), plus (choice 1) any multiple of existing equalities
     let k = rng.random_range(1..=3);
     let mut row = vec![0.0; n];
     let mut bound = 0.0;
+    if choice == 1 && p.a_eq.nrows() > 0 {
+        for _ in 0..rng.random_range(1..=2) {
+            let i = rng.random_range(0..p.a_eq.nrows());
+            let v = uniform(rng, -2.0, 2.0);
+            for (r, a) in row.iter_mut().zip(p.a_eq.row(i).iter()) {
+                *r += v * a;
+            }
+            bound += v * p.b_eq[i];
+        }
+    }
     for _ in 0..k {
         let a = random_row(rng, n);
         let l = dot(&a, xf) - uniform(rng, 0.0, 1.0);

@@ -39,20 +39,42 @@ struct Givens {
 
 impl Givens {
     fn new(a: f64, b: f64) -> Self {
-        let h = a.hypot(b);
+        // √(a² + b²) directly when the squares neither overflow nor underflow (libm's hypot is
+        // several times slower), `hypot` otherwise.
+        let squares = a * a + b * b;
+        let h = if squares.is_finite() && squares >= f64::MIN_POSITIVE {
+            squares.sqrt()
+        } else {
+            a.hypot(b)
+        };
+        let inv = 1.0 / h;
         Self {
-            c: a / h,
-            s: b / h,
+            c: a * inv,
+            s: b * inv,
             h,
         }
     }
 
-    /// `(x, y) ← (c x + s y, −s x + c y)` element-wise.
+    /// `(x, y) ← (c x + s y, −s x + c y)` element-wise (in blocks of four, which the compiler
+    /// turns into SIMD lanes).
     fn apply(self, x: &mut [f64], y: &mut [f64]) {
-        for (xi, yi) in x.iter_mut().zip(y.iter_mut()) {
+        let (c, s) = (self.c, self.s);
+        let len = x.len().min(y.len());
+        let (x, y) = (&mut x[..len], &mut y[..len]);
+        let mut xc = x.chunks_exact_mut(4);
+        let mut yc = y.chunks_exact_mut(4);
+        for (xb, yb) in (&mut xc).zip(&mut yc) {
+            let a = [xb[0], xb[1], xb[2], xb[3]];
+            let b = [yb[0], yb[1], yb[2], yb[3]];
+            for k in 0..4 {
+                xb[k] = c * a[k] + s * b[k];
+                yb[k] = c * b[k] - s * a[k];
+            }
+        }
+        for (xi, yi) in xc.into_remainder().iter_mut().zip(yc.into_remainder()) {
             let (a, b) = (*xi, *yi);
-            *xi = self.c * a + self.s * b;
-            *yi = -self.s * a + self.c * b;
+            *xi = c * a + s * b;
+            *yi = c * b - s * a;
         }
     }
 }
@@ -99,10 +121,25 @@ impl ActiveBasis {
         &self.j.as_slice()[k * self.ld..k * self.ld + self.n]
     }
 
-    /// `d = Jᵀ v` (all `n` entries).
+    /// `d = Jᵀ v` (all `n` entries): `n` dot products with the columns of `J`, or, when `v` has
+    /// few non-zeros (a box row, `v = ±e_i`), `d = Σ_{i: v_i ≠ 0} v_i J[i, :]`.
     pub(crate) fn project(&self, v: &[f64], d: &mut [f64]) {
-        for (k, dk) in d[..self.n].iter_mut().enumerate() {
-            *dk = dot(self.j_col(k), &v[..self.n]);
+        let (n, ld) = (self.n, self.ld);
+        let v = &v[..n];
+        let d = &mut d[..n];
+        let nonzeros = v.iter().filter(|vi| **vi != 0.0).count();
+        if 4 * nonzeros < n {
+            d.fill(0.0);
+            let j = self.j.as_slice();
+            for (i, &vi) in v.iter().enumerate().filter(|(_, vi)| **vi != 0.0) {
+                for (k, dk) in d.iter_mut().enumerate() {
+                    *dk += vi * j[k * ld + i];
+                }
+            }
+        } else {
+            for (k, dk) in d.iter_mut().enumerate() {
+                *dk = dot(self.j_col(k), v);
+            }
         }
     }
 
@@ -120,7 +157,7 @@ impl ActiveBasis {
 
     /// `‖d₂‖ = ‖(d_q, …, d_{n−1})‖`: the size of the new normal orthogonal to the active ones.
     pub(crate) fn orthogonal_norm(&self, d: &[f64]) -> f64 {
-        dot(&d[self.q..self.n], &d[self.q..self.n]).sqrt()
+        norm(&d[self.q..self.n])
     }
 
     /// `r = R⁻¹ d₁`: the dual step direction (minus the rate of change of the active
@@ -193,9 +230,39 @@ impl ActiveBasis {
     }
 }
 
-/// `xᵀ y`.
+/// `xᵀ y` over the common length, with four partial sums (so that the compiler can use SIMD
+/// lanes; strict left-to-right summation cannot be vectorised).
 pub(crate) fn dot(x: &[f64], y: &[f64]) -> f64 {
-    x.iter().zip(y).map(|(a, b)| a * b).sum()
+    let len = x.len().min(y.len());
+    let (x, y) = (&x[..len], &y[..len]);
+    let mut acc = [0.0_f64; 4];
+    let (xc, yc) = (x.chunks_exact(4), y.chunks_exact(4));
+    let tail: f64 = xc
+        .remainder()
+        .iter()
+        .zip(yc.remainder())
+        .map(|(a, b)| a * b)
+        .sum();
+    for (a, b) in xc.zip(yc) {
+        for k in 0..4 {
+            acc[k] += a[k] * b[k];
+        }
+    }
+    (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
+}
+
+/// `‖x‖₂`, without overflow or underflow of the squares: entries are scaled by the largest
+/// magnitude when it lies outside `[1e-150, 1e150]`.
+pub(crate) fn norm(x: &[f64]) -> f64 {
+    /// Magnitudes whose squares (summed over up to 1e6 entries) stay normal and finite.
+    const SAFE: std::ops::RangeInclusive<f64> = 1e-150..=1e150;
+    let largest = x.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    if largest == 0.0 || !largest.is_finite() || SAFE.contains(&largest) {
+        dot(x, x).sqrt()
+    } else {
+        let scaled: f64 = x.iter().map(|v| (v / largest) * (v / largest)).sum();
+        largest * scaled.sqrt()
+    }
 }
 
 /// `y ← y + a x`.

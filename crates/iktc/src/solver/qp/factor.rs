@@ -70,12 +70,7 @@ pub(crate) fn inverse_transpose(l: &[f64], j: &mut [f64], ld: usize, n: usize) {
         col[k] = 1.0 / l[k * ld + k];
         for i in (0..k).rev() {
             let l_col_i = &l[i * ld + i + 1..i * ld + k + 1];
-            let acc: f64 = l_col_i
-                .iter()
-                .zip(&col[i + 1..=k])
-                .map(|(a, b)| a * b)
-                .sum();
-            col[i] = -acc / l[i * ld + i];
+            col[i] = -super::basis::dot(l_col_i, &col[i + 1..=k]) / l[i * ld + i];
         }
     }
 }

@@ -9,8 +9,11 @@
 //! with `H` symmetric positive definite (or `H = I`, [`Hessian::Identity`]) and ends of the
 //! two-sided rows possibly infinite, by the dual method of Goldfarb & Idnani, *A numerically
 //! stable dual method for solving strictly convex quadratic programs*, Mathematical Programming
-//! 27 (1983) 1–33. The sizes in mind are tens of variables and rows (IKTC's correction QP, eq. 23
-//! of the paper, `min ½‖Δh‖²  s.t.  b_l ≤ G Δh + q̈* ≤ b_u`; one level of the GF cascade).
+//! 27 (1983) 1–33. The sizes in mind are tens of variables and rows: IKTC's correction QP
+//! (paper eq. 23, `min ½‖Δh_i^a‖²  s.t.  b_l − q̈_{n_T} ≤ g_i^a Δh_i^a ≤ b_u − q̈_{n_T}`, with
+//! [`Hessian::Identity`]) and one level of the GF cascade. Because the method detects an empty
+//! constraint set by itself ([`QpStatus::Infeasible`]), it also replaces the simplex feasibility
+//! test of the paper's Algorithm 2 (errata §3.3).
 //!
 //! # Method
 //!
@@ -35,7 +38,8 @@
 //! r = R⁻¹ d₁         dual step direction     (N r = n⁺ − H z)
 //! ```
 //!
-//! **Steps.**
+//! **Steps.** `ε_feas` is [`QpSettings::feasibility_tolerance`], `ε_dep`
+//! [`QpSettings::linear_dependence_tolerance`].
 //!
 //! 0. `x ← −H⁻¹ c = −J Jᵀ c` (unconstrained minimum, `J = L⁻ᵀ`), `A ← ∅`.
 //! 1. Equalities (rows of `A_eq`, and rows of `A_in` with `l = u`), in order: orient the normal

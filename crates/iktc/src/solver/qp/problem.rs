@@ -129,13 +129,16 @@ fn check_capacity(what: &str, capacity: usize, got: usize) -> Result<()> {
 
 fn check_matrix_finite(what: &str, m: &DMatrixView<'_, f64>) -> Result<()> {
     for j in 0..m.ncols() {
-        for (i, &v) in m.column(j).iter().enumerate() {
-            if !v.is_finite() {
-                return Err(Error::NonFinite {
-                    what: format!("{what}[({i}, {j})]"),
-                    value: v,
-                });
-            }
+        let column = m.column(j);
+        let column = column.as_slice();
+        if column.iter().all(|v| v.is_finite()) {
+            continue;
+        }
+        if let Some((i, &v)) = column.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+            return Err(Error::NonFinite {
+                what: format!("{what}[({i}, {j})]"),
+                value: v,
+            });
         }
     }
     Ok(())

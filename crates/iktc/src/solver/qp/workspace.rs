@@ -2,12 +2,12 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use super::basis::{axpy, dot, ActiveBasis};
+use super::basis::{axpy, dot, norm, ActiveBasis};
 use super::factor::cholesky;
 use super::problem::Dims;
 use super::{ActiveConstraint, Hessian, QpConstraint, QpProblem, QpReport, QpSettings, QpStatus};
 use crate::error::check_dim;
-use crate::Result;
+use crate::{Error, Result};
 
 /// A constraint row as the solver sees it (before choosing a side).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -172,8 +172,8 @@ impl QpWorkspace {
     /// Invalid settings; sizes that do not match each other or exceed the workspace; a NaN or
     /// infinite entry in `H`, `c`, `A_eq`, `b_eq`, `A_in`; a NaN limit, `l_i > u_i`, `l_i = +∞`
     /// or `u_i = −∞`; an `H` that is not symmetric or not positive definite (see
-    /// [`QpSettings`]). An infeasible problem is not an error: it is
-    /// [`QpStatus::Infeasible`].
+    /// [`QpSettings`]); finite data so large that the iteration overflows. An infeasible
+    /// problem is not an error: it is [`QpStatus::Infeasible`].
     pub fn solve(
         &mut self,
         problem: &QpProblem<'_>,
@@ -184,7 +184,11 @@ impl QpWorkspace {
         let dims = problem.check(self.capacity, settings)?;
         check_dim("length of x", dims.n, x.len())?;
         let n = dims.n;
+        // forget the previous solve first, so that a failed factorisation leaves an empty
+        // active set and zero multipliers behind
         self.last = dims;
+        self.active.clear();
+        self.fill_multipliers();
         match problem.hessian {
             Hessian::Identity => self.basis.reset_identity(n),
             Hessian::Dense(h) => {
@@ -204,7 +208,6 @@ impl QpWorkspace {
         for v in x.iter_mut() {
             *v = -*v;
         }
-        self.active.clear();
         for (state, (&l, &u)) in self.states[..dims.m_in]
             .iter_mut()
             .zip(problem.lower.iter().zip(problem.upper))
@@ -229,10 +232,20 @@ impl QpWorkspace {
             Outcome::MaxIterations => QpStatus::MaxIterations,
         };
         self.fill_multipliers();
+        let objective = self.objective(problem, x);
+        if !objective.is_finite() {
+            // finite data whose products overflow (entries near 1e154 and beyond)
+            return Err(Error::NonFinite {
+                what: "QP objective at the last iterate (the iteration overflowed: rescale H, c \
+                       and the constraint rows)"
+                    .to_string(),
+                value: objective,
+            });
+        }
         Ok(QpReport {
             status,
             iterations,
-            objective: self.objective(problem, x),
+            objective,
             active_count: self.active.len(),
             redundant_equalities: redundant,
             max_violation: self.max_violation(problem, x),
@@ -269,7 +282,7 @@ impl QpWorkspace {
         self.basis
             .dual_direction(self.d.as_slice(), self.r.as_mut_slice());
         let d = &self.d.as_slice()[..n];
-        (dot(d, d).sqrt(), self.basis.orthogonal_norm(d))
+        (norm(d), self.basis.orthogonal_norm(d))
     }
 
     /// Takes the step `x ← x + t z`, `u ← u − t r` (the active multipliers).
@@ -359,7 +372,7 @@ impl QpWorkspace {
                 sign,
                 metric_norm,
             };
-            if orthogonal <= settings.linear_dependence_tolerance * metric_norm {
+            if is_dependent(orthogonal, metric_norm, settings) {
                 if -s <= settings.feasibility_tolerance {
                     *redundant += 1;
                     continue;
@@ -367,7 +380,7 @@ impl QpWorkspace {
                 return Some(Outcome::Infeasible(entry.constraint(sign, true)));
             }
             *iterations += 1;
-            let t = -s / (orthogonal * orthogonal);
+            let t = -s / orthogonal / orthogonal;
             self.step(x, t, true);
             self.push_active(entry, t);
         }
@@ -402,18 +415,19 @@ impl QpWorkspace {
                     metric_norm,
                 };
                 let blocking = self.blocking(metric_norm, settings);
-                let dependent = orthogonal <= settings.linear_dependence_tolerance * metric_norm;
+                let dependent = is_dependent(orthogonal, metric_norm, settings);
                 let full_step = if dependent {
                     f64::INFINITY
                 } else {
                     let s = dot(&self.normal.as_slice()[..n], x) - bound;
-                    (-s).max(0.0) / (orthogonal * orthogonal)
+                    (-s).max(0.0) / orthogonal / orthogonal
                 };
                 match blocking {
                     None if dependent => {
                         return Outcome::Infeasible(entry.constraint(sign, false));
                     }
-                    Some((k, partial_step)) if partial_step < full_step => {
+                    // a dependent normal is never added: only the dual step is possible
+                    Some((k, partial_step)) if dependent || partial_step < full_step => {
                         *iterations += 1;
                         self.step(x, partial_step, !dependent);
                         u_plus += partial_step;
@@ -442,9 +456,7 @@ impl QpWorkspace {
         }
         for (j, &xj) in x.iter().enumerate().take(n) {
             if xj != 0.0 {
-                for (acc, &a) in ax.iter_mut().zip(problem.a_in.column(j).iter()) {
-                    *acc += xj * a;
-                }
+                axpy(xj, problem.a_in.column(j).as_slice(), ax);
             }
         }
     }
@@ -514,7 +526,7 @@ impl QpWorkspace {
                 let hx = &mut self.hx.as_mut_slice()[..x.len()];
                 hx.fill(0.0);
                 for (j, &xj) in x.iter().enumerate() {
-                    axpy_iter(xj, h.column(j).iter(), hx);
+                    axpy(xj, h.column(j).as_slice(), hx);
                 }
                 dot(hx, x)
             }
@@ -537,11 +549,12 @@ impl QpWorkspace {
     }
 }
 
-/// `y ← y + a x` for an iterator `x`.
-fn axpy_iter<'a>(a: f64, x: impl Iterator<Item = &'a f64>, y: &mut [f64]) {
-    if a != 0.0 {
-        for (yi, &xi) in y.iter_mut().zip(x) {
-            *yi += a * xi;
-        }
-    }
+/// `‖d₂‖ ≤ ε_dep ‖d‖`: the new normal depends linearly on the active ones. A NaN (overflow)
+/// counts as dependent, so that nothing is added to a full basis.
+fn is_dependent(orthogonal: f64, metric_norm: f64, settings: &QpSettings) -> bool {
+    let bound = settings.linear_dependence_tolerance * metric_norm;
+    !matches!(
+        orthogonal.partial_cmp(&bound),
+        Some(std::cmp::Ordering::Greater)
+    )
 }

@@ -1,0 +1,64 @@
+//! The solvers allocate nothing per tick (counting global allocator, own test binary).
+
+mod solver_common;
+use solver_common::*;
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use iktc::solver::*;
+use nalgebra::DVector;
+
+struct Counting;
+static ALLOCS: AtomicUsize = AtomicUsize::new(0);
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, l: Layout) -> *mut u8 {
+        ALLOCS.fetch_add(1, Ordering::SeqCst);
+        unsafe { System.alloc(l) }
+    }
+    unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
+        unsafe { System.dealloc(p, l) }
+    }
+    unsafe fn realloc(&self, p: *mut u8, l: Layout, n: usize) -> *mut u8 {
+        ALLOCS.fetch_add(1, Ordering::SeqCst);
+        unsafe { System.realloc(p, l, n) }
+    }
+}
+
+#[global_allocator]
+static A: Counting = Counting;
+
+#[test]
+fn solvers_allocate_nothing() {
+    let dims = [12, 2, 3, 1, 20];
+    let mut r = rng(41);
+    let levels = random_levels(&mut r, 38, &dims);
+    let mut s = Solver::new(38, &dims, SolverSettings::default()).unwrap();
+    let mut q0 = DVector::zeros(38);
+    s.solve(Method::Prioritized, &levels, &wide_box(38), &mut q0)
+        .unwrap();
+    let bx = box_violated_by(&mut r, &q0, 5.0, 3, 0.5);
+    let mut q = DVector::zeros(38);
+    for m in [
+        Method::Iktc,
+        Method::Cascade,
+        Method::Clamp,
+        Method::Prioritized,
+    ] {
+        s.solve(m, &levels, &bx, &mut q).unwrap();
+        let before = ALLOCS.load(Ordering::SeqCst);
+        let rep = s.solve(m, &levels, &bx, &mut q).unwrap();
+        let qps = rep.qp_solves;
+        let after = ALLOCS.load(Ordering::SeqCst);
+        assert_eq!(
+            after - before,
+            0,
+            "{m:?} allocated {} times",
+            after - before
+        );
+        if m == Method::Iktc {
+            assert!(qps >= 1, "the box must force a correction");
+        }
+    }
+}
