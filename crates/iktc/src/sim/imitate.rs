@@ -75,6 +75,10 @@ pub struct ImitateConfig {
     /// before the run: a reference outside the range only makes its task push into the limit.
     /// Larger margins keep the joints further from their limits at the price of fidelity.
     pub reference_margin: f64,
+    /// The COM reference moves from the initial COM to the centre of the support polygon in
+    /// this time \[s\] (quintic blend, zero rate and acceleration at both ends), then stays.
+    /// Shorter blends ask more of the COM task at the start; 0 jumps.
+    pub com_settle_time: f64,
     /// Foot soles and the support polygon.
     pub support: SupportSettings,
     /// A joint within this distance of a position limit counts as sitting on it \[rad\]
@@ -123,6 +127,7 @@ impl ImitateConfig {
                 },
             ],
             reference_margin: 0.05,
+            com_settle_time: 0.5,
             support: SupportSettings::default(),
             on_limit_position: 2e-3,
             on_limit_fraction: 0.01,
@@ -155,6 +160,13 @@ impl ImitateConfig {
                     expected: "finite lo:hi with lo <= hi [rad]".into(),
                 });
             }
+        }
+        if !(self.com_settle_time.is_finite() && self.com_settle_time >= 0.0) {
+            return Err(bad(
+                "com_settle_time",
+                self.com_settle_time,
+                "a finite time >= 0 [s]",
+            ));
         }
         if !(self.on_limit_position.is_finite() && self.on_limit_position >= 0.0) {
             return Err(bad(
@@ -210,6 +222,8 @@ pub struct ImitationController {
     pelvis0: Isometry3<f64>,
     feet0: Vec<Isometry3<f64>>,
     com_ref: Vector3<f64>,
+    com_start: Vector3<f64>,
+    com_settle_time: f64,
     tick: usize,
 }
 
@@ -319,6 +333,7 @@ impl ImitationController {
         let centre =
             polygon.iter().fold(Vector3::zeros(), |a, p| a + p) / polygon.len().max(1) as f64;
         let com_ref = Vector3::new(centre.x, centre.y, kin.com().z);
+        let com_start = kin.com();
         let pelvis_id = robot.frame_id(&cfg.pelvis)?;
         let pelvis0 = kin.frame_pose(robot, pelvis_id)?;
         // Tasks.
@@ -333,7 +348,7 @@ impl ImitationController {
         stack.push(LEVEL_NAMES[0], feet_tasks);
         let mut com = ComTask::new(robot, [true, true, false], g)?;
         com.set_reference(ComReference {
-            position: com_ref,
+            position: com_start,
             velocity: Vector3::zeros(),
             acceleration: Vector3::zeros(),
         })?;
@@ -378,6 +393,8 @@ impl ImitationController {
             pelvis0,
             feet0,
             com_ref,
+            com_start,
+            com_settle_time: cfg.com_settle_time,
             tick: 0,
         })
     }
@@ -402,9 +419,11 @@ impl ImitationController {
             self.upper[1][i] = t.velocity.get(k).copied().unwrap_or(0.0);
             self.upper[2][i] = t.acceleration.get(k).copied().unwrap_or(0.0);
         }
+        let com = self.com_reference_at(k as f64 * self.dt);
         for (li, level) in self.stack.levels.iter_mut().enumerate() {
             for task in level.tasks.iter_mut() {
                 match (li, task) {
+                    (1, Task::Com(c)) => c.set_reference(com)?,
                     (2, Task::Frame(f)) => f.set_reference(FrameReference {
                         pose: Isometry3::from_parts(self.pelvis0.translation, attitude),
                         velocity: Vector6::new(0.0, 0.0, 0.0, w.x, w.y, w.z),
@@ -499,9 +518,32 @@ impl ImitationController {
         &self.pelvis0
     }
 
-    /// The COM reference \[m\] (x, y held; z unused).
+    /// The COM reference once settled \[m\]: the centre of the support polygon (z unused).
     pub fn com_reference(&self) -> Vector3<f64> {
         self.com_ref
+    }
+
+    /// The COM reference at time `t` \[s\]: `c(t) = c_0 + s(τ) (c_∞ − c_0)` with
+    /// `τ = t / T` clamped to \[0, 1\] and the quintic `s = 10τ³ − 15τ⁴ + 6τ⁵`.
+    pub fn com_reference_at(&self, t: f64) -> ComReference {
+        let big_t = self.com_settle_time;
+        let d = self.com_ref - self.com_start;
+        if big_t <= 0.0 || t >= big_t {
+            return ComReference {
+                position: self.com_ref,
+                velocity: Vector3::zeros(),
+                acceleration: Vector3::zeros(),
+            };
+        }
+        let tau = (t / big_t).max(0.0);
+        let s = tau * tau * tau * (10.0 - 15.0 * tau + 6.0 * tau * tau);
+        let sd = 30.0 * tau * tau * (1.0 - tau) * (1.0 - tau) / big_t;
+        let sdd = 60.0 * tau * (1.0 - tau) * (1.0 - 2.0 * tau) / (big_t * big_t);
+        ComReference {
+            position: self.com_start + d * s,
+            velocity: d * sd,
+            acceleration: d * sdd,
+        }
     }
 
     /// The solver's report of the last tick.
