@@ -60,7 +60,7 @@ const slider = document.getElementById("slider"), timeLabel = document.getElemen
 const playBtn = document.getElementById("play"), speedSel = document.getElementById("speed");
 const n = D.robot.frames.length;
 slider.max = String(Math.max(0, n - 1));
-let frame = 0, playing = true, last = null, az = -0.9, el = 0.35, dist = 4.0, acc = 0;
+let frame = 0, playing = true, last = null, az = -0.5, el = 0.3, dist = 7.0, acc = 0;
 let drag = null;
 // Centre of the scene: between the robot and the skeleton at frame 0.
 let cx = 0, cy = 0, cz = 0.7;
@@ -73,8 +73,8 @@ function project(p) {
   const x = p[0] - cx, y = p[1] - cy, z = p[2] - cz;
   const ca = Math.cos(az), sa = Math.sin(az), ce = Math.cos(el), se = Math.sin(el);
   const xr = ca * x - sa * y, yr = sa * x + ca * y;
-  const depth = ce * yr + se * z, up = -se * yr + ce * z;
-  const s = Math.min(cv.width, cv.height) * 0.9 / (dist + depth) ;
+  const depth = ce * yr - se * z, up = se * yr + ce * z;
+  const s = Math.min(cv.width, cv.height) * 1.5 / (dist + depth);
   return [cv.width / 2 + xr * s, cv.height / 2 - up * s];
 }
 function line(a, b, color, w) {
@@ -109,6 +109,12 @@ function draw() {
   const R = D.robot.frames[frame];
   const hot = new Set(D.on_limit[frame] || []);
   D.robot.segments.forEach((s, i) => line(R[s[0]], R[s[1]], hot.has(i) ? "#d62728" : "#1f5fbf", hot.has(i) ? 5 : 3));
+  for (const i of hot) {
+    const s = D.robot.segments[i];
+    if (!s) continue;
+    const q = project(R[s[1]]);
+    ctx.fillStyle = "#d62728"; ctx.beginPath(); ctx.arc(q[0], q[1], 6, 0, 2 * Math.PI); ctx.fill();
+  }
   // COM and its ground projection.
   const c = D.com[frame];
   if (c) {
