@@ -29,6 +29,9 @@ pub struct ImitateStep {
     pub box_upper: Vec<f64>,
     /// ‖x_d − x‖ of each level (task units: \[m\] and \[rad\] mixed for the feet).
     pub level_error: [f64; 5],
+    /// ‖J_i q̈ − h_i‖ of each level at the commanded q̈ \[task unit/s²\]: what the level lost
+    /// at the acceleration level this tick (0 for a level the solution satisfies).
+    pub level_residual: [f64; 5],
     /// ‖Δh_i‖ of each level's correction \[task unit/s²\].
     pub correction: [f64; 5],
     /// Highest-priority corrected level, 1-based; 0 = none.
@@ -135,6 +138,11 @@ pub struct ImitateSummary {
     pub pelvis_corrected_while_narrowed_at_limit: usize,
     /// Largest feet error ‖x_d − x‖ while a lower level was corrected.
     pub feet_error_while_lower_corrected: f64,
+    /// Largest ‖J q̈ − h‖ of the feet level while a lower level was corrected
+    /// \[m/s², rad/s²\] (0 to rounding: the correction leaves the level untouched).
+    pub feet_residual_while_lower_corrected: f64,
+    /// Largest ‖J q̈ − h‖ of the COM level while a lower level was corrected \[m/s²\].
+    pub com_residual_while_lower_corrected: f64,
     /// Largest COM error \[m\] while a lower level was corrected.
     pub com_error_while_lower_corrected: f64,
     /// Largest foot position drift \[m\].
@@ -226,6 +234,10 @@ pub fn run_imitate(
         let state = ctl.state();
         let mut level_error = [0.0; 5];
         let mut correction = [0.0; 5];
+        let mut level_residual = [0.0; 5];
+        for (i, r) in rep.task_error_norms.iter().enumerate().take(5) {
+            level_residual[i] = *r;
+        }
         for (i, e) in ctl.equations().iter().enumerate().take(5) {
             level_error[i] = e.error.norm();
             correction[i] = rep.corrections.get(i).map_or(0.0, |c| c.norm());
@@ -264,6 +276,7 @@ pub fn run_imitate(
             qd,
             qdd,
             level_error,
+            level_residual,
             correction,
             corrected_from: rep.corrected_from.map_or(0, |l| l + 1),
             foot_drift,
@@ -406,6 +419,14 @@ pub fn summarize(
         feet_error_while_lower_corrected: lower_corrected
             .iter()
             .map(|s| s.level_error[0])
+            .fold(0.0, f64::max),
+        feet_residual_while_lower_corrected: lower_corrected
+            .iter()
+            .map(|s| s.level_residual[0])
+            .fold(0.0, f64::max),
+        com_residual_while_lower_corrected: lower_corrected
+            .iter()
+            .map(|s| s.level_residual[1])
             .fold(0.0, f64::max),
         com_error_while_lower_corrected: lower_corrected
             .iter()
