@@ -33,8 +33,7 @@ fn check_limits_independently(robot: &Robot, cfg: &ImitateConfig, run: &ImitateR
         lims[d].upper = n.upper;
     }
     for s in &run.steps {
-        for d in robot.base_nv()..robot.nv() {
-            let l = &lims[d];
+        for (d, l) in lims.iter().enumerate().skip(robot.base_nv()) {
             let name = &run.dof_names[d];
             assert!(
                 s.q[d] >= l.lower - LIMIT_ROUNDING && s.q[d] <= l.upper + LIMIT_ROUNDING,
