@@ -43,6 +43,16 @@ pub struct Args {
     /// L_KNEE=0.55:0.95,L_HIP_R=-0.05:0.05.
     #[arg(long)]
     pub narrow: Option<String>,
+    /// Foot frames (6D tasks of the first level), comma-separated. Default: r_ankle,l_ankle.
+    #[arg(long, value_delimiter = ',')]
+    pub feet: Vec<String>,
+    /// Pelvis frame (attitude and height tasks). Default: PELVIS_S.
+    #[arg(long)]
+    pub pelvis: Option<String>,
+    /// Initial angles [rad] of joints the motion does not drive: NAME=VALUE,... Default
+    /// (JVRC-1): hips −0.4, knees 0.8, ankles −0.4 rad (pitch); `none` for the zero posture.
+    #[arg(long)]
+    pub posture: Option<String>,
     /// Control period [s].
     #[arg(long, default_value_t = 0.005)]
     pub dt: f64,
@@ -76,6 +86,24 @@ fn parse_narrow(s: &str) -> Result<Vec<NarrowedJoint>> {
                 lower,
                 upper,
             })
+        })
+        .collect()
+}
+
+fn parse_posture(s: &str) -> Result<Vec<(String, f64)>> {
+    if s.trim() == "none" || s.trim().is_empty() {
+        return Ok(Vec::new());
+    }
+    s.split(',')
+        .map(|item| {
+            let (name, value) = item
+                .split_once('=')
+                .with_context(|| format!("--posture `{item}`: expected NAME=VALUE"))?;
+            let v: f64 = value
+                .trim()
+                .parse()
+                .with_context(|| format!("--posture `{item}`: `{value}` is not a number"))?;
+            Ok((name.trim().to_string(), v))
         })
         .collect()
 }
@@ -156,6 +184,15 @@ pub fn run(a: &Args) -> Result<()> {
     };
     if let Some(n) = &a.narrow {
         cfg.narrow = parse_narrow(n)?;
+    }
+    if !a.feet.is_empty() {
+        cfg.feet = a.feet.iter().map(|f| f.trim().to_string()).collect();
+    }
+    if let Some(p) = &a.pelvis {
+        cfg.pelvis = p.trim().to_string();
+    }
+    if let Some(p) = &a.posture {
+        cfg.initial_posture = parse_posture(p)?;
     }
     let e = Experiment { robot, clip, map };
     let r = run_experiment(&e, &cfg)?;
