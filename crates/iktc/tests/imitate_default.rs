@@ -219,6 +219,13 @@ fn bad_settings_are_errors() {
         ..ImitateConfig::default()
     }; // references are at 5 ms
     assert!(run_imitate(&robot, &refs, &cfg).is_err());
+    // Hand-made references with a short track are an error, not a panic.
+    let mut short = refs.clone();
+    short.joints[3].velocity.pop();
+    assert!(run_imitate(&robot, &short, &ImitateConfig::default()).is_err());
+    let mut nan = refs.clone();
+    nan.height.position[7] = f64::NAN;
+    assert!(run_imitate(&robot, &nan, &ImitateConfig::default()).is_err());
     let cfg = ImitateConfig {
         pelvis: "NOPE".into(),
         ..ImitateConfig::default()

@@ -89,6 +89,59 @@ impl RobotReferences {
     pub fn is_empty(&self) -> bool {
         self.times.is_empty()
     }
+
+    /// Checks that every track has one finite sample per tick and that there is one track per
+    /// joint name (the fields are public: references may be built by hand).
+    pub fn validate(&self) -> Result<()> {
+        let n = self.times.len();
+        if n == 0 {
+            return Err(Error::InsufficientData {
+                what: "robot references".into(),
+                message: "no tick".into(),
+            });
+        }
+        crate::error::check_dim(
+            "reference joint tracks",
+            self.joint_names.len(),
+            self.joints.len(),
+        )?;
+        let tracks = self
+            .joints
+            .iter()
+            .zip(&self.joint_names)
+            .map(|(t, n)| (t, n.as_str()))
+            .chain([(&self.height, "pelvis height")])
+            .chain(self.angles.iter().map(|t| (t, "pelvis angles")));
+        for (t, name) in tracks {
+            for v in [&t.position, &t.velocity, &t.acceleration] {
+                crate::error::check_dim(&format!("samples of the `{name}` reference"), n, v.len())?;
+                crate::error::check_all_finite(&format!("`{name}` reference"), v)?;
+            }
+        }
+        crate::error::check_dim("attitude samples", n, self.attitude.len())?;
+        crate::error::check_dim("angular velocity samples", n, self.angular_velocity.len())?;
+        crate::error::check_dim(
+            "angular acceleration samples",
+            n,
+            self.angular_acceleration.len(),
+        )?;
+        let finite = self
+            .attitude
+            .iter()
+            .all(|q| q.coords.iter().all(|c| c.is_finite()))
+            && self
+                .angular_velocity
+                .iter()
+                .chain(&self.angular_acceleration)
+                .all(|w| w.iter().all(|c| c.is_finite()));
+        if !finite {
+            return Err(Error::NonFinite {
+                what: "pelvis attitude reference".into(),
+                value: f64::NAN,
+            });
+        }
+        Ok(())
+    }
 }
 
 /// One joint map with everything resolved against the skeleton and the robot.

@@ -72,7 +72,8 @@ pub struct ImitateConfig {
     /// Joint ranges narrowed (applied to the bounds and to the margins).
     pub narrow: Vec<NarrowedJoint>,
     /// Joint references are clamped into the (narrowed) range shrunk by this margin \[rad\]
-    /// before the run: a reference outside the range only makes its task push into the limit.
+    /// before the run (their rate and acceleration set to 0 where clamped): a reference outside
+    /// the range only makes its task push into the limit.
     /// Larger margins keep the joints further from their limits at the price of fidelity.
     pub reference_margin: f64,
     /// The COM reference moves from the initial COM to the centre of the support polygon in
@@ -249,6 +250,7 @@ impl ImitationController {
     /// `cfg.dt`, a narrowed range outside the joint's own.
     pub fn new(robot: &Robot, refs: &RobotReferences, cfg: &ImitateConfig) -> Result<Self> {
         cfg.validate()?;
+        refs.validate()?;
         if (refs.dt - cfg.dt).abs() > 1e-12 * cfg.dt || refs.is_empty() {
             return Err(Error::InvalidSetting {
                 name: "reference period".into(),
