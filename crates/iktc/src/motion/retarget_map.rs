@@ -184,7 +184,8 @@ impl RetargetMap {
         let file: MapFile = toml::from_str(text).map_err(|e| {
             let line = e
                 .span()
-                .map(|s| text[..s.start.min(text.len())].lines().count().max(1))
+                .and_then(|s| text.get(..s.start))
+                .map(|head| head.matches('\n').count() + 1)
                 .unwrap_or(0);
             Error::Parse {
                 source_name: source_name.into(),

@@ -15,9 +15,7 @@
 mod record;
 mod support;
 
-pub use record::{
-    run_imitate, summarize, ImitateRun, ImitateStep, ImitateSummary, JointMargin, LevelSummary,
-};
+pub use record::{run_imitate, ImitateRun, ImitateStep, ImitateSummary, JointMargin, LevelSummary};
 pub use support::{support_polygon, SupportSettings};
 
 use nalgebra::{DVector, Isometry3, Translation3, UnitQuaternion, Vector3, Vector6};

@@ -322,7 +322,7 @@ pub fn run_imitate(
 }
 
 /// The summary of recorded steps (see [`ImitateSummary`]).
-pub fn summarize(
+pub(crate) fn summarize(
     robot: &Robot,
     cfg: &ImitateConfig,
     steps: &[ImitateStep],
