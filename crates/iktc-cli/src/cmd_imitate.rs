@@ -471,6 +471,9 @@ pub fn write_imitate(r: &ImitateRun, e: &Experiment, dir: &Path) -> Result<Vec<(
     Ok(figs)
 }
 
+/// Where the captured skeleton stands in the viewer: this far along +y (the robot's left) [m].
+const SKELETON_OFFSET: f64 = 1.2;
+
 /// The viewer's data: robot links, the skeleton beside it, COM, support polygon, joints on a limit.
 fn viewer_data(r: &ImitateRun, e: &Experiment) -> Result<ViewerData> {
     let robot = &e.robot;
@@ -489,11 +492,6 @@ fn viewer_data(r: &ImitateRun, e: &Experiment) -> Result<ViewerData> {
     let mut skel_frames = Vec::new();
     let sk = e.clip.skeleton();
     let b = e.map.basis;
-    let first = e
-        .clip
-        .frame(0)
-        .map(|p| b * p.root_position)
-        .unwrap_or_default();
     let t0 = e.clip.times().first().copied().unwrap_or(0.0);
     for st in r.steps.iter().step_by(stride) {
         robot_frames.push(
@@ -517,13 +515,16 @@ fn viewer_data(r: &ImitateRun, e: &Experiment) -> Result<ViewerData> {
         );
         let pose = e.clip.sample(t0 + st.t)?;
         let pts = sk.world_positions(&pose)?;
+        // The skeleton is pinned beside the robot: its root's horizontal motion (the stepping,
+        // which the robot does not imitate) is removed.
+        let root = b * pose.root_position;
         skel_frames.push(
             pts.iter()
                 .map(|p| {
                     let q = b * p;
                     [
-                        (q.x - first.x) as f32,
-                        (q.y - first.y + 1.0) as f32,
+                        (q.x - root.x) as f32,
+                        (q.y - root.y + SKELETON_OFFSET) as f32,
                         q.z as f32,
                     ]
                 })

@@ -1,5 +1,6 @@
 //! The 3D viewer of `iktc imitate` (Fig. 21): one self-contained HTML file (inline script, plain
 //! 2D canvas, no network, no library) showing the captured skeleton and the robot side by side.
+//! Drag to orbit, wheel to zoom; `viewer.html#t=1.5` opens paused at 1.5 s.
 
 use std::path::Path;
 
@@ -60,7 +61,7 @@ const slider = document.getElementById("slider"), timeLabel = document.getElemen
 const playBtn = document.getElementById("play"), speedSel = document.getElementById("speed");
 const n = D.robot.frames.length;
 slider.max = String(Math.max(0, n - 1));
-let frame = 0, playing = true, last = null, az = -0.5, el = 0.3, dist = 7.0, acc = 0;
+let frame = 0, playing = true, last = null, az = -1.25, el = 0.25, dist = 7.0, acc = 0;
 let drag = null;
 // Centre of the scene: between the robot and the skeleton at frame 0.
 let cx = 0, cy = 0, cz = 0.7;
@@ -151,6 +152,11 @@ window.onmousemove = e => {
   drag = [e.clientX, e.clientY]; draw();
 };
 cv.onwheel = e => { e.preventDefault(); dist = Math.max(1, Math.min(20, dist * (e.deltaY > 0 ? 1.1 : 0.9))); draw(); };
+// viewer.html#t=1.5 opens paused at 1.5 s.
+{
+  const m = /t=([0-9.]+)/.exec(location.hash);
+  if (m) { frame = Math.max(0, Math.min(n - 1, Math.round(parseFloat(m[1]) / D.dt))); playing = false; playBtn.textContent = "play"; }
+}
 draw();
 document.title = "iktc viewer ready";
 requestAnimationFrame(step);
