@@ -6,11 +6,11 @@ use anyhow::{Context, Result};
 use iktc::limits::BoundMethod;
 use iktc::model::Robot;
 use iktc::motion::{
-    builtin_clip, builtin_map, read_bvh, read_deepmimic, retarget, BvhReadOptions, Clip,
-    RetargetMap, BUILTIN_CLIP_NAMES, BUILTIN_MAP_NAMES,
+    builtin_clip, builtin_map, read_bvh, read_deepmimic, BvhReadOptions, Clip, RetargetMap,
+    BUILTIN_CLIP_NAMES, BUILTIN_MAP_NAMES,
 };
 use iktc::sim::imitate::LEVEL_NAMES;
-use iktc::sim::{run_imitate, ImitateConfig, ImitateRun, NarrowedJoint};
+use iktc::sim::{imitation_references, run_imitate, ImitateConfig, ImitateRun, NarrowedJoint};
 use iktc::solver::Method;
 use iktc_report::{write_csv, write_figure, Figure, Panel, Section, Series, Table};
 
@@ -164,7 +164,7 @@ pub struct Experiment {
 
 /// Retargets and runs.
 pub fn run_experiment(e: &Experiment, cfg: &ImitateConfig) -> Result<ImitateRun> {
-    let refs = retarget(&e.clip, &e.robot, &e.map)?.resample(cfg.dt)?;
+    let refs = imitation_references(&e.robot, &e.clip, &e.map, cfg)?;
     Ok(run_imitate(&e.robot, &refs, cfg)?)
 }
 

@@ -9,17 +9,16 @@ use std::time::{Duration, Instant};
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use iktc::model::{jvrc1, ModelOptions, Robot};
-use iktc::motion::{builtin_clip, builtin_map, retarget, RobotReferences};
-use iktc::sim::{percentile, ImitateConfig, ImitationController};
+use iktc::motion::{builtin_clip, builtin_map, RobotReferences};
+use iktc::sim::{imitation_references, percentile, ImitateConfig, ImitationController};
 use iktc::solver::Method;
 
 fn setup() -> (Robot, RobotReferences) {
     let robot = jvrc1(&ModelOptions::default()).expect("JVRC-1");
     let clip = builtin_clip("humanoid3d_dance_b").expect("clip");
     let map = builtin_map("deepmimic_jvrc1").expect("map");
-    let refs = retarget(&clip, &robot, &map)
-        .and_then(|r| r.resample(0.005))
-        .expect("references");
+    let refs =
+        imitation_references(&robot, &clip, &map, &ImitateConfig::default()).expect("references");
     (robot, refs)
 }
 

@@ -6,8 +6,8 @@ use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use iktc::model::{jvrc1, ModelOptions};
-use iktc::motion::{builtin_clip, builtin_map, retarget};
-use iktc::sim::{ImitateConfig, ImitationController};
+use iktc::motion::{builtin_clip, builtin_map};
+use iktc::sim::{imitation_references, ImitateConfig, ImitationController};
 use iktc::solver::Method;
 
 struct Counting;
@@ -35,10 +35,7 @@ fn the_humanoid_tick_allocates_nothing() {
     let robot = jvrc1(&ModelOptions::default()).unwrap();
     let clip = builtin_clip("humanoid3d_dance_b").unwrap();
     let map = builtin_map("deepmimic_jvrc1").unwrap();
-    let refs = retarget(&clip, &robot, &map)
-        .unwrap()
-        .resample(0.005)
-        .unwrap();
+    let refs = imitation_references(&robot, &clip, &map, &ImitateConfig::default()).unwrap();
     for method in [Method::Iktc, Method::Cascade] {
         let cfg = ImitateConfig {
             method,

@@ -4,8 +4,8 @@
 //! joints sit at their limits, and the higher levels tracked meanwhile.
 
 use iktc::model::{jvrc1, ModelOptions, Robot};
-use iktc::motion::{builtin_clip, builtin_map, retarget, RobotReferences};
-use iktc::sim::{run_imitate, ImitateConfig, ImitateRun};
+use iktc::motion::{builtin_clip, builtin_map, RobotReferences};
+use iktc::sim::{imitation_references, run_imitate, ImitateConfig, ImitateRun};
 use iktc::solver::Method;
 
 /// Stated tolerance on the feet: position drift [m] and orientation drift [rad].
@@ -19,10 +19,7 @@ fn setup() -> (Robot, RobotReferences) {
     let robot = jvrc1(&ModelOptions::default()).unwrap();
     let clip = builtin_clip("humanoid3d_dance_b").unwrap();
     let map = builtin_map("deepmimic_jvrc1").unwrap();
-    let refs = retarget(&clip, &robot, &map)
-        .unwrap()
-        .resample(0.005)
-        .unwrap();
+    let refs = imitation_references(&robot, &clip, &map, &ImitateConfig::default()).unwrap();
     (robot, refs)
 }
 

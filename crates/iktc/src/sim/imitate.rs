@@ -213,6 +213,44 @@ impl Default for ImitateConfig {
     }
 }
 
+/// The references of a run: `clip` retargeted with `map` ([`retarget`]), the joint samples
+/// clamped into their (narrowed) ranges shrunk by `cfg.reference_margin` *before* the
+/// interpolation (so the tracked references stay C²; the controller's own clamp then only trims
+/// the splines' small overshoots), and resampled at `cfg.dt` ([`Retargeted::resample`]).
+///
+/// [`retarget`]: crate::motion::retarget
+/// [`Retargeted::resample`]: crate::motion::Retargeted::resample
+pub fn imitation_references(
+    robot: &Robot,
+    clip: &crate::motion::Clip,
+    map: &crate::motion::RetargetMap,
+    cfg: &ImitateConfig,
+) -> Result<RobotReferences> {
+    cfg.validate()?;
+    let mut r = crate::motion::retarget(clip, robot, map)?;
+    r.clamp_to_limits(robot, cfg.reference_margin)?;
+    for n in &cfg.narrow {
+        let (lo, hi) = (
+            n.lower + cfg.reference_margin,
+            n.upper - cfg.reference_margin,
+        );
+        let (lo, hi) = if lo > hi {
+            let mid = 0.5 * (n.lower + n.upper);
+            (mid, mid)
+        } else {
+            (lo, hi)
+        };
+        for (name, track) in r.joint_names.iter().zip(r.joint_angles.iter_mut()) {
+            if *name == n.joint {
+                for v in track.iter_mut() {
+                    *v = v.clamp(lo, hi);
+                }
+            }
+        }
+    }
+    r.resample(cfg.dt)
+}
+
 /// The closed loop of one imitation run: tasks, bounds, solver and state, sized once.
 #[derive(Debug, Clone)]
 pub struct ImitationController {

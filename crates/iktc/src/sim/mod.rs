@@ -5,8 +5,8 @@ pub mod margins;
 pub mod planar3r;
 
 pub use imitate::{
-    run_imitate, ImitateConfig, ImitateRun, ImitateStep, ImitateSummary, ImitationController,
-    NarrowedJoint,
+    imitation_references, run_imitate, ImitateConfig, ImitateRun, ImitateStep, ImitateSummary,
+    ImitationController, NarrowedJoint,
 };
 pub use margins::{dof_margins, median, percentile, DofMargins};
 pub use planar3r::{
