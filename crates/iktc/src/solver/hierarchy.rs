@@ -54,6 +54,9 @@ pub struct Hierarchy {
     tmp_n: DVector<f64>,
     tmp_m: DVector<f64>,
     residual: DVector<f64>,
+    /// Jᵀ of the current level (n × m_max) and T with permuted columns (m_max × m_max).
+    jt: DMatrix<f64>,
+    tp: DMatrix<f64>,
 }
 
 impl Hierarchy {
@@ -87,6 +90,8 @@ impl Hierarchy {
             tmp_n: DVector::zeros(n),
             tmp_m: DVector::zeros(mmax),
             residual: DVector::zeros(mmax),
+            jt: DMatrix::zeros(n, mmax),
+            tp: DMatrix::zeros(mmax, mmax),
         }
     }
 
@@ -157,22 +162,10 @@ impl Hierarchy {
             let m = self.dims[i];
             self.level_inverse(i, &lvl.jacobian, settings);
             // residual = h_i − J_i q̈_{i−1};  q̈ += J̄⁺ residual.
-            for r in 0..m {
-                let mut s = lvl.rhs[r];
-                for c in 0..n {
-                    s -= lvl.jacobian[(r, c)] * qdd[c];
-                }
-                self.residual[r] = s;
-            }
-            let p = &self.pinv[i];
-            for c in 0..m {
-                let rc = self.residual[c];
-                if rc != 0.0 {
-                    for d in 0..n {
-                        qdd[d] += p[(d, c)] * rc;
-                    }
-                }
-            }
+            let mut res = self.residual.rows_mut(0, m);
+            res.copy_from(&lvl.rhs);
+            res.gemv(-1.0, &lvl.jacobian, qdd, 1.0);
+            qdd.gemv(1.0, &self.pinv[i], &self.residual.rows(0, m), 1.0);
         }
         Ok(())
     }
@@ -189,14 +182,21 @@ impl Hierarchy {
             self.ranks[i] = 0;
             return;
         }
-        // A = (J Z)ᵀ, k × m.
-        for c in 0..m {
-            for a in 0..k {
-                let mut s = 0.0;
-                for d in 0..n {
-                    s += j[(c, d)] * self.z[(d, a)];
+        // A = (J Z)ᵀ = Zᵀ Jᵀ, k × m.
+        self.jt.view_mut((0, 0), (n, m)).tr_copy_from(j);
+        // Entry (a, c) is the dot product of column a of Z and column c of Jᵀ (both contiguous).
+        // Written out: nalgebra's gemm may allocate packing buffers, and the tick must not.
+        {
+            let zs = self.z.as_slice();
+            let js = self.jt.as_slice();
+            let arows = self.a.nrows();
+            let asl = self.a.as_mut_slice();
+            for c in 0..m {
+                let jc = &js[c * n..(c + 1) * n];
+                for a in 0..k {
+                    let za = &zs[a * n..(a + 1) * n];
+                    asl[a + c * arows] = za.iter().zip(jc).map(|(x, y)| x * y).sum();
                 }
-                self.a[(a, c)] = s;
             }
         }
         // Householder QR with column pivoting of A (k × m).
@@ -256,24 +256,18 @@ impl Hierarchy {
             rank = st + 1;
         }
         self.ranks[i] = rank;
-        // ZQ = Z H_1 … H_rank (n × k).
-        for a in 0..k {
-            for d in 0..n {
-                self.zq[(d, a)] = self.z[(d, a)];
-            }
-        }
+        // ZQ = Z H_1 … H_rank (n × k): each reflector is a rank-one update
+        // ZQ ← ZQ − τ (ZQ v) vᵀ on the columns st..k.
+        self.zq.view_mut((0, 0), (n, k)).copy_from(&self.z.view((0, 0), (n, k)));
         for st in 0..rank {
             let tau = self.tau[st];
-            for d in 0..n {
-                let mut s = 0.0;
-                for a in st..k {
-                    s += self.zq[(d, a)] * self.v[(a, st)];
-                }
-                s *= tau;
-                for a in st..k {
-                    self.zq[(d, a)] -= s * self.v[(a, st)];
-                }
-            }
+            let v = self.v.view((st, st), (k - st, 1));
+            let v = v.column(0);
+            let mut w = self.tmp_n.rows_mut(0, n);
+            w.gemv(1.0, &self.zq.view((0, st), (n, k - st)), &v, 0.0);
+            self.zq
+                .view_mut((0, st), (n, k - st))
+                .ger(-tau, &self.tmp_n.rows(0, n), &v, 1.0);
         }
         if rank > 0 {
             // λ² from the damping rule; σ_min estimated by the last kept pivot |R_rr|.
@@ -342,26 +336,36 @@ impl Hierarchy {
                     self.t[(p, c)] = self.tmp_m[p];
                 }
             }
-            // J̄⁺ column perm[c] = ZQ_r · T[:, c].
-            let p = &mut self.pinv[i];
+            // J̄⁺ = ZQ_r · T · Πᵀ: column perm[c] of J̄⁺ is ZQ_r · T[:, c].
             for c in 0..m {
                 let col = self.perm[c];
-                for d in 0..n {
-                    let mut s = 0.0;
-                    for q in 0..rank {
-                        s += self.zq[(d, q)] * self.t[(q, c)];
+                for p in 0..rank {
+                    self.tp[(p, col)] = self.t[(p, c)];
+                }
+            }
+            // Column c of J̄⁺ = Σ_p ZQ[:, p] · Tp[p, c] (contiguous column updates).
+            let zq = self.zq.as_slice();
+            let tprows = self.tp.nrows();
+            let tp = self.tp.as_slice();
+            let pi = self.pinv[i].as_mut_slice();
+            for c in 0..m {
+                let out = &mut pi[c * n..(c + 1) * n];
+                out.fill(0.0);
+                for p in 0..rank {
+                    let f = tp[p + c * tprows];
+                    if f != 0.0 {
+                        for (o, z) in out.iter_mut().zip(&zq[p * n..(p + 1) * n]) {
+                            *o += f * z;
+                        }
                     }
-                    p[(d, col)] = s;
                 }
             }
         }
         // Z ← ZQ[:, rank..k].
         let newk = k - rank;
-        for a in 0..newk {
-            for d in 0..n {
-                self.z[(d, a)] = self.zq[(d, rank + a)];
-            }
-        }
+        self.z
+            .view_mut((0, 0), (n, newk))
+            .copy_from(&self.zq.view((0, rank), (n, newk)));
         self.k = newk;
     }
 
