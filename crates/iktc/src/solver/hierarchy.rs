@@ -195,7 +195,7 @@ impl Hierarchy {
                 let jc = &js[c * n..(c + 1) * n];
                 for a in 0..k {
                     let za = &zs[a * n..(a + 1) * n];
-                    asl[a + c * arows] = za.iter().zip(jc).map(|(x, y)| x * y).sum();
+                    asl[a + c * arows] = dot(za, jc);
                 }
             }
         }
@@ -205,14 +205,16 @@ impl Hierarchy {
             self.perm[c] = c;
         }
         let mut rank = 0;
+        let ar = self.a.nrows();
+        let vr = self.v.nrows();
         for st in 0..steps {
             // Pivot: the remaining column of largest norm (rows st..k).
-            for c in st..m {
-                let mut s = 0.0;
-                for a in st..k {
-                    s += self.a[(a, c)] * self.a[(a, c)];
+            {
+                let asl = self.a.as_slice();
+                for c in st..m {
+                    let col = &asl[c * ar + st..c * ar + k];
+                    self.colnorm[c] = dot(col, col);
                 }
-                self.colnorm[c] = s;
             }
             let mut best = st;
             for c in st + 1..m {
@@ -230,27 +232,24 @@ impl Hierarchy {
                 break;
             }
             // v = x − α e1 with α = −sign(x0)‖x‖; H = I − τ v vᵀ, τ = 2 / vᵀv.
-            let x0 = self.a[(st, st)];
+            let asl = self.a.as_mut_slice();
+            let vsl = self.v.as_mut_slice();
+            let x0 = asl[st * ar + st];
             let alpha = if x0 >= 0.0 { -norm } else { norm };
-            for a in 0..k {
-                self.v[(a, st)] = if a < st { 0.0 } else { self.a[(a, st)] };
-            }
-            self.v[(st, st)] = x0 - alpha;
-            let mut vv = 0.0;
-            for a in st..k {
-                vv += self.v[(a, st)] * self.v[(a, st)];
-            }
+            let vcol = &mut vsl[st * vr..st * vr + k];
+            vcol[..st].fill(0.0);
+            vcol[st..k].copy_from_slice(&asl[st * ar + st..st * ar + k]);
+            vcol[st] = x0 - alpha;
+            let v = &vcol[st..k];
+            let vv = dot(v, v);
             let tau = if vv > 0.0 { 2.0 / vv } else { 0.0 };
             self.tau[st] = tau;
             // Apply H to the remaining columns of A.
             for c in st..m {
-                let mut s = 0.0;
-                for a in st..k {
-                    s += self.v[(a, st)] * self.a[(a, c)];
-                }
-                s *= tau;
-                for a in st..k {
-                    self.a[(a, c)] -= s * self.v[(a, st)];
+                let col = &mut asl[c * ar + st..c * ar + k];
+                let f = tau * dot(v, col);
+                for (x, vi) in col.iter_mut().zip(v) {
+                    *x -= f * vi;
                 }
             }
             rank = st + 1;
@@ -404,4 +403,26 @@ impl Hierarchy {
             }
         }
     }
+}
+
+/// Dot product of two equally long slices with four independent accumulators, so that the
+/// compiler can vectorise it (a single running sum fixes the order of the additions).
+#[inline]
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len().min(b.len());
+    let (a, b) = (&a[..n], &b[..n]);
+    let mut acc = [0.0f64; 4];
+    let mut ca = a.chunks_exact(4);
+    let mut cb = b.chunks_exact(4);
+    for (x, y) in (&mut ca).zip(&mut cb) {
+        acc[0] += x[0] * y[0];
+        acc[1] += x[1] * y[1];
+        acc[2] += x[2] * y[2];
+        acc[3] += x[3] * y[3];
+    }
+    let mut s = (acc[0] + acc[1]) + (acc[2] + acc[3]);
+    for (x, y) in ca.remainder().iter().zip(cb.remainder()) {
+        s += x * y;
+    }
+    s
 }
