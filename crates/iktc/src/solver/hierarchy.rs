@@ -257,7 +257,9 @@ impl Hierarchy {
         self.ranks[i] = rank;
         // ZQ = Z H_1 … H_rank (n × k): each reflector is a rank-one update
         // ZQ ← ZQ − τ (ZQ v) vᵀ on the columns st..k.
-        self.zq.view_mut((0, 0), (n, k)).copy_from(&self.z.view((0, 0), (n, k)));
+        self.zq
+            .view_mut((0, 0), (n, k))
+            .copy_from(&self.z.view((0, 0), (n, k)));
         for st in 0..rank {
             let tau = self.tau[st];
             let v = self.v.view((st, st), (k - st, 1));
