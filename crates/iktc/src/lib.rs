@@ -39,5 +39,6 @@ pub mod motion;
 pub mod sim;
 pub mod solver;
 pub mod task;
+pub mod walk;
 
 pub use error::{Error, Result};
