@@ -192,6 +192,11 @@ pub fn solve_dare(
         }
         let change = (&h_next - &hk).norm();
         let scale = h_next.norm().max(1.0);
+        if !(change.is_finite() && scale.is_finite()) {
+            // The norms overflow: the iterate grows without bound.
+            status = DareStatus::Breakdown;
+            break;
+        }
         hk = h_next;
         gk = g_next;
         ak = a_next;
@@ -201,6 +206,9 @@ pub fn solve_dare(
         }
     }
     let residual = dare_residual(a, b, q, r, &hk)?;
+    if status == DareStatus::Converged && !residual.is_finite() {
+        status = DareStatus::Breakdown;
+    }
     Ok(DareSolution {
         x: hk,
         iterations,
