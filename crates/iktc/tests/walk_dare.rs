@@ -2,13 +2,21 @@
 //! the DARE residual written out here, plain value iteration (backward Riccati recursion
 //! with a long horizon) and the time-varying finite-horizon preview LQ.
 
-use iktc::walk::{solve_dare, CartTable, DareSettings, DareStatus, PreviewController, PreviewSettings};
+use iktc::walk::{
+    solve_dare, CartTable, DareSettings, DareStatus, PreviewController, PreviewSettings,
+};
 use nalgebra::DMatrix;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 /// `X − (AᵀXA − AᵀXB(R + BᵀXB)⁻¹BᵀXA + Q)`, relative to `‖X‖`.
-fn residual(a: &DMatrix<f64>, b: &DMatrix<f64>, q: &DMatrix<f64>, r: &DMatrix<f64>, x: &DMatrix<f64>) -> f64 {
+fn residual(
+    a: &DMatrix<f64>,
+    b: &DMatrix<f64>,
+    q: &DMatrix<f64>,
+    r: &DMatrix<f64>,
+    x: &DMatrix<f64>,
+) -> f64 {
     let s = r + b.transpose() * x * b;
     let s_inv = s.try_inverse().unwrap();
     let rhs = a.transpose() * x * a - a.transpose() * x * b * s_inv * b.transpose() * x * a + q;
@@ -17,7 +25,12 @@ fn residual(a: &DMatrix<f64>, b: &DMatrix<f64>, q: &DMatrix<f64>, r: &DMatrix<f6
 
 /// Value iteration `P ← Q + AᵀPA − AᵀPB(R + BᵀPB)⁻¹BᵀPA` from `P = 0`: the cost-to-go of
 /// ever longer finite horizons. Returns `P` and the number of steps.
-fn value_iteration(a: &DMatrix<f64>, b: &DMatrix<f64>, q: &DMatrix<f64>, r: &DMatrix<f64>) -> (DMatrix<f64>, usize) {
+fn value_iteration(
+    a: &DMatrix<f64>,
+    b: &DMatrix<f64>,
+    q: &DMatrix<f64>,
+    r: &DMatrix<f64>,
+) -> (DMatrix<f64>, usize) {
     let mut p = DMatrix::zeros(a.nrows(), a.nrows());
     for k in 0..2_000_000 {
         let s = r + b.transpose() * &p * b;
@@ -36,7 +49,9 @@ fn gain(a: &DMatrix<f64>, b: &DMatrix<f64>, r: &DMatrix<f64>, p: &DMatrix<f64>) 
     (r + b.transpose() * p * b).try_inverse().unwrap() * b.transpose() * p * a
 }
 
-fn augmented(settings: &PreviewSettings) -> (DMatrix<f64>, DMatrix<f64>, DMatrix<f64>, DMatrix<f64>) {
+fn augmented(
+    settings: &PreviewSettings,
+) -> (DMatrix<f64>, DMatrix<f64>, DMatrix<f64>, DMatrix<f64>) {
     // Built here from the paper's formulas, not taken from the library.
     let (dt, zc, g) = (settings.dt, settings.com_height, settings.gravity);
     let a = DMatrix::from_row_slice(3, 3, &[1.0, dt, dt * dt / 2.0, 0.0, 1.0, dt, 0.0, 0.0, 1.0]);
@@ -93,12 +108,25 @@ fn preview_riccati_solution_satisfies_the_dare_and_matches_value_iteration() {
         assert_eq!(ctrl.riccati().status, DareStatus::Converged);
         let (pv, steps) = value_iteration(&a, &b, &q, &r);
         let rel = (x - &pv).norm() / pv.norm();
-        assert!(rel < 1e-8, "P differs from value iteration ({steps} steps) by {rel}");
+        assert!(
+            rel < 1e-8,
+            "P differs from value iteration ({steps} steps) by {rel}"
+        );
         // Gains [G_I, G_x] of the library against the value-iteration P.
         let k = gain(&a, &b, &r, &pv);
-        let kl = [ctrl.integral_gain(), ctrl.state_gain()[0], ctrl.state_gain()[1], ctrl.state_gain()[2]];
+        let kl = [
+            ctrl.integral_gain(),
+            ctrl.state_gain()[0],
+            ctrl.state_gain()[1],
+            ctrl.state_gain()[2],
+        ];
         for i in 0..4 {
-            assert!((kl[i] - k[(0, i)]).abs() <= 1e-7 * k[(0, i)].abs().max(1.0), "gain {i}: {} vs {}", kl[i], k[(0, i)]);
+            assert!(
+                (kl[i] - k[(0, i)]).abs() <= 1e-7 * k[(0, i)].abs().max(1.0),
+                "gain {i}: {} vs {}",
+                kl[i],
+                k[(0, i)]
+            );
         }
         // Doubling needs far fewer steps than value iteration.
         assert!(ctrl.riccati().iterations < 40);
@@ -111,7 +139,14 @@ fn preview_riccati_solution_satisfies_the_dare_and_matches_value_iteration() {
 /// `P_k = Q + AᵀP_{k+1}A − AᵀP_{k+1}B s_k⁻¹ BᵀP_{k+1}A`,
 /// `g_k = (A − B K_k)ᵀ (P_{k+1} E d_{k+1} + g_{k+1})`, `Δu_k = −s_k⁻¹ Bᵀ(P_{k+1}(A X + E d_{k+1}) + g_{k+1})`,
 /// with `E = −(1, 0, 0, 0)ᵀ` (the error drops when the reference rises).
-fn first_increment(a: &DMatrix<f64>, b: &DMatrix<f64>, q: &DMatrix<f64>, r: &DMatrix<f64>, m: usize, j: usize) -> f64 {
+fn first_increment(
+    a: &DMatrix<f64>,
+    b: &DMatrix<f64>,
+    q: &DMatrix<f64>,
+    r: &DMatrix<f64>,
+    m: usize,
+    j: usize,
+) -> f64 {
     let mut e = DMatrix::zeros(4, 1);
     e[(0, 0)] = -1.0;
     let mut p = q.clone();
@@ -144,7 +179,10 @@ fn preview_gains_match_the_finite_horizon_lq() {
     for j in [1, 2, 5, 20, 100, 200, 320] {
         let du = first_increment(&a, &b, &q, &r, m, j);
         let lib = -gp[j - 1];
-        assert!((du - lib).abs() <= 1e-7 * du.abs().max(1e-3), "j = {j}: {du} vs {lib}");
+        assert!(
+            (du - lib).abs() <= 1e-7 * du.abs().max(1e-3),
+            "j = {j}: {du} vs {lib}"
+        );
     }
     // Preview gains decay: the far future matters less.
     assert!(gp[319].abs() < 0.05 * gp[0].abs());
@@ -171,7 +209,11 @@ fn random_systems_satisfy_the_dare() {
         // Stabilizing: the closed loop's spectral radius is below 1.
         let k = gain(&a, &b, &r, &sol.x);
         let ac = &a - &b * k;
-        let rho = ac.complex_eigenvalues().iter().map(|z| z.norm()).fold(0.0, f64::max);
+        let rho = ac
+            .complex_eigenvalues()
+            .iter()
+            .map(|z| z.norm())
+            .fold(0.0, f64::max);
         assert!(rho < 1.0, "spectral radius {rho}");
     }
 }
@@ -198,9 +240,18 @@ fn non_stabilizable_is_a_status_and_bad_input_an_error() {
     let asym = DMatrix::from_row_slice(2, 2, &[1.0, 0.5, 0.0, 1.0]);
     assert!(solve_dare(&a_ok, &b, &asym, &r, &s).is_err());
     for bad in [
-        DareSettings { tolerance: 0.0, ..s },
-        DareSettings { tolerance: f64::NAN, ..s },
-        DareSettings { max_iterations: 0, ..s },
+        DareSettings {
+            tolerance: 0.0,
+            ..s
+        },
+        DareSettings {
+            tolerance: f64::NAN,
+            ..s
+        },
+        DareSettings {
+            max_iterations: 0,
+            ..s
+        },
     ] {
         assert!(solve_dare(&a_ok, &b, &q, &r, &bad).is_err());
     }

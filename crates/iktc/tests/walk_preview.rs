@@ -50,11 +50,17 @@ fn check_tracking(plan: &FootstepPlan) {
         assert!(err <= ZMP_TOL, "t = {t}: ZMP error {err}");
         let ph = p.timeline().interval_at(t);
         if ph.swing_side().is_some() && t >= ph.start + SSP_SETTLE {
-            assert!(err <= ZMP_TOL_SSP, "t = {t} (single support): ZMP error {err}");
+            assert!(
+                err <= ZMP_TOL_SSP,
+                "t = {t} (single support): ZMP error {err}"
+            );
         }
         p.support_polygon_into(t, &mut poly).unwrap();
         let m = poly.margin((zx, zy));
-        assert!(m >= margin, "t = {t}: ZMP only {m} m inside the support polygon");
+        assert!(
+            m >= margin,
+            "t = {t}: ZMP only {m} m inside the support polygon"
+        );
     }
     let rms = (sum_sq / (n + 1) as f64).sqrt();
     assert!(rms <= ZMP_RMS_TOL, "rms {rms}");
@@ -135,7 +141,11 @@ fn com_is_c2_across_ticks_and_consistent_with_its_derivatives() {
     let h = 1e-4;
     for k in (3..n - 3).step_by(37) {
         let t = (k as f64 + 0.5) * dt;
-        let (m, c, pl) = (p.com(t - h).unwrap(), p.com(t).unwrap(), p.com(t + h).unwrap());
+        let (m, c, pl) = (
+            p.com(t - h).unwrap(),
+            p.com(t).unwrap(),
+            p.com(t + h).unwrap(),
+        );
         let fd_v = (pl.position - m.position) / (2.0 * h);
         let fd_a = (pl.position - 2.0 * c.position + m.position) / (h * h);
         assert!((fd_v - c.velocity).norm() < 1e-7, "t = {t}");
@@ -153,7 +163,9 @@ fn integral_action_removes_the_steady_state_error_and_rest_is_kept() {
     }
     assert_eq!(axis.state, nalgebra::Vector3::new(0.3, 0.0, 0.0));
     // A 5 cm step at 1 s: after 5 s the COM stands on the new reference.
-    let reference: Vec<f64> = (0..1200).map(|k| if k < 200 { 0.0 } else { 0.05 }).collect();
+    let reference: Vec<f64> = (0..1200)
+        .map(|k| if k < 200 { 0.0 } else { 0.05 })
+        .collect();
     let out = ctrl.track(&reference).unwrap();
     let last = out.last().unwrap();
     assert!((last.state[0] - 0.05).abs() < 1e-6);
@@ -177,7 +189,10 @@ fn bad_input_is_an_error() {
     let good = PreviewSettings::default();
     for bad in [
         PreviewSettings { dt: 0.0, ..good },
-        PreviewSettings { dt: f64::NAN, ..good },
+        PreviewSettings {
+            dt: f64::NAN,
+            ..good
+        },
         PreviewSettings {
             preview_time: 0.001,
             ..good

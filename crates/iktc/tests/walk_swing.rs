@@ -40,7 +40,8 @@ fn curved_pattern() -> WalkingPattern {
             }
         })
         .collect();
-    let plan = FootstepPlan::from_root_trajectory(&samples, &RootPlanParams::default(), &w).unwrap();
+    let plan =
+        FootstepPlan::from_root_trajectory(&samples, &RootPlanParams::default(), &w).unwrap();
     WalkingPattern::new(&plan, &w, &PreviewSettings::default()).unwrap()
 }
 
@@ -89,9 +90,18 @@ fn feet_are_c2_over_the_whole_timeline() {
                 let ev = (v1 - v0 - 0.5 * h * (a0 + a1)).abs();
                 let ea = (a1 - a0).abs();
                 let tol = 1e-12;
-                assert!(ep <= h * h * h * j / 12.0 + tol, "{side:?} c{c} t={t}: position {ep}");
-                assert!(ev <= h * h * j / 4.0 + tol, "{side:?} c{c} t={t}: velocity {ev}");
-                assert!(ea <= h * j + tol, "{side:?} c{c} t={t}: acceleration jump {ea}");
+                assert!(
+                    ep <= h * h * h * j / 12.0 + tol,
+                    "{side:?} c{c} t={t}: position {ep}"
+                );
+                assert!(
+                    ev <= h * h * j / 4.0 + tol,
+                    "{side:?} c{c} t={t}: velocity {ev}"
+                );
+                assert!(
+                    ea <= h * j + tol,
+                    "{side:?} c{c} t={t}: acceleration jump {ea}"
+                );
                 // Velocity and acceleration are bounded by what the jerk bound allows.
                 assert!(a1.abs() <= j * t_ssp + tol);
             }
@@ -117,7 +127,10 @@ fn no_jumps_at_phase_boundaries() {
                     // Over ε the change is at most ε times the bound of the derivative:
                     // |a| ≤ J T, |v| ≤ J T² (integrating the jerk bound over one swing).
                     let scale = [t * t, t, 1.0][d];
-                    assert!(jump <= eps * jb[c] * scale + 1e-12, "{side:?} {what} c{c} jumps {jump} at {tb}");
+                    assert!(
+                        jump <= eps * jb[c] * scale + 1e-12,
+                        "{side:?} {what} c{c} jumps {jump} at {tb}"
+                    );
                 }
             }
         }
@@ -136,12 +149,18 @@ fn touch_down_lift_off_and_stance() {
         let target = ph.swing_target.unwrap();
         // Touch-down exactly at the planned footstep, at rest.
         let td = p.foot(swing, ph.end).unwrap();
-        assert_eq!((td.position.x, td.position.y, td.yaw), (target.x, target.y, target.yaw));
+        assert_eq!(
+            (td.position.x, td.position.y, td.yaw),
+            (target.x, target.y, target.yaw)
+        );
         assert_eq!(td.position.z, 0.0);
         // Zero velocity and acceleration at lift-off and touch-down, from the swing side too.
         let lo = p.foot(swing, ph.start).unwrap();
         let from = ph.foot(swing);
-        assert_eq!((lo.position.x, lo.position.y, lo.yaw), (from.x, from.y, from.yaw));
+        assert_eq!(
+            (lo.position.x, lo.position.y, lo.yaw),
+            (from.x, from.y, from.yaw)
+        );
         for f in [lo, td] {
             assert_eq!(f.twist(), [0.0; 6]);
             assert_eq!(f.acceleration(), [0.0; 6]);
@@ -163,7 +182,10 @@ fn touch_down_lift_off_and_stance() {
             // Stance foot at rest where the phase says.
             let s = p.foot(stance, t).unwrap();
             let sp = ph.foot(stance);
-            assert_eq!((s.position.x, s.position.y, s.position.z, s.yaw), (sp.x, sp.y, 0.0, sp.yaw));
+            assert_eq!(
+                (s.position.x, s.position.y, s.position.z, s.yaw),
+                (sp.x, sp.y, 0.0, sp.yaw)
+            );
             assert_eq!(s.twist(), [0.0; 6]);
             assert_eq!(s.acceleration(), [0.0; 6]);
         }

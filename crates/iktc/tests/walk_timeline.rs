@@ -27,8 +27,8 @@ fn timeline_has_the_planned_phases_and_durations() {
     let ph = tl.phases();
     assert_eq!(ph.len(), 2 * 4 + 1);
     // Hand computation of the total duration.
-    let total = w.initial_dsp_duration + 4.0 * w.ssp_duration + 3.0 * w.dsp_duration
-        + w.final_dsp_duration;
+    let total =
+        w.initial_dsp_duration + 4.0 * w.ssp_duration + 3.0 * w.dsp_duration + w.final_dsp_duration;
     assert!((tl.duration() - total).abs() < EPS);
     assert_eq!(ph[0].phase, Phase::DoubleSupport);
     assert!((ph[0].end - w.initial_dsp_duration).abs() < EPS);
@@ -38,7 +38,12 @@ fn timeline_has_the_planned_phases_and_durations() {
         }
         if i % 2 == 1 {
             let step = plan.steps()[i / 2];
-            assert_eq!(p.phase, Phase::SingleSupport { stance: step.side.opposite() });
+            assert_eq!(
+                p.phase,
+                Phase::SingleSupport {
+                    stance: step.side.opposite()
+                }
+            );
             assert!((p.end - p.start - w.ssp_duration).abs() < EPS);
             assert_eq!(p.swing_target, Some(step.pose));
         } else {
@@ -48,8 +53,18 @@ fn timeline_has_the_planned_phases_and_durations() {
     // phase_at inside, at boundaries (start inclusive) and outside.
     let t1 = ph[1].start;
     assert_eq!(tl.phase_at(t1 - 1e-9), Phase::DoubleSupport);
-    assert_eq!(tl.phase_at(t1), Phase::SingleSupport { stance: Side::Right });
-    assert_eq!(tl.phase_at(t1 + 0.3), Phase::SingleSupport { stance: Side::Right });
+    assert_eq!(
+        tl.phase_at(t1),
+        Phase::SingleSupport {
+            stance: Side::Right
+        }
+    );
+    assert_eq!(
+        tl.phase_at(t1 + 0.3),
+        Phase::SingleSupport {
+            stance: Side::Right
+        }
+    );
     assert_eq!(tl.phase_at(-5.0), Phase::DoubleSupport);
     assert_eq!(tl.phase_at(1e3), Phase::DoubleSupport);
     assert_eq!(tl.index_at(1e3), ph.len() - 1);
@@ -123,7 +138,10 @@ fn support_polygons_have_the_expected_shape() {
     for p in pattern.timeline().phases() {
         let t = 0.5 * (p.start + p.end);
         pattern.support_polygon_into(t, &mut buf).unwrap();
-        assert_eq!(buf.vertices(), pattern.support_polygon(t).unwrap().as_slice());
+        assert_eq!(
+            buf.vertices(),
+            pattern.support_polygon(t).unwrap().as_slice()
+        );
         let v = buf.vertices();
         assert!(area(v) > 0.0, "counter-clockwise");
         // Convex: every turn is to the left.

@@ -97,7 +97,12 @@ fn symmetrize(m: &mut DMatrix<f64>) {
     *m *= 0.5;
 }
 
-fn check_inputs(a: &DMatrix<f64>, b: &DMatrix<f64>, q: &DMatrix<f64>, r: &DMatrix<f64>) -> Result<()> {
+fn check_inputs(
+    a: &DMatrix<f64>,
+    b: &DMatrix<f64>,
+    q: &DMatrix<f64>,
+    r: &DMatrix<f64>,
+) -> Result<()> {
     let n = a.nrows();
     check_dim("DARE A (columns)", n, a.ncols())?;
     check_dim("DARE B (rows)", n, b.nrows())?;
@@ -153,7 +158,11 @@ pub fn solve_dare(
     check_inputs(a, b, q, r)?;
     let asym = (q - q.transpose()).norm();
     if asym > settings.tolerance * q.norm().max(1.0) {
-        return Err(invalid("DARE Q asymmetry ‖Q − Qᵀ‖_F", asym, "a symmetric Q"));
+        return Err(invalid(
+            "DARE Q asymmetry ‖Q − Qᵀ‖_F",
+            asym,
+            "a symmetric Q",
+        ));
     }
     let Some(r_chol) = r.clone().cholesky() else {
         return Err(Error::InvalidSetting {

@@ -195,7 +195,11 @@ impl FootstepPlan {
     /// Builds the plan whose footstep `k = 1 … n` lands at the nominal place around
     /// `body(k)` (clamped to `n − 1`, the closing step), sides alternating from
     /// `settings.first_swing`, starting from the nominal stance around `body(0)`.
-    fn from_body_poses(n: usize, settings: &WalkSettings, body: impl Fn(usize) -> Pose2) -> Result<Self> {
+    fn from_body_poses(
+        n: usize,
+        settings: &WalkSettings,
+        body: impl Fn(usize) -> Pose2,
+    ) -> Result<Self> {
         settings.validate()?;
         check_count(n)?;
         let d = settings.foot_separation;
@@ -225,7 +229,9 @@ impl FootstepPlan {
     /// The body advances by `(n − 1) · step_length`.
     pub fn forward(n: usize, step_length: f64, settings: &WalkSettings) -> Result<Self> {
         check_finite(|| "step_length [m]".to_string(), step_length)?;
-        Self::from_body_poses(n, settings, |k| Pose2::new(k as f64 * step_length, 0.0, 0.0))
+        Self::from_body_poses(n, settings, |k| {
+            Pose2::new(k as f64 * step_length, 0.0, 0.0)
+        })
     }
 
     /// `n ≥ 1` steps turning in place about the origin by `yaw_per_step` \[rad\] per footstep
@@ -233,9 +239,15 @@ impl FootstepPlan {
     /// heading `min(k, n − 1) · yaw_per_step`. The body turns by `(n − 1) · yaw_per_step`.
     pub fn turn(n: usize, yaw_per_step: f64, settings: &WalkSettings) -> Result<Self> {
         if !(yaw_per_step.is_finite() && yaw_per_step.abs() < std::f64::consts::FRAC_PI_2) {
-            return Err(invalid("yaw_per_step [rad]", yaw_per_step, "finite, |.| < pi/2"));
+            return Err(invalid(
+                "yaw_per_step [rad]",
+                yaw_per_step,
+                "finite, |.| < pi/2",
+            ));
         }
-        Self::from_body_poses(n, settings, |k| Pose2::new(0.0, 0.0, k as f64 * yaw_per_step))
+        Self::from_body_poses(n, settings, |k| {
+            Pose2::new(0.0, 0.0, k as f64 * yaw_per_step)
+        })
     }
 
     /// Steps along a root (pelvis) trajectory.
@@ -265,10 +277,7 @@ impl FootstepPlan {
         }
         for (i, s) in samples.iter().enumerate() {
             check_finite(|| format!("root sample {i} t [s]"), s.t)?;
-            check_pose(
-                &format!("root sample {i}"),
-                &Pose2::new(s.x, s.y, s.yaw),
-            )?;
+            check_pose(&format!("root sample {i}"), &Pose2::new(s.x, s.y, s.yaw))?;
         }
         // Unwrapped poses and cumulative progress.
         let mut poses = Vec::with_capacity(samples.len());

@@ -121,7 +121,10 @@ impl WalkSettings {
             "WalkSettings::initial_dsp_duration [s]",
             self.initial_dsp_duration,
         )?;
-        check_positive("WalkSettings::final_dsp_duration [s]", self.final_dsp_duration)?;
+        check_positive(
+            "WalkSettings::final_dsp_duration [s]",
+            self.final_dsp_duration,
+        )?;
         if self.initial_dsp_duration < self.dsp_duration {
             return Err(invalid(
                 "WalkSettings::initial_dsp_duration [s]",
@@ -143,7 +146,10 @@ impl WalkSettings {
             return Err(invalid(
                 "WalkSettings::foot_separation [m]",
                 self.foot_separation,
-                &format!("> sole_width = {} (soles must not overlap)", self.sole_width),
+                &format!(
+                    "> sole_width = {} (soles must not overlap)",
+                    self.sole_width
+                ),
             ));
         }
         check_non_negative("WalkSettings::swing_height [m]", self.swing_height)?;
