@@ -7,7 +7,7 @@
 //!   Hogan 1985): `x(t) = x₀ + (x₁ − x₀) s(τ)`, `s(τ) = 10τ³ − 15τ⁴ + 6τ⁵`, likewise `y`, `ψ`;
 //!   `s' = 30τ²(1 − τ)²`, `s'' = 60τ(1 − τ)(1 − 2τ)`: zero velocity and acceleration at
 //!   lift-off and touch-down;
-//! * vertically by the sextic `z(t) = 64 h τ³(1 − τ)³` (`h` = [`WalkSettings::swing_height`]),
+//! * vertically by the sextic `z(t) = 64 h τ³(1 − τ)³` (`h` = [`WalkSettings::swing_height`](super::WalkSettings::swing_height)),
 //!   peak `h` at `τ = ½`, `z' = 192 h τ²(1 − τ)²(1 − 2τ)/T`,
 //!   `z'' = 384 h τ(1 − τ)(1 − 5τ + 5τ²)/T²`: triple roots at both ends, so zero height,
 //!   vertical velocity and vertical acceleration at lift-off and touch-down.
