@@ -4,7 +4,7 @@
 //! controller for a discrete-time system subject to previewable demand", Int. J. Control
 //! 41(3), 1985).
 //!
-//! ## Cart-table model (Kajita 2003, Sec. III)
+//! ## Cart-table model (Kajita 2003, the cart-table model and its discretization)
 //! Per horizontal axis, the COM at constant height `z_c` with jerk input `u = d³x/dt³` held over
 //! each period `Δt` is exactly discretized as
 //!
@@ -17,7 +17,7 @@
 //! Between samples the COM follows the cubic `x(t_k + τ) = x_k + ẋ_k τ + ẍ_k τ²/2 + u_k τ³/6`,
 //! so the acceleration is continuous (piecewise linear).
 //!
-//! ## Optimal preview servo (Katayama 1985; Kajita 2003, Sec. III-B)
+//! ## Optimal preview servo (Katayama 1985; Kajita 2003, the preview controller and its gains)
 //! With the tracking error `e_k = p_k − p^ref_k` and increments `Δx_k = x_k − x_{k−1}`,
 //! `Δu_k = u_k − u_{k−1}`, the augmented state `X_k = (e_k, Δx_kᵀ)ᵀ` obeys
 //!
@@ -52,9 +52,10 @@ use crate::error::{check_finite, Result};
 pub struct PreviewSettings {
     /// Control period `Δt` \[s\], `> 0`. Kajita 2003 uses 5 ms.
     pub dt: f64,
-    /// Preview time `T_p` \[s\], `≥ dt`; the horizon is `N = round(T_p / Δt)` samples. Longer
-    /// previews track better up to about twice the pendulum time constant `√(z_c/g)`, then
-    /// change nothing but cost time. Kajita 2003 uses 1.6 s.
+    /// Preview time `T_p` \[s\], `≥ dt`; the horizon is `N = round(T_p / Δt)` samples. The
+    /// preview gains `G_p(j)` decay with `j` (at the defaults `G_p(N)/G_p(1) ≈ 0.008`), so a
+    /// longer preview changes the pattern little but costs `O(N)` work per tick; a much
+    /// shorter one makes the COM start late and the ZMP error grow. Kajita 2003 uses 1.6 s.
     pub preview_time: f64,
     /// Weight `Q_e` on the ZMP tracking error \[1/m²\], `> 0`.
     pub q_e: f64,

@@ -4,7 +4,7 @@
 //! `DSP₀ (initial) · SSP₁ · DSP₁ · SSP₂ · … · DSPₙ₋₁ · SSPₙ · DSPₙ (final)`, starting at `t = 0`.
 //! Phase `i` covers `[start, end)`; after the last phase the final stance holds.
 //!
-//! ZMP reference (the usual choice of Kajita et al. 2003, Sec. IV, smoothed): in single support
+//! ZMP reference (the choice of Kajita et al. 2003, with smoothed shifts): in single support
 //! it rests at the centre of the stance sole; in double support it moves from the previous
 //! support point `a` to the next `b` by the quintic smoothstep
 //! `p(t) = a + (b − a) s(τ)`, `s(τ) = 10τ³ − 15τ⁴ + 6τ⁵`, `τ = (t − t_s)/(t_e − t_s)` clamped to
