@@ -223,3 +223,40 @@ fn swing_velocity_and_acceleration_match_finite_differences_inside_the_swing() {
     let r = f.rotation();
     assert!((r[(0, 0)] - f.yaw.cos()).abs() < 1e-15 && (r[(2, 2)] - 1.0).abs() < 1e-15);
 }
+
+#[test]
+fn offset_point_follows_rigid_body_kinematics() {
+    let p = curved_pattern();
+    let ankle = nalgebra::Vector3::new(0.03, -0.01, 0.1);
+    let h = 1e-5;
+    for ph in p.timeline().phases() {
+        let Phase::SingleSupport { stance } = ph.phase else {
+            continue;
+        };
+        let swing = stance.opposite();
+        let t = ph.start + 0.37 * (ph.end - ph.start);
+        let at = |t: f64| p.foot(swing, t).unwrap().offset(&ankle);
+        let (m, c, pl) = (at(t - h), at(t), at(t + h));
+        // Position: sole centre plus the rotated offset, computed here by hand.
+        let f = p.foot(swing, t).unwrap();
+        let (sn, cs) = f.yaw.sin_cos();
+        let expect = f.position
+            + nalgebra::Vector3::new(
+                cs * ankle.x - sn * ankle.y,
+                sn * ankle.x + cs * ankle.y,
+                ankle.z,
+            );
+        assert!((c.position - expect).norm() < 1e-14);
+        // Velocity and acceleration: central differences of the offset point.
+        let fd_v = (pl.position - m.position) / (2.0 * h);
+        let fd_a = (pl.linear_velocity - m.linear_velocity) / (2.0 * h);
+        assert!(
+            (fd_v - c.linear_velocity).norm() < 1e-7,
+            "{}",
+            (fd_v - c.linear_velocity).norm()
+        );
+        assert!((fd_a - c.linear_acceleration).norm() < 1e-5);
+        assert_eq!(c.yaw, f.yaw);
+        assert_eq!(c.angular_velocity, f.angular_velocity);
+    }
+}

@@ -57,6 +57,23 @@ impl FootState {
         Rotation3::from_axis_angle(&Vector3::z_axis(), self.yaw)
     }
 
+    /// The state of a point fixed in the foot frame at `offset` \[m\] (foot axes) from the
+    /// sole centre, e.g. the ankle joint above it, with the same orientation. Rigid-body
+    /// kinematics with `r = R_z(ψ) offset`: `p' = p + r`, `v' = v + ω × r`,
+    /// `a' = a + α × r + ω × (ω × r)`; `ω`, `α` unchanged.
+    pub fn offset(&self, offset: &Vector3<f64>) -> FootState {
+        let r = self.rotation() * offset;
+        let w = self.angular_velocity;
+        FootState {
+            position: self.position + r,
+            linear_velocity: self.linear_velocity + w.cross(&r),
+            linear_acceleration: self.linear_acceleration
+                + self.angular_acceleration.cross(&r)
+                + w.cross(&w.cross(&r)),
+            ..*self
+        }
+    }
+
     /// The 6D velocity `(v, ω)` \[m/s, rad/s\], world axes.
     pub fn twist(&self) -> [f64; 6] {
         let (v, w) = (self.linear_velocity, self.angular_velocity);
