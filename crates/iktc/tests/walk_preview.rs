@@ -234,3 +234,53 @@ fn bad_input_is_an_error() {
     assert!(ctrl.track(&[]).is_err());
     assert!(ctrl.track(&[0.0, f64::NAN]).is_err());
 }
+
+/// Seeded random root trajectories (walking with random curvature, speed and turning):
+/// the same tracking tolerance and polygon margin hold on every plan.
+#[test]
+fn random_root_trajectories_keep_the_zmp_inside() {
+    use iktc::walk::{RootPlanParams, RootSample};
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(6);
+    let w = WalkSettings::default();
+    let ps = PreviewSettings::default();
+    let ctrl = PreviewController::new(&ps).unwrap();
+    let margin = 0.5 * w.sole_width - 0.02;
+    for case in 0..8 {
+        let params = RootPlanParams {
+            stride: rng.random_range(0.05..0.25),
+            max_yaw_per_step: rng.random_range(0.1..0.4),
+            ..RootPlanParams::default()
+        };
+        let (mut x, mut y, mut yaw) = (0.0f64, 0.0f64, rng.random_range(-3.0..3.0));
+        let curvature = rng.random_range(-1.5..1.5);
+        let speed = rng.random_range(0.0..0.4);
+        let samples: Vec<RootSample> = (0..30)
+            .map(|i| {
+                let s = RootSample {
+                    t: 0.1 * i as f64,
+                    x,
+                    y,
+                    yaw,
+                };
+                x += 0.1 * speed * yaw.cos();
+                y += 0.1 * speed * yaw.sin();
+                yaw += 0.1 * speed * curvature + 0.02;
+                s
+            })
+            .collect();
+        let plan = FootstepPlan::from_root_trajectory(&samples, &params, &w).unwrap();
+        let p = WalkingPattern::with_controller(&plan, &w, ctrl.clone()).unwrap();
+        let mut poly = SupportPolygon::default();
+        let n = (p.duration() / p.dt()) as usize;
+        for k in 0..=n {
+            let t = k as f64 * p.dt();
+            let s = p.sample(t).unwrap();
+            let err = (s.zmp_model.0 - s.zmp_reference.0).hypot(s.zmp_model.1 - s.zmp_reference.1);
+            assert!(err <= ZMP_TOL, "case {case}, t = {t}: ZMP error {err}");
+            p.support_polygon_into(t, &mut poly).unwrap();
+            let m = poly.margin(s.zmp_model);
+            assert!(m >= margin, "case {case}, t = {t}: margin {m}");
+        }
+    }
+}
