@@ -211,6 +211,10 @@ fn bad_input_is_an_error() {
             gravity: f64::INFINITY,
             ..good
         },
+        PreviewSettings {
+            dt: 1e-9, // a unit slip: 1.6e9 preview samples
+            ..good
+        },
     ] {
         assert!(bad.validate().is_err());
         let err = WalkingPattern::new(&plan, &w, &bad).unwrap_err();
@@ -221,6 +225,12 @@ fn bad_input_is_an_error() {
         ..w
     };
     assert!(WalkingPattern::new(&plan, &bad_walk, &good).is_err());
+    let endless = WalkSettings {
+        ssp_duration: 1e30,
+        ..w
+    };
+    let long_plan = FootstepPlan::forward(2, 0.2, &endless).unwrap();
+    assert!(WalkingPattern::new(&long_plan, &endless, &good).is_err());
     let p = WalkingPattern::new(&plan, &w, &good).unwrap();
     assert!(matches!(p.sample(f64::NAN), Err(Error::NonFinite { .. })));
     assert!(p.com(f64::INFINITY).is_err());

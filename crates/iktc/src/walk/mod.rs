@@ -38,9 +38,11 @@ pub mod timeline;
 
 pub use dare::{dare_residual, solve_dare, DareSettings, DareSolution, DareStatus};
 pub use footstep::{Footstep, FootstepPlan, Pose2, RootPlanParams, RootSample};
-pub use pattern::{ComState, WalkSample, WalkingPattern};
+pub use pattern::{ComState, WalkSample, WalkingPattern, MAX_PATTERN_SAMPLES};
 pub use polygon::{sole_corners, SupportPolygon, MAX_POLYGON_VERTICES};
-pub use preview::{CartSample, CartTable, PreviewAxis, PreviewController, PreviewSettings};
+pub use preview::{
+    CartSample, CartTable, PreviewAxis, PreviewController, PreviewSettings, MAX_PREVIEW_SAMPLES,
+};
 pub use settings::{Side, WalkSettings};
 pub use swing::{foot_state, swing_height_profile, FootState};
 pub use timeline::{smoothstep, Phase, PhaseInterval, Timeline};

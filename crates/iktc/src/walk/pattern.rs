@@ -6,10 +6,14 @@ use nalgebra::Vector3;
 use super::footstep::FootstepPlan;
 use super::polygon::SupportPolygon;
 use super::preview::{CartSample, PreviewController, PreviewSettings};
-use super::settings::{Side, WalkSettings};
+use super::settings::{invalid, Side, WalkSettings};
 use super::swing::{foot_state, FootState};
 use super::timeline::{Phase, Timeline};
 use crate::error::{check_finite, Result};
+
+/// Largest number of COM samples of a pattern (about 14 h at 5 ms): a guard against
+/// durations that would allocate gigabytes.
+pub const MAX_PATTERN_SAMPLES: usize = 10_000_000;
 
 /// COM reference: position, velocity and acceleration, world axes.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -72,7 +76,8 @@ pub struct WalkingPattern {
 }
 
 impl WalkingPattern {
-    /// Precomputes the pattern of `plan`. Errors on invalid settings.
+    /// Precomputes the pattern of `plan`. Errors on invalid settings, and if the pattern
+    /// would need more than [`MAX_PATTERN_SAMPLES`] samples.
     pub fn new(
         plan: &FootstepPlan,
         settings: &WalkSettings,
@@ -91,7 +96,15 @@ impl WalkingPattern {
     ) -> Result<Self> {
         let timeline = Timeline::new(plan, settings)?;
         let dt = controller.settings().dt;
-        let n = (timeline.duration() / dt).ceil() as usize + 1;
+        let samples = (timeline.duration() / dt).ceil() + 1.0;
+        if !(samples <= MAX_PATTERN_SAMPLES as f64) {
+            return Err(invalid(
+                "walking pattern duration / dt [samples]",
+                samples,
+                &format!("<= {MAX_PATTERN_SAMPLES} (shorter plan or durations, or larger dt)"),
+            ));
+        }
+        let n = samples as usize;
         let (mut rx, mut ry) = (Vec::with_capacity(n), Vec::with_capacity(n));
         for k in 0..n {
             let (x, y) = timeline.zmp_reference(k as f64 * dt);

@@ -47,6 +47,10 @@ use super::dare::{solve_dare, DareSettings, DareSolution, DareStatus};
 use super::settings::{check_non_negative, check_positive, invalid};
 use crate::error::{check_finite, Result};
 
+/// Largest preview horizon `N` accepted \[samples\] (500 s at 5 ms): a guard against
+/// settings that would allocate gigabytes (e.g. a `dt` typed in the wrong unit).
+pub const MAX_PREVIEW_SAMPLES: usize = 100_000;
+
 /// Settings of the preview controller.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct PreviewSettings {
@@ -98,6 +102,14 @@ impl PreviewSettings {
                 "PreviewSettings::preview_time [s]",
                 self.preview_time,
                 &format!(">= dt = {}", self.dt),
+            ));
+        }
+        let n = self.preview_time / self.dt;
+        if n.round() > MAX_PREVIEW_SAMPLES as f64 {
+            return Err(invalid(
+                "PreviewSettings::preview_time / dt [samples]",
+                n,
+                &format!("<= {MAX_PREVIEW_SAMPLES}"),
             ));
         }
         check_positive("PreviewSettings::q_e", self.q_e)?;
