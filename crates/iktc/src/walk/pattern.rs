@@ -97,7 +97,7 @@ impl WalkingPattern {
         let timeline = Timeline::new(plan, settings)?;
         let dt = controller.settings().dt;
         let samples = (timeline.duration() / dt).ceil() + 1.0;
-        if !(samples <= MAX_PATTERN_SAMPLES as f64) {
+        if !samples.is_finite() || samples > MAX_PATTERN_SAMPLES as f64 {
             return Err(invalid(
                 "walking pattern duration / dt [samples]",
                 samples,
