@@ -294,3 +294,61 @@ fn random_root_trajectories_keep_the_zmp_inside() {
         }
     }
 }
+
+/// The incremental servo equals Kajita's summed control law
+/// `u_k = −G_I Σ_{i≤k} e_i − G_x x_k − Σ_{j=1}^{N} G_p(j) p^ref_{k+j}` (written out here)
+/// when the COM starts at rest at 0 and the reference is 0 over the first `N` samples, so that
+/// the integration constants of the two forms coincide.
+#[test]
+fn incremental_servo_equals_kajitas_summed_law() {
+    let ps = PreviewSettings::default();
+    let ctrl = PreviewController::new(&ps).unwrap();
+    let n = ctrl.preview_gains().len();
+    // Zero, then a staircase of lateral shifts like a walk.
+    let reference: Vec<f64> = (0..2000)
+        .map(|k| {
+            if k < n + 10 {
+                0.0
+            } else if ((k - n - 10) / 160) % 2 == 0 {
+                0.09
+            } else {
+                -0.09
+            }
+        })
+        .collect();
+    let out = ctrl.track(&reference).unwrap();
+    // Kajita's law on the cart-table written out here.
+    let (dt, zc_g) = (ps.dt, ps.com_height / ps.gravity);
+    let (gi, gx, gp) = (
+        ctrl.integral_gain(),
+        ctrl.state_gain(),
+        ctrl.preview_gains(),
+    );
+    let mut x = [0.0f64; 3];
+    let mut sum_e = 0.0;
+    for (k, s) in out.iter().enumerate() {
+        for c in 0..3 {
+            assert!(
+                (x[c] - s.state[c]).abs() < 1e-9 * (1.0 + x[c].abs()),
+                "k = {k}, c = {c}"
+            );
+        }
+        let p = x[0] - zc_g * x[2];
+        sum_e += p - reference[k];
+        let mut u = -gi * sum_e - (gx[0] * x[0] + gx[1] * x[1] + gx[2] * x[2]);
+        for j in 1..=n {
+            let r = reference[(k + j).min(reference.len() - 1)];
+            u -= gp[j - 1] * r;
+        }
+        assert!(
+            (u - s.jerk).abs() < 1e-6 * (1.0 + u.abs()),
+            "k = {k}: {u} vs {}",
+            s.jerk
+        );
+        x = [
+            x[0] + dt * x[1] + dt * dt / 2.0 * x[2] + dt * dt * dt / 6.0 * u,
+            x[1] + dt * x[2] + dt * dt / 2.0 * u,
+            x[2] + dt * u,
+        ];
+    }
+}

@@ -35,7 +35,8 @@ use crate::error::{check_all_finite, check_dim, Error, Result};
 pub struct DareSettings {
     /// Relative change of the iterate `‖H_{k+1} − H_k‖_F / max(1, ‖H_{k+1}‖_F)` below which the
     /// iteration stops \[–\], in `(0, 1)`. Smaller is more accurate; below ≈ 1e-14 round-off
-    /// may prevent convergence.
+    /// may prevent convergence. Also the largest relative asymmetry `‖Q − Qᵀ‖_F / max(1, ‖Q‖_F)`
+    /// accepted in `Q`.
     pub tolerance: f64,
     /// Most doubling steps, `≥ 1`. Step `k` covers a horizon of `2^k` samples, so 60 steps
     /// are far more than any stabilizable problem needs; hitting it means a (nearly)

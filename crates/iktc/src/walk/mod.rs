@@ -16,6 +16,12 @@
 //! * [`swing`]: foot trajectories (quintic horizontal, sextic vertical);
 //! * [`pattern`]: [`WalkingPattern`], all of it precomputed for a plan, queried per tick.
 //!
+//! Conventions: world frame with `z` up and the ground at `z = 0`; a foot's frame is the centre
+//! of its sole, its `x` axis pointing forward, roll and pitch zero (use [`FootState::offset`]
+//! for the ankle or another point of the foot); the COM moves at the constant height
+//! [`PreviewSettings::com_height`]; time starts at 0 with both feet down and the COM at rest
+//! over the midpoint between the feet.
+//!
 //! ```
 //! use iktc::walk::{FootstepPlan, PreviewSettings, WalkSettings, WalkingPattern};
 //!
