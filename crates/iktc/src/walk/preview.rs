@@ -4,7 +4,7 @@
 //! controller for a discrete-time system subject to previewable demand", Int. J. Control
 //! 41(3), 1985).
 //!
-//! ## Cart-table model (Kajita 2003, the cart-table model and its discretization)
+//! ## Cart-table model (Kajita 2003)
 //! Per horizontal axis, the COM at constant height `z_c` with jerk input `u = d³x/dt³` held over
 //! each period `Δt` is exactly discretized as
 //!
@@ -17,7 +17,7 @@
 //! Between samples the COM follows the cubic `x(t_k + τ) = x_k + ẋ_k τ + ẍ_k τ²/2 + u_k τ³/6`,
 //! so the acceleration is continuous (piecewise linear).
 //!
-//! ## Optimal preview servo (Katayama 1985; Kajita 2003, the preview controller and its gains)
+//! ## Optimal preview servo (Katayama 1985, as used by Kajita 2003)
 //! With the tracking error `e_k = p_k − p^ref_k` and increments `Δx_k = x_k − x_{k−1}`,
 //! `Δu_k = u_k − u_{k−1}`, the augmented state `X_k = (e_k, Δx_kᵀ)ᵀ` obeys
 //!
