@@ -327,9 +327,9 @@ fn incremental_servo_equals_kajitas_summed_law() {
     let mut x = [0.0f64; 3];
     let mut sum_e = 0.0;
     for (k, s) in out.iter().enumerate() {
-        for c in 0..3 {
+        for (c, xc) in x.iter().enumerate() {
             assert!(
-                (x[c] - s.state[c]).abs() < 1e-9 * (1.0 + x[c].abs()),
+                (xc - s.state[c]).abs() < 1e-9 * (1.0 + xc.abs()),
                 "k = {k}, c = {c}"
             );
         }
