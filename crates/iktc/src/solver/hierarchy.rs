@@ -186,7 +186,12 @@ impl Hierarchy {
         self.jt.view_mut((0, 0), (n, m)).tr_copy_from(j);
         // Entry (a, c) is the dot product of column a of Z and column c of Jᵀ (both contiguous).
         // Written out: nalgebra's gemm may allocate packing buffers, and the tick must not.
-        {
+        if k == n && i == 0 {
+            // First level: Z = I, so A = Jᵀ.
+            self.a
+                .view_mut((0, 0), (n, m))
+                .copy_from(&self.jt.view((0, 0), (n, m)));
+        } else {
             let zs = self.z.as_slice();
             let js = self.jt.as_slice();
             let arows = self.a.nrows();
