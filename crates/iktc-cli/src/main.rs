@@ -4,10 +4,12 @@
 use clap::{Parser, Subcommand};
 
 mod cmd_balance;
+mod cmd_imitate;
 mod cmd_model;
 mod cmd_reproduce;
 mod cmd_run;
 mod robot_arg;
+mod viewer;
 
 #[derive(Parser)]
 #[command(
@@ -30,6 +32,8 @@ enum Command {
     Reproduce(cmd_reproduce::Args),
     /// The ZMP damping controller of Section 4: identify, design, push.
     Balance(cmd_balance::BalanceArgs),
+    /// Imitate a captured motion with a humanoid (Section 5.3): figures, summary, 3D viewer.
+    Imitate(cmd_imitate::Args),
 }
 
 fn main() -> std::process::ExitCode {
@@ -39,6 +43,7 @@ fn main() -> std::process::ExitCode {
         Command::Run(a) => cmd_run::run(&a),
         Command::Reproduce(a) => cmd_reproduce::run(&a),
         Command::Balance(a) => cmd_balance::run(a),
+        Command::Imitate(a) => cmd_imitate::run(&a),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

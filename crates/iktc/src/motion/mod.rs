@@ -10,6 +10,9 @@
 //!   and channel order, in centimetres, metres or any length unit.
 //! * [`decompose_rotation`] — a rotation as a product of rotations about 1–3 given joint axes
 //!   (generalised Euler / Davenport angles in closed form, least squares otherwise).
+//! * [`retarget`], [`RetargetMap`], [`builtin_map`] — a clip to robot joint, pelvis height and
+//!   pelvis attitude references (a TOML map names which source joint drives which robot joints),
+//!   resampled to the control rate by C² splines ([`Retargeted::resample`], [`CubicSpline`]).
 //!
 //! ```
 //! use iktc::motion::{builtin_clip, decompose_rotation, write_clip_bvh, BvhExportOptions,
@@ -39,7 +42,10 @@ mod bvh;
 mod clip;
 mod decompose;
 mod deepmimic;
+mod retarget;
+mod retarget_map;
 mod skeleton;
+mod spline;
 
 pub use angles::{nearest_equivalent, unwrap_track, wrap_to_pi};
 pub use bvh::{
@@ -55,4 +61,9 @@ pub use deepmimic::{
     builtin_clip, deepmimic_skeleton, read_deepmimic, read_deepmimic_with, DeepMimicSettings,
     BUILTIN_CLIP_NAMES, DEEPMIMIC_FRAME_LEN, DEEPMIMIC_URDF, DEEPMIMIC_URDF_SCALE,
 };
+pub use retarget::{retarget, Retargeted, RobotReferences, Track};
+pub use retarget_map::{
+    builtin_map, HoldJoint, JointMap, RetargetMap, RootMap, TargetJoint, BUILTIN_MAP_NAMES,
+};
 pub use skeleton::{JointKind, Skeleton, SkeletonJoint};
+pub use spline::CubicSpline;

@@ -1,8 +1,13 @@
 //! Scenarios: the paper's experiments as runnable, recorded simulations.
 
+pub mod imitate;
 pub mod margins;
 pub mod planar3r;
 
+pub use imitate::{
+    run_imitate, ImitateConfig, ImitateRun, ImitateStep, ImitateSummary, ImitationController,
+    NarrowedJoint,
+};
 pub use margins::{dof_margins, median, percentile, DofMargins};
 pub use planar3r::{
     run_planar3r, ArmTask, Planar3rConfig, Planar3rRun, Planar3rStep, Planar3rSummary,

@@ -1,0 +1,563 @@
+//! The humanoid imitation experiment of Section 5.3: a retargeted captured motion tracked by a
+//! floating-base humanoid under joint position, velocity and acceleration limits.
+//!
+//! Task stack (Table 1, priority order; sizes from the model, JVRC-1: 12, 2, 3, 1, 20, n = 38):
+//! 1. both feet, 6D each, held at their initial poses (one level);
+//! 2. COM in the horizontal plane, held over the centre of the support polygon;
+//! 3. pelvis attitude (retargeted from the clip's root orientation);
+//! 4. pelvis height (initial height + the retargeted root height change);
+//! 5. upper-body joints (retargeted joint trajectories).
+//!
+//! One control tick ([`ImitationController::tick`]): kinematics → references → task
+//! linearisation → acceleration box (narrowed joint ranges) → solve (IKTC, GF or clamp) →
+//! constant-acceleration integration. The tick allocates nothing.
+
+mod record;
+mod support;
+
+pub use record::{
+    run_imitate, summarize, ImitateRun, ImitateStep, ImitateSummary, JointMargin, LevelSummary,
+};
+pub use support::{support_polygon, SupportSettings};
+
+use nalgebra::{DVector, Isometry3, Translation3, UnitQuaternion, Vector3, Vector6};
+
+use crate::error::{Error, Result};
+use crate::limits::{compute_box, AccelerationBox, BoundMethod, DofLimits, JointLimits};
+use crate::model::{Kinematics, Robot, State};
+use crate::motion::RobotReferences;
+use crate::solver::{Method, SolveReport, Solver, SolverSettings};
+use crate::task::{
+    Axes, ComReference, ComTask, FrameReference, FrameTask, Gains, JointTask, Task, TaskStack,
+};
+
+/// Names of the five levels, in priority order.
+pub const LEVEL_NAMES: [&str; 5] = [
+    "feet",
+    "com_xy",
+    "pelvis_attitude",
+    "pelvis_height",
+    "upper_body",
+];
+
+/// A joint range narrowed for the experiment (the paper narrows LKN and LHR).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct NarrowedJoint {
+    /// Active joint name.
+    pub joint: String,
+    /// New lower limit \[rad\].
+    pub lower: f64,
+    /// New upper limit \[rad\].
+    pub upper: f64,
+}
+
+/// Settings of the imitation run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ImitateConfig {
+    /// Solver (IKTC by default).
+    pub method: Method,
+    /// Joint bounds (viable by default).
+    pub bounds: BoundMethod,
+    /// Control period Δt \[s\]; must equal the references' period.
+    pub dt: f64,
+    /// CLIK gains of every task (default k_p = 100 s⁻², k_v = 20 s⁻¹, critically damped).
+    pub gains: Gains,
+    /// Frames of the feet (6D tasks, one level).
+    pub feet: Vec<String>,
+    /// Frame of the pelvis (attitude and height tasks).
+    pub pelvis: String,
+    /// Initial joint angles \[rad\] of joints not driven by the references (a standing
+    /// posture with bent knees); the driven ones start at their first reference.
+    pub initial_posture: Vec<(String, f64)>,
+    /// Joint ranges narrowed (applied to the bounds and to the margins).
+    pub narrow: Vec<NarrowedJoint>,
+    /// Joint references are clamped into the (narrowed) range shrunk by this margin \[rad\]
+    /// before the run: a reference outside the range only makes its task push into the limit.
+    /// Larger margins keep the joints further from their limits at the price of fidelity.
+    pub reference_margin: f64,
+    /// The COM reference moves from the initial COM to the centre of the support polygon in
+    /// this time \[s\] (quintic blend, zero rate and acceleration at both ends), then stays.
+    /// Shorter blends ask more of the COM task at the start; 0 jumps.
+    pub com_settle_time: f64,
+    /// Foot soles and the support polygon.
+    pub support: SupportSettings,
+    /// A joint within this distance of a position limit counts as sitting on it \[rad\]
+    /// (reports and viewer only). Larger values flag joints earlier.
+    pub on_limit_position: f64,
+    /// A joint whose |q̇| or |q̈| is above `(1 − fraction)` times its limit counts as sitting on
+    /// it \[–\] (reports and viewer only).
+    pub on_limit_fraction: f64,
+    /// Solver settings.
+    pub solver: SolverSettings,
+}
+
+impl ImitateConfig {
+    /// The defaults for JVRC-1: IKTC, viable bounds, Δt = 5 ms, feet `r_ankle` and `l_ankle`,
+    /// pelvis `PELVIS_S`, hip pitch −0.4, knee 0.8, ankle pitch −0.4 rad, L_KNEE narrowed to
+    /// \[0.55, 0.95\] rad and L_HIP_R to \[−0.05, 0.05\] rad (so that the pelvis height and
+    /// attitude tasks get corrected, as in Fig. 20), reference margin 0.05 rad.
+    pub fn jvrc1() -> Self {
+        let mut posture = Vec::new();
+        for side in ["R", "L"] {
+            posture.push((format!("{side}_HIP_P"), -0.4));
+            posture.push((format!("{side}_KNEE"), 0.8));
+            posture.push((format!("{side}_ANKLE_P"), -0.4));
+        }
+        Self {
+            method: Method::Iktc,
+            bounds: BoundMethod::viable(),
+            dt: 0.005,
+            gains: Gains {
+                kp: 100.0,
+                kv: 20.0,
+            },
+            feet: vec!["r_ankle".into(), "l_ankle".into()],
+            pelvis: "PELVIS_S".into(),
+            initial_posture: posture,
+            narrow: vec![
+                NarrowedJoint {
+                    joint: "L_KNEE".into(),
+                    lower: 0.55,
+                    upper: 0.95,
+                },
+                NarrowedJoint {
+                    joint: "L_HIP_R".into(),
+                    lower: -0.05,
+                    upper: 0.05,
+                },
+            ],
+            reference_margin: 0.05,
+            com_settle_time: 0.5,
+            support: SupportSettings::default(),
+            on_limit_position: 2e-3,
+            on_limit_fraction: 0.01,
+            solver: SolverSettings::default(),
+        }
+    }
+
+    /// Checks the numbers.
+    pub fn validate(&self) -> Result<()> {
+        let bad = |name: &str, value: f64, expected: &str| Error::InvalidSetting {
+            name: name.into(),
+            value: value.to_string(),
+            expected: expected.into(),
+        };
+        if !(self.dt.is_finite() && self.dt > 0.0) {
+            return Err(bad("dt", self.dt, "a finite period > 0 [s]"));
+        }
+        if !(self.reference_margin.is_finite() && self.reference_margin >= 0.0) {
+            return Err(bad(
+                "reference_margin",
+                self.reference_margin,
+                "a finite margin >= 0 [rad]",
+            ));
+        }
+        for n in &self.narrow {
+            if !(n.lower.is_finite() && n.upper.is_finite() && n.lower <= n.upper) {
+                return Err(Error::InvalidSetting {
+                    name: format!("narrowed range of {}", n.joint),
+                    value: format!("{}:{}", n.lower, n.upper),
+                    expected: "finite lo:hi with lo <= hi [rad]".into(),
+                });
+            }
+        }
+        if !(self.com_settle_time.is_finite() && self.com_settle_time >= 0.0) {
+            return Err(bad(
+                "com_settle_time",
+                self.com_settle_time,
+                "a finite time >= 0 [s]",
+            ));
+        }
+        if !(self.on_limit_position.is_finite() && self.on_limit_position >= 0.0) {
+            return Err(bad(
+                "on_limit_position",
+                self.on_limit_position,
+                "a finite distance >= 0 [rad]",
+            ));
+        }
+        if !(self.on_limit_fraction.is_finite() && (0.0..1.0).contains(&self.on_limit_fraction)) {
+            return Err(bad(
+                "on_limit_fraction",
+                self.on_limit_fraction,
+                "a fraction in [0, 1)",
+            ));
+        }
+        if self.feet.is_empty() {
+            return Err(Error::InvalidSetting {
+                name: "feet".into(),
+                value: "none".into(),
+                expected: "at least one foot frame".into(),
+            });
+        }
+        self.gains.validate()?;
+        self.bounds.validate()?;
+        self.support.validate()?;
+        self.solver.validate()
+    }
+}
+
+impl Default for ImitateConfig {
+    fn default() -> Self {
+        Self::jvrc1()
+    }
+}
+
+/// The closed loop of one imitation run: tasks, bounds, solver and state, sized once.
+#[derive(Debug, Clone)]
+pub struct ImitationController {
+    method: Method,
+    bounds: BoundMethod,
+    dt: f64,
+    refs: RobotReferences,
+    limits: JointLimits,
+    stack: TaskStack,
+    eqs: Vec<crate::task::TaskEquation>,
+    solver: Solver,
+    bx: AccelerationBox,
+    state: State,
+    kin: Kinematics,
+    qdd: DVector<f64>,
+    pos: Vec<f64>,
+    upper: [Vec<f64>; 3],
+    pelvis0: Isometry3<f64>,
+    feet0: Vec<Isometry3<f64>>,
+    com_ref: Vector3<f64>,
+    com_start: Vector3<f64>,
+    com_settle_time: f64,
+    tick: usize,
+}
+
+impl ImitationController {
+    /// Builds the stack of Table 1 on `robot` for the references `refs` (one joint task row per
+    /// reference joint), sets the initial state (posture, base placed so that the lowest sole is
+    /// on z = 0), and holds the feet where they start and the COM over the centre of the support
+    /// polygon.
+    ///
+    /// Errors: bad settings, unknown frames or joints, references whose period differs from
+    /// `cfg.dt`, a narrowed range outside the joint's own.
+    pub fn new(robot: &Robot, refs: &RobotReferences, cfg: &ImitateConfig) -> Result<Self> {
+        cfg.validate()?;
+        if (refs.dt - cfg.dt).abs() > 1e-12 * cfg.dt || refs.is_empty() {
+            return Err(Error::InvalidSetting {
+                name: "reference period".into(),
+                value: format!("{} s, {} ticks", refs.dt, refs.len()),
+                expected: format!("references resampled at dt = {} s", cfg.dt),
+            });
+        }
+        let mut refs = refs.clone();
+        // Limits, with the narrowed ranges.
+        let mut dofs: Vec<DofLimits> = robot
+            .dof_limits()
+            .iter()
+            .map(|l| DofLimits {
+                position_min: l.lower,
+                position_max: l.upper,
+                velocity_max: l.velocity,
+                acceleration_max: l.acceleration,
+            })
+            .collect();
+        for n in &cfg.narrow {
+            let v = robot.joint_v_index(&n.joint)?;
+            if let Some(d) = dofs.get_mut(v) {
+                if n.lower < d.position_min || n.upper > d.position_max {
+                    return Err(Error::InvalidSetting {
+                        name: format!("narrowed range of {}", n.joint),
+                        value: format!("{}:{}", n.lower, n.upper),
+                        expected: format!(
+                            "a range inside the joint's own [{}, {}] rad",
+                            d.position_min, d.position_max
+                        ),
+                    });
+                }
+                d.position_min = n.lower;
+                d.position_max = n.upper;
+            }
+        }
+        let limits = JointLimits::new(dofs)?;
+        // Clamp the joint references into the (narrowed) ranges.
+        for (name, track) in refs.joint_names.iter().zip(refs.joints.iter_mut()) {
+            let v = robot.joint_v_index(name)?;
+            if let Some(d) = limits.get(v) {
+                let (mut lo, mut hi) = (
+                    d.position_min + cfg.reference_margin,
+                    d.position_max - cfg.reference_margin,
+                );
+                if lo > hi {
+                    lo = 0.5 * (d.position_min + d.position_max);
+                    hi = lo;
+                }
+                for (p, (v, a)) in track
+                    .position
+                    .iter_mut()
+                    .zip(track.velocity.iter_mut().zip(track.acceleration.iter_mut()))
+                {
+                    if *p < lo || *p > hi {
+                        *p = p.clamp(lo, hi);
+                        *v = 0.0;
+                        *a = 0.0;
+                    }
+                }
+            }
+        }
+        // Initial state.
+        let mut state = State::neutral(robot);
+        for (name, value) in &cfg.initial_posture {
+            state.set_joint(robot, name, *value)?;
+        }
+        for (name, track) in refs.joint_names.iter().zip(&refs.joints) {
+            if let Some(p) = track.position.first() {
+                state.set_joint(robot, name, *p)?;
+            }
+        }
+        let mut kin = Kinematics::new(robot, &state)?;
+        let feet_ids = cfg
+            .feet
+            .iter()
+            .map(|f| robot.frame_id(f))
+            .collect::<Result<Vec<_>>>()?;
+        let lowest = feet_ids
+            .iter()
+            .map(|f| kin.frame_pose(robot, *f).map(|p| p.translation.z))
+            .collect::<Result<Vec<_>>>()?
+            .into_iter()
+            .fold(f64::INFINITY, f64::min);
+        let mut base = state.base_pose(robot);
+        base.translation.vector.z += cfg.support.ankle_height - lowest;
+        state.set_base_pose(robot, &base)?;
+        kin.update(robot, &state)?;
+        let feet0 = feet_ids
+            .iter()
+            .map(|f| kin.frame_pose(robot, *f))
+            .collect::<Result<Vec<_>>>()?;
+        let polygon = support_polygon(&feet0, &cfg.support);
+        let centre =
+            polygon.iter().fold(Vector3::zeros(), |a, p| a + p) / polygon.len().max(1) as f64;
+        let com_ref = Vector3::new(centre.x, centre.y, kin.com().z);
+        let com_start = kin.com();
+        let pelvis_id = robot.frame_id(&cfg.pelvis)?;
+        let pelvis0 = kin.frame_pose(robot, pelvis_id)?;
+        // Tasks.
+        let g = cfg.gains;
+        let mut stack = TaskStack::default();
+        let mut feet_tasks = Vec::new();
+        for (f, pose) in cfg.feet.iter().zip(&feet0) {
+            let mut t = FrameTask::new(robot, f, Axes::ALL, g)?;
+            t.set_reference(FrameReference::hold(*pose))?;
+            feet_tasks.push(Task::Frame(t));
+        }
+        stack.push(LEVEL_NAMES[0], feet_tasks);
+        let mut com = ComTask::new(robot, [true, true, false], g)?;
+        com.set_reference(ComReference {
+            position: com_start,
+            velocity: Vector3::zeros(),
+            acceleration: Vector3::zeros(),
+        })?;
+        stack.push(LEVEL_NAMES[1], vec![Task::Com(com)]);
+        stack.push(
+            LEVEL_NAMES[2],
+            vec![Task::Frame(FrameTask::new(
+                robot,
+                &cfg.pelvis,
+                Axes::ORIENTATION,
+                g,
+            )?)],
+        );
+        stack.push(
+            LEVEL_NAMES[3],
+            vec![Task::Frame(FrameTask::new(robot, &cfg.pelvis, Axes::Z, g)?)],
+        );
+        let names: Vec<&str> = refs.joint_names.iter().map(|s| s.as_str()).collect();
+        stack.push(
+            LEVEL_NAMES[4],
+            vec![Task::Joint(JointTask::new(robot, &names, g)?)],
+        );
+        let eqs = stack.equations(robot);
+        let dims: Vec<usize> = eqs.iter().map(|e| e.dim()).collect();
+        let solver = Solver::new(robot.nv(), &dims, cfg.solver)?;
+        let m = refs.joint_names.len();
+        Ok(Self {
+            method: cfg.method,
+            bounds: cfg.bounds,
+            dt: cfg.dt,
+            refs,
+            limits,
+            stack,
+            eqs,
+            solver,
+            bx: AccelerationBox::new(robot.nv()),
+            state,
+            kin,
+            qdd: DVector::zeros(robot.nv()),
+            pos: vec![0.0; robot.nv()],
+            upper: [vec![0.0; m], vec![0.0; m], vec![0.0; m]],
+            pelvis0,
+            feet0,
+            com_ref,
+            com_start,
+            com_settle_time: cfg.com_settle_time,
+            tick: 0,
+        })
+    }
+
+    /// One control tick at reference index `k` (clamped to the last): kinematics, references,
+    /// task linearisation, acceleration box, solve; q̈ is then available in
+    /// [`ImitationController::qdd`] and not yet applied (see [`ImitationController::integrate`]).
+    /// Allocates nothing.
+    pub fn tick(&mut self, robot: &Robot, k: usize) -> Result<&SolveReport> {
+        let k = k.min(self.refs.len().saturating_sub(1));
+        self.tick = k;
+        self.kin.update(robot, &self.state)?;
+        let r = &self.refs;
+        let attitude = r.attitude.get(k).copied().unwrap_or_default() * self.pelvis0.rotation;
+        let w = r.angular_velocity.get(k).copied().unwrap_or_default();
+        let wd = r.angular_acceleration.get(k).copied().unwrap_or_default();
+        let z = self.pelvis0.translation.z + r.height.position.get(k).copied().unwrap_or(0.0);
+        let zd = r.height.velocity.get(k).copied().unwrap_or(0.0);
+        let zdd = r.height.acceleration.get(k).copied().unwrap_or(0.0);
+        for (i, t) in r.joints.iter().enumerate() {
+            self.upper[0][i] = t.position.get(k).copied().unwrap_or(0.0);
+            self.upper[1][i] = t.velocity.get(k).copied().unwrap_or(0.0);
+            self.upper[2][i] = t.acceleration.get(k).copied().unwrap_or(0.0);
+        }
+        let com = self.com_reference_at(k as f64 * self.dt);
+        for (li, level) in self.stack.levels.iter_mut().enumerate() {
+            for task in level.tasks.iter_mut() {
+                match (li, task) {
+                    (1, Task::Com(c)) => c.set_reference(com)?,
+                    (2, Task::Frame(f)) => f.set_reference(FrameReference {
+                        pose: Isometry3::from_parts(self.pelvis0.translation, attitude),
+                        velocity: Vector6::new(0.0, 0.0, 0.0, w.x, w.y, w.z),
+                        acceleration: Vector6::new(0.0, 0.0, 0.0, wd.x, wd.y, wd.z),
+                    })?,
+                    (3, Task::Frame(f)) => f.set_reference(FrameReference {
+                        pose: Isometry3::from_parts(
+                            Translation3::new(
+                                self.pelvis0.translation.x,
+                                self.pelvis0.translation.y,
+                                z,
+                            ),
+                            UnitQuaternion::identity(),
+                        ),
+                        velocity: Vector6::new(0.0, 0.0, zd, 0.0, 0.0, 0.0),
+                        acceleration: Vector6::new(0.0, 0.0, zdd, 0.0, 0.0, 0.0),
+                    })?,
+                    (4, Task::Joint(j)) => {
+                        j.set_reference(&self.upper[0], &self.upper[1], &self.upper[2])?
+                    }
+                    _ => {}
+                }
+            }
+        }
+        self.stack
+            .linearize(robot, &self.kin, &self.state, &mut self.eqs)?;
+        self.state.dof_positions(robot, &mut self.pos)?;
+        compute_box(
+            &self.limits,
+            &self.bounds,
+            &self.pos,
+            self.state.qd.as_slice(),
+            self.dt,
+            &mut self.bx,
+        )?;
+        self.solver
+            .solve(self.method, &self.eqs, &self.bx, &mut self.qdd)
+    }
+
+    /// Applies the last q̈ over Δt (constant acceleration).
+    pub fn integrate(&mut self, robot: &Robot) -> Result<()> {
+        self.state.integrate(robot, &self.qdd, self.dt)
+    }
+
+    /// The state (at the start of the next tick once integrated).
+    pub fn state(&self) -> &State {
+        &self.state
+    }
+
+    /// Kinematics at the state of the last tick.
+    pub fn kinematics(&self) -> &Kinematics {
+        &self.kin
+    }
+
+    /// The task equations of the last tick (errors `x_d − x` per level).
+    pub fn equations(&self) -> &[crate::task::TaskEquation] {
+        &self.eqs
+    }
+
+    /// The acceleration box of the last tick.
+    pub fn acceleration_box(&self) -> &AccelerationBox {
+        &self.bx
+    }
+
+    /// q̈ of the last tick \[rad/s²\] (base: \[m/s²\], \[rad/s²\]).
+    pub fn qdd(&self) -> &DVector<f64> {
+        &self.qdd
+    }
+
+    /// Dof positions of the last tick \[rad\] (base entries 0).
+    pub fn dof_positions(&self) -> &[f64] {
+        &self.pos
+    }
+
+    /// The limits used (narrowed).
+    pub fn limits(&self) -> &JointLimits {
+        &self.limits
+    }
+
+    /// The references (joint references clamped into the ranges).
+    pub fn references(&self) -> &RobotReferences {
+        &self.refs
+    }
+
+    /// Initial foot poses (held).
+    pub fn feet0(&self) -> &[Isometry3<f64>] {
+        &self.feet0
+    }
+
+    /// Initial pelvis pose.
+    pub fn pelvis0(&self) -> &Isometry3<f64> {
+        &self.pelvis0
+    }
+
+    /// The COM reference once settled \[m\]: the centre of the support polygon (z unused).
+    pub fn com_reference(&self) -> Vector3<f64> {
+        self.com_ref
+    }
+
+    /// The COM reference at time `t` \[s\]: `c(t) = c_0 + s(τ) (c_∞ − c_0)` with
+    /// `τ = t / T` clamped to \[0, 1\] and the quintic `s = 10τ³ − 15τ⁴ + 6τ⁵`.
+    pub fn com_reference_at(&self, t: f64) -> ComReference {
+        let big_t = self.com_settle_time;
+        let d = self.com_ref - self.com_start;
+        if big_t <= 0.0 || t >= big_t {
+            return ComReference {
+                position: self.com_ref,
+                velocity: Vector3::zeros(),
+                acceleration: Vector3::zeros(),
+            };
+        }
+        let tau = (t / big_t).max(0.0);
+        let s = tau * tau * tau * (10.0 - 15.0 * tau + 6.0 * tau * tau);
+        let sd = 30.0 * tau * tau * (1.0 - tau) * (1.0 - tau) / big_t;
+        let sdd = 60.0 * tau * (1.0 - tau) * (1.0 - 2.0 * tau) / (big_t * big_t);
+        ComReference {
+            position: self.com_start + d * s,
+            velocity: d * sd,
+            acceleration: d * sdd,
+        }
+    }
+
+    /// The solver's report of the last tick.
+    pub fn report(&self) -> &SolveReport {
+        self.solver.report()
+    }
+
+    /// Reference index of the last tick.
+    pub fn tick_index(&self) -> usize {
+        self.tick
+    }
+
+    /// Level sizes m_i in priority order.
+    pub fn level_dims(&self) -> Vec<usize> {
+        self.eqs.iter().map(|e| e.dim()).collect()
+    }
+}

@@ -1,0 +1,451 @@
+//! Running the imitation experiment and recording it: steps and summary.
+
+use std::time::Instant;
+
+use nalgebra::UnitQuaternion;
+use serde::Serialize;
+
+use super::support::{polygon_margin, support_polygon};
+use super::{ImitateConfig, ImitationController, NarrowedJoint, LEVEL_NAMES};
+use crate::error::Result;
+use crate::model::{JointLimit, Robot};
+use crate::motion::RobotReferences;
+use crate::sim::margins::{dof_margins, median, percentile};
+
+/// One recorded tick (state at its start, command applied over it).
+#[derive(Debug, Clone, Serialize)]
+pub struct ImitateStep {
+    /// Time \[s\].
+    pub t: f64,
+    /// Dof positions \[rad\] (base entries 0), nv entries.
+    pub q: Vec<f64>,
+    /// Dof rates \[rad/s\] (base: body twist \[m/s\], \[rad/s\]).
+    pub qd: Vec<f64>,
+    /// Commanded q̈ \[rad/s²\].
+    pub qdd: Vec<f64>,
+    /// Acceleration box, lower side \[rad/s²\].
+    pub box_lower: Vec<f64>,
+    /// Acceleration box, upper side \[rad/s²\].
+    pub box_upper: Vec<f64>,
+    /// ‖x_d − x‖ of each level (task units: \[m\] and \[rad\] mixed for the feet).
+    pub level_error: [f64; 5],
+    /// ‖J_i q̈ − h_i‖ of each level at the commanded q̈ \[task unit/s²\]: what the level lost
+    /// at the acceleration level this tick (0 for a level the solution satisfies).
+    pub level_residual: [f64; 5],
+    /// ‖Δh_i‖ of each level's correction \[task unit/s²\].
+    pub correction: [f64; 5],
+    /// Highest-priority corrected level, 1-based; 0 = none.
+    pub corrected_from: usize,
+    /// Largest foot position drift from the initial pose \[m\].
+    pub foot_drift: f64,
+    /// Largest foot orientation drift \[rad\].
+    pub foot_rotation_drift: f64,
+    /// COM \[m\].
+    pub com: [f64; 3],
+    /// Signed distance from the COM's ground projection to the support polygon's edge \[m\]
+    /// (positive inside).
+    pub com_margin: f64,
+    /// Desired pelvis height \[m\].
+    pub pelvis_height_desired: f64,
+    /// Pelvis height \[m\].
+    pub pelvis_height: f64,
+    /// Desired pelvis (roll, pitch, yaw) \[rad\] (Z-Y-X angles).
+    pub pelvis_rpy_desired: [f64; 3],
+    /// Pelvis (roll, pitch, yaw) \[rad\].
+    pub pelvis_rpy: [f64; 3],
+    /// World positions of every link origin \[m\] (for the viewer).
+    pub links: Vec<[f64; 3]>,
+    /// Dofs sitting on a position, velocity or acceleration limit.
+    pub on_limit: Vec<usize>,
+    /// QPs solved this tick.
+    pub qp_solves: usize,
+    /// Dofs with an empty box.
+    pub empty_dofs: usize,
+    /// Whether a fallback was taken.
+    pub fallback: bool,
+    /// Time of the tick (kinematics, tasks, bounds, solve) \[µs\].
+    pub tick_us: f64,
+}
+
+/// Margins of one joint: the largest excursion beyond each limit (positive = exceeded).
+#[derive(Debug, Clone, Serialize)]
+pub struct JointMargin {
+    /// Joint name.
+    pub joint: String,
+    /// \[rad\].
+    pub position: f64,
+    /// \[rad/s\].
+    pub velocity: f64,
+    /// \[rad/s²\].
+    pub acceleration: f64,
+}
+
+/// Tracking of one level over the run.
+#[derive(Debug, Clone, Serialize)]
+pub struct LevelSummary {
+    /// Level name.
+    pub name: String,
+    /// Rows m_i.
+    pub dim: usize,
+    /// Largest ‖x_d − x‖ \[task unit\].
+    pub max_error: f64,
+    /// RMS of ‖x_d − x‖ over the run.
+    pub rms_error: f64,
+    /// Ticks where this level was corrected.
+    pub corrected_steps: usize,
+    /// First and last time it was corrected \[s\] (NaN if never).
+    pub corrected_span: [f64; 2],
+}
+
+/// The run's summary (`summary.json`).
+#[derive(Debug, Clone, Serialize)]
+pub struct ImitateSummary {
+    /// Solver name.
+    pub solver: String,
+    /// Bound method.
+    pub bounds: String,
+    /// Δt \[s\].
+    pub dt: f64,
+    /// Duration \[s\].
+    pub duration: f64,
+    /// Ticks.
+    pub steps: usize,
+    /// n.
+    pub nv: usize,
+    /// Level sizes m_i.
+    pub level_dims: Vec<usize>,
+    /// Narrowed ranges.
+    pub narrowed: Vec<NarrowedJoint>,
+    /// Margins of every joint (narrowed ranges).
+    pub joints: Vec<JointMargin>,
+    /// Largest position excursion over all joints \[rad\] (≤ 0: no limit exceeded).
+    pub worst_position_margin: f64,
+    /// Largest velocity excursion \[rad/s\].
+    pub worst_velocity_margin: f64,
+    /// Largest acceleration excursion \[rad/s²\].
+    pub worst_acceleration_margin: f64,
+    /// Ticks where some joint sat on its position limit.
+    pub position_binding_steps: usize,
+    /// Ticks where some joint sat on its velocity limit.
+    pub velocity_binding_steps: usize,
+    /// Ticks where some joint sat on its acceleration limit.
+    pub acceleration_binding_steps: usize,
+    /// Ticks where a narrowed joint sat on its position limit.
+    pub narrowed_at_limit_steps: usize,
+    /// Ticks where the pelvis attitude or height level was corrected.
+    pub pelvis_corrected_steps: usize,
+    /// Ticks where a pelvis level was corrected while a narrowed joint sat on its limit.
+    pub pelvis_corrected_while_narrowed_at_limit: usize,
+    /// Largest feet error ‖x_d − x‖ while a lower level was corrected.
+    pub feet_error_while_lower_corrected: f64,
+    /// Largest ‖J q̈ − h‖ of the feet level while a lower level was corrected
+    /// \[m/s², rad/s²\] (0 to rounding: the correction leaves the level untouched).
+    pub feet_residual_while_lower_corrected: f64,
+    /// Largest ‖J q̈ − h‖ of the COM level while a lower level was corrected \[m/s²\].
+    pub com_residual_while_lower_corrected: f64,
+    /// Largest COM error \[m\] while a lower level was corrected.
+    pub com_error_while_lower_corrected: f64,
+    /// Largest foot position drift \[m\].
+    pub foot_drift: f64,
+    /// Largest foot orientation drift \[rad\].
+    pub foot_rotation_drift: f64,
+    /// Whether the COM stayed over the support polygon at every tick.
+    pub com_inside_support: bool,
+    /// Smallest COM margin to the polygon edge \[m\].
+    pub com_min_margin: f64,
+    /// Tracking per level.
+    pub levels: Vec<LevelSummary>,
+    /// Ticks with an empty box.
+    pub empty_box_steps: usize,
+    /// Ticks with a fallback.
+    pub fallback_steps: usize,
+    /// Mean QPs per tick.
+    pub qp_per_step_mean: f64,
+    /// Largest QPs in a tick.
+    pub qp_per_step_max: usize,
+    /// Median tick time \[µs\].
+    pub tick_median_us: f64,
+    /// 99th percentile tick time \[µs\].
+    pub tick_p99_us: f64,
+}
+
+/// A whole run.
+#[derive(Debug, Clone, Serialize)]
+pub struct ImitateRun {
+    /// Every tick.
+    pub steps: Vec<ImitateStep>,
+    /// Summary.
+    pub summary: ImitateSummary,
+    /// Names of the dofs (nv).
+    pub dof_names: Vec<String>,
+    /// The limits used, per dof (narrowed).
+    pub limits: Vec<JointLimit>,
+    /// The references actually tracked (joint references clamped into the ranges).
+    #[serde(skip)]
+    pub references: RobotReferences,
+    /// Support polygon \[m\] (counter-clockwise).
+    pub support: Vec<[f64; 3]>,
+}
+
+/// Z-Y-X angles as (roll, pitch, yaw) \[rad\].
+fn rpy(q: &UnitQuaternion<f64>) -> [f64; 3] {
+    let (r, p, y) = q.euler_angles();
+    [r, p, y]
+}
+
+/// Runs the experiment: [`ImitationController::new`], then one tick per reference sample.
+pub fn run_imitate(
+    robot: &Robot,
+    refs: &RobotReferences,
+    cfg: &ImitateConfig,
+) -> Result<ImitateRun> {
+    let mut ctl = ImitationController::new(robot, refs, cfg)?;
+    let n = ctl.references().len();
+    let nv = robot.nv();
+    let limits: Vec<JointLimit> = ctl
+        .limits()
+        .dofs()
+        .iter()
+        .zip(robot.dof_limits())
+        .map(|(d, l)| JointLimit {
+            lower: d.position_min,
+            upper: d.position_max,
+            velocity: d.velocity_max,
+            acceleration: d.acceleration_max,
+            effort: l.effort,
+        })
+        .collect();
+    let feet_ids = cfg
+        .feet
+        .iter()
+        .map(|f| robot.frame_id(f))
+        .collect::<Result<Vec<_>>>()?;
+    let pelvis = robot.frame_id(&cfg.pelvis)?;
+    let polygon = support_polygon(ctl.feet0(), &cfg.support);
+    let pos_tol = cfg.on_limit_position;
+    let frac = cfg.on_limit_fraction;
+    let mut steps = Vec::with_capacity(n);
+    for k in 0..n {
+        let start = Instant::now();
+        ctl.tick(robot, k)?;
+        let tick_us = start.elapsed().as_secs_f64() * 1e6;
+        let rep = ctl.report();
+        let kin = ctl.kinematics();
+        let state = ctl.state();
+        let mut level_error = [0.0; 5];
+        let mut correction = [0.0; 5];
+        let mut level_residual = [0.0; 5];
+        for (i, r) in rep.task_error_norms.iter().enumerate().take(5) {
+            level_residual[i] = *r;
+        }
+        for (i, e) in ctl.equations().iter().enumerate().take(5) {
+            level_error[i] = e.error.norm();
+            correction[i] = rep.corrections.get(i).map_or(0.0, |c| c.norm());
+        }
+        let mut foot_drift = 0.0f64;
+        let mut foot_rotation_drift = 0.0f64;
+        for (id, p0) in feet_ids.iter().zip(ctl.feet0()) {
+            let p = kin.frame_pose(robot, *id)?;
+            foot_drift = foot_drift.max((p.translation.vector - p0.translation.vector).norm());
+            foot_rotation_drift = foot_rotation_drift.max(p.rotation.angle_to(&p0.rotation));
+        }
+        let com = kin.com();
+        let pp = kin.frame_pose(robot, pelvis)?;
+        let r = ctl.references();
+        let kk = k.min(r.len().saturating_sub(1));
+        let desired_att = r.attitude[kk] * ctl.pelvis0().rotation;
+        let q = ctl.dof_positions().to_vec();
+        let qd = state.qd.as_slice().to_vec();
+        let qdd = ctl.qdd().as_slice().to_vec();
+        let mut on_limit = Vec::new();
+        for d in robot.base_nv()..nv {
+            let l = &limits[d];
+            let at_pos = q[d] <= l.lower + pos_tol || q[d] >= l.upper - pos_tol;
+            let at_vel = qd[d].abs() >= (1.0 - frac) * l.velocity;
+            let at_acc = qdd[d].abs() >= (1.0 - frac) * l.acceleration;
+            if at_pos || at_vel || at_acc {
+                on_limit.push(d);
+            }
+        }
+        let bx = ctl.acceleration_box();
+        steps.push(ImitateStep {
+            t: k as f64 * cfg.dt,
+            box_lower: bx.lower.as_slice().to_vec(),
+            box_upper: bx.upper.as_slice().to_vec(),
+            q,
+            qd,
+            qdd,
+            level_error,
+            level_residual,
+            correction,
+            corrected_from: rep.corrected_from.map_or(0, |l| l + 1),
+            foot_drift,
+            foot_rotation_drift,
+            com: [com.x, com.y, com.z],
+            com_margin: polygon_margin(&polygon, &com),
+            pelvis_height_desired: ctl.pelvis0().translation.z + r.height.position[kk],
+            pelvis_height: pp.translation.z,
+            pelvis_rpy_desired: rpy(&desired_att),
+            pelvis_rpy: rpy(&pp.rotation),
+            links: kin
+                .link_poses()
+                .iter()
+                .map(|p| [p.translation.x, p.translation.y, p.translation.z])
+                .collect(),
+            on_limit,
+            qp_solves: rep.qp_solves,
+            empty_dofs: rep.empty_box_dofs,
+            fallback: rep.fallback.is_some(),
+            tick_us,
+        });
+        ctl.integrate(robot)?;
+    }
+    let dof_names = robot.dof_names();
+    let summary = summarize(robot, cfg, &steps, &limits, &ctl.level_dims());
+    Ok(ImitateRun {
+        steps,
+        summary,
+        dof_names,
+        limits,
+        references: ctl.references().clone(),
+        support: polygon.iter().map(|p| [p.x, p.y, p.z]).collect(),
+    })
+}
+
+/// The summary of recorded steps (see [`ImitateSummary`]).
+pub fn summarize(
+    robot: &Robot,
+    cfg: &ImitateConfig,
+    steps: &[ImitateStep],
+    limits: &[JointLimit],
+    level_dims: &[usize],
+) -> ImitateSummary {
+    let names = robot.dof_names();
+    let nb = robot.base_nv();
+    let joints: Vec<JointMargin> = (nb..robot.nv())
+        .map(|d| {
+            let col = |f: &dyn Fn(&ImitateStep) -> f64| steps.iter().map(f).collect::<Vec<f64>>();
+            let q = col(&|s| s.q[d]);
+            let qd = col(&|s| s.qd[d]);
+            let qdd = col(&|s| s.qdd[d]);
+            let m = dof_margins(d, &q, &qd, &qdd, cfg.dt, &limits[d]);
+            JointMargin {
+                joint: names.get(d).cloned().unwrap_or_default(),
+                position: m.position,
+                velocity: m.velocity,
+                acceleration: m.acceleration,
+            }
+        })
+        .collect();
+    let worst =
+        |f: &dyn Fn(&JointMargin) -> f64| joints.iter().map(f).fold(f64::NEG_INFINITY, f64::max);
+    let (pos_tol, frac) = (cfg.on_limit_position, cfg.on_limit_fraction);
+    let count = |f: &dyn Fn(&ImitateStep, usize) -> bool| {
+        steps
+            .iter()
+            .filter(|s| (nb..robot.nv()).any(|d| f(s, d)))
+            .count()
+    };
+    let position_binding_steps =
+        count(&|s, d| s.q[d] <= limits[d].lower + pos_tol || s.q[d] >= limits[d].upper - pos_tol);
+    let velocity_binding_steps = count(&|s, d| s.qd[d].abs() >= (1.0 - frac) * limits[d].velocity);
+    let acceleration_binding_steps =
+        count(&|s, d| s.qdd[d].abs() >= (1.0 - frac) * limits[d].acceleration);
+    let narrowed_dofs: Vec<usize> = cfg
+        .narrow
+        .iter()
+        .filter_map(|n| robot.joint_v_index(&n.joint).ok())
+        .collect();
+    let narrowed_at = |s: &ImitateStep| {
+        narrowed_dofs
+            .iter()
+            .any(|&d| s.q[d] <= limits[d].lower + pos_tol || s.q[d] >= limits[d].upper - pos_tol)
+    };
+    let pelvis_corrected = |s: &ImitateStep| (1..=4).contains(&s.corrected_from);
+    let lower_corrected: Vec<&ImitateStep> =
+        steps.iter().filter(|s| s.corrected_from >= 3).collect();
+    let ticks: Vec<f64> = steps.iter().map(|s| s.tick_us).collect();
+    let levels = (0..level_dims.len().min(5))
+        .map(|i| {
+            let errs: Vec<f64> = steps.iter().map(|s| s.level_error[i]).collect();
+            let corrected: Vec<f64> = steps
+                .iter()
+                .filter(|s| s.corrected_from > 0 && s.corrected_from <= i + 1)
+                .map(|s| s.t)
+                .collect();
+            LevelSummary {
+                name: LEVEL_NAMES[i].into(),
+                dim: level_dims[i],
+                max_error: errs.iter().copied().fold(0.0, f64::max),
+                rms_error: (errs.iter().map(|e| e * e).sum::<f64>() / errs.len().max(1) as f64)
+                    .sqrt(),
+                corrected_steps: corrected.len(),
+                corrected_span: [
+                    corrected.first().copied().unwrap_or(f64::NAN),
+                    corrected.last().copied().unwrap_or(f64::NAN),
+                ],
+            }
+        })
+        .collect();
+    let com_min_margin = steps
+        .iter()
+        .map(|s| s.com_margin)
+        .fold(f64::INFINITY, f64::min);
+    ImitateSummary {
+        solver: cfg.method.name().into(),
+        bounds: match cfg.bounds {
+            crate::limits::BoundMethod::Paper => "paper".into(),
+            crate::limits::BoundMethod::Viable(_) => "viable".into(),
+        },
+        dt: cfg.dt,
+        duration: steps.len() as f64 * cfg.dt,
+        steps: steps.len(),
+        nv: robot.nv(),
+        level_dims: level_dims.to_vec(),
+        narrowed: cfg.narrow.clone(),
+        worst_position_margin: worst(&|m| m.position),
+        worst_velocity_margin: worst(&|m| m.velocity),
+        worst_acceleration_margin: worst(&|m| m.acceleration),
+        joints,
+        position_binding_steps,
+        velocity_binding_steps,
+        acceleration_binding_steps,
+        narrowed_at_limit_steps: steps.iter().filter(|s| narrowed_at(s)).count(),
+        pelvis_corrected_steps: steps.iter().filter(|s| pelvis_corrected(s)).count(),
+        pelvis_corrected_while_narrowed_at_limit: steps
+            .iter()
+            .filter(|s| pelvis_corrected(s) && narrowed_at(s))
+            .count(),
+        feet_error_while_lower_corrected: lower_corrected
+            .iter()
+            .map(|s| s.level_error[0])
+            .fold(0.0, f64::max),
+        feet_residual_while_lower_corrected: lower_corrected
+            .iter()
+            .map(|s| s.level_residual[0])
+            .fold(0.0, f64::max),
+        com_residual_while_lower_corrected: lower_corrected
+            .iter()
+            .map(|s| s.level_residual[1])
+            .fold(0.0, f64::max),
+        com_error_while_lower_corrected: lower_corrected
+            .iter()
+            .map(|s| s.level_error[1])
+            .fold(0.0, f64::max),
+        foot_drift: steps.iter().map(|s| s.foot_drift).fold(0.0, f64::max),
+        foot_rotation_drift: steps
+            .iter()
+            .map(|s| s.foot_rotation_drift)
+            .fold(0.0, f64::max),
+        com_inside_support: com_min_margin > 0.0,
+        com_min_margin,
+        levels,
+        empty_box_steps: steps.iter().filter(|s| s.empty_dofs > 0).count(),
+        fallback_steps: steps.iter().filter(|s| s.fallback).count(),
+        qp_per_step_mean: steps.iter().map(|s| s.qp_solves as f64).sum::<f64>()
+            / steps.len().max(1) as f64,
+        qp_per_step_max: steps.iter().map(|s| s.qp_solves).max().unwrap_or(0),
+        tick_median_us: median(&ticks),
+        tick_p99_us: percentile(&ticks, 0.99),
+    }
+}
