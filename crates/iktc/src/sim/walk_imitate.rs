@@ -149,6 +149,9 @@ pub struct WalkStep {
     pub qp_solves: usize,
     /// Tick time: pattern sample, damping controller and IK \[µs\].
     pub tick_us: f64,
+    /// World positions of every link \[m\] (for the viewer).
+    #[serde(skip)]
+    pub links: Vec<[f64; 3]>,
     /// Dof positions (joint angles; 0 for the base) \[rad\].
     #[serde(skip)]
     pub q: Vec<f64>,
@@ -468,6 +471,11 @@ pub fn run_walk_imitate(
             corrected_from,
             qp_solves,
             tick_us,
+            links: kin
+                .link_poses()
+                .iter()
+                .map(|p| [p.translation.x, p.translation.y, p.translation.z])
+                .collect(),
             q: ctl.dof_positions().to_vec(),
             qd: state.qd.as_slice().to_vec(),
             qdd: ctl.qdd().as_slice().to_vec(),
