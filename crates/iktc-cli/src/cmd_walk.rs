@@ -63,6 +63,9 @@ fn config(imitate: &ImitateConfig, w: &WalkArgs, damping: bool) -> Result<WalkIm
     })
 }
 
+/// Figures written (path relative to the output directory, caption).
+pub type Figures = Vec<(String, String)>;
+
 /// Runs the walking imitation with and without the damping controller (for the comparison),
 /// writes everything to `dir` and returns the figures (path relative to `dir`, caption) and the
 /// two runs (with, without).
@@ -71,7 +74,7 @@ pub fn run_walk(
     imitate: &ImitateConfig,
     w: &WalkArgs,
     dir: &Path,
-) -> Result<(Vec<(String, String)>, WalkRun, WalkRun)> {
+) -> Result<(Figures, WalkRun, WalkRun)> {
     let refs = retarget(&e.clip, &e.robot, &e.map)?.resample(imitate.dt)?;
     let main = run_walk_imitate(&e.robot, &refs, &config(imitate, w, !w.no_damping)?)?;
     let other = run_walk_imitate(&e.robot, &refs, &config(imitate, w, w.no_damping)?)?;

@@ -82,7 +82,7 @@ fn walking_viewer_loads_and_draws() {
 
 /// Loads `page` in headless Chromium: the script finishes, logs no error, and draws a picture.
 fn check_viewer(browser: &Path, dir: &Path, page: &Path) {
-    let html = std::fs::read_to_string(&page).unwrap();
+    let html = std::fs::read_to_string(page).unwrap();
     // Self-contained: no external script, stylesheet or image.
     for bad in [
         "src=\"http",
