@@ -53,9 +53,9 @@ fn bvh_clip_is_imitated_within_limits() {
     let run = run_imitate(&robot, &refs, &cfg).unwrap();
     let s = &run.summary;
     assert_eq!(s.level_dims, vec![12, 2, 3, 1, 20]);
-    assert!(s.worst_position_margin <= 1e-9);
-    assert!(s.worst_velocity_margin <= 1e-9);
-    assert!(s.worst_acceleration_margin <= 1e-9);
+    assert!(s.worst_position_margin <= 1e-6);
+    assert!(s.worst_velocity_margin <= 1e-6);
+    assert!(s.worst_acceleration_margin <= 1e-6);
     assert!(s.foot_drift < 2e-3, "{}", s.foot_drift);
     // The arms follow: the right elbow bends (the forearm's Y rotation maps to R_ELBOW_P).
     let elbow = refs

@@ -79,6 +79,10 @@ pub struct ImitateConfig {
     /// this time \[s\] (quintic blend, zero rate and acceleration at both ends), then stays.
     /// Shorter blends ask more of the COM task at the start; 0 jumps.
     pub com_settle_time: f64,
+    /// For solvers that report no corrected level (GF, clamp), a level counts as corrected at a
+    /// tick when `‖J_i q̈ − h_i‖` exceeds this \[task unit/s²\] (reports only). Larger values
+    /// ignore small sacrifices; smaller ones flag rounding.
+    pub corrected_tolerance: f64,
     /// Foot soles and the support polygon.
     pub support: SupportSettings,
     /// A joint within this distance of a position limit counts as sitting on it \[rad\]
@@ -128,6 +132,7 @@ impl ImitateConfig {
             ],
             reference_margin: 0.05,
             com_settle_time: 0.5,
+            corrected_tolerance: 1e-3,
             support: SupportSettings::default(),
             on_limit_position: 2e-3,
             on_limit_fraction: 0.01,
@@ -166,6 +171,13 @@ impl ImitateConfig {
                 "com_settle_time",
                 self.com_settle_time,
                 "a finite time >= 0 [s]",
+            ));
+        }
+        if !(self.corrected_tolerance.is_finite() && self.corrected_tolerance > 0.0) {
+            return Err(bad(
+                "corrected_tolerance",
+                self.corrected_tolerance,
+                "a finite tolerance > 0 [task unit/s²]",
             ));
         }
         if !(self.on_limit_position.is_finite() && self.on_limit_position >= 0.0) {

@@ -11,6 +11,7 @@ use crate::error::Result;
 use crate::model::{JointLimit, Robot};
 use crate::motion::RobotReferences;
 use crate::sim::margins::{dof_margins, median, percentile};
+use crate::solver::Method;
 
 /// One recorded tick (state at its start, command applied over it).
 #[derive(Debug, Clone, Serialize)]
@@ -34,7 +35,9 @@ pub struct ImitateStep {
     pub level_residual: [f64; 5],
     /// ‖Δh_i‖ of each level's correction \[task unit/s²\].
     pub correction: [f64; 5],
-    /// Highest-priority corrected level, 1-based; 0 = none.
+    /// Highest-priority corrected level, 1-based; 0 = none. IKTC's own report; for GF and
+    /// clamp, the first level whose `‖J_i q̈ − h_i‖` exceeds
+    /// [`ImitateConfig::corrected_tolerance`].
     pub corrected_from: usize,
     /// Largest foot position drift from the initial pose \[m\].
     pub foot_drift: f64,
@@ -278,7 +281,13 @@ pub fn run_imitate(
             level_error,
             level_residual,
             correction,
-            corrected_from: rep.corrected_from.map_or(0, |l| l + 1),
+            corrected_from: match (rep.method, rep.corrected_from) {
+                (Method::Iktc, c) => c.map_or(0, |l| l + 1),
+                _ => level_residual
+                    .iter()
+                    .position(|r| *r > cfg.corrected_tolerance)
+                    .map_or(0, |l| l + 1),
+            },
             foot_drift,
             foot_rotation_drift,
             com: [com.x, com.y, com.z],
