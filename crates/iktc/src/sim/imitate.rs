@@ -259,16 +259,7 @@ impl ImitationController {
         }
         let mut refs = refs.clone();
         // Limits, with the narrowed ranges.
-        let mut dofs: Vec<DofLimits> = robot
-            .dof_limits()
-            .iter()
-            .map(|l| DofLimits {
-                position_min: l.lower,
-                position_max: l.upper,
-                velocity_max: l.velocity,
-                acceleration_max: l.acceleration,
-            })
-            .collect();
+        let mut dofs: Vec<DofLimits> = JointLimits::from_robot(robot)?.dofs().to_vec();
         for n in &cfg.narrow {
             let v = robot.joint_v_index(&n.joint)?;
             if let Some(d) = dofs.get_mut(v) {
