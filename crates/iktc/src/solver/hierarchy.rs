@@ -265,15 +265,28 @@ impl Hierarchy {
         self.zq
             .view_mut((0, 0), (n, k))
             .copy_from(&self.z.view((0, 0), (n, k)));
-        for st in 0..rank {
-            let tau = self.tau[st];
-            let v = self.v.view((st, st), (k - st, 1));
-            let v = v.column(0);
-            let mut w = self.tmp_n.rows_mut(0, n);
-            w.gemv(1.0, &self.zq.view((0, st), (n, k - st)), &v, 0.0);
-            self.zq
-                .view_mut((0, st), (n, k - st))
-                .ger(-tau, &self.tmp_n.rows(0, n), &v, 1.0);
+        {
+            let vr = self.v.nrows();
+            let vsl = self.v.as_slice();
+            let zq = self.zq.as_mut_slice();
+            let w = &mut self.tmp_n.as_mut_slice()[..n];
+            for st in 0..rank {
+                let tau = self.tau[st];
+                let v = &vsl[st * vr + st..st * vr + k];
+                // w = ZQ[:, st..k] v, then ZQ[:, st + a] −= τ v_a w. Zero entries of v (dofs a
+                // level does not move, e.g. the arms for the feet) are skipped.
+                w.fill(0.0);
+                for (a, &va) in v.iter().enumerate() {
+                    if va != 0.0 {
+                        axpy(va, &zq[(st + a) * n..(st + a + 1) * n], w);
+                    }
+                }
+                for (a, &va) in v.iter().enumerate() {
+                    if va != 0.0 {
+                        axpy(-tau * va, w, &mut zq[(st + a) * n..(st + a + 1) * n]);
+                    }
+                }
+            }
         }
         if rank > 0 {
             // λ² from the damping rule; σ_min estimated by the last kept pivot |R_rr|.
@@ -432,4 +445,12 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
         s += x * y;
     }
     s
+}
+
+/// y += α x.
+#[inline]
+fn axpy(alpha: f64, x: &[f64], y: &mut [f64]) {
+    for (yi, xi) in y.iter_mut().zip(x) {
+        *yi += alpha * xi;
+    }
 }
