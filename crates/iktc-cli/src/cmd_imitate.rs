@@ -60,6 +60,8 @@ pub struct Args {
     /// Output directory.
     #[arg(long, default_value = "out/imitate")]
     pub out: PathBuf,
+    #[command(flatten)]
+    pub walk: crate::cmd_walk::WalkArgs,
 }
 
 fn parse_narrow(s: &str) -> Result<Vec<NarrowedJoint>> {
@@ -196,6 +198,16 @@ pub fn run(a: &Args) -> Result<()> {
         cfg.initial_posture = parse_posture(p)?;
     }
     let e = Experiment { robot, clip, map };
+    if a.walk.walk {
+        let (figs, with, without) = crate::cmd_walk::run_walk(&e, &cfg, &a.walk, &a.out)?;
+        crate::cmd_walk::print_walk(&with, &without);
+        println!(
+            "wrote {} figures, walk.csv, walk_summary.json and walk_viewer.html to {}",
+            figs.len(),
+            a.out.display()
+        );
+        return Ok(());
+    }
     let r = run_experiment(&e, &cfg)?;
     let files = write_imitate(&r, &e, &a.out)?;
     print_summary(&r);
@@ -564,6 +576,9 @@ fn viewer_data(r: &ImitateRun, e: &Experiment) -> Result<ViewerData> {
             .collect(),
         on_limit,
         on_limit_names,
+        support_frames: Vec::new(),
+        footsteps: Vec::new(),
+        phases: Vec::new(),
     })
 }
 
@@ -597,14 +612,23 @@ fn summary_row(name: &str, r: &ImitateRun) -> Vec<String> {
 
 /// Runs the default imitation (JVRC-1, humanoid3d_dance_b) with IKTC, and GF for comparison,
 /// under `out/imitate`, and returns the report section.
+/// The default experiment: JVRC-1, `humanoid3d_dance_b`, the built-in map, the default
+/// configuration.
+pub fn default_experiment() -> Result<(Experiment, ImitateConfig)> {
+    let robot = iktc::model::jvrc1(&iktc::model::ModelOptions::default())?;
+    Ok((
+        Experiment {
+            robot,
+            clip: builtin_clip("humanoid3d_dance_b")?,
+            map: builtin_map("deepmimic_jvrc1")?,
+        },
+        ImitateConfig::jvrc1(),
+    ))
+}
+
 pub fn imitate_section(out: &Path) -> Result<Section> {
     let base = out.join("imitate");
-    let robot = iktc::model::jvrc1(&iktc::model::ModelOptions::default())?;
-    let e = Experiment {
-        robot,
-        clip: builtin_clip("humanoid3d_dance_b")?,
-        map: builtin_map("deepmimic_jvrc1")?,
-    };
+    let (e, _) = default_experiment()?;
     let mut sec = Section::new("Imitating a captured motion with JVRC-1 (Section 5.3)").intro(
         "<p>The DeepMimic clip <code>humanoid3d_dance_b</code> is retargeted onto JVRC-1 (built-in map <code>deepmimic_jvrc1</code>: \
          chest → waist, neck → neck, shoulders and elbows → arms, root → pelvis height and attitude; natural cubic splines to 200 Hz). \

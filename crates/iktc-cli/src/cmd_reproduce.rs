@@ -24,6 +24,8 @@ pub fn run(a: &Args) -> Result<()> {
     report = report.section(crate::cmd_balance::balance_section(&a.out)?);
     eprintln!("running the imitation experiment (Section 5.3)…");
     report = report.section(crate::cmd_imitate::imitate_section(&a.out)?);
+    eprintln!("running the walking imitation with the damping controller (Sections 4 and 5.3)…");
+    report = report.section(crate::cmd_walk::walk_section(&a.out)?);
     let path = write_report(&report, &a.out)?;
     println!("report: {}", path.display());
     Ok(())

@@ -8,6 +8,7 @@ mod cmd_imitate;
 mod cmd_model;
 mod cmd_reproduce;
 mod cmd_run;
+mod cmd_walk;
 mod robot_arg;
 mod viewer;
 

@@ -37,6 +37,15 @@ pub struct ViewerData {
     pub on_limit: Vec<Vec<usize>>,
     /// Per frame: names of the joints on a limit.
     pub on_limit_names: Vec<Vec<String>>,
+    /// Walking: the support polygon of every frame (replaces `support` when not empty).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub support_frames: Vec<Vec<[f32; 3]>>,
+    /// Walking: the footsteps' sole outlines \[m\].
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub footsteps: Vec<Vec<[f32; 3]>>,
+    /// Walking: the support phase of every frame.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub phases: Vec<String>,
 }
 
 /// The page; `__DATA__` is replaced by the JSON of [`ViewerData`].
@@ -93,11 +102,18 @@ function draw() {
     line([cx + g, cy - 2.5, 0], [cx + g, cy + 2.5, 0], "#e2e2e2", 1);
     line([cx - 2.5, cy + g, 0], [cx + 2.5, cy + g, 0], "#e2e2e2", 1);
   }
-  // Support polygon.
-  if (D.support.length > 2) {
+  // Footsteps (walking).
+  for (const f of (D.footsteps || [])) {
+    ctx.strokeStyle = "#888"; ctx.lineWidth = 1; ctx.beginPath();
+    f.forEach((p, i) => { const q = project(p); if (i) ctx.lineTo(q[0], q[1]); else ctx.moveTo(q[0], q[1]); });
+    ctx.closePath(); ctx.stroke();
+  }
+  // Support polygon (per frame when walking).
+  const SP = (D.support_frames && D.support_frames.length) ? D.support_frames[Math.min(frame, D.support_frames.length - 1)] : D.support;
+  if (SP.length > 2) {
     ctx.fillStyle = "rgba(60,160,90,0.25)"; ctx.strokeStyle = "#3a9a5a"; ctx.lineWidth = 1.5;
     ctx.beginPath();
-    D.support.forEach((p, i) => { const q = project(p); if (i) ctx.lineTo(q[0], q[1]); else ctx.moveTo(q[0], q[1]); });
+    SP.forEach((p, i) => { const q = project(p); if (i) ctx.lineTo(q[0], q[1]); else ctx.moveTo(q[0], q[1]); });
     ctx.closePath(); ctx.fill(); ctx.stroke();
   }
   // Skeleton.
@@ -129,6 +145,7 @@ function draw() {
   ctx.fillText("blue: robot, red: joint on a limit, green: captured skeleton, orange: COM and its projection, green area: support polygon", 10, 40);
   const names = D.on_limit_names[frame] || [];
   ctx.fillText("on a limit: " + (names.length ? names.join(", ") : "none"), 10, 60);
+  if (D.phases && D.phases.length) ctx.fillText("support: " + D.phases[Math.min(frame, D.phases.length - 1)] + " (grey: footsteps)", 10, 80);
   timeLabel.textContent = (frame * D.dt).toFixed(2) + " s";
   slider.value = String(frame);
 }

@@ -53,8 +53,36 @@ fn viewer_loads_and_draws() {
         .status()
         .unwrap();
     assert!(status.success(), "iktc imitate failed");
-    let page = out.join("viewer.html");
+    check_viewer(&browser, &dir, &out.join("viewer.html"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn walking_viewer_loads_and_draws() {
+    let browser = chromium();
+    let dir = std::env::temp_dir().join(format!("iktc_walk_viewer_test_{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("run");
+    let status = Command::new(env!("CARGO_BIN_EXE_iktc"))
+        .args(["imitate", "--walk", "--out"])
+        .arg(&out)
+        .status()
+        .unwrap();
+    assert!(status.success(), "iktc imitate --walk failed");
+    let page = out.join("walk_viewer.html");
     let html = std::fs::read_to_string(&page).unwrap();
+    assert!(
+        html.contains("\"footsteps\"") && html.contains("\"phases\""),
+        "footsteps and phases in the data"
+    );
+    check_viewer(&browser, &dir, &page);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Loads `page` in headless Chromium: the script finishes, logs no error, and draws a picture.
+fn check_viewer(browser: &Path, dir: &Path, page: &Path) {
+    let html = std::fs::read_to_string(page).unwrap();
     // Self-contained: no external script, stylesheet or image.
     for bad in [
         "src=\"http",
@@ -72,7 +100,7 @@ fn viewer_loads_and_draws() {
 
     // The page script sets the title to "iktc viewer ready" once it has drawn a frame; a JS
     // error before that leaves "iktc viewer (loading)".
-    let dom = Command::new(&browser)
+    let dom = Command::new(browser)
         .args(chromium_args(&dir.join("profile_dom")))
         .arg("--dump-dom")
         .arg(&url)
@@ -87,7 +115,7 @@ fn viewer_loads_and_draws() {
 
     // Console errors are logged on stderr with --enable-logging=stderr.
     let shot = dir.join("shot.png");
-    let run = Command::new(&browser)
+    let run = Command::new(browser)
         .args(chromium_args(&dir.join("profile_shot")))
         .args(["--enable-logging=stderr", "--v=0"])
         .arg(format!("--screenshot={}", shot.display()))
@@ -134,5 +162,4 @@ fn viewer_loads_and_draws() {
     );
     assert!(blue > 200, "no robot drawn ({blue} blue pixels)");
     assert!(green > 200, "no skeleton drawn ({green} green pixels)");
-    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -39,6 +39,7 @@ pub mod motion;
 pub mod sim;
 pub mod solver;
 pub mod task;
+pub mod walk;
 
 pub use error::{Error, Result};
 

@@ -2,25 +2,37 @@
 //! checked with a counting global allocator (its own test binary).
 
 use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::cell::Cell;
 
 use iktc::model::*;
 use iktc::task::*;
 use nalgebra::DMatrix;
 
 struct Counting;
-static ALLOCS: AtomicUsize = AtomicUsize::new(0);
+
+thread_local! {
+    // Counted per thread: the test harness may allocate on its own threads meanwhile.
+    static ALLOCS: Cell<usize> = const { Cell::new(0) };
+}
+
+fn count() -> usize {
+    ALLOCS.with(|c| c.get())
+}
+
+fn bump() {
+    let _ = ALLOCS.try_with(|c| c.set(c.get() + 1));
+}
 
 unsafe impl GlobalAlloc for Counting {
     unsafe fn alloc(&self, l: Layout) -> *mut u8 {
-        ALLOCS.fetch_add(1, Ordering::SeqCst);
+        bump();
         unsafe { System.alloc(l) }
     }
     unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
         unsafe { System.dealloc(p, l) }
     }
     unsafe fn realloc(&self, p: *mut u8, l: Layout, n: usize) -> *mut u8 {
-        ALLOCS.fetch_add(1, Ordering::SeqCst);
+        bump();
         unsafe { System.realloc(p, l, n) }
     }
 }
@@ -65,7 +77,7 @@ fn kinematics_and_tasks_allocate_nothing() {
     let mut j6 = DMatrix::zeros(6, robot.nv());
     let mut j3 = DMatrix::zeros(3, robot.nv());
     let foot = robot.frame_id("r_ankle").unwrap();
-    let before = ALLOCS.load(Ordering::SeqCst);
+    let before = count();
     for k in 0..10 {
         s.q[7 + k] += 0.01;
         kin.update(&robot, &s).unwrap();
@@ -74,7 +86,7 @@ fn kinematics_and_tasks_allocate_nothing() {
         kin.com_jacobian(&robot, &mut j3).unwrap();
         stack.linearize(&robot, &kin, &s, &mut eqs).unwrap();
     }
-    let after = ALLOCS.load(Ordering::SeqCst);
+    let after = count();
     assert_eq!(
         after - before,
         0,

@@ -4,24 +4,36 @@ mod solver_common;
 use solver_common::*;
 
 use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::cell::Cell;
 
 use iktc::solver::*;
 use nalgebra::DVector;
 
 struct Counting;
-static ALLOCS: AtomicUsize = AtomicUsize::new(0);
+
+thread_local! {
+    // Counted per thread: the test harness may allocate on its own threads meanwhile.
+    static ALLOCS: Cell<usize> = const { Cell::new(0) };
+}
+
+fn count() -> usize {
+    ALLOCS.with(|c| c.get())
+}
+
+fn bump() {
+    let _ = ALLOCS.try_with(|c| c.set(c.get() + 1));
+}
 
 unsafe impl GlobalAlloc for Counting {
     unsafe fn alloc(&self, l: Layout) -> *mut u8 {
-        ALLOCS.fetch_add(1, Ordering::SeqCst);
+        bump();
         unsafe { System.alloc(l) }
     }
     unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
         unsafe { System.dealloc(p, l) }
     }
     unsafe fn realloc(&self, p: *mut u8, l: Layout, n: usize) -> *mut u8 {
-        ALLOCS.fetch_add(1, Ordering::SeqCst);
+        bump();
         unsafe { System.realloc(p, l, n) }
     }
 }
@@ -47,10 +59,10 @@ fn solvers_allocate_nothing() {
         Method::Prioritized,
     ] {
         s.solve(m, &levels, &bx, &mut q).unwrap();
-        let before = ALLOCS.load(Ordering::SeqCst);
+        let before = count();
         let rep = s.solve(m, &levels, &bx, &mut q).unwrap();
         let qps = rep.qp_solves;
-        let after = ALLOCS.load(Ordering::SeqCst);
+        let after = count();
         assert_eq!(
             after - before,
             0,

@@ -121,8 +121,40 @@ impl SimPlant {
         params.validate()?;
         settings.validate()?;
         let h = settings.control_period / settings.substeps as f64;
-        let ip = params.model.ipcj.state_space();
-        let ts = params.model.lag;
+        let (ad, bd) = discretize(&params.model, h);
+        let len = (params.delay / h).ceil() as usize + 2;
+        Ok(Self {
+            params,
+            ad,
+            bd,
+            h,
+            substeps: settings.substeps,
+            state: Vector3::zeros(),
+            line: vec![0.0; len],
+            head: 0,
+            noise: NoiseSource::new(settings.seed),
+            time: 0.0,
+        })
+    }
+
+    /// Changes the compliance model (a support-phase change) keeping the state, the delay line
+    /// and the noise: the pendulum does not jump, its stiffness does. (It recomputes a matrix
+    /// exponential: part of the simulated world, not of the control tick.)
+    pub fn switch_model(&mut self, model: FullModelParams) -> Result<()> {
+        model.validate()?;
+        let (ad, bd) = discretize(&model, self.h);
+        self.ad = ad;
+        self.bd = bd;
+        self.params.model = model;
+        Ok(())
+    }
+}
+
+/// Exact zero-order-hold discretisation over `h` \[s\] of the IPCJ with its lag (3 states).
+fn discretize(model: &FullModelParams, h: f64) -> (Matrix3<f64>, Vector3<f64>) {
+    {
+        let ip = model.ipcj.state_space();
+        let ts = model.lag;
         let a = Matrix3::new(
             ip.a[(0, 0)],
             ip.a[(0, 1)],
@@ -139,21 +171,14 @@ impl SimPlant {
         m.view_mut((0, 0), (3, 3)).copy_from(&(a * h));
         m.view_mut((0, 3), (3, 1)).copy_from(&(b * h));
         let e = m.exp();
-        let len = (params.delay / h).ceil() as usize + 2;
-        Ok(Self {
-            params,
-            ad: e.fixed_view::<3, 3>(0, 0).into_owned(),
-            bd: e.fixed_view::<3, 1>(0, 3).into_owned(),
-            h,
-            substeps: settings.substeps,
-            state: Vector3::zeros(),
-            line: vec![0.0; len],
-            head: 0,
-            noise: NoiseSource::new(settings.seed),
-            time: 0.0,
-        })
+        (
+            e.fixed_view::<3, 3>(0, 0).into_owned(),
+            e.fixed_view::<3, 1>(0, 3).into_owned(),
+        )
     }
+}
 
+impl SimPlant {
     /// The plant's parameters.
     pub fn params(&self) -> &PlantParams {
         &self.params

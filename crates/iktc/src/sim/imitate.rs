@@ -273,6 +273,7 @@ pub struct ImitationController {
     com_ref: Vector3<f64>,
     com_start: Vector3<f64>,
     com_settle_time: f64,
+    com_override: Option<ComReference>,
     tick: usize,
 }
 
@@ -296,16 +297,7 @@ impl ImitationController {
         }
         let mut refs = refs.clone();
         // Limits, with the narrowed ranges.
-        let mut dofs: Vec<DofLimits> = robot
-            .dof_limits()
-            .iter()
-            .map(|l| DofLimits {
-                position_min: l.lower,
-                position_max: l.upper,
-                velocity_max: l.velocity,
-                acceleration_max: l.acceleration,
-            })
-            .collect();
+        let mut dofs: Vec<DofLimits> = JointLimits::from_robot(robot)?.dofs().to_vec();
         for n in &cfg.narrow {
             let v = robot.joint_v_index(&n.joint)?;
             if let Some(d) = dofs.get_mut(v) {
@@ -445,6 +437,7 @@ impl ImitationController {
             com_ref,
             com_start,
             com_settle_time: cfg.com_settle_time,
+            com_override: None,
             tick: 0,
         })
     }
@@ -469,7 +462,10 @@ impl ImitationController {
             self.upper[1][i] = t.velocity.get(k).copied().unwrap_or(0.0);
             self.upper[2][i] = t.acceleration.get(k).copied().unwrap_or(0.0);
         }
-        let com = self.com_reference_at(k as f64 * self.dt);
+        let com = match self.com_override {
+            Some(c) => c,
+            None => self.com_reference_at(k as f64 * self.dt),
+        };
         for (li, level) in self.stack.levels.iter_mut().enumerate() {
             for task in level.tasks.iter_mut() {
                 match (li, task) {
@@ -511,6 +507,27 @@ impl ImitationController {
         )?;
         self.solver
             .solve(self.method, &self.eqs, &self.bx, &mut self.qdd)
+    }
+
+    /// Replaces the references of the feet tasks (level 1), one per foot in the order of
+    /// [`ImitateConfig::feet`]: a walking pattern moves the feet this way. Allocates nothing.
+    pub fn set_feet_references(&mut self, refs: &[FrameReference]) -> Result<()> {
+        let Some(level) = self.stack.levels.first_mut() else {
+            return Ok(());
+        };
+        crate::error::check_dim("feet references", level.tasks.len(), refs.len())?;
+        for (task, r) in level.tasks.iter_mut().zip(refs) {
+            if let Task::Frame(f) = task {
+                f.set_reference(*r)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Overrides the COM reference of the next ticks (a walking pattern plus the damping
+    /// controller's offset); `None` returns to the standing reference. Allocates nothing.
+    pub fn set_com_override(&mut self, r: Option<ComReference>) {
+        self.com_override = r;
     }
 
     /// Applies the last q̈ over Δt (constant acceleration).

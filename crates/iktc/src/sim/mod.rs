@@ -3,6 +3,7 @@
 pub mod imitate;
 pub mod margins;
 pub mod planar3r;
+pub mod walk_imitate;
 
 pub use imitate::{
     imitation_references, run_imitate, ImitateConfig, ImitateRun, ImitateStep, ImitateSummary,
@@ -12,3 +13,4 @@ pub use margins::{dof_margins, median, percentile, DofMargins};
 pub use planar3r::{
     run_planar3r, ArmTask, Planar3rConfig, Planar3rRun, Planar3rStep, Planar3rSummary,
 };
+pub use walk_imitate::{run_walk_imitate, Push, WalkImitateConfig, WalkRun, WalkStep, WalkSummary};

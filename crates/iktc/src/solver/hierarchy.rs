@@ -54,6 +54,9 @@ pub struct Hierarchy {
     tmp_n: DVector<f64>,
     tmp_m: DVector<f64>,
     residual: DVector<f64>,
+    /// Jᵀ of the current level (n × m_max) and T with permuted columns (m_max × m_max).
+    jt: DMatrix<f64>,
+    tp: DMatrix<f64>,
 }
 
 impl Hierarchy {
@@ -87,6 +90,8 @@ impl Hierarchy {
             tmp_n: DVector::zeros(n),
             tmp_m: DVector::zeros(mmax),
             residual: DVector::zeros(mmax),
+            jt: DMatrix::zeros(n, mmax),
+            tp: DMatrix::zeros(mmax, mmax),
         }
     }
 
@@ -157,22 +162,10 @@ impl Hierarchy {
             let m = self.dims[i];
             self.level_inverse(i, &lvl.jacobian, settings);
             // residual = h_i − J_i q̈_{i−1};  q̈ += J̄⁺ residual.
-            for r in 0..m {
-                let mut s = lvl.rhs[r];
-                for c in 0..n {
-                    s -= lvl.jacobian[(r, c)] * qdd[c];
-                }
-                self.residual[r] = s;
-            }
-            let p = &self.pinv[i];
-            for c in 0..m {
-                let rc = self.residual[c];
-                if rc != 0.0 {
-                    for d in 0..n {
-                        qdd[d] += p[(d, c)] * rc;
-                    }
-                }
-            }
+            let mut res = self.residual.rows_mut(0, m);
+            res.copy_from(&lvl.rhs);
+            res.gemv(-1.0, &lvl.jacobian, qdd, 1.0);
+            qdd.gemv(1.0, &self.pinv[i], &self.residual.rows(0, m), 1.0);
         }
         Ok(())
     }
@@ -189,14 +182,26 @@ impl Hierarchy {
             self.ranks[i] = 0;
             return;
         }
-        // A = (J Z)ᵀ, k × m.
-        for c in 0..m {
-            for a in 0..k {
-                let mut s = 0.0;
-                for d in 0..n {
-                    s += j[(c, d)] * self.z[(d, a)];
+        // A = (J Z)ᵀ = Zᵀ Jᵀ, k × m.
+        self.jt.view_mut((0, 0), (n, m)).tr_copy_from(j);
+        // Entry (a, c) is the dot product of column a of Z and column c of Jᵀ (both contiguous).
+        // Written out: nalgebra's gemm may allocate packing buffers, and the tick must not.
+        if k == n && i == 0 {
+            // First level: Z = I, so A = Jᵀ.
+            self.a
+                .view_mut((0, 0), (n, m))
+                .copy_from(&self.jt.view((0, 0), (n, m)));
+        } else {
+            let zs = self.z.as_slice();
+            let js = self.jt.as_slice();
+            let arows = self.a.nrows();
+            let asl = self.a.as_mut_slice();
+            for c in 0..m {
+                let jc = &js[c * n..(c + 1) * n];
+                for a in 0..k {
+                    let za = &zs[a * n..(a + 1) * n];
+                    asl[a + c * arows] = dot(za, jc);
                 }
-                self.a[(a, c)] = s;
             }
         }
         // Householder QR with column pivoting of A (k × m).
@@ -205,14 +210,16 @@ impl Hierarchy {
             self.perm[c] = c;
         }
         let mut rank = 0;
+        let ar = self.a.nrows();
+        let vr = self.v.nrows();
         for st in 0..steps {
             // Pivot: the remaining column of largest norm (rows st..k).
-            for c in st..m {
-                let mut s = 0.0;
-                for a in st..k {
-                    s += self.a[(a, c)] * self.a[(a, c)];
+            {
+                let asl = self.a.as_slice();
+                for c in st..m {
+                    let col = &asl[c * ar + st..c * ar + k];
+                    self.colnorm[c] = dot(col, col);
                 }
-                self.colnorm[c] = s;
             }
             let mut best = st;
             for c in st + 1..m {
@@ -230,48 +237,54 @@ impl Hierarchy {
                 break;
             }
             // v = x − α e1 with α = −sign(x0)‖x‖; H = I − τ v vᵀ, τ = 2 / vᵀv.
-            let x0 = self.a[(st, st)];
+            let asl = self.a.as_mut_slice();
+            let vsl = self.v.as_mut_slice();
+            let x0 = asl[st * ar + st];
             let alpha = if x0 >= 0.0 { -norm } else { norm };
-            for a in 0..k {
-                self.v[(a, st)] = if a < st { 0.0 } else { self.a[(a, st)] };
-            }
-            self.v[(st, st)] = x0 - alpha;
-            let mut vv = 0.0;
-            for a in st..k {
-                vv += self.v[(a, st)] * self.v[(a, st)];
-            }
+            let vcol = &mut vsl[st * vr..st * vr + k];
+            vcol[..st].fill(0.0);
+            vcol[st..k].copy_from_slice(&asl[st * ar + st..st * ar + k]);
+            vcol[st] = x0 - alpha;
+            let v = &vcol[st..k];
+            let vv = dot(v, v);
             let tau = if vv > 0.0 { 2.0 / vv } else { 0.0 };
             self.tau[st] = tau;
             // Apply H to the remaining columns of A.
             for c in st..m {
-                let mut s = 0.0;
-                for a in st..k {
-                    s += self.v[(a, st)] * self.a[(a, c)];
-                }
-                s *= tau;
-                for a in st..k {
-                    self.a[(a, c)] -= s * self.v[(a, st)];
+                let col = &mut asl[c * ar + st..c * ar + k];
+                let f = tau * dot(v, col);
+                for (x, vi) in col.iter_mut().zip(v) {
+                    *x -= f * vi;
                 }
             }
             rank = st + 1;
         }
         self.ranks[i] = rank;
-        // ZQ = Z H_1 … H_rank (n × k).
-        for a in 0..k {
-            for d in 0..n {
-                self.zq[(d, a)] = self.z[(d, a)];
-            }
-        }
-        for st in 0..rank {
-            let tau = self.tau[st];
-            for d in 0..n {
-                let mut s = 0.0;
-                for a in st..k {
-                    s += self.zq[(d, a)] * self.v[(a, st)];
+        // ZQ = Z H_1 … H_rank (n × k): each reflector is a rank-one update
+        // ZQ ← ZQ − τ (ZQ v) vᵀ on the columns st..k.
+        self.zq
+            .view_mut((0, 0), (n, k))
+            .copy_from(&self.z.view((0, 0), (n, k)));
+        {
+            let vr = self.v.nrows();
+            let vsl = self.v.as_slice();
+            let zq = self.zq.as_mut_slice();
+            let w = &mut self.tmp_n.as_mut_slice()[..n];
+            for st in 0..rank {
+                let tau = self.tau[st];
+                let v = &vsl[st * vr + st..st * vr + k];
+                // w = ZQ[:, st..k] v, then ZQ[:, st + a] −= τ v_a w. Zero entries of v (dofs a
+                // level does not move, e.g. the arms for the feet) are skipped.
+                w.fill(0.0);
+                for (a, &va) in v.iter().enumerate() {
+                    if va != 0.0 {
+                        axpy(va, &zq[(st + a) * n..(st + a + 1) * n], w);
+                    }
                 }
-                s *= tau;
-                for a in st..k {
-                    self.zq[(d, a)] -= s * self.v[(a, st)];
+                for (a, &va) in v.iter().enumerate() {
+                    if va != 0.0 {
+                        axpy(-tau * va, w, &mut zq[(st + a) * n..(st + a + 1) * n]);
+                    }
                 }
             }
         }
@@ -342,26 +355,36 @@ impl Hierarchy {
                     self.t[(p, c)] = self.tmp_m[p];
                 }
             }
-            // J̄⁺ column perm[c] = ZQ_r · T[:, c].
-            let p = &mut self.pinv[i];
+            // J̄⁺ = ZQ_r · T · Πᵀ: column perm[c] of J̄⁺ is ZQ_r · T[:, c].
             for c in 0..m {
                 let col = self.perm[c];
-                for d in 0..n {
-                    let mut s = 0.0;
-                    for q in 0..rank {
-                        s += self.zq[(d, q)] * self.t[(q, c)];
+                for p in 0..rank {
+                    self.tp[(p, col)] = self.t[(p, c)];
+                }
+            }
+            // Column c of J̄⁺ = Σ_p ZQ[:, p] · Tp[p, c] (contiguous column updates).
+            let zq = self.zq.as_slice();
+            let tprows = self.tp.nrows();
+            let tp = self.tp.as_slice();
+            let pi = self.pinv[i].as_mut_slice();
+            for c in 0..m {
+                let out = &mut pi[c * n..(c + 1) * n];
+                out.fill(0.0);
+                for p in 0..rank {
+                    let f = tp[p + c * tprows];
+                    if f != 0.0 {
+                        for (o, z) in out.iter_mut().zip(&zq[p * n..(p + 1) * n]) {
+                            *o += f * z;
+                        }
                     }
-                    p[(d, col)] = s;
                 }
             }
         }
         // Z ← ZQ[:, rank..k].
         let newk = k - rank;
-        for a in 0..newk {
-            for d in 0..n {
-                self.z[(d, a)] = self.zq[(d, rank + a)];
-            }
-        }
+        self.z
+            .view_mut((0, 0), (n, newk))
+            .copy_from(&self.zq.view((0, rank), (n, newk)));
         self.k = newk;
     }
 
@@ -399,5 +422,35 @@ impl Hierarchy {
                 }
             }
         }
+    }
+}
+
+/// Dot product of two equally long slices with four independent accumulators, so that the
+/// compiler can vectorise it (a single running sum fixes the order of the additions).
+#[inline]
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len().min(b.len());
+    let (a, b) = (&a[..n], &b[..n]);
+    let mut acc = [0.0f64; 4];
+    let mut ca = a.chunks_exact(4);
+    let mut cb = b.chunks_exact(4);
+    for (x, y) in (&mut ca).zip(&mut cb) {
+        acc[0] += x[0] * y[0];
+        acc[1] += x[1] * y[1];
+        acc[2] += x[2] * y[2];
+        acc[3] += x[3] * y[3];
+    }
+    let mut s = (acc[0] + acc[1]) + (acc[2] + acc[3]);
+    for (x, y) in ca.remainder().iter().zip(cb.remainder()) {
+        s += x * y;
+    }
+    s
+}
+
+/// y += α x.
+#[inline]
+fn axpy(alpha: f64, x: &[f64], y: &mut [f64]) {
+    for (yi, xi) in y.iter_mut().zip(x) {
+        *yi += alpha * xi;
     }
 }

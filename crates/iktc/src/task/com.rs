@@ -3,7 +3,7 @@
 use nalgebra::{DMatrix, Vector3};
 
 use super::equation::{write_row, Gains, TaskEquation};
-use crate::error::{check_all_finite, check_dim, Error, Result};
+use crate::error::{check_all_finite, Error, Result};
 use crate::model::{Kinematics, Robot, State};
 
 /// Desired COM position \[m\], velocity \[m/s\] and acceleration \[m/s²\], world axes.
@@ -75,14 +75,7 @@ impl ComTask {
         out: &mut TaskEquation,
         offset: usize,
     ) -> Result<()> {
-        check_dim("task equation columns (nv)", robot.nv(), out.nv())?;
-        if offset + self.dim() > out.dim() {
-            return Err(Error::DimensionMismatch {
-                what: "rows of the task equation for the COM".into(),
-                expected: offset + self.dim(),
-                got: out.dim(),
-            });
-        }
+        out.check_room(robot.nv(), offset, self.dim(), || "the COM".to_string())?;
         kin.com_jacobian(robot, &mut self.scratch)?;
         let e = self.reference.position - kin.com();
         let edot = self.reference.velocity - kin.com_velocity();

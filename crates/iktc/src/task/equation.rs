@@ -83,6 +83,26 @@ impl TaskEquation {
         self.jacobian.ncols()
     }
 
+    /// Checks that a task of `dim` rows fits at `offset` and that the columns are `nv`; `what`
+    /// names the task in the error (formatted only on failure: this runs every tick).
+    pub(crate) fn check_room(
+        &self,
+        nv: usize,
+        offset: usize,
+        dim: usize,
+        what: impl FnOnce() -> String,
+    ) -> Result<()> {
+        crate::error::check_dim("task equation columns (nv)", nv, self.nv())?;
+        if offset + dim > self.dim() {
+            return Err(Error::DimensionMismatch {
+                what: format!("rows of the task equation for {}", what()),
+                expected: offset + dim,
+                got: self.dim(),
+            });
+        }
+        Ok(())
+    }
+
     /// Checks that sizes agree and every entry is finite.
     pub fn validate(&self) -> Result<()> {
         // Messages are formatted only on failure: this runs every tick and must not allocate.

@@ -3,7 +3,7 @@
 use nalgebra::{DMatrix, Isometry3, Vector6};
 
 use super::equation::{write_row, Gains, TaskEquation};
-use crate::error::{check_all_finite, check_dim, Error, Result};
+use crate::error::{check_all_finite, Error, Result};
 use crate::model::{FrameId, Kinematics, Robot, State};
 
 /// Which of the six axes (x, y, z position in world axes; x, y, z rotation in world axes) a
@@ -133,14 +133,9 @@ impl FrameTask {
         out: &mut TaskEquation,
         offset: usize,
     ) -> Result<()> {
-        check_dim("task equation columns (nv)", robot.nv(), out.nv())?;
-        if offset + self.dim() > out.dim() {
-            return Err(Error::DimensionMismatch {
-                what: format!("rows of the task equation for `{}`", self.frame_name),
-                expected: offset + self.dim(),
-                got: out.dim(),
-            });
-        }
+        out.check_room(robot.nv(), offset, self.dim(), || {
+            format!("`{}`", self.frame_name)
+        })?;
         kin.frame_jacobian(robot, self.frame, &mut self.scratch)?;
         let pose = kin.frame_pose(robot, self.frame)?;
         let vel = kin.frame_velocity(robot, self.frame)?;

@@ -93,14 +93,9 @@ impl JointTask {
         out: &mut TaskEquation,
         offset: usize,
     ) -> Result<()> {
-        check_dim("task equation columns (nv)", robot.nv(), out.nv())?;
-        if offset + self.dim() > out.dim() {
-            return Err(Error::DimensionMismatch {
-                what: "rows of the task equation for a joint task".into(),
-                expected: offset + self.dim(),
-                got: out.dim(),
-            });
-        }
+        out.check_room(robot.nv(), offset, self.dim(), || {
+            "a joint task".to_string()
+        })?;
         let nv = robot.nv();
         for k in 0..self.dim() {
             let (iv, iq) = (self.v_index[k], self.q_index[k]);

@@ -1,0 +1,617 @@
+//! The humanoid walks while it imitates (Section 5.3 with the paper's own walking pattern for
+//! the legs, and the damping controller of Section 4 in the loop).
+//!
+//! Per tick of Δt:
+//!
+//! 1. the walking pattern ([`crate::walk::WalkingPattern`]) gives both feet (pose, twist,
+//!    acceleration), the COM by preview control, the ZMP reference and the support phase;
+//! 2. the damping controller ([`crate::balance::BalanceController`]) reads the measured ZMP
+//!    deviation of the simulated robot in the local frame of Figure 11 (SSP: at the stance
+//!    foot; DSP: between the feet) and returns the COM offset Δc = l (u − u_ref), rotated to
+//!    world axes; the COM task's reference is the pattern's COM plus Δc;
+//! 3. the IK tick of the imitation ([`ImitationController`]): feet, COM, pelvis attitude and
+//!    height, upper-body joints from the clip, under the joint box;
+//! 4. the simulated robot: per plane an IPCJ with the robot's COM height as its length, the
+//!    sensor lag, a true delay line and sensor noise ([`crate::balance::SimPlant`]), driven by
+//!    the commanded COM's deviation from the pattern (u = deviation / l) and giving the measured
+//!    ZMP deviation; its compliance switches with the support phase; a push is a force impulse
+//!    on the COM.
+//!
+//! The simulated robot is the compliance dynamics about the nominal motion: the measured ZMP is
+//! the pattern's cart-table ZMP plus the IPCJ's output. This is the model the controller is
+//! designed on (the four synthetic cases of [`CaseParams::synthetic`] with the pendulum length
+//! set to the robot's COM height), with a true delay instead of its Padé term.
+
+use std::time::Instant;
+
+use nalgebra::{Isometry3, Rotation2, Translation3, UnitQuaternion, Vector2, Vector3, Vector6};
+use serde::Serialize;
+
+use super::imitate::{ImitateConfig, ImitationController};
+use super::margins::{dof_margins, median, percentile, DofMargins};
+use crate::balance::{
+    analyse_response, BalanceController, BalanceSettings, CaseParams, FullModelParams, Plane,
+    PlantParams, ResponseSettings, SimPlant, SimSettings, SupportPhase,
+};
+use crate::error::{Error, Result};
+use crate::model::{Robot, State};
+use crate::motion::RobotReferences;
+use crate::task::{ComReference, FrameReference};
+use crate::walk::{
+    FootState, FootstepPlan, Phase, PreviewSettings, Side, SupportPolygon, WalkSettings,
+    WalkingPattern,
+};
+
+/// A push on the COM during the walk.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Push {
+    /// When \[s\].
+    pub time: f64,
+    /// Horizontal impulse (world x, y) \[N·s\].
+    pub impulse: [f64; 2],
+}
+
+/// Settings of the walking imitation.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WalkImitateConfig {
+    /// The imitation (stack, solver, bounds, narrowed joints, posture, soles).
+    pub imitate: ImitateConfig,
+    /// Number of footsteps (the last one closes the feet side by side).
+    pub steps: usize,
+    /// Step length along x \[m\]; 0 steps in place.
+    pub step_length: f64,
+    /// Walking timing and swing height; the foot separation and the sole size are taken from
+    /// the robot's initial stance and [`ImitateConfig::support`].
+    pub walk: WalkSettings,
+    /// Preview control; the COM height is taken from the robot's initial COM.
+    pub preview: PreviewSettings,
+    /// Whether the damping controller is in the loop.
+    pub damping: bool,
+    /// The damping controller's design (poles, observer, hand-over).
+    pub balance: BalanceSettings,
+    /// The four compliance cases (their pendulum length is replaced by the COM height).
+    pub cases: CaseParams,
+    /// An optional push.
+    pub push: Option<Push>,
+    /// Standard deviation of the ZMP sensor noise \[m\].
+    pub noise_std: f64,
+    /// Seed of the sensor noise.
+    pub seed: u64,
+    /// The initial difference between the robot's COM and the pattern's is blended out over
+    /// this time \[s\] (quintic, zero rate and acceleration at both ends).
+    pub com_blend_time: f64,
+}
+
+impl WalkImitateConfig {
+    /// The default run on JVRC-1: the imitation defaults, 4 steps of 0.1 m (0.6 s single
+    /// support, 0.1 s double support, 0.8 s initial and final double support, 4 cm swing), the
+    /// damping controller on, a forward push of 5 N·s at 2.15 s (single support), 1 mm noise.
+    pub fn jvrc1() -> Result<Self> {
+        Ok(Self {
+            imitate: ImitateConfig::jvrc1(),
+            steps: 4,
+            step_length: 0.1,
+            walk: WalkSettings {
+                ssp_duration: 0.6,
+                dsp_duration: 0.1,
+                initial_dsp_duration: 0.8,
+                final_dsp_duration: 0.8,
+                swing_height: 0.04,
+                ..WalkSettings::default()
+            },
+            preview: PreviewSettings::default(),
+            damping: true,
+            balance: BalanceSettings::default(),
+            cases: CaseParams::synthetic()?,
+            push: Some(Push {
+                time: 2.15,
+                impulse: [5.0, 0.0],
+            }),
+            noise_std: 1e-3,
+            seed: 7,
+            com_blend_time: 0.5,
+        })
+    }
+}
+
+/// One recorded tick.
+#[derive(Debug, Clone, Serialize)]
+pub struct WalkStep {
+    /// Time \[s\].
+    pub t: f64,
+    /// 0 = double support, 1 = left foot in stance, 2 = right foot in stance.
+    pub phase: u8,
+    /// ZMP reference of the pattern (world) \[m\].
+    pub zmp_reference: [f64; 2],
+    /// ZMP of the pattern's cart-table model (world) \[m\].
+    pub zmp_model: [f64; 2],
+    /// Measured ZMP of the simulated robot (world) \[m\].
+    pub zmp_measured: [f64; 2],
+    /// Signed distance of the measured ZMP inside the support polygon \[m\] (negative: outside).
+    pub zmp_margin: f64,
+    /// Measured ZMP deviation in the local frame (x̃, ỹ) \[m\].
+    pub zmp_deviation: [f64; 2],
+    /// The pattern's COM (world) \[m\].
+    pub com_pattern: [f64; 2],
+    /// The COM reference given to the IK (pattern, blend and Δc) \[m\].
+    pub com_reference: [f64; 2],
+    /// The commanded COM (the IK's robot) \[m\].
+    pub com: [f64; 3],
+    /// The damping controller's offset Δc (world) \[m\].
+    pub com_offset: [f64; 2],
+    /// Left and right ankle references (world) \[m\].
+    pub feet_reference: [[f64; 3]; 2],
+    /// Left and right ankles achieved (world) \[m\].
+    pub feet: [[f64; 3]; 2],
+    /// Level (1-based) IKTC corrected from; 0 = none.
+    pub corrected_from: usize,
+    /// QPs this tick.
+    pub qp_solves: usize,
+    /// Tick time: pattern sample, damping controller and IK \[µs\].
+    pub tick_us: f64,
+    /// World positions of every link \[m\] (for the viewer).
+    #[serde(skip)]
+    pub links: Vec<[f64; 3]>,
+    /// Dof positions (joint angles; 0 for the base) \[rad\].
+    #[serde(skip)]
+    pub q: Vec<f64>,
+    /// Dof velocities.
+    #[serde(skip)]
+    pub qd: Vec<f64>,
+    /// Dof accelerations.
+    #[serde(skip)]
+    pub qdd: Vec<f64>,
+}
+
+/// The run's summary.
+#[derive(Debug, Clone, Serialize)]
+pub struct WalkSummary {
+    /// Whether the damping controller was in the loop.
+    pub damping: bool,
+    /// Footsteps.
+    pub steps: usize,
+    /// Duration \[s\].
+    pub duration: f64,
+    /// Smallest signed distance of the measured ZMP inside the support polygon \[m\].
+    pub min_zmp_margin: f64,
+    /// The measured ZMP stayed inside the support polygon at every tick.
+    pub zmp_inside: bool,
+    /// Largest horizontal error of a stance foot's ankle against its reference \[m\].
+    pub max_stance_foot_error: f64,
+    /// Largest horizontal drift of a stance foot within one stance interval \[m\].
+    pub max_stance_foot_slip: f64,
+    /// Worst signed margins over all joints (position \[rad\], velocity \[rad/s\],
+    /// acceleration \[rad/s²\]); ≤ 0: no limit exceeded.
+    pub worst_margins: [f64; 3],
+    /// Margins of every joint (narrowed ranges).
+    pub margins: Vec<(String, DofMargins)>,
+    /// Peak |ZMP deviation| after the push (x̃) \[m\].
+    pub push_peak: f64,
+    /// Damping ratio measured from the ZMP deviation after the push (x̃) \[–\].
+    pub push_damping_ratio: f64,
+    /// Settling time of the ZMP deviation after the push (x̃) \[s\], if it settled.
+    pub push_settling_time: Option<f64>,
+    /// Ticks whose correction started above the lowest level.
+    pub climbed_ticks: usize,
+    /// Ticks with any correction.
+    pub corrected_ticks: usize,
+    /// Median tick time \[µs\].
+    pub tick_median_us: f64,
+    /// 99th percentile tick time \[µs\].
+    pub tick_p99_us: f64,
+}
+
+/// A whole run.
+#[derive(Debug, Clone, Serialize)]
+pub struct WalkRun {
+    /// Every tick.
+    pub steps: Vec<WalkStep>,
+    /// The footsteps (world x, y, yaw; side 0 = left, 1 = right), initial feet first.
+    pub footsteps: Vec<(u8, [f64; 3])>,
+    /// The phase intervals (start, end \[s\], phase code as in [`WalkStep::phase`]).
+    pub phases: Vec<(f64, f64, u8)>,
+    /// Summary.
+    pub summary: WalkSummary,
+}
+
+fn phase_code(p: Phase) -> u8 {
+    match p {
+        Phase::DoubleSupport => 0,
+        Phase::SingleSupport { stance: Side::Left } => 1,
+        Phase::SingleSupport {
+            stance: Side::Right,
+        } => 2,
+    }
+}
+
+fn with_length(m: &FullModelParams, l: f64) -> FullModelParams {
+    let mut m = *m;
+    m.ipcj.length = l;
+    m
+}
+
+fn ankle_reference(
+    foot: &FootState,
+    offset: &Vector3<f64>,
+    origin: &Vector2<f64>,
+) -> FrameReference {
+    let a = foot.offset(offset);
+    let rotation = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), a.yaw);
+    let tw = a.twist();
+    let ac = a.acceleration();
+    FrameReference {
+        pose: Isometry3::from_parts(
+            Translation3::new(
+                a.position.x + origin.x,
+                a.position.y + origin.y,
+                a.position.z,
+            ),
+            rotation,
+        ),
+        velocity: Vector6::from_row_slice(&tw),
+        acceleration: Vector6::from_row_slice(&ac),
+    }
+}
+
+/// Runs the walking imitation.
+pub fn run_walk_imitate(
+    robot: &Robot,
+    refs: &RobotReferences,
+    cfg: &WalkImitateConfig,
+) -> Result<WalkRun> {
+    let dt = cfg.imitate.dt;
+    if (cfg.preview.dt - dt).abs() > 1e-12 {
+        return Err(Error::InvalidSetting {
+            name: "preview.dt".into(),
+            value: cfg.preview.dt.to_string(),
+            expected: format!("the control period {dt} s"),
+        });
+    }
+    let mut ctl = ImitationController::new(robot, refs, &cfg.imitate)?;
+    let feet_ids = cfg
+        .imitate
+        .feet
+        .iter()
+        .map(|f| robot.frame_id(f))
+        .collect::<Result<Vec<_>>>()?;
+    if feet_ids.len() != 2 {
+        return Err(Error::InvalidSetting {
+            name: "imitate.feet".into(),
+            value: cfg.imitate.feet.join(","),
+            expected: "two feet: right, then left".into(),
+        });
+    }
+    // The imitation lists the right foot first, then the left.
+    let (r0, l0) = (ctl.feet0()[0], ctl.feet0()[1]);
+    let origin = Vector2::new(
+        0.5 * (r0.translation.x + l0.translation.x),
+        0.5 * (r0.translation.y + l0.translation.y),
+    );
+    let ankle_offset = Vector3::new(0.0, 0.0, r0.translation.z.min(l0.translation.z));
+    let com0 = ctl.kinematics().com();
+    let support = cfg.imitate.support;
+    let walk = WalkSettings {
+        foot_separation: (l0.translation.y - r0.translation.y).abs(),
+        sole_length: support.sole_length,
+        sole_width: support.sole_width,
+        ..cfg.walk
+    };
+    let preview = PreviewSettings {
+        com_height: com0.z,
+        dt,
+        ..cfg.preview
+    };
+    let plan = if cfg.step_length == 0.0 {
+        FootstepPlan::in_place(cfg.steps, &walk)?
+    } else {
+        FootstepPlan::forward(cfg.steps, cfg.step_length, &walk)?
+    };
+    let pattern = WalkingPattern::new(&plan, &walk, &preview)?;
+    let l = com0.z;
+    let cases = CaseParams {
+        xz_ssp: with_length(&cfg.cases.xz_ssp, l),
+        xz_dsp: with_length(&cfg.cases.xz_dsp, l),
+        yz_ssp: with_length(&cfg.cases.yz_ssp, l),
+        yz_dsp: with_length(&cfg.cases.yz_dsp, l),
+    };
+    let mut bal = BalanceController::new(&cases, &cfg.balance, SupportPhase::Double)?;
+    let sim = SimSettings {
+        control_period: dt,
+        seed: cfg.seed,
+        ..SimSettings::default()
+    };
+    let mass = robot.total_mass();
+    let mut plants = [
+        SimPlant::new(
+            PlantParams::from_model(
+                *cases.get(Plane::Xz, SupportPhase::Double),
+                mass,
+                cfg.noise_std,
+            ),
+            &sim,
+        )?,
+        SimPlant::new(
+            PlantParams::from_model(
+                *cases.get(Plane::Yz, SupportPhase::Double),
+                mass,
+                cfg.noise_std,
+            ),
+            &SimSettings {
+                seed: cfg.seed.wrapping_add(1),
+                ..sim
+            },
+        )?,
+    ];
+    let s0 = pattern.sample(0.0)?;
+    let blend0 = Vector2::new(
+        com0.x - origin.x - s0.com.position.x,
+        com0.y - origin.y - s0.com.position.y,
+    );
+    let n = (pattern.duration() / dt).round() as usize + 1;
+    let mut steps = Vec::with_capacity(n);
+    let mut polygon = SupportPolygon::default();
+    let mut last_phase = SupportPhase::Double;
+    let mut feet_refs = [FrameReference::hold(r0), FrameReference::hold(l0)];
+    let push_tick = cfg.push.map(|p| (p.time / dt).round() as usize);
+    // Δc and its backward-difference rate: fed forward to the COM task so that the commanded
+    // COM follows the controller's offset within a tick instead of through the CLIK lag.
+    let (mut dc_prev, mut dcd_prev) = (Vector2::zeros(), Vector2::zeros());
+    for k in 0..n {
+        let t = k as f64 * dt;
+        let start = Instant::now();
+        let s = pattern.sample(t)?;
+        let phase = match s.phase {
+            Phase::DoubleSupport => SupportPhase::Double,
+            Phase::SingleSupport { .. } => SupportPhase::Single,
+        };
+        // Local frame of Figure 11: yaw of the stance foot (SSP) or of both feet (DSP).
+        let yaw = match s.phase {
+            Phase::DoubleSupport => 0.5 * (s.left.yaw + s.right.yaw),
+            Phase::SingleSupport { stance } => s.foot(stance).yaw,
+        };
+        let rot = Rotation2::new(yaw);
+        // Measured ZMP deviation, local frame.
+        let dev = [plants[0].measure(), plants[1].measure()];
+        let offset_world = if cfg.damping {
+            let out = bal.step(phase, [0.0, 0.0], dev)?;
+            rot * Vector2::new(out.com_offset[0], out.com_offset[1])
+        } else {
+            Vector2::zeros()
+        };
+        // COM reference: pattern + blend of the initial offset + Δc.
+        let tb = cfg.com_blend_time;
+        let (b, bd, bdd) = if tb > 0.0 && t < tb {
+            let x = t / tb;
+            (
+                1.0 - x * x * x * (10.0 - 15.0 * x + 6.0 * x * x),
+                -30.0 * x * x * (1.0 - x) * (1.0 - x) / tb,
+                -60.0 * x * (1.0 - x) * (1.0 - 2.0 * x) / (tb * tb),
+            )
+        } else {
+            (0.0, 0.0, 0.0)
+        };
+        let cp = s.com.position;
+        let cref = Vector2::new(cp.x + origin.x, cp.y + origin.y) + blend0 * b + offset_world;
+        let dcd = (offset_world - dc_prev) / dt;
+        let dcdd = (dcd - dcd_prev) / dt;
+        dc_prev = offset_world;
+        dcd_prev = dcd;
+        ctl.set_com_override(Some(ComReference {
+            position: Vector3::new(cref.x, cref.y, com0.z),
+            velocity: Vector3::new(
+                s.com.velocity.x + blend0.x * bd + dcd.x,
+                s.com.velocity.y + blend0.y * bd + dcd.y,
+                0.0,
+            ),
+            acceleration: Vector3::new(
+                s.com.acceleration.x + blend0.x * bdd + dcdd.x,
+                s.com.acceleration.y + blend0.y * bdd + dcdd.y,
+                0.0,
+            ),
+        }));
+        feet_refs[0] = ankle_reference(&s.right, &ankle_offset, &origin);
+        feet_refs[1] = ankle_reference(&s.left, &ankle_offset, &origin);
+        ctl.set_feet_references(&feet_refs)?;
+        let rep = ctl.tick(robot, k)?;
+        let (corrected_from, qp_solves) = (rep.corrected_from.map_or(0, |l| l + 1), rep.qp_solves);
+        let tick_us = start.elapsed().as_secs_f64() * 1e6;
+        // The simulated robot: commanded COM deviation from the nominal → pendulum command.
+        let kin = ctl.kinematics();
+        let com = kin.com();
+        let nominal = Vector2::new(cp.x + origin.x, cp.y + origin.y) + blend0 * b;
+        let d_local = rot.inverse() * (Vector2::new(com.x, com.y) - nominal);
+        if phase != last_phase {
+            for (p, plane) in plants.iter_mut().zip(Plane::BOTH) {
+                p.switch_model(*cases.get(plane, phase))?;
+            }
+            last_phase = phase;
+        }
+        if Some(k) == push_tick {
+            if let Some(p) = cfg.push {
+                let j = rot.inverse() * Vector2::new(p.impulse[0], p.impulse[1]);
+                plants[0].push(j.x)?;
+                plants[1].push(j.y)?;
+            }
+        }
+        for (i, p) in plants.iter_mut().enumerate() {
+            p.advance(d_local[i] / l)?;
+        }
+        // Record.
+        let zdev = rot * Vector2::new(dev[0], dev[1]);
+        let zm = (
+            s.zmp_model.0 + origin.x + zdev.x,
+            s.zmp_model.1 + origin.y + zdev.y,
+        );
+        pattern.support_polygon_into(t, &mut polygon)?;
+        let zmp_margin = polygon.margin((zm.0 - origin.x, zm.1 - origin.y));
+        let mut feet = [[0.0; 3]; 2];
+        for (slot, id) in feet.iter_mut().zip([feet_ids[1], feet_ids[0]]) {
+            let p = kin.frame_pose(robot, id)?.translation.vector;
+            *slot = [p.x, p.y, p.z];
+        }
+        let fr = |r: &FrameReference| {
+            let p = r.pose.translation.vector;
+            [p.x, p.y, p.z]
+        };
+        let state: &State = ctl.state();
+        steps.push(WalkStep {
+            t,
+            phase: phase_code(s.phase),
+            zmp_reference: [s.zmp_reference.0 + origin.x, s.zmp_reference.1 + origin.y],
+            zmp_model: [s.zmp_model.0 + origin.x, s.zmp_model.1 + origin.y],
+            zmp_measured: [zm.0, zm.1],
+            zmp_margin,
+            zmp_deviation: dev,
+            com_pattern: [nominal.x, nominal.y],
+            com_reference: [cref.x, cref.y],
+            com: [com.x, com.y, com.z],
+            com_offset: [offset_world.x, offset_world.y],
+            feet_reference: [fr(&feet_refs[1]), fr(&feet_refs[0])],
+            feet,
+            corrected_from,
+            qp_solves,
+            tick_us,
+            links: kin
+                .link_poses()
+                .iter()
+                .map(|p| [p.translation.x, p.translation.y, p.translation.z])
+                .collect(),
+            q: ctl.dof_positions().to_vec(),
+            qd: state.qd.as_slice().to_vec(),
+            qdd: ctl.qdd().as_slice().to_vec(),
+        });
+        ctl.integrate(robot)?;
+    }
+    let footsteps = {
+        let mut v = vec![
+            (
+                0u8,
+                [
+                    plan.initial(Side::Left).x + origin.x,
+                    plan.initial(Side::Left).y + origin.y,
+                    plan.initial(Side::Left).yaw,
+                ],
+            ),
+            (
+                1u8,
+                [
+                    plan.initial(Side::Right).x + origin.x,
+                    plan.initial(Side::Right).y + origin.y,
+                    plan.initial(Side::Right).yaw,
+                ],
+            ),
+        ];
+        for f in plan.steps() {
+            let side = if f.side == Side::Left { 0 } else { 1 };
+            v.push((side, [f.pose.x + origin.x, f.pose.y + origin.y, f.pose.yaw]));
+        }
+        v
+    };
+    let phases = pattern
+        .timeline()
+        .phases()
+        .iter()
+        .map(|p| (p.start, p.end, phase_code(p.phase)))
+        .collect();
+    let summary = summarize(robot, cfg, &ctl, &steps, pattern.duration())?;
+    Ok(WalkRun {
+        steps,
+        footsteps,
+        phases,
+        summary,
+    })
+}
+
+fn summarize(
+    robot: &Robot,
+    cfg: &WalkImitateConfig,
+    ctl: &ImitationController,
+    steps: &[WalkStep],
+    duration: f64,
+) -> Result<WalkSummary> {
+    let dt = cfg.imitate.dt;
+    let names = robot.dof_names();
+    let mut margins = Vec::new();
+    let mut worst = [f64::NEG_INFINITY; 3];
+    for (d, lim) in ctl.limits().dofs().iter().enumerate().skip(robot.base_nv()) {
+        let col = |f: &dyn Fn(&WalkStep) -> f64| steps.iter().map(f).collect::<Vec<f64>>();
+        let limit = crate::model::JointLimit {
+            lower: lim.position_min,
+            upper: lim.position_max,
+            velocity: lim.velocity_max,
+            acceleration: lim.acceleration_max,
+            effort: f64::INFINITY,
+        };
+        let m = dof_margins(
+            d,
+            &col(&|s| s.q[d]),
+            &col(&|s| s.qd[d]),
+            &col(&|s| s.qdd[d]),
+            dt,
+            &limit,
+        );
+        worst[0] = worst[0].max(m.position);
+        worst[1] = worst[1].max(m.velocity);
+        worst[2] = worst[2].max(m.acceleration);
+        margins.push((names.get(d).cloned().unwrap_or_default(), m));
+    }
+    // Stance feet: error against the reference, and drift within each stance interval.
+    let mut max_err = 0.0f64;
+    let mut max_slip = 0.0f64;
+    for foot in 0..2 {
+        let stance_code = if foot == 0 { 1 } else { 2 };
+        let mut anchor: Option<[f64; 3]> = None;
+        for s in steps {
+            let in_stance = s.phase == 0 || s.phase == stance_code;
+            if in_stance {
+                let (p, r) = (s.feet[foot], s.feet_reference[foot]);
+                max_err = max_err.max(((p[0] - r[0]).powi(2) + (p[1] - r[1]).powi(2)).sqrt());
+                match anchor {
+                    None => anchor = Some(p),
+                    Some(a) => {
+                        max_slip =
+                            max_slip.max(((p[0] - a[0]).powi(2) + (p[1] - a[1]).powi(2)).sqrt())
+                    }
+                }
+            } else {
+                anchor = None;
+            }
+        }
+    }
+    let min_margin = steps
+        .iter()
+        .map(|s| s.zmp_margin)
+        .fold(f64::INFINITY, f64::min);
+    let (push_peak, push_damping_ratio, push_settling_time) = match cfg.push {
+        Some(p) => {
+            let t: Vec<f64> = steps.iter().map(|s| s.t).collect();
+            let y: Vec<f64> = steps.iter().map(|s| s.zmp_deviation[0]).collect();
+            let m = analyse_response(&t, &y, p.time, cfg.noise_std, &ResponseSettings::default())?;
+            (m.peak, m.damping_ratio, m.settling_time)
+        }
+        None => (0.0, 0.0, None),
+    };
+    let ticks: Vec<f64> = steps.iter().map(|s| s.tick_us).collect();
+    let nt = ctl.level_dims().len();
+    Ok(WalkSummary {
+        damping: cfg.damping,
+        steps: cfg.steps,
+        duration,
+        min_zmp_margin: min_margin,
+        zmp_inside: min_margin >= 0.0,
+        max_stance_foot_error: max_err,
+        max_stance_foot_slip: max_slip,
+        worst_margins: worst,
+        margins,
+        push_peak,
+        push_damping_ratio,
+        push_settling_time,
+        climbed_ticks: steps
+            .iter()
+            .filter(|s| s.corrected_from > 0 && s.corrected_from < nt)
+            .count(),
+        corrected_ticks: steps.iter().filter(|s| s.corrected_from > 0).count(),
+        tick_median_us: median(&ticks),
+        tick_p99_us: percentile(&ticks, 0.99),
+    })
+}

@@ -1,0 +1,114 @@
+//! Support polygons: sole rectangles and their convex hull, in fixed-size storage.
+
+use serde::Serialize;
+
+use super::footstep::Pose2;
+
+/// Most vertices a support polygon can have (two rectangles).
+pub const MAX_POLYGON_VERTICES: usize = 8;
+
+/// A convex polygon on the ground, counter-clockwise, without allocation: up to
+/// [`MAX_POLYGON_VERTICES`] vertices `(x, y)` \[m\] in a fixed array.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct SupportPolygon {
+    points: [(f64, f64); MAX_POLYGON_VERTICES],
+    len: usize,
+}
+
+impl Default for SupportPolygon {
+    fn default() -> Self {
+        Self {
+            points: [(0.0, 0.0); MAX_POLYGON_VERTICES],
+            len: 0,
+        }
+    }
+}
+
+/// The four corners of a sole of `length × width` \[m\] centred on `pose`, counter-clockwise
+/// (world coordinates \[m\]).
+pub fn sole_corners(pose: &Pose2, length: f64, width: f64) -> [(f64, f64); 4] {
+    let (hl, hw) = (0.5 * length, 0.5 * width);
+    [
+        pose.transform_point(hl, hw),
+        pose.transform_point(-hl, hw),
+        pose.transform_point(-hl, -hw),
+        pose.transform_point(hl, -hw),
+    ]
+}
+
+fn cross(o: (f64, f64), a: (f64, f64), b: (f64, f64)) -> f64 {
+    (a.0 - o.0) * (b.1 - o.1) - (a.1 - o.1) * (b.0 - o.0)
+}
+
+impl SupportPolygon {
+    /// The vertices, counter-clockwise \[m\].
+    pub fn vertices(&self) -> &[(f64, f64)] {
+        &self.points[..self.len]
+    }
+
+    /// Sets the polygon to one sole rectangle.
+    pub fn set_sole(&mut self, pose: &Pose2, length: f64, width: f64) {
+        let c = sole_corners(pose, length, width);
+        self.points[..4].copy_from_slice(&c);
+        self.len = 4;
+    }
+
+    /// Sets the polygon to the convex hull of two sole rectangles (Andrew's monotone chain:
+    /// sort by `x` then `y`, build the lower and upper chains, dropping points that do not
+    /// turn left; collinear points are dropped). Allocation-free.
+    pub fn set_hull_of_soles(&mut self, a: &Pose2, b: &Pose2, length: f64, width: f64) {
+        let ca = sole_corners(a, length, width);
+        let cb = sole_corners(b, length, width);
+        let mut pts = [(0.0, 0.0); MAX_POLYGON_VERTICES];
+        pts[..4].copy_from_slice(&ca);
+        pts[4..].copy_from_slice(&cb);
+        pts.sort_by(|p, q| p.0.total_cmp(&q.0).then(p.1.total_cmp(&q.1)));
+        // Hull buffer: at most 2n points during construction.
+        let mut hull = [(0.0, 0.0); 2 * MAX_POLYGON_VERTICES];
+        let mut k = 0usize;
+        for &p in pts.iter() {
+            while k >= 2 && cross(hull[k - 2], hull[k - 1], p) <= 0.0 {
+                k -= 1;
+            }
+            hull[k] = p;
+            k += 1;
+        }
+        let lower = k + 1;
+        for &p in pts.iter().rev().skip(1) {
+            while k >= lower && cross(hull[k - 2], hull[k - 1], p) <= 0.0 {
+                k -= 1;
+            }
+            hull[k] = p;
+            k += 1;
+        }
+        // The last point repeats the first.
+        let n = (k - 1).min(MAX_POLYGON_VERTICES);
+        self.points[..n].copy_from_slice(&hull[..n]);
+        self.len = n;
+    }
+
+    /// Signed distance \[m\] from `p` to the boundary: positive inside, negative outside
+    /// (for an outside point, a lower bound on the distance's magnitude: the largest
+    /// violation of one edge's half-plane). `−∞` for an empty polygon.
+    pub fn margin(&self, p: (f64, f64)) -> f64 {
+        let v = self.vertices();
+        let mut m = f64::INFINITY;
+        if v.is_empty() {
+            return f64::NEG_INFINITY;
+        }
+        for i in 0..v.len() {
+            let a = v[i];
+            let b = v[(i + 1) % v.len()];
+            let len = (b.0 - a.0).hypot(b.1 - a.1);
+            if len > 0.0 {
+                m = m.min(cross(a, b, p) / len);
+            }
+        }
+        m
+    }
+
+    /// Whether `p` is inside the polygon shrunk by `margin` \[m\] (`margin ≥ 0` shrinks).
+    pub fn contains(&self, p: (f64, f64), margin: f64) -> bool {
+        self.margin(p) >= margin
+    }
+}
