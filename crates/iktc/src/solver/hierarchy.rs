@@ -57,6 +57,8 @@ pub struct Hierarchy {
     /// Jᵀ of the current level (n × m_max) and T with permuted columns (m_max × m_max).
     jt: DMatrix<f64>,
     tp: DMatrix<f64>,
+    /// Indices of the non-zero entries of one task row.
+    nz: Vec<usize>,
 }
 
 impl Hierarchy {
@@ -92,6 +94,7 @@ impl Hierarchy {
             residual: DVector::zeros(mmax),
             jt: DMatrix::zeros(n, mmax),
             tp: DMatrix::zeros(mmax, mmax),
+            nz: vec![0; n],
         }
     }
 
@@ -198,9 +201,27 @@ impl Hierarchy {
             let asl = self.a.as_mut_slice();
             for c in 0..m {
                 let jc = &js[c * n..(c + 1) * n];
-                for a in 0..k {
-                    let za = &zs[a * n..(a + 1) * n];
-                    asl[a + c * arows] = dot(za, jc);
+                // Task rows are often sparse (a joint task selects one dof, the pelvis moves
+                // with the base only): when fewer than half the entries are non-zero, sum over
+                // those alone.
+                let mut nnz = 0;
+                for (d, v) in jc.iter().enumerate() {
+                    if *v != 0.0 {
+                        self.nz[nnz] = d;
+                        nnz += 1;
+                    }
+                }
+                if 2 * nnz < n {
+                    let idx = &self.nz[..nnz];
+                    for a in 0..k {
+                        let za = &zs[a * n..(a + 1) * n];
+                        asl[a + c * arows] = idx.iter().map(|&d| za[d] * jc[d]).sum();
+                    }
+                } else {
+                    for a in 0..k {
+                        let za = &zs[a * n..(a + 1) * n];
+                        asl[a + c * arows] = dot(za, jc);
+                    }
                 }
             }
         }
