@@ -59,6 +59,12 @@ pub struct Hierarchy {
     tp: DMatrix<f64>,
     /// Indices of the non-zero entries of one task row.
     nz: Vec<usize>,
+    /// The last level keeps J̄⁺ factored as Z · Y with Y = Q_r T Πᵀ (k × m): its solution
+    /// needs only J̄⁺ times the residual, and J̄⁺ itself only when G is built.
+    y_last: DMatrix<f64>,
+    tmp_k: DVector<f64>,
+    k_last: usize,
+    last_ready: bool,
 }
 
 impl Hierarchy {
@@ -95,6 +101,10 @@ impl Hierarchy {
             jt: DMatrix::zeros(n, mmax),
             tp: DMatrix::zeros(mmax, mmax),
             nz: vec![0; n],
+            y_last: DMatrix::zeros(n.max(1), mmax),
+            tmp_k: DVector::zeros(n),
+            k_last: 0,
+            last_ready: true,
         }
     }
 
@@ -119,8 +129,33 @@ impl Hierarchy {
     }
 
     /// J̄_i^{λ+} of level i (n × m_i), from the last solve.
-    pub fn pinv(&self, i: usize) -> &DMatrix<f64> {
+    pub fn pinv(&mut self, i: usize) -> &DMatrix<f64> {
+        self.ensure_last_pinv();
         &self.pinv[i]
+    }
+
+    /// Forms J̄⁺ = Z · Y of the last level if it is still factored.
+    fn ensure_last_pinv(&mut self) {
+        if self.last_ready || self.dims.is_empty() {
+            return;
+        }
+        let last = self.dims.len() - 1;
+        let (n, m, k) = (self.n, self.dims[last], self.k_last);
+        let zs = self.z.as_slice();
+        let yr = self.y_last.nrows();
+        let ys = self.y_last.as_slice();
+        let pi = self.pinv[last].as_mut_slice();
+        for c in 0..m {
+            let out = &mut pi[c * n..(c + 1) * n];
+            out.fill(0.0);
+            for a in 0..k {
+                let f = ys[a + c * yr];
+                if f != 0.0 {
+                    axpy(f, &zs[a * n..(a + 1) * n], out);
+                }
+            }
+        }
+        self.last_ready = true;
     }
 
     /// G (n × Σm_i); the blocks of levels ≥ `from` are valid after
@@ -168,7 +203,25 @@ impl Hierarchy {
             let mut res = self.residual.rows_mut(0, m);
             res.copy_from(&lvl.rhs);
             res.gemv(-1.0, &lvl.jacobian, qdd, 1.0);
-            qdd.gemv(1.0, &self.pinv[i], &self.residual.rows(0, m), 1.0);
+            if i + 1 == levels.len() {
+                // q̈ += Z (Y residual).
+                let k = self.k_last;
+                let mut y = self.tmp_k.rows_mut(0, k);
+                y.gemv(
+                    1.0,
+                    &self.y_last.view((0, 0), (k, m)),
+                    &self.residual.rows(0, m),
+                    0.0,
+                );
+                qdd.gemv(
+                    1.0,
+                    &self.z.view((0, 0), (n, k)),
+                    &self.tmp_k.rows(0, k),
+                    1.0,
+                );
+            } else {
+                qdd.gemv(1.0, &self.pinv[i], &self.residual.rows(0, m), 1.0);
+            }
         }
         Ok(())
     }
@@ -176,12 +229,13 @@ impl Hierarchy {
     /// J̄_i^{λ+} for level i from the current basis Z, then Z ← basis of null(J_i Z) within Z.
     fn level_inverse(&mut self, i: usize, j: &DMatrix<f64>, settings: &SolverSettings) {
         let (n, m, k) = (self.n, self.dims[i], self.k);
+        let last = i + 1 == self.dims.len();
         self.pinv[i].fill(0.0);
-        if m == 0 {
-            self.ranks[i] = 0;
-            return;
+        if last {
+            self.k_last = 0;
+            self.last_ready = true;
         }
-        if k == 0 {
+        if m == 0 || k == 0 {
             self.ranks[i] = 0;
             return;
         }
@@ -283,10 +337,10 @@ impl Hierarchy {
         self.ranks[i] = rank;
         // ZQ = Z H_1 … H_rank (n × k): each reflector is a rank-one update
         // ZQ ← ZQ − τ (ZQ v) vᵀ on the columns st..k.
-        self.zq
-            .view_mut((0, 0), (n, k))
-            .copy_from(&self.z.view((0, 0), (n, k)));
-        {
+        if !last {
+            self.zq
+                .view_mut((0, 0), (n, k))
+                .copy_from(&self.z.view((0, 0), (n, k)));
             let vr = self.v.nrows();
             let vsl = self.v.as_slice();
             let zq = self.zq.as_mut_slice();
@@ -383,6 +437,34 @@ impl Hierarchy {
                     self.tp[(p, col)] = self.t[(p, c)];
                 }
             }
+            if last {
+                // Y = Q_r Tp = H_1 … H_r [Tp; 0] (k × m): reflectors applied last to first.
+                let yr = self.y_last.nrows();
+                let vr = self.v.nrows();
+                let tprows = self.tp.nrows();
+                let ys = self.y_last.as_mut_slice();
+                let tp = self.tp.as_slice();
+                let vsl = self.v.as_slice();
+                for c in 0..m {
+                    let col = &mut ys[c * yr..c * yr + k];
+                    col.fill(0.0);
+                    for p in 0..rank {
+                        col[p] = tp[p + c * tprows];
+                    }
+                }
+                for st in (0..rank).rev() {
+                    let tau = self.tau[st];
+                    let v = &vsl[st * vr + st..st * vr + k];
+                    for c in 0..m {
+                        let col = &mut ys[c * yr + st..c * yr + k];
+                        let f = tau * dot(v, col);
+                        axpy(-f, v, col);
+                    }
+                }
+                self.k_last = k;
+                self.last_ready = false;
+                return;
+            }
             // Column c of J̄⁺ = Σ_p ZQ[:, p] · Tp[p, c] (contiguous column updates).
             let zq = self.zq.as_slice();
             let tprows = self.tp.nrows();
@@ -401,6 +483,10 @@ impl Hierarchy {
                 }
             }
         }
+        if last {
+            // Rank 0: J̄⁺ = 0 (k_last = 0), and no level follows.
+            return;
+        }
         // Z ← ZQ[:, rank..k].
         let newk = k - rank;
         self.z
@@ -412,6 +498,7 @@ impl Hierarchy {
     /// Builds the block g_i of G (Algorithm 1), using the inverses of the last
     /// [`Hierarchy::solve`]. Allocates nothing.
     pub fn build_g_level(&mut self, levels: &[TaskEquation], i: usize) {
+        self.ensure_last_pinv();
         let n = self.n;
         {
             let off = self.offsets[i];
