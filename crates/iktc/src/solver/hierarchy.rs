@@ -407,27 +407,33 @@ impl Hierarchy {
                     self.s[(r, p)] = x / l;
                 }
             }
-            // T = S⁻¹ R_r (r × m), column by column (R entries below the diagonal are zero).
-            for c in 0..m {
-                for p in 0..rank {
-                    self.tmp_m[p] = if p <= c { self.a[(p, c)] } else { 0.0 };
-                }
-                for p in 0..rank {
-                    let mut x = self.tmp_m[p];
-                    for q in 0..p {
-                        x -= self.s[(p, q)] * self.tmp_m[q];
+            // T = S⁻¹ R_r (r × m), column by column (R entries below the diagonal are zero):
+            // L y = b by columns of L, then Lᵀ x = y by dot products with columns of L (L is
+            // stored column-major in the lower triangle of `s`).
+            {
+                let sr = self.s.nrows();
+                let ls = self.s.as_slice();
+                let ar = self.a.nrows();
+                let asl = self.a.as_slice();
+                let x = &mut self.tmp_m.as_mut_slice()[..rank];
+                for c in 0..m {
+                    for (p, xp) in x.iter_mut().enumerate() {
+                        *xp = if p <= c { asl[p + c * ar] } else { 0.0 };
                     }
-                    self.tmp_m[p] = x / self.s[(p, p)];
-                }
-                for p in (0..rank).rev() {
-                    let mut x = self.tmp_m[p];
-                    for q in p + 1..rank {
-                        x -= self.s[(q, p)] * self.tmp_m[q];
+                    for q in 0..rank {
+                        let xq = x[q] / ls[q + q * sr];
+                        x[q] = xq;
+                        if xq != 0.0 {
+                            axpy(-xq, &ls[q * sr + q + 1..q * sr + rank], &mut x[q + 1..rank]);
+                        }
                     }
-                    self.tmp_m[p] = x / self.s[(p, p)];
-                }
-                for p in 0..rank {
-                    self.t[(p, c)] = self.tmp_m[p];
+                    for p in (0..rank).rev() {
+                        let tail = dot(&ls[p * sr + p + 1..p * sr + rank], &x[p + 1..rank]);
+                        x[p] = (x[p] - tail) / ls[p + p * sr];
+                    }
+                    for (p, xp) in x.iter().enumerate() {
+                        self.t[(p, c)] = *xp;
+                    }
                 }
             }
             // J̄⁺ = ZQ_r · T · Πᵀ: column perm[c] of J̄⁺ is ZQ_r · T[:, c].
