@@ -72,5 +72,82 @@ fn bench(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench);
+/// The walking tick (issue 6): walking pattern, damping controller and IK, with the ZMP of the
+/// simulated compliant robot fed back (the plant's step is outside the timed region).
+fn bench_walk(c: &mut Criterion) {
+    use iktc::balance::{Plane, PlantParams, SimPlant, SimSettings, SupportPhase};
+    use iktc::sim::{WalkImitateConfig, WalkingController};
+    use nalgebra::{Rotation2, Vector2};
+    let (robot, refs) = setup();
+    let cfg = WalkImitateConfig::jvrc1().expect("config");
+    let initial = WalkingController::new(&robot, &refs, &cfg).expect("walking controller");
+    let n = initial.ticks();
+    let cases = *initial.cases();
+    let l = initial.pendulum_length();
+    let plants0 = [Plane::Xz, Plane::Yz].map(|plane| {
+        SimPlant::new(
+            PlantParams::from_model(
+                *cases.get(plane, SupportPhase::Double),
+                robot.total_mass(),
+                1e-3,
+            ),
+            &SimSettings::default(),
+        )
+        .expect("plant")
+    });
+    // One pass: returns the time of each tick [µs].
+    let pass = |wc: &mut WalkingController,
+                plants: &mut [SimPlant; 2],
+                ticks: &mut Vec<f64>,
+                k: usize|
+     -> Duration {
+        let dev = [plants[0].measure(), plants[1].measure()];
+        let start = Instant::now();
+        let wt = std::hint::black_box(wc.tick(&robot, k, dev)).expect("tick");
+        let _ = wc.integrate(&robot);
+        let el = start.elapsed();
+        ticks.push(el.as_secs_f64() * 1e6);
+        let com = wc.imitation().kinematics().com();
+        let d =
+            Rotation2::new(wt.local_yaw).inverse() * (Vector2::new(com.x, com.y) - wt.com_nominal);
+        for (i, p) in plants.iter_mut().enumerate() {
+            let _ = p.advance(d[i] / l);
+        }
+        el
+    };
+    c.bench_function("humanoid_tick/walking_iktc", |b| {
+        b.iter_custom(|iters| {
+            let (mut wc, mut plants) = (initial.clone(), plants0.clone());
+            let mut scratch = Vec::new();
+            let mut k = 0;
+            let mut total = Duration::ZERO;
+            for _ in 0..iters {
+                if k == n {
+                    wc = initial.clone();
+                    plants = plants0.clone();
+                    k = 0;
+                }
+                scratch.clear();
+                total += pass(&mut wc, &mut plants, &mut scratch, k);
+                k += 1;
+            }
+            total
+        })
+    });
+    let mut ticks = Vec::with_capacity(3 * n);
+    for _ in 0..3 {
+        let (mut wc, mut plants) = (initial.clone(), plants0.clone());
+        for k in 0..n {
+            pass(&mut wc, &mut plants, &mut ticks, k);
+        }
+    }
+    eprintln!(
+        "humanoid_tick/walking_iktc: single ticks over 3 passes of {n}: median {:.1} µs, p99 {:.1} µs, max {:.1} µs",
+        percentile(&ticks, 0.5),
+        percentile(&ticks, 0.99),
+        percentile(&ticks, 1.0)
+    );
+}
+
+criterion_group!(benches, bench, bench_walk);
 criterion_main!(benches);

@@ -13,4 +13,7 @@ pub use margins::{dof_margins, median, percentile, DofMargins};
 pub use planar3r::{
     run_planar3r, ArmTask, Planar3rConfig, Planar3rRun, Planar3rStep, Planar3rSummary,
 };
-pub use walk_imitate::{run_walk_imitate, Push, WalkImitateConfig, WalkRun, WalkStep, WalkSummary};
+pub use walk_imitate::{
+    run_walk_imitate, Push, WalkImitateConfig, WalkRun, WalkStep, WalkSummary, WalkTick,
+    WalkingController,
+};

@@ -38,8 +38,8 @@ use crate::model::{Robot, State};
 use crate::motion::RobotReferences;
 use crate::task::{ComReference, FrameReference};
 use crate::walk::{
-    FootState, FootstepPlan, Phase, PreviewSettings, Side, SupportPolygon, WalkSettings,
-    WalkingPattern,
+    FootState, FootstepPlan, Phase, PreviewSettings, Side, SupportPolygon, WalkSample,
+    WalkSettings, WalkingPattern,
 };
 
 /// A push on the COM during the walk.
@@ -253,113 +253,175 @@ fn ankle_reference(
     }
 }
 
-/// Runs the walking imitation.
-pub fn run_walk_imitate(
-    robot: &Robot,
-    refs: &RobotReferences,
-    cfg: &WalkImitateConfig,
-) -> Result<WalkRun> {
-    let dt = cfg.imitate.dt;
-    if (cfg.preview.dt - dt).abs() > 1e-12 {
-        return Err(Error::InvalidSetting {
-            name: "preview.dt".into(),
-            value: cfg.preview.dt.to_string(),
-            expected: format!("the control period {dt} s"),
-        });
+/// What one tick of the [`WalkingController`] decided.
+#[derive(Debug, Clone, Copy)]
+pub struct WalkTick {
+    /// The pattern at this tick (pattern frame: add [`WalkingController::origin`] for world).
+    pub sample: WalkSample,
+    /// The support phase.
+    pub phase: SupportPhase,
+    /// Yaw of the local frame of Figure 11 \[rad\].
+    pub local_yaw: f64,
+    /// The damping controller's COM offset Δc, world axes \[m\].
+    pub com_offset: Vector2<f64>,
+    /// The COM reference given to the IK, world \[m\].
+    pub com_reference: Vector2<f64>,
+    /// The nominal COM (pattern and initial blend, without Δc), world \[m\].
+    pub com_nominal: Vector2<f64>,
+    /// Level (1-based) IKTC corrected from; 0 = none.
+    pub corrected_from: usize,
+    /// QPs this tick.
+    pub qp_solves: usize,
+}
+
+/// The walking imitation's control loop — walking pattern, damping controller and the IK of
+/// the imitation — sized once; [`WalkingController::tick`] allocates nothing.
+#[derive(Debug, Clone)]
+pub struct WalkingController {
+    ctl: ImitationController,
+    plan: FootstepPlan,
+    pattern: WalkingPattern,
+    bal: BalanceController,
+    cases: CaseParams,
+    damping: bool,
+    dt: f64,
+    origin: Vector2<f64>,
+    ankle_offset: Vector3<f64>,
+    com0: Vector3<f64>,
+    blend0: Vector2<f64>,
+    com_blend_time: f64,
+    feet_refs: [FrameReference; 2],
+    dc_prev: Vector2<f64>,
+    dcd_prev: Vector2<f64>,
+}
+
+impl WalkingController {
+    /// Builds the imitation controller, the walking pattern (feet and COM of the robot's
+    /// initial stance, COM height as the cart-table height) and the damping controller (the
+    /// four cases with the COM height as pendulum length).
+    pub fn new(robot: &Robot, refs: &RobotReferences, cfg: &WalkImitateConfig) -> Result<Self> {
+        let dt = cfg.imitate.dt;
+        if (cfg.preview.dt - dt).abs() > 1e-12 {
+            return Err(Error::InvalidSetting {
+                name: "preview.dt".into(),
+                value: cfg.preview.dt.to_string(),
+                expected: format!("the control period {dt} s"),
+            });
+        }
+        if cfg.imitate.feet.len() != 2 {
+            return Err(Error::InvalidSetting {
+                name: "imitate.feet".into(),
+                value: cfg.imitate.feet.join(","),
+                expected: "two feet: right, then left".into(),
+            });
+        }
+        let ctl = ImitationController::new(robot, refs, &cfg.imitate)?;
+        // The imitation lists the right foot first, then the left.
+        let (r0, l0) = (ctl.feet0()[0], ctl.feet0()[1]);
+        let origin = Vector2::new(
+            0.5 * (r0.translation.x + l0.translation.x),
+            0.5 * (r0.translation.y + l0.translation.y),
+        );
+        let ankle_offset = Vector3::new(0.0, 0.0, r0.translation.z.min(l0.translation.z));
+        let com0 = ctl.kinematics().com();
+        let support = cfg.imitate.support;
+        let walk = WalkSettings {
+            foot_separation: (l0.translation.y - r0.translation.y).abs(),
+            sole_length: support.sole_length,
+            sole_width: support.sole_width,
+            ..cfg.walk
+        };
+        let preview = PreviewSettings {
+            com_height: com0.z,
+            dt,
+            ..cfg.preview
+        };
+        let plan = if cfg.step_length == 0.0 {
+            FootstepPlan::in_place(cfg.steps, &walk)?
+        } else {
+            FootstepPlan::forward(cfg.steps, cfg.step_length, &walk)?
+        };
+        let pattern = WalkingPattern::new(&plan, &walk, &preview)?;
+        let l = com0.z;
+        let cases = CaseParams {
+            xz_ssp: with_length(&cfg.cases.xz_ssp, l),
+            xz_dsp: with_length(&cfg.cases.xz_dsp, l),
+            yz_ssp: with_length(&cfg.cases.yz_ssp, l),
+            yz_dsp: with_length(&cfg.cases.yz_dsp, l),
+        };
+        let bal = BalanceController::new(&cases, &cfg.balance, SupportPhase::Double)?;
+        let s0 = pattern.sample(0.0)?;
+        let blend0 = Vector2::new(
+            com0.x - origin.x - s0.com.position.x,
+            com0.y - origin.y - s0.com.position.y,
+        );
+        Ok(Self {
+            feet_refs: [FrameReference::hold(r0), FrameReference::hold(l0)],
+            ctl,
+            plan,
+            pattern,
+            bal,
+            cases,
+            damping: cfg.damping,
+            dt,
+            origin,
+            ankle_offset,
+            com0,
+            blend0,
+            com_blend_time: cfg.com_blend_time,
+            dc_prev: Vector2::zeros(),
+            dcd_prev: Vector2::zeros(),
+        })
     }
-    let mut ctl = ImitationController::new(robot, refs, &cfg.imitate)?;
-    let feet_ids = cfg
-        .imitate
-        .feet
-        .iter()
-        .map(|f| robot.frame_id(f))
-        .collect::<Result<Vec<_>>>()?;
-    if feet_ids.len() != 2 {
-        return Err(Error::InvalidSetting {
-            name: "imitate.feet".into(),
-            value: cfg.imitate.feet.join(","),
-            expected: "two feet: right, then left".into(),
-        });
+
+    /// Ticks in the walk (its duration over Δt, plus one).
+    pub fn ticks(&self) -> usize {
+        (self.pattern.duration() / self.dt).round() as usize + 1
     }
-    // The imitation lists the right foot first, then the left.
-    let (r0, l0) = (ctl.feet0()[0], ctl.feet0()[1]);
-    let origin = Vector2::new(
-        0.5 * (r0.translation.x + l0.translation.x),
-        0.5 * (r0.translation.y + l0.translation.y),
-    );
-    let ankle_offset = Vector3::new(0.0, 0.0, r0.translation.z.min(l0.translation.z));
-    let com0 = ctl.kinematics().com();
-    let support = cfg.imitate.support;
-    let walk = WalkSettings {
-        foot_separation: (l0.translation.y - r0.translation.y).abs(),
-        sole_length: support.sole_length,
-        sole_width: support.sole_width,
-        ..cfg.walk
-    };
-    let preview = PreviewSettings {
-        com_height: com0.z,
-        dt,
-        ..cfg.preview
-    };
-    let plan = if cfg.step_length == 0.0 {
-        FootstepPlan::in_place(cfg.steps, &walk)?
-    } else {
-        FootstepPlan::forward(cfg.steps, cfg.step_length, &walk)?
-    };
-    let pattern = WalkingPattern::new(&plan, &walk, &preview)?;
-    let l = com0.z;
-    let cases = CaseParams {
-        xz_ssp: with_length(&cfg.cases.xz_ssp, l),
-        xz_dsp: with_length(&cfg.cases.xz_dsp, l),
-        yz_ssp: with_length(&cfg.cases.yz_ssp, l),
-        yz_dsp: with_length(&cfg.cases.yz_dsp, l),
-    };
-    let mut bal = BalanceController::new(&cases, &cfg.balance, SupportPhase::Double)?;
-    let sim = SimSettings {
-        control_period: dt,
-        seed: cfg.seed,
-        ..SimSettings::default()
-    };
-    let mass = robot.total_mass();
-    let mut plants = [
-        SimPlant::new(
-            PlantParams::from_model(
-                *cases.get(Plane::Xz, SupportPhase::Double),
-                mass,
-                cfg.noise_std,
-            ),
-            &sim,
-        )?,
-        SimPlant::new(
-            PlantParams::from_model(
-                *cases.get(Plane::Yz, SupportPhase::Double),
-                mass,
-                cfg.noise_std,
-            ),
-            &SimSettings {
-                seed: cfg.seed.wrapping_add(1),
-                ..sim
-            },
-        )?,
-    ];
-    let s0 = pattern.sample(0.0)?;
-    let blend0 = Vector2::new(
-        com0.x - origin.x - s0.com.position.x,
-        com0.y - origin.y - s0.com.position.y,
-    );
-    let n = (pattern.duration() / dt).round() as usize + 1;
-    let mut steps = Vec::with_capacity(n);
-    let mut polygon = SupportPolygon::default();
-    let mut last_phase = SupportPhase::Double;
-    let mut feet_refs = [FrameReference::hold(r0), FrameReference::hold(l0)];
-    let push_tick = cfg.push.map(|p| (p.time / dt).round() as usize);
-    // Δc and its backward-difference rate: fed forward to the COM task so that the commanded
-    // COM follows the controller's offset within a tick instead of through the CLIK lag.
-    let (mut dc_prev, mut dcd_prev) = (Vector2::zeros(), Vector2::zeros());
-    for k in 0..n {
+
+    /// The walking pattern (its own frame; see [`WalkingController::origin`]).
+    pub fn pattern(&self) -> &WalkingPattern {
+        &self.pattern
+    }
+
+    /// The footstep plan.
+    pub fn plan(&self) -> &FootstepPlan {
+        &self.plan
+    }
+
+    /// World position of the pattern's origin (between the initial ankles) \[m\].
+    pub fn origin(&self) -> Vector2<f64> {
+        self.origin
+    }
+
+    /// The four compliance cases with the pendulum length set to the COM height.
+    pub fn cases(&self) -> &CaseParams {
+        &self.cases
+    }
+
+    /// Pendulum length: the initial COM height \[m\].
+    pub fn pendulum_length(&self) -> f64 {
+        self.com0.z
+    }
+
+    /// The imitation's controller (state, kinematics, solver report, limits).
+    pub fn imitation(&self) -> &ImitationController {
+        &self.ctl
+    }
+
+    /// The feet references of the last tick (left, right).
+    pub fn feet_references(&self) -> [FrameReference; 2] {
+        [self.feet_refs[1], self.feet_refs[0]]
+    }
+
+    /// One control tick at index `k` with the measured ZMP deviation `zmp` (x̃, ỹ in the local
+    /// frame of Figure 11) \[m\]: pattern sample, damping controller, COM and feet references,
+    /// IK solve. q̈ is then in the imitation controller, applied by
+    /// [`WalkingController::integrate`]. Allocates nothing.
+    pub fn tick(&mut self, robot: &Robot, k: usize, zmp: [f64; 2]) -> Result<WalkTick> {
+        let dt = self.dt;
         let t = k as f64 * dt;
-        let start = Instant::now();
-        let s = pattern.sample(t)?;
+        let s = self.pattern.sample(t)?;
         let phase = match s.phase {
             Phase::DoubleSupport => SupportPhase::Double,
             Phase::SingleSupport { .. } => SupportPhase::Single,
@@ -370,16 +432,15 @@ pub fn run_walk_imitate(
             Phase::SingleSupport { stance } => s.foot(stance).yaw,
         };
         let rot = Rotation2::new(yaw);
-        // Measured ZMP deviation, local frame.
-        let dev = [plants[0].measure(), plants[1].measure()];
-        let offset_world = if cfg.damping {
-            let out = bal.step(phase, [0.0, 0.0], dev)?;
+        let offset_world = if self.damping {
+            let out = self.bal.step(phase, [0.0, 0.0], zmp)?;
             rot * Vector2::new(out.com_offset[0], out.com_offset[1])
         } else {
             Vector2::zeros()
         };
-        // COM reference: pattern + blend of the initial offset + Δc.
-        let tb = cfg.com_blend_time;
+        // COM reference: pattern + blend of the initial offset + Δc, with Δc's backward
+        // differences fed forward so that the commanded COM follows it within a tick.
+        let tb = self.com_blend_time;
         let (b, bd, bdd) = if tb > 0.0 && t < tb {
             let x = t / tb;
             (
@@ -390,14 +451,16 @@ pub fn run_walk_imitate(
         } else {
             (0.0, 0.0, 0.0)
         };
+        let (origin, blend0) = (self.origin, self.blend0);
         let cp = s.com.position;
-        let cref = Vector2::new(cp.x + origin.x, cp.y + origin.y) + blend0 * b + offset_world;
-        let dcd = (offset_world - dc_prev) / dt;
-        let dcdd = (dcd - dcd_prev) / dt;
-        dc_prev = offset_world;
-        dcd_prev = dcd;
-        ctl.set_com_override(Some(ComReference {
-            position: Vector3::new(cref.x, cref.y, com0.z),
+        let nominal = Vector2::new(cp.x + origin.x, cp.y + origin.y) + blend0 * b;
+        let cref = nominal + offset_world;
+        let dcd = (offset_world - self.dc_prev) / dt;
+        let dcdd = (dcd - self.dcd_prev) / dt;
+        self.dc_prev = offset_world;
+        self.dcd_prev = dcd;
+        self.ctl.set_com_override(Some(ComReference {
+            position: Vector3::new(cref.x, cref.y, self.com0.z),
             velocity: Vector3::new(
                 s.com.velocity.x + blend0.x * bd + dcd.x,
                 s.com.velocity.y + blend0.y * bd + dcd.y,
@@ -409,22 +472,85 @@ pub fn run_walk_imitate(
                 0.0,
             ),
         }));
-        feet_refs[0] = ankle_reference(&s.right, &ankle_offset, &origin);
-        feet_refs[1] = ankle_reference(&s.left, &ankle_offset, &origin);
-        ctl.set_feet_references(&feet_refs)?;
-        let rep = ctl.tick(robot, k)?;
-        let (corrected_from, qp_solves) = (rep.corrected_from.map_or(0, |l| l + 1), rep.qp_solves);
+        self.feet_refs[0] = ankle_reference(&s.right, &self.ankle_offset, &origin);
+        self.feet_refs[1] = ankle_reference(&s.left, &self.ankle_offset, &origin);
+        self.ctl.set_feet_references(&self.feet_refs)?;
+        let rep = self.ctl.tick(robot, k)?;
+        Ok(WalkTick {
+            sample: s,
+            phase,
+            local_yaw: yaw,
+            com_offset: offset_world,
+            com_reference: cref,
+            com_nominal: nominal,
+            corrected_from: rep.corrected_from.map_or(0, |l| l + 1),
+            qp_solves: rep.qp_solves,
+        })
+    }
+
+    /// Applies the last q̈ over Δt.
+    pub fn integrate(&mut self, robot: &Robot) -> Result<()> {
+        self.ctl.integrate(robot)
+    }
+}
+
+/// Runs the walking imitation on the simulated compliant robot.
+pub fn run_walk_imitate(
+    robot: &Robot,
+    refs: &RobotReferences,
+    cfg: &WalkImitateConfig,
+) -> Result<WalkRun> {
+    let dt = cfg.imitate.dt;
+    let mut wc = WalkingController::new(robot, refs, cfg)?;
+    let feet_ids = cfg
+        .imitate
+        .feet
+        .iter()
+        .map(|f| robot.frame_id(f))
+        .collect::<Result<Vec<_>>>()?;
+    let origin = wc.origin();
+    let l = wc.pendulum_length();
+    let cases = *wc.cases();
+    let sim = SimSettings {
+        control_period: dt,
+        seed: cfg.seed,
+        ..SimSettings::default()
+    };
+    let mass = robot.total_mass();
+    let plant = |plane, seed| {
+        SimPlant::new(
+            PlantParams::from_model(*cases.get(plane, SupportPhase::Double), mass, cfg.noise_std),
+            &SimSettings { seed, ..sim },
+        )
+    };
+    let mut plants = [
+        plant(Plane::Xz, cfg.seed)?,
+        plant(Plane::Yz, cfg.seed.wrapping_add(1))?,
+    ];
+    let n = wc.ticks();
+    let mut steps = Vec::with_capacity(n);
+    let mut polygon = SupportPolygon::default();
+    let mut last_phase = SupportPhase::Double;
+    let push_tick = cfg.push.map(|p| (p.time / dt).round() as usize);
+    for k in 0..n {
+        let t = k as f64 * dt;
+        // Measured ZMP deviation of the simulated robot, local frame.
+        let dev = [plants[0].measure(), plants[1].measure()];
+        let start = Instant::now();
+        let wt = wc.tick(robot, k, dev)?;
         let tick_us = start.elapsed().as_secs_f64() * 1e6;
+        let s = wt.sample;
+        let rot = Rotation2::new(wt.local_yaw);
         // The simulated robot: commanded COM deviation from the nominal → pendulum command.
+        let ctl = wc.imitation();
         let kin = ctl.kinematics();
         let com = kin.com();
-        let nominal = Vector2::new(cp.x + origin.x, cp.y + origin.y) + blend0 * b;
-        let d_local = rot.inverse() * (Vector2::new(com.x, com.y) - nominal);
-        if phase != last_phase {
+        let d_local = rot.inverse() * (Vector2::new(com.x, com.y) - wt.com_nominal);
+        if wt.phase != last_phase {
             for (p, plane) in plants.iter_mut().zip(Plane::BOTH) {
-                p.switch_model(*cases.get(plane, phase))?;
+                p.switch_model(*cases.get(plane, wt.phase))?;
             }
-            last_phase = phase;
+            last_phase = wt.phase;
         }
         if Some(k) == push_tick {
             if let Some(p) = cfg.push {
@@ -442,7 +568,7 @@ pub fn run_walk_imitate(
             s.zmp_model.0 + origin.x + zdev.x,
             s.zmp_model.1 + origin.y + zdev.y,
         );
-        pattern.support_polygon_into(t, &mut polygon)?;
+        wc.pattern().support_polygon_into(t, &mut polygon)?;
         let zmp_margin = polygon.margin((zm.0 - origin.x, zm.1 - origin.y));
         let mut feet = [[0.0; 3]; 2];
         for (slot, id) in feet.iter_mut().zip([feet_ids[1], feet_ids[0]]) {
@@ -453,6 +579,7 @@ pub fn run_walk_imitate(
             let p = r.pose.translation.vector;
             [p.x, p.y, p.z]
         };
+        let frefs = wc.feet_references();
         let state: &State = ctl.state();
         steps.push(WalkStep {
             t,
@@ -462,14 +589,14 @@ pub fn run_walk_imitate(
             zmp_measured: [zm.0, zm.1],
             zmp_margin,
             zmp_deviation: dev,
-            com_pattern: [nominal.x, nominal.y],
-            com_reference: [cref.x, cref.y],
+            com_pattern: [wt.com_nominal.x, wt.com_nominal.y],
+            com_reference: [wt.com_reference.x, wt.com_reference.y],
             com: [com.x, com.y, com.z],
-            com_offset: [offset_world.x, offset_world.y],
-            feet_reference: [fr(&feet_refs[1]), fr(&feet_refs[0])],
+            com_offset: [wt.com_offset.x, wt.com_offset.y],
+            feet_reference: [fr(&frefs[0]), fr(&frefs[1])],
             feet,
-            corrected_from,
-            qp_solves,
+            corrected_from: wt.corrected_from,
+            qp_solves: wt.qp_solves,
             tick_us,
             links: kin
                 .link_poses()
@@ -480,8 +607,11 @@ pub fn run_walk_imitate(
             qd: state.qd.as_slice().to_vec(),
             qdd: ctl.qdd().as_slice().to_vec(),
         });
-        ctl.integrate(robot)?;
+        wc.integrate(robot)?;
     }
+    let plan = wc.plan();
+    let pattern = wc.pattern();
+    let ctl = wc.imitation();
     let footsteps = {
         let mut v = vec![
             (
@@ -513,7 +643,7 @@ pub fn run_walk_imitate(
         .iter()
         .map(|p| (p.start, p.end, phase_code(p.phase)))
         .collect();
-    let summary = summarize(robot, cfg, &ctl, &steps, pattern.duration())?;
+    let summary = summarize(robot, cfg, ctl, &steps, pattern.duration())?;
     Ok(WalkRun {
         steps,
         footsteps,
