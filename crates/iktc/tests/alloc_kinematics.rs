@@ -1,44 +1,15 @@
 //! The control tick allocates nothing: kinematics and task linearisation on a built model,
 //! checked with a counting global allocator (its own test binary).
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
-
 use iktc::model::*;
 use iktc::task::*;
 use nalgebra::DMatrix;
 
-struct Counting;
-
-thread_local! {
-    // Counted per thread: the test harness may allocate on its own threads meanwhile.
-    static ALLOCS: Cell<usize> = const { Cell::new(0) };
-}
-
-fn count() -> usize {
-    ALLOCS.with(|c| c.get())
-}
-
-fn bump() {
-    let _ = ALLOCS.try_with(|c| c.set(c.get() + 1));
-}
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, l: Layout) -> *mut u8 {
-        bump();
-        unsafe { System.alloc(l) }
-    }
-    unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
-        unsafe { System.dealloc(p, l) }
-    }
-    unsafe fn realloc(&self, p: *mut u8, l: Layout, n: usize) -> *mut u8 {
-        bump();
-        unsafe { System.realloc(p, l, n) }
-    }
-}
+mod counting_alloc;
+use counting_alloc::allocations as count;
 
 #[global_allocator]
-static A: Counting = Counting;
+static A: counting_alloc::Counting = counting_alloc::Counting;
 
 #[test]
 fn kinematics_and_tasks_allocate_nothing() {

@@ -2,33 +2,18 @@
 //! GF, integration) allocates nothing, checked with a counting global allocator (its own test
 //! binary).
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
-
 use iktc::model::{jvrc1, ModelOptions};
 use iktc::motion::{builtin_clip, builtin_map};
-use iktc::sim::{imitation_references, ImitateConfig, ImitationController};
+use iktc::sim::{
+    imitation_references, ImitateConfig, ImitationController, WalkImitateConfig, WalkingController,
+};
 use iktc::solver::Method;
 
-struct Counting;
-static ALLOCS: AtomicUsize = AtomicUsize::new(0);
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, l: Layout) -> *mut u8 {
-        ALLOCS.fetch_add(1, Ordering::SeqCst);
-        unsafe { System.alloc(l) }
-    }
-    unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
-        unsafe { System.dealloc(p, l) }
-    }
-    unsafe fn realloc(&self, p: *mut u8, l: Layout, n: usize) -> *mut u8 {
-        ALLOCS.fetch_add(1, Ordering::SeqCst);
-        unsafe { System.realloc(p, l, n) }
-    }
-}
+mod counting_alloc;
+use counting_alloc::allocations;
 
 #[global_allocator]
-static A: Counting = Counting;
+static A: counting_alloc::Counting = counting_alloc::Counting;
 
 #[test]
 fn the_humanoid_tick_allocates_nothing() {
@@ -43,12 +28,12 @@ fn the_humanoid_tick_allocates_nothing() {
         };
         let mut ctl = ImitationController::new(&robot, &refs, &cfg).unwrap();
         let mut qps = 0;
-        let before = ALLOCS.load(Ordering::SeqCst);
+        let before = allocations();
         for k in 0..refs.len() {
             qps += ctl.tick(&robot, k).unwrap().qp_solves;
             ctl.integrate(&robot).unwrap();
         }
-        let after = ALLOCS.load(Ordering::SeqCst);
+        let after = allocations();
         // The run must have exercised the QPs, not only the unconstrained solution.
         assert!(qps > 100, "{} QPs", qps);
         assert_eq!(
@@ -60,4 +45,40 @@ fn the_humanoid_tick_allocates_nothing() {
             method
         );
     }
+}
+
+#[test]
+fn the_walking_tick_allocates_nothing() {
+    let robot = jvrc1(&ModelOptions::default()).unwrap();
+    let clip = builtin_clip("humanoid3d_dance_b").unwrap();
+    let map = builtin_map("deepmimic_jvrc1").unwrap();
+    let refs = imitation_references(&robot, &clip, &map, &ImitateConfig::default()).unwrap();
+    let mut wc =
+        WalkingController::new(&robot, &refs, &WalkImitateConfig::jvrc1().unwrap()).unwrap();
+    let n = wc.ticks();
+    let before = allocations();
+    let mut single = 0;
+    for k in 0..n {
+        // A small measured ZMP deviation keeps the damping controller busy.
+        let zmp = [
+            1e-3 * (0.01 * k as f64).sin(),
+            -1e-3 * (0.013 * k as f64).cos(),
+        ];
+        let t = wc.tick(&robot, k, zmp).unwrap();
+        if t.phase == iktc::balance::SupportPhase::Single {
+            single += 1;
+        }
+        wc.integrate(&robot).unwrap();
+    }
+    let after = allocations();
+    assert!(
+        single > 100,
+        "the walk must include single support ({single} ticks)"
+    );
+    assert_eq!(
+        after - before,
+        0,
+        "{} allocations in {n} walking ticks",
+        after - before
+    );
 }
