@@ -10,17 +10,30 @@
 //! * IKTC: when the prioritized solution leaves the box, an optimal correction of the
 //!   lowest-priority tasks by one small QP (eqs. 19–25, Algorithms 1–2);
 //! * baselines: the cascade of QPs (GF, Kanoun et al.) and clamping;
-//! * the ZMP damping controller on the inverted pendulum with a compliant joint (Section 4).
+//! * the ZMP damping controller on the inverted pendulum with a compliant joint (Section 4);
+//! * captured motion (DeepMimic, BVH) retargeted to robot references, a walking pattern
+//!   generator, and the paper's experiments as scenarios.
 //!
 //! The flow of one control tick is
 //! *state → [`model::Kinematics`] → tasks (plain `J q̈ = h` data) → acceleration box → solver*.
+//!
+//! | module | what |
+//! |---|---|
+//! | [`model`] | robot model (URDF or code), state, kinematics |
+//! | [`task`] | frame, COM and joint tasks, the priority stack |
+//! | [`limits`] | joint limits → acceleration box (eq. 14, viable bounds) |
+//! | [`solver`] | prioritized solution, IKTC, GF, clamp, the dense QP |
+//! | [`balance`] | the damping controller of Section 4 |
+//! | [`motion`] | motion capture readers, retargeting |
+//! | [`walk`] | footsteps, ZMP preview control, swing feet |
+//! | [`sim`] | the 3R arm, the imitation, walking while imitating |
 //!
 //! ## Notation
 //!
 //! | symbol | meaning | unit |
 //! |---|---|---|
 //! | `q` | configuration: floating-base position and unit quaternion (if any), then joint positions | m, –, rad or m |
-//! | `q̇` (`qd`) | generalized velocity, length `nv`: base twist (linear, angular, world axes) then joint rates | m/s, rad/s |
+//! | `q̇` (`qd`) | generalized velocity, length `nv`: base body twist (linear, angular, in base axes) then joint rates | m/s, rad/s |
 //! | `q̈` (`qdd`) | generalized acceleration, length `nv` | m/s², rad/s² |
 //! | `J_i` | Jacobian of task *i*, `m_i × nv` | – |
 //! | `h_i` | right-hand side of task *i*, `ẍ_d + k_v(ẋ_d − ẋ) + k_p(x_d − x) − J̇q̇` (eqs. 3, 11) | task units / s² |
