@@ -336,15 +336,19 @@ impl Robot {
         }
         // Locked values and acceleration limits by name.
         let all_joint_names = || b.joints.iter().map(|j| j.name.clone()).collect::<Vec<_>>();
+        let find_joint = |kind: &'static str, name: &str| -> Result<usize> {
+            joint_names
+                .get(name)
+                .copied()
+                .ok_or_else(|| Error::UnknownName {
+                    kind,
+                    name: name.to_string(),
+                    valid: all_joint_names(),
+                })
+        };
         let mut locked: HashMap<usize, f64> = HashMap::new();
         for (name, value) in &options.locked {
-            let j = *joint_names
-                .get(name.as_str())
-                .ok_or_else(|| Error::UnknownName {
-                    kind: "joint",
-                    name: name.clone(),
-                    valid: all_joint_names(),
-                })?;
+            let j = find_joint("joint", name)?;
             crate::error::check_finite(|| format!("locked value of joint `{name}`"), *value)?;
             if matches!(b.joints[j].kind, JointKind::Fixed) {
                 return Err(Error::InvalidSetting {
@@ -358,13 +362,7 @@ impl Robot {
         }
         let mut accel: HashMap<usize, f64> = HashMap::new();
         for (name, value) in &options.acceleration_limits {
-            let j = *joint_names
-                .get(name.as_str())
-                .ok_or_else(|| Error::UnknownName {
-                    kind: "joint",
-                    name: name.clone(),
-                    valid: all_joint_names(),
-                })?;
+            let j = find_joint("joint", name)?;
             if value.is_nan() || *value <= 0.0 {
                 return Err(Error::InvalidSetting {
                     name: format!("acceleration limit of joint `{name}`"),
@@ -428,13 +426,7 @@ impl Robot {
             if locked.contains_key(&j) || matches!(s.kind, JointKind::Fixed) {
                 continue;
             }
-            let m = *joint_names
-                .get(master.as_str())
-                .ok_or_else(|| Error::UnknownName {
-                    kind: "joint (mimic master)",
-                    name: master.clone(),
-                    valid: all_joint_names(),
-                })?;
+            let m = find_joint("joint (mimic master)", master)?;
             crate::error::check_all_finite(
                 &format!("mimic of joint `{}`", s.name),
                 &[*mult, *off],
