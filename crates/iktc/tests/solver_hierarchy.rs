@@ -145,17 +145,26 @@ fn rank_deficient_levels_are_handled() {
 fn g_is_the_derivative_of_the_solution_with_respect_to_h() {
     // Algorithm 1: the solution is affine in the right-hand sides; column j of g_i is the
     // change of q̈ when h_i moves by e_j (eq. 20), measured by re-running the recursion.
+    // Damping depends on the Jacobians only, so the solution stays affine in h with any
+    // damping rule: cases cycle through none, fixed and the default (adaptive).
     let mut r = rng(24);
     for case in 0..30 {
         let n = 10 + case % 10;
         let dims = [3, 2, 1 + case % 4];
         let mut levels = random_levels(&mut r, n, &dims);
+        let settings = SolverSettings {
+            damping: match case % 3 {
+                0 => Damping::None,
+                1 => Damping::Fixed(0.2),
+                _ => SolverSettings::default().damping,
+            },
+            ..Default::default()
+        };
         let mut h = Hierarchy::new(n, &dims);
         let mut q0 = DVector::zeros(n);
-        h.solve(&levels, &SolverSettings::default(), &mut q0)
-            .unwrap();
+        h.solve(&levels, &settings, &mut q0).unwrap();
         for i in 0..dims.len() {
-            h.build_g_level(&levels, i);
+            h.build_g_level(i);
         }
         let g = h.g().clone();
         let mut col = 0;
@@ -164,8 +173,7 @@ fn g_is_the_derivative_of_the_solution_with_respect_to_h() {
                 levels[i].rhs[j] += 1.0;
                 let mut q1 = DVector::zeros(n);
                 let mut h2 = Hierarchy::new(n, &dims);
-                h2.solve(&levels, &SolverSettings::default(), &mut q1)
-                    .unwrap();
+                h2.solve(&levels, &settings, &mut q1).unwrap();
                 levels[i].rhs[j] -= 1.0;
                 let d = &q1 - &q0;
                 assert!(
@@ -174,6 +182,45 @@ fn g_is_the_derivative_of_the_solution_with_respect_to_h() {
                 );
                 col += 1;
             }
+        }
+    }
+}
+
+#[test]
+fn pinv_is_the_pseudo_inverse_of_the_projected_jacobian() {
+    // J̄_i⁺ = (J_i N_{i−1})⁺ with N_{i−1} = I − A⁺A from the stacked Jacobian A of the levels
+    // above, by SVD (λ = 0), against the matrix the factorization forms on request.
+    let mut r = rng(25);
+    let settings = SolverSettings {
+        damping: Damping::None,
+        ..Default::default()
+    };
+    for case in 0..40 {
+        let n = 6 + case % 10;
+        let dims = [2, 1 + case % 3, 3];
+        let levels = random_levels(&mut r, n, &dims);
+        let mut h = Hierarchy::new(n, &dims);
+        let mut q = DVector::zeros(n);
+        h.solve(&levels, &settings, &mut q).unwrap();
+        let mut stacked = DMatrix::<f64>::zeros(0, n);
+        for (i, l) in levels.iter().enumerate() {
+            let na = if stacked.nrows() == 0 {
+                DMatrix::<f64>::identity(n, n)
+            } else {
+                DMatrix::<f64>::identity(n, n)
+                    - stacked.clone().pseudo_inverse(1e-9).unwrap() * &stacked
+            };
+            let want = (&l.jacobian * na).pseudo_inverse(1e-9).unwrap();
+            let got = h.pinv(i).clone();
+            assert!(
+                (&got - &want).norm() < REL_TOL * (1.0 + want.norm()),
+                "case {case} level {i}: {}",
+                (&got - &want).norm()
+            );
+            let mut b = DMatrix::zeros(stacked.nrows() + l.dim(), n);
+            b.rows_mut(0, stacked.nrows()).copy_from(&stacked);
+            b.rows_mut(stacked.nrows(), l.dim()).copy_from(&l.jacobian);
+            stacked = b;
         }
     }
 }

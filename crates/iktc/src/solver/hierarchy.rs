@@ -6,19 +6,33 @@
 //!
 //! q̈_i = q̈_{i−1} + J̄_i^{λ+} (h_i − J_i q̈_{i−1}),  J̄_i = J_i N_{i−1}  (eqs. 5–7),
 //!
-//! where N_{i−1} projects onto the null space of the levels above. Instead of n × n projectors
-//! we keep an orthonormal basis Z (n × k) of that null space, N_{i−1} = Z Zᵀ. Then
-//! J̄_i = (J_i Z) Zᵀ and, with the column-pivoted QR (J_i Z)ᵀ Π = Q R of rank r (pivots
-//! |R_jj| above the rank threshold), J_i Z = Π R_rᵀ Q_rᵀ, so
+//! where N_{i−1} projects onto the null space of the levels above. No n × n projector is
+//! formed. The levels are reduced one after the other by Householder reflectors, as in a
+//! complete orthogonal decomposition of the stacked Jacobian: with Q = H_0 H_1 ⋯ (all
+//! reflectors so far) and u = Qᵀ q̈, the levels above level i occupy the first p_i reduced
+//! coordinates, and the null space of the levels above is spanned by the remaining columns
+//! Z = Q\[:, p_i..n\], so N_{i−1} = Z Zᵀ. The rows of every lower level are kept multiplied by
+//! the reflectors found so far, W_j = J_j Q, so the reduced Jacobian of level i is simply
+//! A_iᵀ = W_i\[:, p_i..n\] = J_i Z (m_i × k, k = n − p_i) — no product with a basis.
+//!
+//! The column-pivoted Householder QR A_i Π = H_{p_i} ⋯ H_{p_i+r−1} R keeps the r pivots with
+//! |R_jj| above the rank threshold. Then J_i Z = Π R_rᵀ Q_rᵀ and
 //!
 //! J̄_i^{λ+} = Z Q_r (R_r R_rᵀ + λ² I)⁻¹ R_r Πᵀ,
 //!
-//! which is the Moore–Penrose inverse for λ = 0 (eq. 4) and the damped least-squares inverse
-//! (eqs. 8–9) otherwise. The next basis is Z Q_{r+1..k}. Cost O(n k m) per level: no n × n
-//! product, no SVD.
+//! the Moore–Penrose inverse for λ = 0 (eq. 4) and the damped least-squares inverse (eqs. 8–9)
+//! otherwise. Z Q_r are the reduced coordinates p_i..p_i + r, so level i sets
+//!
+//! u\[p_i..p_i+r\] = S_i⁻¹ R_r Πᵀ (h_i − W_i\[:, 0..p_i\] u\[0..p_i\]),  S_i = R_r R_rᵀ + λ² I,
+//!
+//! the new reflectors are applied to the rows of the lower levels, and p_{i+1} = p_i + r. At
+//! the end q̈ = Q u. Cost: one Householder reduction of the stacked Jacobian, O(n² Σm_i),
+//! instead of the O(n² Σm_i) products with an explicit basis on top of it; no SVD.
 //!
 //! Algorithm 1 builds G = \[g_1 … g_{n_T}\] with g_i = (Π_{k>i} (I − J̄_k^{λ+} J_k)) J̄_i^{λ+},
-//! so that adding corrections Δh to the right-hand sides changes the solution by G Δh (eq. 20).
+//! which is ∂q̈/∂h_i: adding corrections Δh to the right-hand sides changes the solution by
+//! G Δh (eq. 20). In reduced coordinates it is the same forward substitution as the solution,
+//! driven by a unit right-hand side of level i and no h elsewhere, followed by Q.
 
 use nalgebra::{DMatrix, DVector};
 
@@ -31,40 +45,39 @@ use crate::task::TaskEquation;
 pub struct Hierarchy {
     n: usize,
     dims: Vec<usize>,
+    /// Offset of level i among the stacked task rows (and the columns of G).
     offsets: Vec<usize>,
-    /// J̄_i^{λ+}, n × m_i per level.
-    pinv: Vec<DMatrix<f64>>,
-    /// Rank kept per level.
+    /// Rank r_i kept per level.
     ranks: Vec<usize>,
-    /// G, n × Σm_i, blocks in level order; columns of level i valid once built.
-    g: DMatrix<f64>,
-    /// Null-space basis Z (first k columns valid) and its product with Q.
-    z: DMatrix<f64>,
-    zq: DMatrix<f64>,
-    k: usize,
-    /// (J Z)ᵀ in place → R (upper part), Householder vectors.
-    a: DMatrix<f64>,
+    /// First reduced coordinate p_i of level i.
+    starts: Vec<usize>,
+    /// Wᵀ (n × Σm_i): column j is stacked task row j multiplied by the reflectors of the
+    /// levels above its own.
+    w: DMatrix<f64>,
+    /// Householder vectors: column s acts on the coordinates s..vend\[s\]
+    /// (H_s = I − τ_s v_s v_sᵀ); there is one reflector per kept pivot, Σ r_i ≤ n in all.
     v: DMatrix<f64>,
     tau: Vec<f64>,
-    perm: Vec<usize>,
+    vend: Vec<usize>,
+    /// Number of reflectors, Σ r_i.
+    nref: usize,
+    /// Per level: R_r (upper trapezoidal, r_i × m_i, in an m_i × m_i buffer), the Cholesky
+    /// factor L of S_i (lower, r_i × r_i) and the pivot order Π.
+    rfac: Vec<DMatrix<f64>>,
+    chol: Vec<DMatrix<f64>>,
+    perm: Vec<Vec<usize>>,
+    /// Scratch: A_i (k × m_i) during the QR, its column norms, the reduced solution u, a
+    /// reduced G column, a level residual and a small vector.
+    a: DMatrix<f64>,
     colnorm: Vec<f64>,
-    /// Small r × r system and r × m result.
-    s: DMatrix<f64>,
-    t: DMatrix<f64>,
-    tmp_n: DVector<f64>,
-    tmp_m: DVector<f64>,
-    residual: DVector<f64>,
-    /// Jᵀ of the current level (n × m_max) and T with permuted columns (m_max × m_max).
-    jt: DMatrix<f64>,
-    tp: DMatrix<f64>,
-    /// Indices of the non-zero entries of one task row.
-    nz: Vec<usize>,
-    /// The last level keeps J̄⁺ factored as Z · Y with Y = Q_r T Πᵀ (k × m): its solution
-    /// needs only J̄⁺ times the residual, and J̄⁺ itself only when G is built.
-    y_last: DMatrix<f64>,
-    tmp_k: DVector<f64>,
-    k_last: usize,
-    last_ready: bool,
+    u: DVector<f64>,
+    y: Vec<f64>,
+    res: Vec<f64>,
+    x: Vec<f64>,
+    /// G, n × Σm_i, blocks in level order; columns of level i valid once built.
+    g: DMatrix<f64>,
+    /// J̄_i^{λ+} formed on request ([`Hierarchy::pinv`]); never in the tick.
+    pinv: Vec<DMatrix<f64>>,
 }
 
 impl Hierarchy {
@@ -82,29 +95,24 @@ impl Hierarchy {
             n,
             dims: dims.to_vec(),
             offsets,
-            pinv: dims.iter().map(|&m| DMatrix::zeros(n, m)).collect(),
             ranks: vec![0; dims.len()],
-            g: DMatrix::zeros(n, total.max(1)),
-            z: DMatrix::zeros(n, n),
-            zq: DMatrix::zeros(n, n),
-            k: n,
+            starts: vec![0; dims.len()],
+            w: DMatrix::zeros(n, total.max(1)),
+            v: DMatrix::zeros(n, n),
+            tau: vec![0.0; n],
+            vend: vec![0; n],
+            nref: 0,
+            rfac: dims.iter().map(|&m| DMatrix::zeros(m, m)).collect(),
+            chol: dims.iter().map(|&m| DMatrix::zeros(m, m)).collect(),
+            perm: dims.iter().map(|&m| vec![0; m]).collect(),
             a: DMatrix::zeros(n.max(1), mmax),
-            v: DMatrix::zeros(n.max(1), mmax),
-            tau: vec![0.0; mmax],
-            perm: vec![0; mmax],
             colnorm: vec![0.0; mmax],
-            s: DMatrix::zeros(mmax, mmax),
-            t: DMatrix::zeros(mmax, mmax),
-            tmp_n: DVector::zeros(n),
-            tmp_m: DVector::zeros(mmax),
-            residual: DVector::zeros(mmax),
-            jt: DMatrix::zeros(n, mmax),
-            tp: DMatrix::zeros(mmax, mmax),
-            nz: vec![0; n],
-            y_last: DMatrix::zeros(n.max(1), mmax),
-            tmp_k: DVector::zeros(n),
-            k_last: 0,
-            last_ready: true,
+            u: DVector::zeros(n),
+            y: vec![0.0; n],
+            res: vec![0.0; mmax],
+            x: vec![0.0; mmax],
+            g: DMatrix::zeros(n, total.max(1)),
+            pinv: dims.iter().map(|&m| DMatrix::zeros(n, m)).collect(),
         }
     }
 
@@ -128,34 +136,17 @@ impl Hierarchy {
         &self.ranks
     }
 
-    /// J̄_i^{λ+} of level i (n × m_i), from the last solve.
+    /// J̄_i^{λ+} of level i (n × m_i), from the last solve. Formed on request from the
+    /// factorization (column c is Q applied to S_i⁻¹ R_r Πᵀ e_c placed at p_i); not needed by
+    /// the solvers, which use the factors directly.
     pub fn pinv(&mut self, i: usize) -> &DMatrix<f64> {
-        self.ensure_last_pinv();
+        for c in 0..self.dims[i] {
+            self.y.fill(0.0);
+            self.level_unit(i, c, false);
+            self.apply_q_to_y();
+            self.pinv[i].column_mut(c).copy_from_slice(&self.y);
+        }
         &self.pinv[i]
-    }
-
-    /// Forms J̄⁺ = Z · Y of the last level if it is still factored.
-    fn ensure_last_pinv(&mut self) {
-        if self.last_ready || self.dims.is_empty() {
-            return;
-        }
-        let last = self.dims.len() - 1;
-        let (n, m, k) = (self.n, self.dims[last], self.k_last);
-        let zs = self.z.as_slice();
-        let yr = self.y_last.nrows();
-        let ys = self.y_last.as_slice();
-        let pi = self.pinv[last].as_mut_slice();
-        for c in 0..m {
-            let out = &mut pi[c * n..(c + 1) * n];
-            out.fill(0.0);
-            for a in 0..k {
-                let f = ys[a + c * yr];
-                if f != 0.0 {
-                    axpy(f, &zs[a * n..(a + 1) * n], out);
-                }
-            }
-        }
-        self.last_ready = true;
     }
 
     /// G (n × Σm_i); the blocks of levels ≥ `from` are valid after
@@ -189,103 +180,83 @@ impl Hierarchy {
     ) -> Result<()> {
         self.check(levels)?;
         check_dim("q̈", self.n, qdd.len())?;
-        let n = self.n;
-        qdd.fill(0.0);
-        self.z.fill(0.0);
-        for d in 0..n {
-            self.z[(d, d)] = 1.0;
-        }
-        self.k = n;
+        // Wᵀ ← Jᵀ of every level.
+        let wr = self.w.nrows();
         for (i, lvl) in levels.iter().enumerate() {
-            let m = self.dims[i];
-            self.level_inverse(i, &lvl.jacobian, settings);
-            // residual = h_i − J_i q̈_{i−1};  q̈ += J̄⁺ residual.
-            let mut res = self.residual.rows_mut(0, m);
-            res.copy_from(&lvl.rhs);
-            res.gemv(-1.0, &lvl.jacobian, qdd, 1.0);
-            if i + 1 == levels.len() {
-                // q̈ += Z (Y residual).
-                let k = self.k_last;
-                let mut y = self.tmp_k.rows_mut(0, k);
-                y.gemv(
-                    1.0,
-                    &self.y_last.view((0, 0), (k, m)),
-                    &self.residual.rows(0, m),
-                    0.0,
-                );
-                qdd.gemv(
-                    1.0,
-                    &self.z.view((0, 0), (n, k)),
-                    &self.tmp_k.rows(0, k),
-                    1.0,
-                );
-            } else {
-                qdd.gemv(1.0, &self.pinv[i], &self.residual.rows(0, m), 1.0);
+            let off = self.offsets[i];
+            let ws = self.w.as_mut_slice();
+            for r in 0..lvl.dim() {
+                let col = &mut ws[(off + r) * wr..(off + r + 1) * wr];
+                for (d, x) in col.iter_mut().enumerate() {
+                    *x = lvl.jacobian[(r, d)];
+                }
             }
         }
+        self.u.fill(0.0);
+        self.nref = 0;
+        for (i, lvl) in levels.iter().enumerate() {
+            let p = self.nref;
+            self.starts[i] = p;
+            self.reduce_level(i, settings);
+            let (m, r) = (self.dims[i], self.ranks[i]);
+            if r == 0 {
+                continue;
+            }
+            // residual = h_i − W_i[:, 0..p] u[0..p] (u is zero from p on).
+            let off = self.offsets[i];
+            let ws = self.w.as_slice();
+            let us = &self.u.as_slice()[..p];
+            for c in 0..m {
+                let wc = &ws[(off + c) * wr..(off + c) * wr + p];
+                self.res[c] = lvl.rhs[c] - dot(wc, us);
+            }
+            // u[p..p+r] = S⁻¹ R_r Πᵀ residual.
+            for c in 0..m {
+                self.x[c] = self.res[self.perm[i][c]];
+            }
+            let (rf, ch) = (&self.rfac[i], &self.chol[i]);
+            let out = &mut self.u.as_mut_slice()[p..p + r];
+            apply_t(rf, ch, r, m, &self.x[..m], out);
+        }
+        // q̈ = Q u.
+        qdd.copy_from(&self.u);
+        apply_q(
+            &self.v,
+            &self.tau,
+            &self.vend,
+            self.nref,
+            qdd.as_mut_slice(),
+        );
         Ok(())
     }
 
-    /// J̄_i^{λ+} for level i from the current basis Z, then Z ← basis of null(J_i Z) within Z.
-    fn level_inverse(&mut self, i: usize, j: &DMatrix<f64>, settings: &SolverSettings) {
-        let (n, m, k) = (self.n, self.dims[i], self.k);
-        let last = i + 1 == self.dims.len();
-        self.pinv[i].fill(0.0);
-        if last {
-            self.k_last = 0;
-            self.last_ready = true;
-        }
+    /// Reduces level i: pivoted QR of A_i = (W_i\[:, p..n\])ᵀ, the factors R_r, L and Π, the
+    /// damping, and the new reflectors applied to the rows of the lower levels.
+    fn reduce_level(&mut self, i: usize, settings: &SolverSettings) {
+        let (n, m, p) = (self.n, self.dims[i], self.nref);
+        let k = n - p;
+        self.ranks[i] = 0;
         if m == 0 || k == 0 {
-            self.ranks[i] = 0;
             return;
         }
-        // A = (J Z)ᵀ = Zᵀ Jᵀ, k × m.
-        self.jt.view_mut((0, 0), (n, m)).tr_copy_from(j);
-        // Entry (a, c) is the dot product of column a of Z and column c of Jᵀ (both contiguous).
-        // Written out: nalgebra's gemm may allocate packing buffers, and the tick must not.
-        if k == n && i == 0 {
-            // First level: Z = I, so A = Jᵀ.
-            self.a
-                .view_mut((0, 0), (n, m))
-                .copy_from(&self.jt.view((0, 0), (n, m)));
-        } else {
-            let zs = self.z.as_slice();
-            let js = self.jt.as_slice();
-            let arows = self.a.nrows();
+        let off = self.offsets[i];
+        let wr = self.w.nrows();
+        let ar = self.a.nrows();
+        {
+            let ws = self.w.as_slice();
             let asl = self.a.as_mut_slice();
             for c in 0..m {
-                let jc = &js[c * n..(c + 1) * n];
-                // Task rows are often sparse (a joint task selects one dof, the pelvis moves
-                // with the base only): when fewer than half the entries are non-zero, sum over
-                // those alone.
-                let mut nnz = 0;
-                for (d, v) in jc.iter().enumerate() {
-                    if *v != 0.0 {
-                        self.nz[nnz] = d;
-                        nnz += 1;
-                    }
-                }
-                if 2 * nnz < n {
-                    let idx = &self.nz[..nnz];
-                    for a in 0..k {
-                        let za = &zs[a * n..(a + 1) * n];
-                        asl[a + c * arows] = idx.iter().map(|&d| za[d] * jc[d]).sum();
-                    }
-                } else {
-                    for a in 0..k {
-                        let za = &zs[a * n..(a + 1) * n];
-                        asl[a + c * arows] = dot(za, jc);
-                    }
-                }
+                asl[c * ar..c * ar + k]
+                    .copy_from_slice(&ws[(off + c) * wr + p..(off + c + 1) * wr]);
             }
+        }
+        let perm = &mut self.perm[i];
+        for (c, pc) in perm.iter_mut().enumerate() {
+            *pc = c;
         }
         // Householder QR with column pivoting of A (k × m).
         let steps = k.min(m);
-        for c in 0..m {
-            self.perm[c] = c;
-        }
         let mut rank = 0;
-        let ar = self.a.nrows();
         let vr = self.v.nrows();
         for st in 0..steps {
             // Pivot: the remaining column of largest norm (rows st..k).
@@ -304,7 +275,7 @@ impl Hierarchy {
             }
             if best != st {
                 self.a.swap_columns(st, best);
-                self.perm.swap(st, best);
+                perm.swap(st, best);
                 self.colnorm.swap(st, best);
             }
             let norm = self.colnorm[st].sqrt();
@@ -312,229 +283,214 @@ impl Hierarchy {
                 break;
             }
             // v = x − α e1 with α = −sign(x0)‖x‖; H = I − τ v vᵀ, τ = 2 / vᵀv.
+            let s = p + st;
             let asl = self.a.as_mut_slice();
             let vsl = self.v.as_mut_slice();
             let x0 = asl[st * ar + st];
             let alpha = if x0 >= 0.0 { -norm } else { norm };
-            let vcol = &mut vsl[st * vr..st * vr + k];
-            vcol[..st].fill(0.0);
-            vcol[st..k].copy_from_slice(&asl[st * ar + st..st * ar + k]);
-            vcol[st] = x0 - alpha;
-            let v = &vcol[st..k];
+            let vcol = &mut vsl[s * vr + s..s * vr + n];
+            vcol.copy_from_slice(&asl[st * ar + st..st * ar + k]);
+            vcol[0] = x0 - alpha;
+            let mut end = vcol.len();
+            while end > 1 && vcol[end - 1] == 0.0 {
+                end -= 1;
+            }
+            self.vend[s] = s + end;
+            let v = &vcol[..end];
             let vv = dot(v, v);
             let tau = if vv > 0.0 { 2.0 / vv } else { 0.0 };
-            self.tau[st] = tau;
-            // Apply H to the remaining columns of A.
-            for c in st..m {
-                let col = &mut asl[c * ar + st..c * ar + k];
+            self.tau[s] = tau;
+            // Apply H to the remaining columns of A: column st becomes α e1.
+            asl[st * ar + st] = alpha;
+            asl[st * ar + st + 1..st * ar + k].fill(0.0);
+            for c in st + 1..m {
+                let col = &mut asl[c * ar + st..c * ar + st + end];
                 let f = tau * dot(v, col);
-                for (x, vi) in col.iter_mut().zip(v) {
-                    *x -= f * vi;
+                if f != 0.0 {
+                    axpy(-f, v, col);
                 }
             }
             rank = st + 1;
         }
         self.ranks[i] = rank;
-        // ZQ = Z H_1 … H_rank (n × k): each reflector is a rank-one update
-        // ZQ ← ZQ − τ (ZQ v) vᵀ on the columns st..k.
-        if !last {
-            self.zq
-                .view_mut((0, 0), (n, k))
-                .copy_from(&self.z.view((0, 0), (n, k)));
-            let vr = self.v.nrows();
-            let vsl = self.v.as_slice();
-            let zq = self.zq.as_mut_slice();
-            let w = &mut self.tmp_n.as_mut_slice()[..n];
-            for st in 0..rank {
-                let tau = self.tau[st];
-                let v = &vsl[st * vr + st..st * vr + k];
-                // w = ZQ[:, st..k] v, then ZQ[:, st + a] −= τ v_a w. Zero entries of v (dofs a
-                // level does not move, e.g. the arms for the feet) are skipped.
-                w.fill(0.0);
-                for (a, &va) in v.iter().enumerate() {
-                    if va != 0.0 {
-                        axpy(va, &zq[(st + a) * n..(st + a + 1) * n], w);
-                    }
-                }
-                for (a, &va) in v.iter().enumerate() {
-                    if va != 0.0 {
-                        axpy(-tau * va, w, &mut zq[(st + a) * n..(st + a + 1) * n]);
-                    }
-                }
-            }
-        }
-        if rank > 0 {
-            // λ² from the damping rule; σ_min estimated by the last kept pivot |R_rr|.
-            let sigma = self.a[(rank - 1, rank - 1)].abs();
-            let lambda2 = match settings.damping {
-                Damping::None => 0.0,
-                Damping::Fixed(l) => l * l,
-                Damping::Adaptive { max, threshold } => {
-                    if sigma < threshold {
-                        (1.0 - (sigma / threshold).powi(2)) * max * max
-                    } else {
-                        0.0
-                    }
-                }
-            };
-            // S = R_r R_rᵀ + λ² I (r × r), R_r = rows 0..r of R (upper trapezoidal, r × m).
-            for p in 0..rank {
-                for q in 0..=p {
-                    let mut s = 0.0;
-                    for c in p.max(q)..m {
-                        s += self.a[(p, c)] * self.a[(q, c)];
-                    }
-                    if p == q {
-                        s += lambda2;
-                    }
-                    self.s[(p, q)] = s;
-                    self.s[(q, p)] = s;
-                }
-            }
-            // Cholesky S = L Lᵀ in place (lower). S is SPD: R_r has full row rank r.
-            for p in 0..rank {
-                let mut d = self.s[(p, p)];
-                for q in 0..p {
-                    d -= self.s[(p, q)] * self.s[(p, q)];
-                }
-                let l = d.max(f64::MIN_POSITIVE).sqrt();
-                self.s[(p, p)] = l;
-                for r in p + 1..rank {
-                    let mut x = self.s[(r, p)];
-                    for q in 0..p {
-                        x -= self.s[(r, q)] * self.s[(p, q)];
-                    }
-                    self.s[(r, p)] = x / l;
-                }
-            }
-            // T = S⁻¹ R_r (r × m), column by column (R entries below the diagonal are zero):
-            // L y = b by columns of L, then Lᵀ x = y by dot products with columns of L (L is
-            // stored column-major in the lower triangle of `s`).
-            {
-                let sr = self.s.nrows();
-                let ls = self.s.as_slice();
-                let ar = self.a.nrows();
-                let asl = self.a.as_slice();
-                let x = &mut self.tmp_m.as_mut_slice()[..rank];
-                for c in 0..m {
-                    for (p, xp) in x.iter_mut().enumerate() {
-                        *xp = if p <= c { asl[p + c * ar] } else { 0.0 };
-                    }
-                    for q in 0..rank {
-                        let xq = x[q] / ls[q + q * sr];
-                        x[q] = xq;
-                        if xq != 0.0 {
-                            axpy(-xq, &ls[q * sr + q + 1..q * sr + rank], &mut x[q + 1..rank]);
-                        }
-                    }
-                    for p in (0..rank).rev() {
-                        let tail = dot(&ls[p * sr + p + 1..p * sr + rank], &x[p + 1..rank]);
-                        x[p] = (x[p] - tail) / ls[p + p * sr];
-                    }
-                    for (p, xp) in x.iter().enumerate() {
-                        self.t[(p, c)] = *xp;
-                    }
-                }
-            }
-            // J̄⁺ = ZQ_r · T · Πᵀ: column perm[c] of J̄⁺ is ZQ_r · T[:, c].
-            for c in 0..m {
-                let col = self.perm[c];
-                for p in 0..rank {
-                    self.tp[(p, col)] = self.t[(p, c)];
-                }
-            }
-            if last {
-                // Y = Q_r Tp = H_1 … H_r [Tp; 0] (k × m): reflectors applied last to first.
-                let yr = self.y_last.nrows();
-                let vr = self.v.nrows();
-                let tprows = self.tp.nrows();
-                let ys = self.y_last.as_mut_slice();
-                let tp = self.tp.as_slice();
-                let vsl = self.v.as_slice();
-                for c in 0..m {
-                    let col = &mut ys[c * yr..c * yr + k];
-                    col.fill(0.0);
-                    for p in 0..rank {
-                        col[p] = tp[p + c * tprows];
-                    }
-                }
-                for st in (0..rank).rev() {
-                    let tau = self.tau[st];
-                    let v = &vsl[st * vr + st..st * vr + k];
-                    for c in 0..m {
-                        let col = &mut ys[c * yr + st..c * yr + k];
-                        let f = tau * dot(v, col);
-                        axpy(-f, v, col);
-                    }
-                }
-                self.k_last = k;
-                self.last_ready = false;
-                return;
-            }
-            // Column c of J̄⁺ = Σ_p ZQ[:, p] · Tp[p, c] (contiguous column updates).
-            let zq = self.zq.as_slice();
-            let tprows = self.tp.nrows();
-            let tp = self.tp.as_slice();
-            let pi = self.pinv[i].as_mut_slice();
-            for c in 0..m {
-                let out = &mut pi[c * n..(c + 1) * n];
-                out.fill(0.0);
-                for p in 0..rank {
-                    let f = tp[p + c * tprows];
-                    if f != 0.0 {
-                        for (o, z) in out.iter_mut().zip(&zq[p * n..(p + 1) * n]) {
-                            *o += f * z;
-                        }
-                    }
-                }
-            }
-        }
-        if last {
-            // Rank 0: J̄⁺ = 0 (k_last = 0), and no level follows.
+        if rank == 0 {
             return;
         }
-        // Z ← ZQ[:, rank..k].
-        let newk = k - rank;
-        self.z
-            .view_mut((0, 0), (n, newk))
-            .copy_from(&self.zq.view((0, rank), (n, newk)));
-        self.k = newk;
-    }
-
-    /// Builds the block g_i of G (Algorithm 1), using the inverses of the last
-    /// [`Hierarchy::solve`]. Allocates nothing.
-    pub fn build_g_level(&mut self, levels: &[TaskEquation], i: usize) {
-        self.ensure_last_pinv();
-        let n = self.n;
+        self.nref = p + rank;
+        // The rows of the lower levels: w ← H_{p+r−1} ⋯ H_p w on the coordinates p..n.
         {
-            let off = self.offsets[i];
-            for c in 0..self.dims[i] {
-                for d in 0..n {
-                    self.tmp_n[d] = self.pinv[i][(d, c)];
-                }
-                // ψ ← (I − J̄_k⁺ J_k) ψ for k = i+1..n_T.
-                for (k, lvl) in levels.iter().enumerate().skip(i + 1) {
-                    let mk = self.dims[k];
-                    for r in 0..mk {
-                        let mut s = 0.0;
-                        for d in 0..n {
-                            s += lvl.jacobian[(r, d)] * self.tmp_n[d];
-                        }
-                        self.tmp_m[r] = s;
+            let total = self.w.ncols();
+            let vsl = self.v.as_slice();
+            let ws = self.w.as_mut_slice();
+            for col in off + m..total {
+                let wc = &mut ws[col * wr..(col + 1) * wr];
+                for s in p..p + rank {
+                    let (b, e) = (s, self.vend[s]);
+                    let v = &vsl[s * vr + b..s * vr + e];
+                    let f = self.tau[s] * dot(v, &wc[b..e]);
+                    if f != 0.0 {
+                        axpy(-f, v, &mut wc[b..e]);
                     }
-                    for r in 0..mk {
-                        let s = self.tmp_m[r];
-                        if s != 0.0 {
-                            for d in 0..n {
-                                self.tmp_n[d] -= self.pinv[k][(d, r)] * s;
-                            }
-                        }
-                    }
-                }
-                for d in 0..n {
-                    self.g[(d, off + c)] = self.tmp_n[d];
                 }
             }
+        }
+        // λ² from the damping rule; σ_min estimated by the last kept pivot |R_rr|.
+        let sigma = self.a[(rank - 1, rank - 1)].abs();
+        let lambda2 = match settings.damping {
+            Damping::None => 0.0,
+            Damping::Fixed(l) => l * l,
+            Damping::Adaptive { max, threshold } => {
+                if sigma < threshold {
+                    (1.0 - (sigma / threshold).powi(2)) * max * max
+                } else {
+                    0.0
+                }
+            }
+        };
+        // R_r = rows 0..r of R (upper trapezoidal, r × m).
+        let rf = &mut self.rfac[i];
+        for c in 0..m {
+            for q in 0..rank {
+                rf[(q, c)] = if q <= c { self.a[(q, c)] } else { 0.0 };
+            }
+        }
+        // S = R_r R_rᵀ + λ² I (r × r), then Cholesky S = L Lᵀ (lower). S is SPD: R_r has full
+        // row rank r.
+        let l = &mut self.chol[i];
+        for q in 0..rank {
+            for t in 0..=q {
+                let mut s = 0.0;
+                for c in q..m {
+                    s += rf[(q, c)] * rf[(t, c)];
+                }
+                if q == t {
+                    s += lambda2;
+                }
+                l[(q, t)] = s;
+            }
+        }
+        for q in 0..rank {
+            let mut d = l[(q, q)];
+            for t in 0..q {
+                d -= l[(q, t)] * l[(q, t)];
+            }
+            let lq = d.max(f64::MIN_POSITIVE).sqrt();
+            l[(q, q)] = lq;
+            for r in q + 1..rank {
+                let mut x = l[(r, q)];
+                for t in 0..q {
+                    x -= l[(r, t)] * l[(q, t)];
+                }
+                l[(r, q)] = x / lq;
+            }
+        }
+    }
+
+    /// Writes into `y` (zero outside p_i..) the reduced-coordinate change of q̈ caused by a unit
+    /// change of row c of h_i: level i's own step (J̄_i⁺ e_c), then, if `propagate`, every lower
+    /// level's response (g_i e_c).
+    fn level_unit(&mut self, i: usize, c: usize, propagate: bool) {
+        let (m, r, p) = (self.dims[i], self.ranks[i], self.starts[i]);
+        if r == 0 {
+            // Level i moves nothing, so nothing below it moves either.
+            return;
+        }
+        for (j, x) in self.x[..m].iter_mut().enumerate() {
+            *x = if self.perm[i][j] == c { 1.0 } else { 0.0 };
+        }
+        apply_t(
+            &self.rfac[i],
+            &self.chol[i],
+            r,
+            m,
+            &self.x[..m],
+            &mut self.y[p..p + r],
+        );
+        if !propagate {
+            return;
+        }
+        let wr = self.w.nrows();
+        for k in i + 1..self.dims.len() {
+            let (mk, rk, pk) = (self.dims[k], self.ranks[k], self.starts[k]);
+            if rk == 0 {
+                continue;
+            }
+            let off = self.offsets[k];
+            let ws = self.w.as_slice();
+            for t in 0..mk {
+                let wc = &ws[(off + t) * wr + p..(off + t) * wr + pk];
+                self.res[t] = -dot(wc, &self.y[p..pk]);
+            }
+            for t in 0..mk {
+                self.x[t] = self.res[self.perm[k][t]];
+            }
+            apply_t(
+                &self.rfac[k],
+                &self.chol[k],
+                rk,
+                mk,
+                &self.x[..mk],
+                &mut self.y[pk..pk + rk],
+            );
+        }
+    }
+
+    /// y ← Q y.
+    fn apply_q_to_y(&mut self) {
+        apply_q(&self.v, &self.tau, &self.vend, self.nref, &mut self.y);
+    }
+
+    /// Builds the block g_i of G (Algorithm 1), using the factors of the last
+    /// [`Hierarchy::solve`]. Allocates nothing.
+    pub fn build_g_level(&mut self, i: usize) {
+        let off = self.offsets[i];
+        for c in 0..self.dims[i] {
+            self.y.fill(0.0);
+            self.level_unit(i, c, true);
+            self.apply_q_to_y();
+            self.g.column_mut(off + c).copy_from_slice(&self.y);
+        }
+    }
+}
+
+/// out = S⁻¹ R_r b (r entries) for b of length m: z = R_r b, then L w = z and Lᵀ out = w.
+fn apply_t(rf: &DMatrix<f64>, l: &DMatrix<f64>, r: usize, m: usize, b: &[f64], out: &mut [f64]) {
+    // z = R_r b (R_r upper trapezoidal: row q starts at column q).
+    let rr = rf.nrows();
+    let rs = rf.as_slice();
+    out.fill(0.0);
+    for (c, &bc) in b.iter().enumerate().take(m) {
+        if bc != 0.0 {
+            let top = (c + 1).min(r);
+            axpy(bc, &rs[c * rr..c * rr + top], &mut out[..top]);
+        }
+    }
+    // Forward substitution with the columns of L, then back substitution with its rows.
+    let lr = l.nrows();
+    let ls = l.as_slice();
+    for q in 0..r {
+        let xq = out[q] / ls[q + q * lr];
+        out[q] = xq;
+        if xq != 0.0 {
+            axpy(-xq, &ls[q * lr + q + 1..q * lr + r], &mut out[q + 1..r]);
+        }
+    }
+    for q in (0..r).rev() {
+        let tail = dot(&ls[q * lr + q + 1..q * lr + r], &out[q + 1..r]);
+        out[q] = (out[q] - tail) / ls[q + q * lr];
+    }
+}
+
+/// x ← Q x = H_0 H_1 ⋯ H_{nref−1} x: the reflectors applied last to first.
+fn apply_q(v: &DMatrix<f64>, tau: &[f64], vend: &[usize], nref: usize, x: &mut [f64]) {
+    let vr = v.nrows();
+    let vs = v.as_slice();
+    for s in (0..nref).rev() {
+        let e = vend[s];
+        let vv = &vs[s * vr + s..s * vr + e];
+        let f = tau[s] * dot(vv, &x[s..e]);
+        if f != 0.0 {
+            axpy(-f, vv, &mut x[s..e]);
         }
     }
 }

@@ -168,7 +168,7 @@ impl Solver {
             self.qp_hi[d] = self.hi[d] - self.q0[d];
         }
         for i in (0..nt).rev() {
-            self.hierarchy.build_g_level(levels, i);
+            self.hierarchy.build_g_level(i);
             let off = self.hierarchy.offset(i);
             let ma = total - off;
             if ma == 0 {
