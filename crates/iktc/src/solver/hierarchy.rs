@@ -36,6 +36,7 @@
 
 use nalgebra::{DMatrix, DVector};
 
+use super::reflectors::{axpy, dot, Reflectors};
 use super::settings::{Damping, SolverSettings};
 use crate::error::{check_dim, Error, Result};
 use crate::task::TaskEquation;
@@ -54,18 +55,11 @@ pub struct Hierarchy {
     /// Wᵀ (n × Σm_i): column j is stacked task row j multiplied by the reflectors of the
     /// levels above its own.
     w: DMatrix<f64>,
-    /// Householder vectors: column s acts on the coordinates s..vend\[s\]
-    /// (H_s = I − τ_s v_s v_sᵀ); there is one reflector per kept pivot, Σ r_i ≤ n in all.
-    v: DMatrix<f64>,
-    tau: Vec<f64>,
-    vend: Vec<usize>,
-    /// Number of reflectors, Σ r_i.
-    nref: usize,
-    /// Per level: R_r (upper trapezoidal, r_i × m_i, in an m_i × m_i buffer), the Cholesky
-    /// factor L of S_i (lower, r_i × r_i) and the pivot order Π.
-    rfac: Vec<DMatrix<f64>>,
-    chol: Vec<DMatrix<f64>>,
-    perm: Vec<Vec<usize>>,
+    /// The Householder reflectors of all levels so far, one per kept pivot (Σ r_i ≤ n); their
+    /// number is the next free reduced coordinate.
+    refl: Reflectors,
+    /// Per level: the factors of J̄_i^{λ+} in reduced coordinates.
+    fac: Vec<LevelFactor>,
     /// Scratch: A_i (k × m_i) during the QR, its column norms, the reduced solution u, a
     /// reduced G column, a level residual and a small vector.
     a: DMatrix<f64>,
@@ -98,13 +92,8 @@ impl Hierarchy {
             ranks: vec![0; dims.len()],
             starts: vec![0; dims.len()],
             w: DMatrix::zeros(n, total.max(1)),
-            v: DMatrix::zeros(n, n),
-            tau: vec![0.0; n],
-            vend: vec![0; n],
-            nref: 0,
-            rfac: dims.iter().map(|&m| DMatrix::zeros(m, m)).collect(),
-            chol: dims.iter().map(|&m| DMatrix::zeros(m, m)).collect(),
-            perm: dims.iter().map(|&m| vec![0; m]).collect(),
+            refl: Reflectors::new(n),
+            fac: dims.iter().map(|&m| LevelFactor::new(m)).collect(),
             a: DMatrix::zeros(n.max(1), mmax),
             colnorm: vec![0.0; mmax],
             u: DVector::zeros(n),
@@ -193,9 +182,9 @@ impl Hierarchy {
             }
         }
         self.u.fill(0.0);
-        self.nref = 0;
+        self.refl.truncate(0);
         for (i, lvl) in levels.iter().enumerate() {
-            let p = self.nref;
+            let p = self.refl.len();
             self.starts[i] = p;
             self.reduce_level(i, settings);
             let (m, r) = (self.dims[i], self.ranks[i]);
@@ -211,29 +200,22 @@ impl Hierarchy {
                 self.res[c] = lvl.rhs[c] - dot(wc, us);
             }
             // u[p..p+r] = S⁻¹ R_r Πᵀ residual.
+            let f = &self.fac[i];
             for c in 0..m {
-                self.x[c] = self.res[self.perm[i][c]];
+                self.x[c] = self.res[f.perm[c]];
             }
-            let (rf, ch) = (&self.rfac[i], &self.chol[i]);
-            let out = &mut self.u.as_mut_slice()[p..p + r];
-            apply_t(rf, ch, r, m, &self.x[..m], out);
+            f.apply(r, m, &self.x[..m], &mut self.u.as_mut_slice()[p..p + r]);
         }
         // q̈ = Q u.
         qdd.copy_from(&self.u);
-        apply_q(
-            &self.v,
-            &self.tau,
-            &self.vend,
-            self.nref,
-            qdd.as_mut_slice(),
-        );
+        self.refl.apply_q(qdd.as_mut_slice());
         Ok(())
     }
 
     /// Reduces level i: pivoted QR of A_i = (W_i\[:, p..n\])ᵀ, the factors R_r, L and Π, the
     /// damping, and the new reflectors applied to the rows of the lower levels.
     fn reduce_level(&mut self, i: usize, settings: &SolverSettings) {
-        let (n, m, p) = (self.n, self.dims[i], self.nref);
+        let (n, m, p) = (self.n, self.dims[i], self.refl.len());
         let k = n - p;
         self.ranks[i] = 0;
         if m == 0 || k == 0 {
@@ -250,14 +232,13 @@ impl Hierarchy {
                     .copy_from_slice(&ws[(off + c) * wr + p..(off + c + 1) * wr]);
             }
         }
-        let perm = &mut self.perm[i];
+        let perm = &mut self.fac[i].perm;
         for (c, pc) in perm.iter_mut().enumerate() {
             *pc = c;
         }
         // Householder QR with column pivoting of A (k × m).
         let steps = k.min(m);
         let mut rank = 0;
-        let vr = self.v.nrows();
         for st in 0..steps {
             // Pivot: the remaining column of largest norm (rows st..k).
             {
@@ -283,23 +264,14 @@ impl Hierarchy {
                 break;
             }
             // v = x − α e1 with α = −sign(x0)‖x‖; H = I − τ v vᵀ, τ = 2 / vᵀv.
-            let s = p + st;
             let asl = self.a.as_mut_slice();
-            let vsl = self.v.as_mut_slice();
             let x0 = asl[st * ar + st];
             let alpha = if x0 >= 0.0 { -norm } else { norm };
-            let vcol = &mut vsl[s * vr + s..s * vr + n];
+            let vcol = self.refl.next_slot();
             vcol.copy_from_slice(&asl[st * ar + st..st * ar + k]);
             vcol[0] = x0 - alpha;
-            let mut end = vcol.len();
-            while end > 1 && vcol[end - 1] == 0.0 {
-                end -= 1;
-            }
-            self.vend[s] = s + end;
-            let v = &vcol[..end];
-            let vv = dot(v, v);
-            let tau = if vv > 0.0 { 2.0 / vv } else { 0.0 };
-            self.tau[s] = tau;
+            let (tau, end) = self.refl.commit();
+            let v = self.refl.vector(p + st);
             // Apply H to the remaining columns of A: column st becomes α e1.
             asl[st * ar + st] = alpha;
             asl[st * ar + st + 1..st * ar + k].fill(0.0);
@@ -316,24 +288,11 @@ impl Hierarchy {
         if rank == 0 {
             return;
         }
-        self.nref = p + rank;
         // The rows of the lower levels: w ← H_{p+r−1} ⋯ H_p w on the coordinates p..n.
-        {
-            let total = self.w.ncols();
-            let vsl = self.v.as_slice();
-            let ws = self.w.as_mut_slice();
-            for col in off + m..total {
-                let wc = &mut ws[col * wr..(col + 1) * wr];
-                for s in p..p + rank {
-                    let (b, e) = (s, self.vend[s]);
-                    let v = &vsl[s * vr + b..s * vr + e];
-                    let f = self.tau[s] * dot(v, &wc[b..e]);
-                    if f != 0.0 {
-                        axpy(-f, v, &mut wc[b..e]);
-                    }
-                }
-            }
-        }
+        let total = self.w.ncols();
+        let ws = self.w.as_mut_slice();
+        self.refl
+            .apply_forward(p, p + rank, &mut ws[(off + m) * wr..total * wr]);
         // λ² from the damping rule; σ_min estimated by the last kept pivot |R_rr|.
         let sigma = self.a[(rank - 1, rank - 1)].abs();
         let lambda2 = match settings.damping {
@@ -348,42 +307,13 @@ impl Hierarchy {
             }
         };
         // R_r = rows 0..r of R (upper trapezoidal, r × m).
-        let rf = &mut self.rfac[i];
+        let f = &mut self.fac[i];
         for c in 0..m {
             for q in 0..rank {
-                rf[(q, c)] = if q <= c { self.a[(q, c)] } else { 0.0 };
+                f.r[(q, c)] = if q <= c { self.a[(q, c)] } else { 0.0 };
             }
         }
-        // S = R_r R_rᵀ + λ² I (r × r), then Cholesky S = L Lᵀ (lower). S is SPD: R_r has full
-        // row rank r.
-        let l = &mut self.chol[i];
-        for q in 0..rank {
-            for t in 0..=q {
-                let mut s = 0.0;
-                for c in q..m {
-                    s += rf[(q, c)] * rf[(t, c)];
-                }
-                if q == t {
-                    s += lambda2;
-                }
-                l[(q, t)] = s;
-            }
-        }
-        for q in 0..rank {
-            let mut d = l[(q, q)];
-            for t in 0..q {
-                d -= l[(q, t)] * l[(q, t)];
-            }
-            let lq = d.max(f64::MIN_POSITIVE).sqrt();
-            l[(q, q)] = lq;
-            for r in q + 1..rank {
-                let mut x = l[(r, q)];
-                for t in 0..q {
-                    x -= l[(r, t)] * l[(q, t)];
-                }
-                l[(r, q)] = x / lq;
-            }
-        }
+        f.factor(rank, m, lambda2);
     }
 
     /// Writes into `y` (zero outside p_i..) the reduced-coordinate change of q̈ caused by a unit
@@ -395,17 +325,11 @@ impl Hierarchy {
             // Level i moves nothing, so nothing below it moves either.
             return;
         }
+        let f = &self.fac[i];
         for (j, x) in self.x[..m].iter_mut().enumerate() {
-            *x = if self.perm[i][j] == c { 1.0 } else { 0.0 };
+            *x = if f.perm[j] == c { 1.0 } else { 0.0 };
         }
-        apply_t(
-            &self.rfac[i],
-            &self.chol[i],
-            r,
-            m,
-            &self.x[..m],
-            &mut self.y[p..p + r],
-        );
+        f.apply(r, m, &self.x[..m], &mut self.y[p..p + r]);
         if !propagate {
             return;
         }
@@ -421,106 +345,128 @@ impl Hierarchy {
                 let wc = &ws[(off + t) * wr + p..(off + t) * wr + pk];
                 self.res[t] = -dot(wc, &self.y[p..pk]);
             }
+            let f = &self.fac[k];
             for t in 0..mk {
-                self.x[t] = self.res[self.perm[k][t]];
+                self.x[t] = self.res[f.perm[t]];
             }
-            apply_t(
-                &self.rfac[k],
-                &self.chol[k],
-                rk,
-                mk,
-                &self.x[..mk],
-                &mut self.y[pk..pk + rk],
-            );
+            f.apply(rk, mk, &self.x[..mk], &mut self.y[pk..pk + rk]);
         }
     }
 
     /// y ← Q y.
     fn apply_q_to_y(&mut self) {
-        apply_q(&self.v, &self.tau, &self.vend, self.nref, &mut self.y);
+        self.refl.apply_q(&mut self.y);
     }
 
     /// Builds the block g_i of G (Algorithm 1), using the factors of the last
     /// [`Hierarchy::solve`]. Allocates nothing.
     pub fn build_g_level(&mut self, i: usize) {
-        let off = self.offsets[i];
-        for c in 0..self.dims[i] {
+        let (off, m, n) = (self.offsets[i], self.dims[i], self.n);
+        for c in 0..m {
             self.y.fill(0.0);
             self.level_unit(i, c, true);
-            self.apply_q_to_y();
             self.g.column_mut(off + c).copy_from_slice(&self.y);
         }
+        // G_i = Q Y_i, the whole block at once.
+        self.refl
+            .apply_q(&mut self.g.as_mut_slice()[off * n..(off + m) * n]);
     }
 }
 
-/// out = S⁻¹ R_r b (r entries) for b of length m: z = R_r b, then L w = z and Lᵀ out = w.
-fn apply_t(rf: &DMatrix<f64>, l: &DMatrix<f64>, r: usize, m: usize, b: &[f64], out: &mut [f64]) {
-    // z = R_r b (R_r upper trapezoidal: row q starts at column q).
-    let rr = rf.nrows();
-    let rs = rf.as_slice();
-    out.fill(0.0);
-    for (c, &bc) in b.iter().enumerate().take(m) {
-        if bc != 0.0 {
-            let top = (c + 1).min(r);
-            axpy(bc, &rs[c * rr..c * rr + top], &mut out[..top]);
+/// The factors of one level's J̄^{λ+} in reduced coordinates: out = S⁻¹ R_r Πᵀ b with
+/// S = R_r R_rᵀ + λ² I.
+#[derive(Debug, Clone)]
+struct LevelFactor {
+    /// R_r, upper trapezoidal r × m (in an m × m buffer).
+    r: DMatrix<f64>,
+    /// The Cholesky factor L of S (lower, r × r); unused when `direct`.
+    l: DMatrix<f64>,
+    /// The pivot order Π: position c of the pivoted rows holds task row perm\[c\].
+    perm: Vec<usize>,
+    /// λ = 0 and r = m: R_r is square and invertible, S⁻¹ R_r = R_r⁻ᵀ, one triangular solve.
+    direct: bool,
+}
+
+impl LevelFactor {
+    fn new(m: usize) -> Self {
+        Self {
+            r: DMatrix::zeros(m, m),
+            l: DMatrix::zeros(m, m),
+            perm: vec![0; m],
+            direct: false,
         }
     }
-    // Forward substitution with the columns of L, then back substitution with its rows.
-    let lr = l.nrows();
-    let ls = l.as_slice();
-    for q in 0..r {
-        let xq = out[q] / ls[q + q * lr];
-        out[q] = xq;
-        if xq != 0.0 {
-            axpy(-xq, &ls[q * lr + q + 1..q * lr + r], &mut out[q + 1..r]);
+
+    /// Factors S = R_r R_rᵀ + λ² I = L Lᵀ, unless λ² = 0 and R_r is square. S is SPD: R_r
+    /// has full row rank r.
+    fn factor(&mut self, r: usize, m: usize, lambda2: f64) {
+        self.direct = lambda2 == 0.0 && r == m;
+        if self.direct {
+            return;
+        }
+        let (rf, l) = (&self.r, &mut self.l);
+        for q in 0..r {
+            for t in 0..=q {
+                let mut s = 0.0;
+                for c in q..m {
+                    s += rf[(q, c)] * rf[(t, c)];
+                }
+                if q == t {
+                    s += lambda2;
+                }
+                l[(q, t)] = s;
+            }
+        }
+        for q in 0..r {
+            let mut d = l[(q, q)];
+            for t in 0..q {
+                d -= l[(q, t)] * l[(q, t)];
+            }
+            let lq = d.max(f64::MIN_POSITIVE).sqrt();
+            l[(q, q)] = lq;
+            for i in q + 1..r {
+                let mut x = l[(i, q)];
+                for t in 0..q {
+                    x -= l[(i, t)] * l[(q, t)];
+                }
+                l[(i, q)] = x / lq;
+            }
         }
     }
-    for q in (0..r).rev() {
-        let tail = dot(&ls[q * lr + q + 1..q * lr + r], &out[q + 1..r]);
-        out[q] = (out[q] - tail) / ls[q + q * lr];
-    }
-}
 
-/// x ← Q x = H_0 H_1 ⋯ H_{nref−1} x: the reflectors applied last to first.
-fn apply_q(v: &DMatrix<f64>, tau: &[f64], vend: &[usize], nref: usize, x: &mut [f64]) {
-    let vr = v.nrows();
-    let vs = v.as_slice();
-    for s in (0..nref).rev() {
-        let e = vend[s];
-        let vv = &vs[s * vr + s..s * vr + e];
-        let f = tau[s] * dot(vv, &x[s..e]);
-        if f != 0.0 {
-            axpy(-f, vv, &mut x[s..e]);
+    /// out = S⁻¹ R_r b (r entries) for b = Πᵀ residual of length m.
+    fn apply(&self, r: usize, m: usize, b: &[f64], out: &mut [f64]) {
+        let rr = self.r.nrows();
+        let rs = self.r.as_slice();
+        if self.direct {
+            // R_rᵀ out = b by forward substitution; column q of R holds R[0..q, q].
+            for q in 0..r {
+                let t = dot(&rs[q * rr..q * rr + q], &out[..q]);
+                out[q] = (b[q] - t) / rs[q * rr + q];
+            }
+            return;
         }
-    }
-}
-
-/// Dot product of two equally long slices with four independent accumulators, so that the
-/// compiler can vectorise it (a single running sum fixes the order of the additions).
-#[inline]
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    let n = a.len().min(b.len());
-    let (a, b) = (&a[..n], &b[..n]);
-    let mut acc = [0.0f64; 4];
-    let mut ca = a.chunks_exact(4);
-    let mut cb = b.chunks_exact(4);
-    for (x, y) in (&mut ca).zip(&mut cb) {
-        acc[0] += x[0] * y[0];
-        acc[1] += x[1] * y[1];
-        acc[2] += x[2] * y[2];
-        acc[3] += x[3] * y[3];
-    }
-    let mut s = (acc[0] + acc[1]) + (acc[2] + acc[3]);
-    for (x, y) in ca.remainder().iter().zip(cb.remainder()) {
-        s += x * y;
-    }
-    s
-}
-
-/// y += α x.
-#[inline]
-fn axpy(alpha: f64, x: &[f64], y: &mut [f64]) {
-    for (yi, xi) in y.iter_mut().zip(x) {
-        *yi += alpha * xi;
+        // z = R_r b (R_r upper trapezoidal: row q starts at column q).
+        out.fill(0.0);
+        for (c, &bc) in b.iter().enumerate().take(m) {
+            if bc != 0.0 {
+                let top = (c + 1).min(r);
+                axpy(bc, &rs[c * rr..c * rr + top], &mut out[..top]);
+            }
+        }
+        // Forward substitution with the columns of L, then back substitution with its rows.
+        let lr = self.l.nrows();
+        let ls = self.l.as_slice();
+        for q in 0..r {
+            let xq = out[q] / ls[q + q * lr];
+            out[q] = xq;
+            if xq != 0.0 {
+                axpy(-xq, &ls[q * lr + q + 1..q * lr + r], &mut out[q + 1..r]);
+            }
+        }
+        for q in (0..r).rev() {
+            let tail = dot(&ls[q * lr + q + 1..q * lr + r], &out[q + 1..r]);
+            out[q] = (out[q] - tail) / ls[q + q * lr];
+        }
     }
 }

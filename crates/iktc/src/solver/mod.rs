@@ -7,6 +7,7 @@ pub use qp::{
 };
 
 mod hierarchy;
+mod reflectors;
 mod report;
 mod settings;
 mod solve;
