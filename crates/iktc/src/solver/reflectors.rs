@@ -121,18 +121,12 @@ impl Reflectors {
         let mut f = [0.0; 4];
         if forward {
             for j in 0..4 {
-                let mut t = d[j];
-                for i in 0..j {
-                    t -= f[i] * b.c[j][i];
-                }
+                let t = d[j] - (0..j).map(|i| f[i] * b.c[j][i]).sum::<f64>();
                 f[j] = b.tau[j] * t;
             }
         } else {
             for j in (0..4).rev() {
-                let mut t = d[j];
-                for i in j + 1..4 {
-                    t -= f[i] * b.c[j][i];
-                }
+                let t = d[j] - (j + 1..4).map(|i| f[i] * b.c[j][i]).sum::<f64>();
                 f[j] = b.tau[j] * t;
             }
         }
