@@ -219,3 +219,81 @@ fn bad_input_is_an_error() {
     };
     assert!(Solver::new(5, &[2], bad).is_err());
 }
+
+#[test]
+fn climbing_from_the_last_level_finds_the_same_correction_as_from_the_bottom() {
+    // Feasibility is monotone in the level, so starting the climb where the last tick ended
+    // must give the level and the q̈ of Algorithm 2 as printed. One solver of each kind runs
+    // through the same sequence of problems (state carries over between them); each problem
+    // is repeated with small box changes, as consecutive ticks are.
+    let mut r = rng(35);
+    let dims = [6, 6, 6];
+    let n = 20;
+    let bottom = SolverSettings {
+        climb: Climb::FromBottom,
+        ..Default::default()
+    };
+    let last = SolverSettings {
+        climb: Climb::FromLast,
+        ..Default::default()
+    };
+    let mut sb = Solver::new(n, &dims, bottom).unwrap();
+    let mut sl = Solver::new(n, &dims, last).unwrap();
+    let (mut qps_bottom, mut qps_last, mut started_above, mut levels_seen) = (0, 0, 0, [0usize; 3]);
+    let mut prev_from = None;
+    for case in 0..120 {
+        let levels = random_levels(&mut r, n, &dims);
+        let mut q0 = DVector::zeros(n);
+        sb.solve(Method::Prioritized, &levels, &wide_box(n), &mut q0)
+            .unwrap();
+        let bx0 = box_violated_by(&mut r, &q0, 1.0, 1 + case % 6, 1.0);
+        for tick in 0..4 {
+            let mut bx = bx0.clone();
+            for d in 0..n {
+                let shift = 0.01 * tick as f64;
+                bx.lower[d] -= shift;
+                bx.upper[d] += shift;
+            }
+            let (mut qb, mut ql) = (DVector::zeros(n), DVector::zeros(n));
+            let rb = sb
+                .solve(Method::Iktc, &levels, &bx, &mut qb)
+                .unwrap()
+                .clone();
+            let rl = sl
+                .solve(Method::Iktc, &levels, &bx, &mut ql)
+                .unwrap()
+                .clone();
+            assert_eq!(
+                rb.corrected_from, rl.corrected_from,
+                "case {case} tick {tick}"
+            );
+            assert_eq!(rb.fallback, rl.fallback, "case {case} tick {tick}");
+            assert!(
+                (&qb - &ql).norm() <= 1e-9 * (1.0 + qb.norm()),
+                "case {case} tick {tick}: {}",
+                (&qb - &ql).norm()
+            );
+            if let (Some(p), Some(f)) = (prev_from, rl.corrected_from) {
+                if p < dims.len() - 1 && p != f {
+                    started_above += 1;
+                }
+            }
+            if let Some(f) = rl.corrected_from {
+                levels_seen[f] += 1;
+                prev_from = Some(f);
+            }
+            qps_bottom += rb.qp_solves;
+            qps_last += rl.qp_solves;
+        }
+    }
+    println!("QPs: from the bottom {qps_bottom}, from the last level {qps_last}; corrected levels {levels_seen:?}");
+    assert!(
+        levels_seen.iter().all(|&c| c > 10),
+        "every level must be exercised: {levels_seen:?}"
+    );
+    assert!(
+        started_above > 5,
+        "the test must exercise climbs that start above the bottom and move ({started_above})"
+    );
+    assert!(qps_last < qps_bottom);
+}

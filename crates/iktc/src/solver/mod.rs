@@ -14,5 +14,5 @@ mod solve;
 
 pub use hierarchy::Hierarchy;
 pub use report::{Fallback, Method, SolveReport};
-pub use settings::{Damping, SolverSettings};
+pub use settings::{Climb, Damping, SolverSettings};
 pub use solve::Solver;

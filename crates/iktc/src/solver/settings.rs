@@ -22,6 +22,24 @@ pub enum Damping {
     },
 }
 
+/// Where IKTC's climb (Algorithm 2) starts looking for the lowest-priority level whose
+/// correction brings q̈ into the box.
+///
+/// Feasibility is monotone in the level: the correction of levels i..n_T may use every
+/// column that the correction of levels i+1..n_T may use, so if level i+1 is feasible so is
+/// level i. The answer — the largest feasible i — is therefore the same from any start; only
+/// the number of QPs differs. An infeasible QP is the expensive one (the dual active-set method
+/// proves infeasibility only after fixing every variable), so starting where the last tick
+/// ended saves the infeasible checks below it when the limits bind for many ticks in a row.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Climb {
+    /// Algorithm 2 as printed: from the lowest-priority level upwards.
+    FromBottom,
+    /// From the level the last correction started from (the bottom on the first tick): down
+    /// while feasible, else up until feasible. Same answer, fewer QPs in steady contact.
+    FromLast,
+}
+
 /// Settings of [`Solver`](super::Solver). Every threshold is documented with what it trades.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SolverSettings {
@@ -40,6 +58,8 @@ pub struct SolverSettings {
     /// \[–\]. Larger values bias the cascade towards small q̈; smaller ones make its Hessian
     /// ill-conditioned. Default 1e-8.
     pub cascade_regularization: f64,
+    /// Where IKTC's climb starts. Default [`Climb::FromLast`].
+    pub climb: Climb,
     /// Settings of the QPs.
     pub qp: QpSettings,
 }
@@ -51,6 +71,7 @@ impl Default for SolverSettings {
             rank_threshold: 1e-9,
             box_tolerance: 1e-9,
             cascade_regularization: 1e-8,
+            climb: Climb::FromLast,
             qp: QpSettings::default(),
         }
     }

@@ -5,7 +5,7 @@ use nalgebra::{DMatrix, DVector};
 use super::hierarchy::Hierarchy;
 use super::qp::{Hessian, QpProblem, QpStatus, QpWorkspace};
 use super::report::{Fallback, Method, SolveReport};
-use super::settings::SolverSettings;
+use super::settings::{Climb, SolverSettings};
 use crate::error::{check_dim, Result};
 use crate::limits::AccelerationBox;
 use crate::task::TaskEquation;
@@ -26,6 +26,8 @@ pub struct Solver {
     zeros: Vec<f64>,
     /// QP solution buffers: one per IKTC level (size Σ_{k≥i} m_k), then one of size n.
     xs: Vec<DVector<f64>>,
+    /// The level the last IKTC correction started from ([`Climb::FromLast`]).
+    last_from: Option<usize>,
     // Cascade buffers.
     h: DMatrix<f64>,
     c: Vec<f64>,
@@ -57,6 +59,7 @@ impl Solver {
                 v.push(DVector::zeros(nv));
                 v
             },
+            last_from: None,
             h: DMatrix::zeros(nv, nv),
             c: vec![0.0; nv],
             a_eq: DMatrix::zeros(total.max(1), nv),
@@ -153,8 +156,10 @@ impl Solver {
     }
 
     /// IKTC (Algorithms 1–2, eqs. 23–25): if the prioritized q̈ leaves the box, find the least
-    /// correction of levels i..n_T, min ½‖Δh^a_i‖² s.t. b_l − q̈ ≤ g^a_i Δh^a_i ≤ b_u − q̈, from
-    /// i = n_T upwards until the QP is feasible; q̈* = q̈ + g^a_i Δh^a_i.
+    /// correction of levels i..n_T, min ½‖Δh^a_i‖² s.t. b_l − q̈ ≤ g^a_i Δh^a_i ≤ b_u − q̈, for
+    /// the largest i for which the QP is feasible; q̈* = q̈ + g^a_i Δh^a_i. The search starts at
+    /// the bottom or where the last correction started ([`Climb`]); feasibility is monotone in
+    /// i, so both find the same level.
     fn iktc(&mut self, levels: &[TaskEquation], qdd: &mut DVector<f64>) -> Result<()> {
         qdd.copy_from(&self.q0);
         if self.report.violation_before <= self.settings.box_tolerance {
@@ -162,59 +167,104 @@ impl Solver {
         }
         let n = self.hierarchy.n();
         let nt = levels.len();
-        let total: usize = self.hierarchy.dims().iter().sum();
+        if nt == 0 {
+            self.report.fallback = Some(Fallback::ClampedToBox);
+            self.clamp(qdd);
+            return Ok(());
+        }
         for d in 0..n {
             self.qp_lo[d] = self.lo[d] - self.q0[d];
             self.qp_hi[d] = self.hi[d] - self.q0[d];
         }
-        for i in (0..nt).rev() {
+        let start = match self.settings.climb {
+            Climb::FromBottom => nt - 1,
+            Climb::FromLast => self.last_from.unwrap_or(nt - 1).min(nt - 1),
+        };
+        // G blocks of levels start..n_T (Algorithm 1 builds them bottom-up; each is independent).
+        for i in (start..nt).rev() {
             self.hierarchy.build_g_level(i);
-            let off = self.hierarchy.offset(i);
-            let ma = total - off;
-            if ma == 0 {
-                continue;
-            }
-            let g = self.hierarchy.g().columns(off, ma);
-            let problem = QpProblem {
-                hessian: Hessian::Identity,
-                c: &self.zeros[..ma],
-                a_eq: self.a_eq.rows(0, 0),
-                b_eq: &[],
-                a_in: g,
-                lower: &self.qp_lo,
-                upper: &self.qp_hi,
-            };
-            let rep = self
-                .qp
-                .solve(&problem, &self.settings.qp, &mut self.xs[i])?;
-            self.report.qp_solves += 1;
-            self.report.qp_iterations += rep.iterations;
-            if rep.status == QpStatus::Optimal {
-                self.report.corrected_from = Some(i);
-                let g = self.hierarchy.g();
-                let x = &self.xs[i];
-                for c in 0..ma {
-                    let dh = x[c];
-                    if dh != 0.0 {
-                        for d in 0..n {
-                            qdd[d] += g[(d, off + c)] * dh;
-                        }
-                    }
-                }
-                let mut c = 0;
-                for corr in self.report.corrections.iter_mut().skip(i) {
-                    for r in 0..corr.len() {
-                        corr[r] = x[c];
-                        c += 1;
-                    }
-                }
-                return Ok(());
-            }
-            self.report.qp_infeasible += 1;
         }
-        self.report.fallback = Some(Fallback::ClampedToBox);
-        self.clamp(qdd);
+        let mut found = None;
+        if self.level_feasible(start)? {
+            // Down the priorities while still feasible.
+            found = Some(start);
+            for i in start + 1..nt {
+                if !self.level_feasible(i)? {
+                    break;
+                }
+                found = Some(i);
+            }
+        } else {
+            // Up the priorities until feasible.
+            for i in (0..start).rev() {
+                self.hierarchy.build_g_level(i);
+                if self.level_feasible(i)? {
+                    found = Some(i);
+                    break;
+                }
+            }
+        }
+        let Some(i) = found else {
+            self.last_from = Some(0);
+            self.report.fallback = Some(Fallback::ClampedToBox);
+            self.clamp(qdd);
+            return Ok(());
+        };
+        self.last_from = Some(i);
+        self.report.corrected_from = Some(i);
+        let off = self.hierarchy.offset(i);
+        let total: usize = self.hierarchy.dims().iter().sum();
+        let g = self.hierarchy.g();
+        let x = &self.xs[i];
+        for c in 0..total - off {
+            let dh = x[c];
+            if dh != 0.0 {
+                for d in 0..n {
+                    qdd[d] += g[(d, off + c)] * dh;
+                }
+            }
+        }
+        let mut c = 0;
+        for corr in self.report.corrections.iter_mut().skip(i) {
+            for r in 0..corr.len() {
+                corr[r] = x[c];
+                c += 1;
+            }
+        }
         Ok(())
+    }
+
+    /// Solves the correction QP of levels i..n_T into `xs[i]` (G blocks of those levels built);
+    /// true when it is feasible. Counts the QP in the report.
+    fn level_feasible(&mut self, i: usize) -> Result<bool> {
+        let off = self.hierarchy.offset(i);
+        let total: usize = self.hierarchy.dims().iter().sum();
+        let ma = total - off;
+        if ma == 0 {
+            // Nothing to correct: feasible only if already inside, which it is not.
+            return Ok(false);
+        }
+        let g = self.hierarchy.g().columns(off, ma);
+        let problem = QpProblem {
+            hessian: Hessian::Identity,
+            c: &self.zeros[..ma],
+            a_eq: self.a_eq.rows(0, 0),
+            b_eq: &[],
+            a_in: g,
+            lower: &self.qp_lo,
+            upper: &self.qp_hi,
+        };
+        let rep = self
+            .qp
+            .solve(&problem, &self.settings.qp, &mut self.xs[i])?;
+        self.report.qp_solves += 1;
+        self.report.qp_iterations += rep.iterations;
+        if rep.status == QpStatus::Optimal {
+            Ok(true)
+        } else {
+            self.report.qp_infeasible += 1;
+            Ok(false)
+        }
     }
 
     /// GF (Kanoun et al.): for k = 1..n_T, min ½‖J_k q̈ − h_k‖² + ½ε‖q̈‖² subject to the box
