@@ -65,7 +65,11 @@ pub struct Hierarchy {
     a: DMatrix<f64>,
     colnorm: Vec<f64>,
     u: DVector<f64>,
-    y: Vec<f64>,
+    /// Row-major n × m_i block of reduced G columns, a row-major right-hand side block and
+    /// the four-row scratch of the reflectors.
+    yb: Vec<f64>,
+    bb: Vec<f64>,
+    qscratch: Vec<f64>,
     res: Vec<f64>,
     x: Vec<f64>,
     /// G, n × Σm_i, blocks in level order; columns of level i valid once built.
@@ -97,7 +101,9 @@ impl Hierarchy {
             a: DMatrix::zeros(n.max(1), mmax),
             colnorm: vec![0.0; mmax],
             u: DVector::zeros(n),
-            y: vec![0.0; n],
+            yb: vec![0.0; n * mmax],
+            bb: vec![0.0; mmax * mmax],
+            qscratch: vec![0.0; 4 * mmax],
             res: vec![0.0; mmax],
             x: vec![0.0; mmax],
             g: DMatrix::zeros(n, total.max(1)),
@@ -129,11 +135,14 @@ impl Hierarchy {
     /// factorization (column c is Q applied to S_i⁻¹ R_r Πᵀ e_c placed at p_i); not needed by
     /// the solvers, which use the factors directly.
     pub fn pinv(&mut self, i: usize) -> &DMatrix<f64> {
-        for c in 0..self.dims[i] {
-            self.y.fill(0.0);
-            self.level_unit(i, c, false);
-            self.apply_q_to_y();
-            self.pinv[i].column_mut(c).copy_from_slice(&self.y);
+        let (m, n) = (self.dims[i], self.n);
+        self.reduced_block(i, false);
+        self.refl
+            .apply_q_rows(&mut self.yb[..n * m], m, &mut self.qscratch);
+        for c in 0..m {
+            for d in 0..n {
+                self.pinv[i][(d, c)] = self.yb[d * m + c];
+            }
         }
         &self.pinv[i]
     }
@@ -316,60 +325,69 @@ impl Hierarchy {
         f.factor(rank, m, lambda2);
     }
 
-    /// Writes into `y` (zero outside p_i..) the reduced-coordinate change of q̈ caused by a unit
-    /// change of row c of h_i: level i's own step (J̄_i⁺ e_c), then, if `propagate`, every lower
-    /// level's response (g_i e_c).
-    fn level_unit(&mut self, i: usize, c: usize, propagate: bool) {
-        let (m, r, p) = (self.dims[i], self.ranks[i], self.starts[i]);
-        if r == 0 {
+    /// Writes into `yb` (row-major n × m_i, rows p_i.. written, the rows above zero) the
+    /// reduced-coordinate change of q̈ caused by unit changes of the rows of h_i: level i's own
+    /// step (J̄_i⁺ in reduced coordinates), then, if `propagate`, every lower level's response
+    /// (g_i). All m_i columns at once: each step is a row operation on m_i-long rows.
+    fn reduced_block(&mut self, i: usize, propagate: bool) {
+        let (n, nc, r, p) = (self.n, self.dims[i], self.ranks[i], self.starts[i]);
+        let yb = &mut self.yb[..n * nc];
+        yb.fill(0.0);
+        if r == 0 || nc == 0 {
             // Level i moves nothing, so nothing below it moves either.
             return;
         }
+        // B = Πᵀ I: row j is e_{perm[j]}.
         let f = &self.fac[i];
-        for (j, x) in self.x[..m].iter_mut().enumerate() {
-            *x = if f.perm[j] == c { 1.0 } else { 0.0 };
+        let bb = &mut self.bb[..nc * nc];
+        bb.fill(0.0);
+        for (j, &pj) in f.perm.iter().enumerate() {
+            bb[j * nc + pj] = 1.0;
         }
-        f.apply(r, m, &self.x[..m], &mut self.y[p..p + r]);
+        f.apply_rows(r, nc, nc, bb, &mut yb[p * nc..(p + r) * nc]);
         if !propagate {
             return;
         }
         let wr = self.w.nrows();
+        let ws = self.w.as_slice();
         for k in i + 1..self.dims.len() {
             let (mk, rk, pk) = (self.dims[k], self.ranks[k], self.starts[k]);
             if rk == 0 {
                 continue;
             }
             let off = self.offsets[k];
-            let ws = self.w.as_slice();
-            for t in 0..mk {
-                let wc = &ws[(off + t) * wr + p..(off + t) * wr + pk];
-                self.res[t] = -dot(wc, &self.y[p..pk]);
-            }
             let f = &self.fac[k];
-            for t in 0..mk {
-                self.x[t] = self.res[f.perm[t]];
+            // B row j = −Σ_{s ∈ [p, p_k)} W[s, row perm[j] of level k] · Y[s, :].
+            let bb = &mut self.bb[..mk * nc];
+            bb.fill(0.0);
+            for (j, &pj) in f.perm.iter().enumerate() {
+                let wc = &ws[(off + pj) * wr..(off + pj + 1) * wr];
+                let brow = &mut bb[j * nc..(j + 1) * nc];
+                for sidx in p..pk {
+                    let c = wc[sidx];
+                    if c != 0.0 {
+                        axpy(-c, &yb[sidx * nc..(sidx + 1) * nc], brow);
+                    }
+                }
             }
-            f.apply(rk, mk, &self.x[..mk], &mut self.y[pk..pk + rk]);
+            f.apply_rows(rk, mk, nc, bb, &mut yb[pk * nc..(pk + rk) * nc]);
         }
-    }
-
-    /// y ← Q y.
-    fn apply_q_to_y(&mut self) {
-        self.refl.apply_q(&mut self.y);
     }
 
     /// Builds the block g_i of G (Algorithm 1), using the factors of the last
     /// [`Hierarchy::solve`]. Allocates nothing.
     pub fn build_g_level(&mut self, i: usize) {
         let (off, m, n) = (self.offsets[i], self.dims[i], self.n);
-        for c in 0..m {
-            self.y.fill(0.0);
-            self.level_unit(i, c, true);
-            self.g.column_mut(off + c).copy_from_slice(&self.y);
-        }
-        // G_i = Q Y_i, the whole block at once.
+        self.reduced_block(i, true);
+        // G_i = Q Y_i, on the rows of Y, then into the columns of G.
         self.refl
-            .apply_q(&mut self.g.as_mut_slice()[off * n..(off + m) * n]);
+            .apply_q_rows(&mut self.yb[..n * m], m, &mut self.qscratch);
+        let gs = &mut self.g.as_mut_slice()[off * n..(off + m) * n];
+        for (c, col) in gs.chunks_exact_mut(n).enumerate() {
+            for (d, x) in col.iter_mut().enumerate() {
+                *x = self.yb[d * m + c];
+            }
+        }
     }
 }
 
@@ -431,6 +449,62 @@ impl LevelFactor {
                 }
                 l[(i, q)] = x / lq;
             }
+        }
+    }
+
+    /// The same for nc right-hand sides at once: `b` row-major m × nc (overwritten), `out`
+    /// row-major r × nc.
+    fn apply_rows(&self, r: usize, m: usize, nc: usize, b: &mut [f64], out: &mut [f64]) {
+        let rr = self.r.nrows();
+        let rs = self.r.as_slice();
+        if self.direct {
+            // R_rᵀ X = B row by row: X[q] = (B[q] − Σ_{t<q} R[t, q] X[t]) / R[q, q].
+            for q in 0..r {
+                let (done, rest) = out.split_at_mut(q * nc);
+                let row = &mut rest[..nc];
+                row.copy_from_slice(&b[q * nc..(q + 1) * nc]);
+                for t in 0..q {
+                    let c = rs[q * rr + t];
+                    if c != 0.0 {
+                        axpy(-c, &done[t * nc..(t + 1) * nc], row);
+                    }
+                }
+                let inv = 1.0 / rs[q * rr + q];
+                row.iter_mut().for_each(|x| *x *= inv);
+            }
+            return;
+        }
+        // Z = R_r B (R_r upper trapezoidal: row q starts at column q).
+        for q in 0..r {
+            let row = &mut out[q * nc..(q + 1) * nc];
+            row.fill(0.0);
+            for c in q..m {
+                let f = rs[c * rr + q];
+                if f != 0.0 {
+                    axpy(f, &b[c * nc..(c + 1) * nc], row);
+                }
+            }
+        }
+        // L W = Z, then Lᵀ X = W, row by row.
+        let lr = self.l.nrows();
+        let ls = self.l.as_slice();
+        for q in 0..r {
+            let (done, rest) = out.split_at_mut(q * nc);
+            let row = &mut rest[..nc];
+            for t in 0..q {
+                axpy(-ls[t * lr + q], &done[t * nc..(t + 1) * nc], row);
+            }
+            let inv = 1.0 / ls[q * lr + q];
+            row.iter_mut().for_each(|x| *x *= inv);
+        }
+        for q in (0..r).rev() {
+            let (head, tail) = out.split_at_mut((q + 1) * nc);
+            let row = &mut head[q * nc..];
+            for t in q + 1..r {
+                axpy(-ls[q * lr + t], &tail[(t - q - 1) * nc..(t - q) * nc], row);
+            }
+            let inv = 1.0 / ls[q * lr + q];
+            row.iter_mut().for_each(|x| *x *= inv);
         }
     }
 

@@ -164,30 +164,77 @@ impl Reflectors {
         }
     }
 
-    /// Applies Q = H_0 H_1 ⋯ H_{len−1} (the last reflector first) to every column of `cols`.
+    /// Applies Q = H_0 H_1 ⋯ H_{len−1} (the last reflector first) to every column of `cols`
+    /// (column-major, columns of length n); for one vector or a few (blocks of columns go
+    /// through [`Reflectors::apply_q_rows`]).
     pub(crate) fn apply_q(&self, cols: &mut [f64]) {
-        let n = self.n;
-        let ncols = cols.len() / n.max(1);
-        if ncols <= 1 {
-            // One vector: the block coefficients would cost as much as they save.
-            for x in cols.chunks_exact_mut(n) {
-                for s in (0..self.len).rev() {
-                    self.apply_one(s, x);
-                }
+        for x in cols.chunks_exact_mut(self.n.max(1)) {
+            for s in (0..self.len).rev() {
+                self.apply_one(s, x);
             }
+        }
+    }
+}
+
+impl Reflectors {
+    /// Applies Q = H_0 ⋯ H_{len−1} to the nc columns of a row-major n × nc block `y`: per
+    /// block of four reflectors, w_j = v_jᵀ Y (four rows of length nc, one pass over Y), the
+    /// coefficients F_j = τ_j (w_j − Σ_{i>j} (v_j·v_i) F_i), and Y −= Σ_j v_j F_jᵀ (another
+    /// pass). `scratch` holds at least 4 nc entries.
+    pub(crate) fn apply_q_rows(&self, y: &mut [f64], nc: usize, scratch: &mut [f64]) {
+        let n = self.n;
+        if nc == 0 {
             return;
         }
+        let vs = self.v.as_slice();
         let mut s = self.len;
         while s >= 4 {
             s -= 4;
             let b = self.block(s);
-            for x in cols.chunks_exact_mut(n) {
-                self.apply_block(&b, false, x);
+            let w = &mut scratch[..4 * nc];
+            w.fill(0.0);
+            for t in b.s..b.end {
+                let yrow = &y[t * nc..(t + 1) * nc];
+                for j in 0..4 {
+                    let vj = vs[(b.s + j) * n + t];
+                    if vj != 0.0 {
+                        axpy(vj, yrow, &mut w[j * nc..(j + 1) * nc]);
+                    }
+                }
+            }
+            for j in (0..4).rev() {
+                let (head, tail) = w.split_at_mut((j + 1) * nc);
+                let fj = &mut head[j * nc..];
+                for i in j + 1..4 {
+                    axpy(-b.c[j][i], &tail[(i - j - 1) * nc..(i - j) * nc], fj);
+                }
+                let tau = b.tau[j];
+                fj.iter_mut().for_each(|x| *x *= tau);
+            }
+            for t in b.s..b.end {
+                let yrow = &mut y[t * nc..(t + 1) * nc];
+                for j in 0..4 {
+                    let vj = vs[(b.s + j) * n + t];
+                    if vj != 0.0 {
+                        axpy(-vj, &w[j * nc..(j + 1) * nc], yrow);
+                    }
+                }
             }
         }
         for s in (0..s).rev() {
-            for x in cols.chunks_exact_mut(n) {
-                self.apply_one(s, x);
+            let w = &mut scratch[..nc];
+            w.fill(0.0);
+            let v = self.vector(s);
+            for (a, &va) in v.iter().enumerate() {
+                if va != 0.0 {
+                    axpy(va, &y[(s + a) * nc..(s + a + 1) * nc], w);
+                }
+            }
+            let tau = self.tau[s];
+            for (a, &va) in v.iter().enumerate() {
+                if va != 0.0 {
+                    axpy(-tau * va, w, &mut y[(s + a) * nc..(s + a + 1) * nc]);
+                }
             }
         }
     }
