@@ -41,6 +41,11 @@ use super::settings::{Damping, SolverSettings};
 use crate::error::{check_dim, Error, Result};
 use crate::task::TaskEquation;
 
+/// Relative size below which a downdated squared column norm of the pivoted QR is recomputed
+/// from its entries \[–\]: √ε, LAPACK's choice in xGEQP3 (the downdate has then lost about half
+/// the significant digits).
+const NORM_DOWNDATE_TOL: f64 = 1.4901161193847656e-8;
+
 /// Workspace of the prioritized recursion, sized once for given level dimensions.
 #[derive(Debug, Clone)]
 pub struct Hierarchy {
@@ -64,6 +69,7 @@ pub struct Hierarchy {
     /// reduced G column, a level residual and a small vector.
     a: DMatrix<f64>,
     colnorm: Vec<f64>,
+    colnorm_ref: Vec<f64>,
     u: DVector<f64>,
     /// Row-major n × m_i block of reduced G columns, a row-major right-hand side block and
     /// the four-row scratch of the reflectors.
@@ -100,6 +106,7 @@ impl Hierarchy {
             fac: dims.iter().map(|&m| LevelFactor::new(m)).collect(),
             a: DMatrix::zeros(n.max(1), mmax),
             colnorm: vec![0.0; mmax],
+            colnorm_ref: vec![0.0; mmax],
             u: DVector::zeros(n),
             yb: vec![0.0; n * mmax],
             bb: vec![0.0; mmax * mmax],
@@ -248,15 +255,18 @@ impl Hierarchy {
         // Householder QR with column pivoting of A (k × m).
         let steps = k.min(m);
         let mut rank = 0;
-        for st in 0..steps {
-            // Pivot: the remaining column of largest norm (rows st..k).
-            {
-                let asl = self.a.as_slice();
-                for c in st..m {
-                    let col = &asl[c * ar + st..c * ar + k];
-                    self.colnorm[c] = dot(col, col);
-                }
+        // Squared column norms over the rows not yet reduced, downdated after each step
+        // (‖x[st+1..]‖² = ‖x[st..]‖² − x_st²) and recomputed when the downdate has cancelled
+        // to below NORM_DOWNDATE_TOL of the last exact value, as LAPACK's xGEQP3 does.
+        {
+            let asl = self.a.as_slice();
+            for c in 0..m {
+                let col = &asl[c * ar..c * ar + k];
+                self.colnorm[c] = dot(col, col);
+                self.colnorm_ref[c] = self.colnorm[c];
             }
+        }
+        for st in 0..steps {
             let mut best = st;
             for c in st + 1..m {
                 if self.colnorm[c] > self.colnorm[best] {
@@ -267,8 +277,13 @@ impl Hierarchy {
                 self.a.swap_columns(st, best);
                 perm.swap(st, best);
                 self.colnorm.swap(st, best);
+                self.colnorm_ref.swap(st, best);
             }
-            let norm = self.colnorm[st].sqrt();
+            // The pivot's norm exactly: it decides the rank and forms the reflector.
+            let norm = {
+                let col = &self.a.as_slice()[st * ar + st..st * ar + k];
+                dot(col, col).sqrt()
+            };
             if norm <= settings.rank_threshold {
                 break;
             }
@@ -289,6 +304,13 @@ impl Hierarchy {
                 let f = tau * dot(v, col);
                 if f != 0.0 {
                     axpy(-f, v, col);
+                }
+                let top = asl[c * ar + st];
+                self.colnorm[c] -= top * top;
+                if self.colnorm[c] <= NORM_DOWNDATE_TOL * self.colnorm_ref[c] {
+                    let rest = &asl[c * ar + st + 1..c * ar + k];
+                    self.colnorm[c] = dot(rest, rest);
+                    self.colnorm_ref[c] = self.colnorm[c];
                 }
             }
             rank = st + 1;

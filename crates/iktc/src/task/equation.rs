@@ -114,13 +114,13 @@ impl TaskEquation {
                 self.jacobian.nrows(),
             );
         }
-        if self.jacobian.iter().any(|v| !v.is_finite()) {
+        if !crate::error::all_finite(self.jacobian.as_slice()) {
             return crate::error::check_all_finite(
                 &format!("J of `{}`", self.name),
                 self.jacobian.as_slice(),
             );
         }
-        if self.rhs.iter().any(|v| !v.is_finite()) {
+        if !crate::error::all_finite(self.rhs.as_slice()) {
             return crate::error::check_all_finite(
                 &format!("h of `{}`", self.name),
                 self.rhs.as_slice(),

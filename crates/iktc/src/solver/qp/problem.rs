@@ -131,7 +131,7 @@ fn check_matrix_finite(what: &str, m: &DMatrixView<'_, f64>) -> Result<()> {
     for j in 0..m.ncols() {
         let column = m.column(j);
         let column = column.as_slice();
-        if column.iter().all(|v| v.is_finite()) {
+        if crate::error::all_finite(column) {
             continue;
         }
         if let Some((i, &v)) = column.iter().enumerate().find(|(_, v)| !v.is_finite()) {
