@@ -297,3 +297,74 @@ fn climbing_from_the_last_level_finds_the_same_correction_as_from_the_bottom() {
     );
     assert!(qps_last < qps_bottom);
 }
+
+#[test]
+fn the_infeasibility_screen_never_changes_the_answer() {
+    // The screen may only skip QPs that would have been infeasible: with and without it, the
+    // same sequence of problems gives the same level, fallback and q̈. Consecutive ticks repeat
+    // a problem with small box changes, so that a level stays infeasible and the certificate
+    // of its last QP gets reused.
+    let mut r = rng(36);
+    let dims = [6, 6, 6];
+    let n = 20;
+    let on = SolverSettings::default();
+    assert!(on.screen);
+    let off = SolverSettings {
+        screen: false,
+        ..Default::default()
+    };
+    let mut s_on = Solver::new(n, &dims, on).unwrap();
+    let mut s_off = Solver::new(n, &dims, off).unwrap();
+    let (mut screened, mut qps_on, mut qps_off, mut iters_on, mut iters_off) = (0, 0, 0, 0, 0);
+    for case in 0..150 {
+        let levels = random_levels(&mut r, n, &dims);
+        let mut q0 = DVector::zeros(n);
+        s_off
+            .solve(Method::Prioritized, &levels, &wide_box(n), &mut q0)
+            .unwrap();
+        let bx0 = box_violated_by(&mut r, &q0, 1.0, 2 + case % 6, 1.0);
+        for tick in 0..5 {
+            let mut bx = bx0.clone();
+            for d in 0..n {
+                let shift = 0.02 * tick as f64 * if d % 2 == 0 { 1.0 } else { -0.5 };
+                bx.lower[d] += shift;
+                bx.upper[d] += shift;
+            }
+            let (mut a, mut b) = (DVector::zeros(n), DVector::zeros(n));
+            let ra = s_on
+                .solve(Method::Iktc, &levels, &bx, &mut a)
+                .unwrap()
+                .clone();
+            let rb = s_off
+                .solve(Method::Iktc, &levels, &bx, &mut b)
+                .unwrap()
+                .clone();
+            assert_eq!(
+                ra.corrected_from, rb.corrected_from,
+                "case {case} tick {tick}"
+            );
+            assert_eq!(ra.fallback, rb.fallback, "case {case} tick {tick}");
+            assert!(
+                (&a - &b).norm() <= 1e-9 * (1.0 + b.norm()),
+                "case {case} tick {tick}"
+            );
+            assert_eq!(rb.screened_infeasible, 0);
+            // Every level checked is counted once: by a QP or by the screen.
+            assert_eq!(
+                ra.qp_solves + ra.screened_infeasible,
+                rb.qp_solves,
+                "case {case} tick {tick}"
+            );
+            screened += ra.screened_infeasible;
+            qps_on += ra.qp_solves;
+            qps_off += rb.qp_solves;
+            iters_on += ra.qp_iterations;
+            iters_off += rb.qp_iterations;
+        }
+    }
+    println!(
+        "screened {screened} levels; QPs {qps_on} vs {qps_off}, iterations {iters_on} vs {iters_off}"
+    );
+    assert!(screened > 50, "the screen must fire ({screened})");
+    assert!(iters_on < iters_off);
+}

@@ -9,6 +9,7 @@ pub use qp::{
 mod hierarchy;
 mod reflectors;
 mod report;
+mod screen;
 mod settings;
 mod solve;
 

@@ -60,6 +60,11 @@ pub struct SolveReport {
     pub qp_solves: usize,
     /// QPs that reported an infeasible constraint set.
     pub qp_infeasible: usize,
+    /// IKTC feasibility checks settled without a QP: levels proved infeasible by the
+    /// certificate of the rows their last infeasible QP ended with active (see
+    /// [`SolverSettings::screen`](super::SolverSettings::screen)). Each such level also counts
+    /// as a feasibility check, not as a QP.
+    pub screened_infeasible: usize,
     /// Active-set iterations over all QPs.
     pub qp_iterations: usize,
     /// Dofs whose box was empty (b_l > b_u); they were given the midpoint, the least possible
@@ -85,6 +90,7 @@ impl SolveReport {
             ranks: vec![0; dims.len()],
             qp_solves: 0,
             qp_infeasible: 0,
+            screened_infeasible: 0,
             qp_iterations: 0,
             empty_box_dofs: 0,
             violation_before: 0.0,
@@ -101,6 +107,7 @@ impl SolveReport {
         }
         self.qp_solves = 0;
         self.qp_infeasible = 0;
+        self.screened_infeasible = 0;
         self.qp_iterations = 0;
         self.empty_box_dofs = 0;
         self.violation_before = 0.0;

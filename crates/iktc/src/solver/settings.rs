@@ -58,6 +58,12 @@ pub struct SolverSettings {
     /// \[–\]. Larger values bias the cascade towards small q̈; smaller ones make its Hessian
     /// ill-conditioned. Default 1e-8.
     pub cascade_regularization: f64,
+    /// Before each IKTC correction QP, try to prove the level infeasible with the rows the
+    /// last infeasible QP of that level ended with active (a relaxation: it never rejects a
+    /// feasible level, and it allows the QP's feasibility tolerance; see the `screen` module
+    /// notes in the solver). Saves the m_c iterations an infeasible QP needs when a level stays
+    /// infeasible tick after tick. Default true.
+    pub screen: bool,
     /// Where IKTC's climb starts. Default [`Climb::FromLast`].
     pub climb: Climb,
     /// Settings of the QPs.
@@ -71,6 +77,7 @@ impl Default for SolverSettings {
             rank_threshold: 1e-9,
             box_tolerance: 1e-9,
             cascade_regularization: 1e-8,
+            screen: true,
             climb: Climb::FromLast,
             qp: QpSettings::default(),
         }

@@ -5,6 +5,7 @@ use nalgebra::{DMatrix, DVector};
 use super::hierarchy::Hierarchy;
 use super::qp::{Hessian, QpProblem, QpStatus, QpWorkspace};
 use super::report::{Fallback, Method, SolveReport};
+use super::screen::Screen;
 use super::settings::{Climb, SolverSettings};
 use crate::error::{check_dim, Result};
 use crate::limits::AccelerationBox;
@@ -28,6 +29,8 @@ pub struct Solver {
     xs: Vec<DVector<f64>>,
     /// The level the last IKTC correction started from ([`Climb::FromLast`]).
     last_from: Option<usize>,
+    /// The infeasibility certificate tried before each correction QP.
+    screen: Screen,
     // Cascade buffers.
     h: DMatrix<f64>,
     c: Vec<f64>,
@@ -60,6 +63,7 @@ impl Solver {
                 v
             },
             last_from: None,
+            screen: Screen::new(dims.len(), total),
             h: DMatrix::zeros(nv, nv),
             c: vec![0.0; nv],
             a_eq: DMatrix::zeros(total.max(1), nv),
@@ -245,6 +249,18 @@ impl Solver {
             return Ok(false);
         }
         let g = self.hierarchy.g().columns(off, ma);
+        if self.settings.screen
+            && self.screen.proves_infeasible(
+                i,
+                &g,
+                &self.qp_lo,
+                &self.qp_hi,
+                self.settings.qp.feasibility_tolerance,
+            )
+        {
+            self.report.screened_infeasible += 1;
+            return Ok(false);
+        }
         let problem = QpProblem {
             hessian: Hessian::Identity,
             c: &self.zeros[..ma],
@@ -263,6 +279,11 @@ impl Solver {
             Ok(true)
         } else {
             self.report.qp_infeasible += 1;
+            let failed = match rep.status {
+                QpStatus::Infeasible { constraint } => Some(constraint),
+                _ => None,
+            };
+            self.screen.remember(i, self.qp.active_set(), failed);
             Ok(false)
         }
     }
