@@ -193,7 +193,7 @@ impl Screen {
                 hi += a1.max(a2);
                 mag += a1.abs() + a2.abs();
             }
-            if !bounded || !(lo.is_finite() && hi.is_finite()) {
+            if !(bounded && lo.is_finite() && hi.is_finite()) {
                 continue;
             }
             let finite = |x: f64| if x.is_finite() { x.abs() } else { 0.0 };
