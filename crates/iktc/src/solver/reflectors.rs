@@ -130,6 +130,10 @@ impl Reflectors {
                 f[j] = b.tau[j] * t;
             }
         }
+        if f == [0.0; 4] {
+            // x is orthogonal to the block (a sparse task row outside its support).
+            return;
+        }
         for (i, xi) in x.iter_mut().enumerate() {
             *xi -= f[0] * v0[i] + f[1] * v1[i] + f[2] * v2[i] + f[3] * v3[i];
         }

@@ -132,13 +132,21 @@ impl Solver {
         }
         self.report.violation = self.violation(qdd);
         for (i, l) in levels.iter().enumerate() {
+            // e = J q̈ − h, by columns of J (contiguous).
             let e = &mut self.report.task_errors[i];
-            for r in 0..l.dim() {
-                let mut s = -l.rhs[r];
-                for c in 0..n {
-                    s += l.jacobian[(r, c)] * qdd[c];
+            let m = l.dim();
+            let es = e.as_mut_slice();
+            for (x, h) in es.iter_mut().zip(l.rhs.iter()) {
+                *x = -h;
+            }
+            let js = l.jacobian.as_slice();
+            for c in 0..n {
+                let qc = qdd[c];
+                if qc != 0.0 {
+                    for (x, j) in es.iter_mut().zip(&js[c * m..(c + 1) * m]) {
+                        *x += j * qc;
+                    }
                 }
-                e[r] = s;
             }
             self.report.task_error_norms[i] = e.norm();
         }
