@@ -74,6 +74,8 @@ pub struct Hierarchy {
     /// Row-major n × m_i block of reduced G columns, a row-major right-hand side block and
     /// the four-row scratch of the reflectors.
     yb: Vec<f64>,
+    /// Row-major n × Σm_i: the reduced blocks of several levels side by side.
+    yall: Vec<f64>,
     bb: Vec<f64>,
     qscratch: Vec<f64>,
     res: Vec<f64>,
@@ -110,7 +112,8 @@ impl Hierarchy {
             u: DVector::zeros(n),
             yb: vec![0.0; n * mmax],
             bb: vec![0.0; mmax * mmax],
-            qscratch: vec![0.0; 4 * mmax],
+            yall: vec![0.0; n * total],
+            qscratch: vec![0.0; 4 * total.max(1)],
             res: vec![0.0; mmax],
             x: vec![0.0; mmax],
             g: DMatrix::zeros(n, total.max(1)),
@@ -399,15 +402,37 @@ impl Hierarchy {
     /// Builds the block g_i of G (Algorithm 1), using the factors of the last
     /// [`Hierarchy::solve`]. Allocates nothing.
     pub fn build_g_level(&mut self, i: usize) {
-        let (off, m, n) = (self.offsets[i], self.dims[i], self.n);
-        self.reduced_block(i, true);
-        // G_i = Q Y_i, on the rows of Y, then into the columns of G.
+        self.build_g_levels(i, i + 1);
+    }
+
+    /// Builds the blocks g_i of the levels `from..to` together: each level's reduced block,
+    /// then Q applied once to all their columns (one pass over the reflectors instead of one
+    /// per level). Allocates nothing.
+    pub fn build_g_levels(&mut self, from: usize, to: usize) {
+        let n = self.n;
+        let to = to.min(self.dims.len());
+        if from >= to {
+            return;
+        }
+        let (c0, width) = (self.offsets[from], self.offsets[to - 1] + self.dims[to - 1]);
+        let w = width - c0;
+        if w == 0 {
+            return;
+        }
+        for i in from..to {
+            let (m, co) = (self.dims[i], self.offsets[i] - c0);
+            self.reduced_block(i, true);
+            for d in 0..n {
+                self.yall[d * w + co..d * w + co + m].copy_from_slice(&self.yb[d * m..(d + 1) * m]);
+            }
+        }
+        // G = Q Y on the rows of Y, then into the columns of G.
         self.refl
-            .apply_q_rows(&mut self.yb[..n * m], m, &mut self.qscratch);
-        let gs = &mut self.g.as_mut_slice()[off * n..(off + m) * n];
+            .apply_q_rows(&mut self.yall[..n * w], w, &mut self.qscratch);
+        let gs = &mut self.g.as_mut_slice()[c0 * n..width * n];
         for (c, col) in gs.chunks_exact_mut(n).enumerate() {
             for (d, x) in col.iter_mut().enumerate() {
-                *x = self.yb[d * m + c];
+                *x = self.yall[d * w + c];
             }
         }
     }

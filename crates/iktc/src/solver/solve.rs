@@ -193,9 +193,7 @@ impl Solver {
             Climb::FromLast => self.last_from.unwrap_or(nt - 1).min(nt - 1),
         };
         // G blocks of levels start..n_T (Algorithm 1 builds them bottom-up; each is independent).
-        for i in (start..nt).rev() {
-            self.hierarchy.build_g_level(i);
-        }
+        self.hierarchy.build_g_levels(start, nt);
         let mut found = None;
         if self.level_feasible(start)? {
             // Down the priorities while still feasible.
