@@ -27,6 +27,9 @@ pub(crate) struct ActiveBasis {
     j: DMatrix<f64>,
     /// `R`, leading `q × q` upper triangle used.
     r: DMatrix<f64>,
+    /// Scratch of [`ActiveBasis::add`]: the Householder vector and `J v`.
+    hv: Vec<f64>,
+    hw: Vec<f64>,
 }
 
 /// A plane rotation `[c s; −s c]` that maps `(a, b)` to `(h, 0)`, `h = √(a² + b²)`.
@@ -88,6 +91,8 @@ impl ActiveBasis {
             q: 0,
             j: DMatrix::zeros(capacity, capacity),
             r: DMatrix::zeros(capacity, capacity),
+            hv: vec![0.0; capacity],
+            hw: vec![0.0; capacity],
         }
     }
 
@@ -180,10 +185,59 @@ impl ActiveBasis {
         }
     }
 
-    /// Appends the normal whose projection is `d = Jᵀ n` (overwritten): rotations of columns
-    /// `(k−1, k)` of `J`, `k = n−1 … q+1`, zero `d_k` into `d_{k−1}`; then `R`'s new column is
-    /// `(d_0, …, d_q)`. The caller has checked that `d₂ ≠ 0` (the normal is independent).
+    /// Appends the normal whose projection is `d = Jᵀ n` (overwritten): one Householder
+    /// reflection H of columns `q..n` of `J` maps `(d_q, …, d_{n−1})` to `(−σ sign d_q, 0, …)`,
+    /// σ = ‖d₂‖, and the sign of column `q` is chosen so that `R`'s new diagonal entry is +σ;
+    /// then `R`'s new column is `(d_0, …, d_q)`. `J H Hᵀ Jᵀ = J Jᵀ`, so `J Jᵀ = H⁻¹` still
+    /// holds. When σ(σ + |d_q|) is not a normal number (data near under- or overflow) the
+    /// reflection's scale is unsafe and rotations of adjacent columns are used instead. The
+    /// caller has checked that `d₂ ≠ 0` (the normal is independent).
     pub(crate) fn add(&mut self, d: &mut [f64]) {
+        let (n, q, ld) = (self.n, self.q, self.ld);
+        if n > q + 1 && d[q + 1..n].iter().any(|x| *x != 0.0) {
+            let sigma = norm(&d[q..n]);
+            let dq = d[q];
+            let scale = sigma * (sigma + dq.abs());
+            if scale.is_normal() {
+                // v = d₂ − α e₁, α = −sign(d_q) σ;  τ = 2 / vᵀv = 1 / (σ (σ + |d_q|)).
+                let alpha = if dq >= 0.0 { -sigma } else { sigma };
+                let len = n - q;
+                let v = &mut self.hv[..len];
+                v.copy_from_slice(&d[q..n]);
+                v[0] = dq - alpha;
+                let tau = 1.0 / scale;
+                let j = self.j.as_mut_slice();
+                let w = &mut self.hw[..n];
+                w.fill(0.0);
+                for (a, &va) in v.iter().enumerate() {
+                    if va != 0.0 {
+                        axpy(va, &j[(q + a) * ld..(q + a) * ld + n], w);
+                    }
+                }
+                for (a, &va) in v.iter().enumerate() {
+                    if va != 0.0 {
+                        axpy(-tau * va, w, &mut j[(q + a) * ld..(q + a) * ld + n]);
+                    }
+                }
+                // Column q now gives α; flip it when α < 0 so that R_qq = σ > 0.
+                if alpha < 0.0 {
+                    for x in &mut j[q * ld..q * ld + n] {
+                        *x = -*x;
+                    }
+                }
+                d[q] = sigma;
+                d[q + 1..n].fill(0.0);
+            } else {
+                self.rotate_in(d);
+            }
+        }
+        self.r.as_mut_slice()[q * ld..q * ld + q + 1].copy_from_slice(&d[..=q]);
+        self.q += 1;
+    }
+
+    /// The rotation form of [`ActiveBasis::add`]'s reduction: rotations of columns `(k−1, k)`
+    /// of `J`, `k = n−1 … q+1`, zero `d_k` into `d_{k−1}` (safe for any finite scale).
+    fn rotate_in(&mut self, d: &mut [f64]) {
         let (n, q, ld) = (self.n, self.q, self.ld);
         let j = self.j.as_mut_slice();
         for k in ((q + 1)..n).rev() {
@@ -196,8 +250,6 @@ impl ActiveBasis {
             let (left, right) = j.split_at_mut(k * ld);
             g.apply(&mut left[(k - 1) * ld..(k - 1) * ld + n], &mut right[..n]);
         }
-        self.r.as_mut_slice()[q * ld..q * ld + q + 1].copy_from_slice(&d[..=q]);
-        self.q += 1;
     }
 
     /// Removes the active normal at position `k < q`: deletes column `k` of `R`, then rotations
@@ -310,6 +362,37 @@ mod tests {
                 let expected = if i <= k { basis.r[(i, k)] } else { 0.0 };
                 assert!((col[i] - expected).abs() < TOL, "entry ({i}, {k})");
             }
+        }
+    }
+
+    #[test]
+    fn tiny_normals_take_the_rotation_path_and_keep_the_factorisation() {
+        // Normals of size 1e-160: σ(σ + |d_q|) underflows, so `add` rotates instead of
+        // reflecting. Checked relative to that size, with H = I (J Jᵀ = I).
+        let mut rng = Lcg(11);
+        let n = 6;
+        let scale = 1e-160;
+        let mut basis = ActiveBasis::new(n);
+        basis.reset_identity(n);
+        let mut d = vec![0.0; n];
+        let mut normals = Vec::new();
+        for _ in 0..4 {
+            let v: Vec<f64> = (0..n).map(|_| rng.next() * scale).collect();
+            basis.project(&v, &mut d);
+            let sigma = norm(&d[basis.q..n]);
+            assert!(!(sigma * sigma).is_normal());
+            basis.add(&mut d);
+            normals.push(v);
+        }
+        let j = basis.j.view((0, 0), (n, n)).into_owned();
+        assert!((&j * j.transpose() - DMatrix::identity(n, n)).amax() < TOL);
+        for (k, nk) in normals.iter().enumerate() {
+            let col = j.transpose() * DVector::from_column_slice(nk) / scale;
+            for i in 0..n {
+                let expected = if i <= k { basis.r[(i, k)] / scale } else { 0.0 };
+                assert!((col[i] - expected).abs() < TOL, "entry ({i}, {k})");
+            }
+            assert!(basis.r[(k, k)] > 0.0);
         }
     }
 
