@@ -36,7 +36,8 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use super::reflectors::{axpy, dot, Reflectors};
+use super::kernels::{axpy, dot};
+use super::reflectors::Reflectors;
 use super::settings::{Damping, SolverSettings};
 use crate::error::{check_dim, Error, Result};
 use crate::task::TaskEquation;

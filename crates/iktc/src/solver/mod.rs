@@ -7,6 +7,7 @@ pub use qp::{
 };
 
 mod hierarchy;
+mod kernels;
 mod reflectors;
 mod report;
 mod screen;

@@ -14,6 +14,8 @@
 
 use nalgebra::DMatrix;
 
+use super::kernels::{axpy, dot};
+
 /// Householder vectors stored by column: column s acts on the coordinates s..end(s) and is
 /// zero elsewhere (H_s = I − τ_s v_s v_sᵀ). Sized once; pushing allocates nothing.
 #[derive(Debug, Clone)]
@@ -274,34 +276,4 @@ fn dot4(v: [&[f64]; 4], x: &[f64]) -> [f64; 4] {
         d[3] += v3[i] * xi;
     }
     d
-}
-
-/// Dot product of two equally long slices with four independent accumulators, so that the
-/// compiler can vectorise it (a single running sum fixes the order of the additions).
-#[inline]
-pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
-    let n = a.len().min(b.len());
-    let (a, b) = (&a[..n], &b[..n]);
-    let mut acc = [0.0f64; 4];
-    let mut ca = a.chunks_exact(4);
-    let mut cb = b.chunks_exact(4);
-    for (x, y) in (&mut ca).zip(&mut cb) {
-        acc[0] += x[0] * y[0];
-        acc[1] += x[1] * y[1];
-        acc[2] += x[2] * y[2];
-        acc[3] += x[3] * y[3];
-    }
-    let mut s = (acc[0] + acc[1]) + (acc[2] + acc[3]);
-    for (x, y) in ca.remainder().iter().zip(cb.remainder()) {
-        s += x * y;
-    }
-    s
-}
-
-/// y += α x.
-#[inline]
-pub(crate) fn axpy(alpha: f64, x: &[f64], y: &mut [f64]) {
-    for (yi, xi) in y.iter_mut().zip(x) {
-        *yi += alpha * xi;
-    }
 }

@@ -14,6 +14,8 @@
 
 use nalgebra::DMatrix;
 
+pub(crate) use crate::solver::kernels::{axpy, dot};
+
 /// `J` and `R` on column-major storage of the workspace's capacity.
 #[derive(Debug, Clone)]
 pub(crate) struct ActiveBasis {
@@ -282,27 +284,6 @@ impl ActiveBasis {
     }
 }
 
-/// `xᵀ y` over the common length, with four partial sums (so that the compiler can use SIMD
-/// lanes; strict left-to-right summation cannot be vectorised).
-pub(crate) fn dot(x: &[f64], y: &[f64]) -> f64 {
-    let len = x.len().min(y.len());
-    let (x, y) = (&x[..len], &y[..len]);
-    let mut acc = [0.0_f64; 4];
-    let (xc, yc) = (x.chunks_exact(4), y.chunks_exact(4));
-    let tail: f64 = xc
-        .remainder()
-        .iter()
-        .zip(yc.remainder())
-        .map(|(a, b)| a * b)
-        .sum();
-    for (a, b) in xc.zip(yc) {
-        for k in 0..4 {
-            acc[k] += a[k] * b[k];
-        }
-    }
-    (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
-}
-
 /// `‖x‖₂`, without overflow or underflow of the squares: entries are scaled by the largest
 /// magnitude when it lies outside `[1e-150, 1e150]`.
 pub(crate) fn norm(x: &[f64]) -> f64 {
@@ -314,13 +295,6 @@ pub(crate) fn norm(x: &[f64]) -> f64 {
     } else {
         let scaled: f64 = x.iter().map(|v| (v / largest) * (v / largest)).sum();
         largest * scaled.sqrt()
-    }
-}
-
-/// `y ← y + a x`.
-pub(crate) fn axpy(a: f64, x: &[f64], y: &mut [f64]) {
-    for (yi, &xi) in y.iter_mut().zip(x) {
-        *yi += a * xi;
     }
 }
 
