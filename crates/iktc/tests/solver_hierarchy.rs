@@ -7,6 +7,27 @@ use iktc::solver::*;
 use iktc::task::TaskEquation;
 use nalgebra::{DMatrix, DVector};
 
+/// N_{i−1} = I − A⁺A for every level i, with A the stacked Jacobian of the levels above it
+/// (the meaning of eq. 7), by SVD with a relative rank threshold; N_0 = I.
+fn projectors_above(levels: &[TaskEquation]) -> Vec<DMatrix<f64>> {
+    let n = levels[0].nv();
+    let mut stacked = DMatrix::<f64>::zeros(0, n);
+    let mut out = Vec::with_capacity(levels.len());
+    for l in levels {
+        out.push(if stacked.nrows() == 0 {
+            DMatrix::<f64>::identity(n, n)
+        } else {
+            DMatrix::<f64>::identity(n, n)
+                - stacked.clone().pseudo_inverse(1e-9).unwrap() * &stacked
+        });
+        let mut b = DMatrix::zeros(stacked.nrows() + l.dim(), n);
+        b.rows_mut(0, stacked.nrows()).copy_from(&stacked);
+        b.rows_mut(stacked.nrows(), l.dim()).copy_from(&l.jacobian);
+        stacked = b;
+    }
+    out
+}
+
 /// Eqs. 5–7 with explicit n × n projectors and SVD pseudo-inverses (λ = 0) or the DLS formula
 /// J̄ᵀ(J̄J̄ᵀ + λ²I)⁻¹ — a second, straightforward implementation. N_{i−1} is computed from
 /// the stacked Jacobian of the levels above, N = I − A⁺A (the meaning of eq. 7), by SVD with a
@@ -14,12 +35,7 @@ use nalgebra::{DMatrix, DVector};
 fn reference_solution(levels: &[TaskEquation], lambda: f64) -> DVector<f64> {
     let n = levels[0].nv();
     let mut q = DVector::zeros(n);
-    let mut stacked: Option<DMatrix<f64>> = None;
-    for l in levels {
-        let na = match &stacked {
-            None => DMatrix::<f64>::identity(n, n),
-            Some(a) => DMatrix::<f64>::identity(n, n) - a.clone().pseudo_inverse(1e-9).unwrap() * a,
-        };
+    for (l, na) in levels.iter().zip(projectors_above(levels)) {
         let jb = &l.jacobian * &na;
         let pinv = if lambda == 0.0 {
             jb.clone().pseudo_inverse(1e-9).unwrap()
@@ -29,15 +45,6 @@ fn reference_solution(levels: &[TaskEquation], lambda: f64) -> DVector<f64> {
             jb.transpose() * s.try_inverse().unwrap()
         };
         q += &pinv * (&l.rhs - &l.jacobian * &q);
-        stacked = Some(match stacked {
-            None => l.jacobian.clone(),
-            Some(a) => {
-                let mut b = DMatrix::zeros(a.nrows() + l.dim(), n);
-                b.rows_mut(0, a.nrows()).copy_from(&a);
-                b.rows_mut(a.nrows(), l.dim()).copy_from(&l.jacobian);
-                b
-            }
-        });
     }
     q
 }
@@ -51,15 +58,7 @@ const REL_TOL: f64 = 1e-8;
 /// levels above, N_{i−1} J_iᵀ (h_i − J_i q̈) = 0, with N_{i−1} = I − A⁺A from the stacked
 /// Jacobian A of the levels above.
 fn check_lexicographic(levels: &[TaskEquation], q: &DVector<f64>, tol: f64) {
-    let n = q.len();
-    let mut stacked = DMatrix::<f64>::zeros(0, n);
-    for (i, l) in levels.iter().enumerate() {
-        let na = if stacked.nrows() == 0 {
-            DMatrix::<f64>::identity(n, n)
-        } else {
-            DMatrix::<f64>::identity(n, n)
-                - stacked.clone().pseudo_inverse(1e-9).unwrap() * &stacked
-        };
+    for (i, (l, na)) in levels.iter().zip(projectors_above(levels)).enumerate() {
         let res = &l.rhs - &l.jacobian * q;
         let g = &na * l.jacobian.transpose() * &res;
         assert!(
@@ -67,10 +66,6 @@ fn check_lexicographic(levels: &[TaskEquation], q: &DVector<f64>, tol: f64) {
             "level {i}: gradient {}",
             g.norm()
         );
-        let mut b = DMatrix::zeros(stacked.nrows() + l.dim(), n);
-        b.rows_mut(0, stacked.nrows()).copy_from(&stacked);
-        b.rows_mut(stacked.nrows(), l.dim()).copy_from(&l.jacobian);
-        stacked = b;
     }
 }
 
@@ -207,14 +202,7 @@ fn pinv_is_the_pseudo_inverse_of_the_projected_jacobian() {
         let mut h = Hierarchy::new(n, &dims);
         let mut q = DVector::zeros(n);
         h.solve(&levels, &settings, &mut q).unwrap();
-        let mut stacked = DMatrix::<f64>::zeros(0, n);
-        for (i, l) in levels.iter().enumerate() {
-            let na = if stacked.nrows() == 0 {
-                DMatrix::<f64>::identity(n, n)
-            } else {
-                DMatrix::<f64>::identity(n, n)
-                    - stacked.clone().pseudo_inverse(1e-9).unwrap() * &stacked
-            };
+        for (i, (l, na)) in levels.iter().zip(projectors_above(&levels)).enumerate() {
             let want = (&l.jacobian * na).pseudo_inverse(1e-9).unwrap();
             let got = h.pinv(i).clone();
             assert!(
@@ -222,10 +210,6 @@ fn pinv_is_the_pseudo_inverse_of_the_projected_jacobian() {
                 "case {case} level {i}: {}",
                 (&got - &want).norm()
             );
-            let mut b = DMatrix::zeros(stacked.nrows() + l.dim(), n);
-            b.rows_mut(0, stacked.nrows()).copy_from(&stacked);
-            b.rows_mut(stacked.nrows(), l.dim()).copy_from(&l.jacobian);
-            stacked = b;
         }
     }
 }

@@ -13,6 +13,10 @@ use crate::task::TaskEquation;
 
 /// Solves a task hierarchy under an acceleration box. Made once for given level sizes; each
 /// [`Solver::solve`] allocates nothing.
+///
+/// The solver remembers, from one solve to the next, the level IKTC last corrected from and
+/// the rows of each level's last infeasible QP ([`Climb`], [`SolverSettings::screen`]). That
+/// history changes how many QPs a solve runs, never its result.
 #[derive(Debug, Clone)]
 pub struct Solver {
     settings: SolverSettings,
