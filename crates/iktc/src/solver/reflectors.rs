@@ -115,6 +115,12 @@ impl Reflectors {
         let vs = self.v.as_slice();
         let len = b.end - b.s;
         let x = &mut x[b.s..b.end];
+        if x.iter().all(|v| *v == 0.0) {
+            // x is zero on the block's support (a sparse task row, e.g. a joint task's unit
+            // row under the reflectors of the legs): H x = x. The test stops at the first
+            // non-zero, so it costs a dense x almost nothing.
+            return;
+        }
         let v0 = &vs[b.s * n + b.s..][..len];
         let v1 = &vs[(b.s + 1) * n + b.s..][..len];
         let v2 = &vs[(b.s + 2) * n + b.s..][..len];
@@ -133,7 +139,6 @@ impl Reflectors {
             }
         }
         if f == [0.0; 4] {
-            // x is orthogonal to the block (a sparse task row outside its support).
             return;
         }
         for (i, xi) in x.iter_mut().enumerate() {
@@ -145,6 +150,9 @@ impl Reflectors {
         let e = self.end[s];
         let v = self.vector(s);
         let x = &mut x[s..e];
+        if x.iter().all(|v| *v == 0.0) {
+            return;
+        }
         let f = self.tau[s] * dot(v, x);
         if f != 0.0 {
             axpy(-f, v, x);

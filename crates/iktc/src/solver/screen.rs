@@ -96,56 +96,76 @@ impl Screen {
         if mc == 0 || rows.len() != mc || mc > self.piv.len() {
             return false;
         }
-        // A = G_Sᵀ (column a of A is row rows[a] of G), factored P A = L U in place.
-        let ld = self.lu.nrows();
-        let a = self.lu.as_mut_slice();
-        let mut scale: f64 = 0.0;
-        for (col, &row) in rows.iter().enumerate() {
-            for k in 0..mc {
-                let v = g[(row, k)];
-                a[col * ld + k] = v;
-                scale = scale.max(v.abs());
+        // A = G_Sᵀ (column a of A is row rows[a] of G), mc × mc stored compactly (leading
+        // dimension mc), factored P A = L U in place.
+        let a = &mut self.lu.as_mut_slice()[..mc * mc];
+        for k in 0..mc {
+            let gk = g.column(k);
+            let gk = gk.as_slice();
+            for (col, &row) in rows.iter().enumerate() {
+                a[col * mc + k] = gk[row];
             }
         }
+        // max |a|, four independent lanes (f64::max is a serial chain with NaN handling).
+        let mut lanes = [0.0_f64; 4];
+        for chunk in a.chunks(4) {
+            for (m, v) in lanes.iter_mut().zip(chunk) {
+                let v = v.abs();
+                *m = if v > *m { v } else { *m };
+            }
+        }
+        let scale = lanes
+            .iter()
+            .fold(0.0_f64, |m, &v| if v > m { v } else { m });
         if scale == 0.0 || !scale.is_finite() {
             return false;
         }
         for k in 0..mc {
+            let (head, tail) = a.split_at_mut((k + 1) * mc);
+            let colk = &mut head[k * mc..];
             let mut p = k;
-            for r in k + 1..mc {
-                if a[k * ld + r].abs() > a[k * ld + p].abs() {
+            let mut big = colk[k].abs();
+            for (r, v) in colk.iter().enumerate().skip(k + 1) {
+                if v.abs() > big {
+                    big = v.abs();
                     p = r;
                 }
             }
-            if a[k * ld + p].abs() <= PIVOT_TOLERANCE * scale {
+            if big <= PIVOT_TOLERANCE * scale {
                 return false;
             }
             self.piv[k] = p;
             if p != k {
-                for col in 0..mc {
-                    a.swap(col * ld + k, col * ld + p);
+                colk.swap(k, p);
+                for col in head[..k * mc].chunks_exact_mut(mc) {
+                    col.swap(k, p);
+                }
+                for col in tail.chunks_exact_mut(mc) {
+                    col.swap(k, p);
                 }
             }
-            let inv = 1.0 / a[k * ld + k];
-            for r in k + 1..mc {
-                a[k * ld + r] *= inv;
+            let colk = &mut head[k * mc..];
+            let inv = 1.0 / colk[k];
+            for v in &mut colk[k + 1..] {
+                *v *= inv;
             }
-            for col in k + 1..mc {
-                let f = a[col * ld + k];
+            let lk = &colk[k + 1..];
+            for col in tail.chunks_exact_mut(mc) {
+                let f = col[k];
                 if f != 0.0 {
-                    let (left, right) = a.split_at_mut(col * ld);
-                    let lk = &left[k * ld + k + 1..k * ld + mc];
-                    for (x, l) in right[k + 1..mc].iter_mut().zip(lk) {
+                    for (x, l) in col[k + 1..].iter_mut().zip(lk) {
                         *x -= f * l;
                     }
                 }
             }
         }
+        let ld = mc;
         // Candidates: the row the last QP failed on (the row of its own certificate), then
         // the rows violated at Δh = 0.
         let n = g.nrows();
         let first = self.failed[level].filter(|&j| j < n);
-        for j in first.into_iter().chain(0..n) {
+        let rest = (0..n).filter(|&j| Some(j) != first);
+        for j in first.into_iter().chain(rest) {
             let (lj, uj) = (lower[j], upper[j]);
             let violated = lj > tol || uj < -tol;
             if (!violated && Some(j) != first) || rows.contains(&j) {
@@ -154,7 +174,7 @@ impl Screen {
             // A c = g_j: permute, L y = P g_j, U c = y.
             let c = &mut self.c[..mc];
             for (k, ck) in c.iter_mut().enumerate() {
-                *ck = g[(j, k)];
+                *ck = g.column(k)[j];
             }
             for k in 0..mc {
                 c.swap(k, self.piv[k]);
@@ -162,8 +182,9 @@ impl Screen {
             for k in 0..mc {
                 let ck = c[k];
                 if ck != 0.0 {
-                    for r in k + 1..mc {
-                        c[r] -= ck * a[k * ld + r];
+                    let lk = &a[k * ld + k + 1..(k + 1) * ld];
+                    for (x, l) in c[k + 1..].iter_mut().zip(lk) {
+                        *x -= ck * l;
                     }
                 }
             }
@@ -171,8 +192,9 @@ impl Screen {
                 c[k] /= a[k * ld + k];
                 let ck = c[k];
                 if ck != 0.0 {
-                    for r in 0..k {
-                        c[r] -= ck * a[k * ld + r];
+                    let uk = &a[k * ld..k * ld + k];
+                    for (x, u) in c[..k].iter_mut().zip(uk) {
+                        *x -= ck * u;
                     }
                 }
             }

@@ -95,6 +95,8 @@ pub struct QpWorkspace {
     active: Vec<Entry>,
     /// `A_in x`.
     ax: DVector<f64>,
+    /// `ax` holds `A_in x` at the current `x` (no primal step since it was computed).
+    ax_current: bool,
     /// `H x` (objective evaluation).
     hx: DVector<f64>,
     states: Vec<RowState>,
@@ -127,6 +129,7 @@ impl QpWorkspace {
             u: DVector::zeros(max_vars),
             active: Vec::with_capacity(max_vars),
             ax: DVector::zeros(max_ineq),
+            ax_current: false,
             hx: DVector::zeros(max_vars),
             states: vec![RowState::Inactive; max_ineq],
             y_eq: DVector::zeros(max_eq),
@@ -184,6 +187,7 @@ impl QpWorkspace {
         let dims = problem.check(self.capacity, settings)?;
         check_dim("length of x", dims.n, x.len())?;
         let n = dims.n;
+        self.ax_current = false;
         // forget the previous solve first, so that a failed factorisation leaves an empty
         // active set and zero multipliers behind
         self.last = dims;
@@ -290,6 +294,7 @@ impl QpWorkspace {
         let q = self.basis.active();
         if primal {
             axpy(t, &self.z.as_slice()[..x.len()], x);
+            self.ax_current = false;
         }
         axpy(-t, &self.r.as_slice()[..q], &mut self.u.as_mut_slice()[..q]);
     }
@@ -446,8 +451,13 @@ impl QpWorkspace {
         }
     }
 
-    /// `ax ← A_in x`.
+    /// `ax ← A_in x`, unless it is current (the optimality check and the final violation
+    /// share one product).
     fn compute_ax(&mut self, problem: &QpProblem<'_>, x: &[f64]) {
+        if self.ax_current {
+            return;
+        }
+        self.ax_current = true;
         let Dims { n, m_in, .. } = self.last;
         let ax = &mut self.ax.as_mut_slice()[..m_in];
         ax.fill(0.0);
