@@ -45,6 +45,7 @@
 #![warn(missing_docs)]
 
 pub mod balance;
+mod buffer;
 pub mod error;
 pub mod limits;
 pub mod model;

@@ -82,3 +82,51 @@ fn the_walking_tick_allocates_nothing() {
         after - before
     );
 }
+
+/// A clone of a controller is as preallocated as the original (a derived `Vec` clone keeps only
+/// the length: the solver's active-set and screen buffers would then allocate, and the screen
+/// would see a full row list and stop remembering), and it computes the same ticks.
+#[test]
+fn a_cloned_controller_allocates_nothing_and_matches_the_original() {
+    let robot = jvrc1(&ModelOptions::default()).unwrap();
+    let clip = builtin_clip("humanoid3d_dance_b").unwrap();
+    let map = builtin_map("deepmimic_jvrc1").unwrap();
+    let refs = imitation_references(&robot, &clip, &map, &ImitateConfig::default()).unwrap();
+    let mut original = ImitationController::new(&robot, &refs, &ImitateConfig::default()).unwrap();
+    let mut clone = original.clone();
+    let (mut screened, mut qps) = (0, 0);
+    let before = allocations();
+    for k in 0..refs.len() {
+        let a = original.tick(&robot, k).unwrap().clone_counts();
+        let b = clone.tick(&robot, k).unwrap().clone_counts();
+        assert_eq!(a, b, "tick {k}: the clone solved differently");
+        assert_eq!(original.qdd(), clone.qdd(), "tick {k}");
+        screened += b.1;
+        qps += b.0;
+        original.integrate(&robot).unwrap();
+        clone.integrate(&robot).unwrap();
+    }
+    let after = allocations();
+    assert!(qps > 100, "{qps} QPs");
+    assert!(
+        screened > 50,
+        "the clone's screen must fire ({screened} levels)"
+    );
+    assert_eq!(after - before, 0, "{} allocations", after - before);
+}
+
+trait Counts {
+    /// (QPs, screened levels, QP iterations, corrected level).
+    fn clone_counts(&self) -> (usize, usize, usize, Option<usize>);
+}
+
+impl Counts for iktc::solver::SolveReport {
+    fn clone_counts(&self) -> (usize, usize, usize, Option<usize>) {
+        (
+            self.qp_solves,
+            self.screened_infeasible,
+            self.qp_iterations,
+            self.corrected_from,
+        )
+    }
+}

@@ -21,6 +21,7 @@
 use nalgebra::{DMatrix, DMatrixView};
 
 use super::qp::{ActiveConstraint, QpConstraint};
+use crate::buffer::Buffer;
 
 /// Relative rounding allowance of the interval test \[–\]: the interval must miss the row's
 /// bounds by this fraction of the magnitudes summed into it, on top of the feasibility
@@ -34,7 +35,7 @@ const PIVOT_TOLERANCE: f64 = 1e-10;
 /// Workspace of the test: the rows remembered per level, the LU factors, a solution vector.
 #[derive(Debug, Clone)]
 pub(crate) struct Screen {
-    rows: Vec<Vec<usize>>,
+    rows: Vec<Buffer<usize>>,
     /// Per level: the row the last infeasible QP could not add (its certificate's own row).
     failed: Vec<Option<usize>>,
     lu: DMatrix<f64>,
@@ -46,7 +47,7 @@ impl Screen {
     /// Room for `levels` levels and QPs of up to `cap` variables.
     pub(crate) fn new(levels: usize, cap: usize) -> Self {
         Self {
-            rows: (0..levels).map(|_| Vec::with_capacity(cap)).collect(),
+            rows: (0..levels).map(|_| Buffer::with_capacity(cap)).collect(),
             failed: vec![None; levels],
             lu: DMatrix::zeros(cap.max(1), cap.max(1)),
             piv: vec![0; cap],

@@ -6,6 +6,7 @@ use super::basis::{axpy, dot, norm, ActiveBasis};
 use super::factor::cholesky;
 use super::problem::Dims;
 use super::{ActiveConstraint, Hessian, QpConstraint, QpProblem, QpReport, QpSettings, QpStatus};
+use crate::buffer::Buffer;
 use crate::error::check_dim;
 use crate::{Error, Result};
 
@@ -92,7 +93,7 @@ pub struct QpWorkspace {
     /// Multipliers of the active set, in its order (sign convention of the signed normals).
     u: DVector<f64>,
     /// Active constraints, in the order of the columns of `R`.
-    active: Vec<Entry>,
+    active: Buffer<Entry>,
     /// `A_in x`.
     ax: DVector<f64>,
     /// `ax` holds `A_in x` at the current `x` (no primal step since it was computed).
@@ -102,7 +103,7 @@ pub struct QpWorkspace {
     states: Vec<RowState>,
     y_eq: DVector<f64>,
     y_in: DVector<f64>,
-    active_out: Vec<ActiveConstraint>,
+    active_out: Buffer<ActiveConstraint>,
 }
 
 impl QpWorkspace {
@@ -127,14 +128,14 @@ impl QpWorkspace {
             z: DVector::zeros(max_vars),
             r: DVector::zeros(max_vars),
             u: DVector::zeros(max_vars),
-            active: Vec::with_capacity(max_vars),
+            active: Buffer::with_capacity(max_vars),
             ax: DVector::zeros(max_ineq),
             ax_current: false,
             hx: DVector::zeros(max_vars),
             states: vec![RowState::Inactive; max_ineq],
             y_eq: DVector::zeros(max_eq),
             y_in: DVector::zeros(max_ineq),
-            active_out: Vec::with_capacity(max_vars),
+            active_out: Buffer::with_capacity(max_vars),
         }
     }
 
