@@ -65,8 +65,9 @@
 //! the method ends after finitely many steps; [`QpSettings::max_iterations`] bounds degenerate
 //! cases.
 //!
-//! **Updates.** Adding `n⁺`: plane (Givens) rotations of columns `(k−1, k)` of `J`,
-//! `k = n−1, …, q+1`, zero `d_k` into `d_{k−1}`; `R` gains the column `(d₀, …, d_q)`. Dropping
+//! **Updates.** Adding `n⁺`: one Householder reflection of columns `q, …, n−1` of `J` maps
+//! `d₂` to `(‖d₂‖, 0, …, 0)` (plane rotations of adjacent columns when the data are near
+//! under- or overflow); `R` gains the column `(d₀, …, d_q)`. Dropping
 //! the `k`-th active normal: delete column `k` of `R`, then rotations of rows `(i, i+1)` of `R`
 //! and columns `(i, i+1)` of `J`, `i = k, …, q−2`, restore the triangle. Each update is
 //! `O(n²)`; nothing is refactorised during the iteration.
