@@ -8,19 +8,12 @@
 use std::time::{Duration, Instant};
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use iktc::model::{jvrc1, ModelOptions, Robot};
-use iktc::motion::{builtin_clip, builtin_map, RobotReferences};
-use iktc::sim::{imitation_references, percentile, ImitateConfig, ImitationController};
+use iktc::sim::{percentile, ImitateConfig, ImitationController};
 use iktc::solver::Method;
 
-fn setup() -> (Robot, RobotReferences) {
-    let robot = jvrc1(&ModelOptions::default()).expect("JVRC-1");
-    let clip = builtin_clip("humanoid3d_dance_b").expect("clip");
-    let map = builtin_map("deepmimic_jvrc1").expect("map");
-    let refs =
-        imitation_references(&robot, &clip, &map, &ImitateConfig::default()).expect("references");
-    (robot, refs)
-}
+#[path = "common/walking.rs"]
+mod walking_common;
+use walking_common::{feed_plants, imitation_setup as setup, walking_setup};
 
 fn bench(c: &mut Criterion) {
     let (robot, refs) = setup();
@@ -75,26 +68,11 @@ fn bench(c: &mut Criterion) {
 /// The walking tick (issue 6): walking pattern, damping controller and IK, with the ZMP of the
 /// simulated compliant robot fed back (the plant's step is outside the timed region).
 fn bench_walk(c: &mut Criterion) {
-    use iktc::balance::{Plane, PlantParams, SimPlant, SimSettings, SupportPhase};
-    use iktc::sim::{WalkImitateConfig, WalkingController};
-    use nalgebra::{Rotation2, Vector2};
+    use iktc::balance::SimPlant;
+    use iktc::sim::WalkingController;
     let (robot, refs) = setup();
-    let cfg = WalkImitateConfig::jvrc1().expect("config");
-    let initial = WalkingController::new(&robot, &refs, &cfg).expect("walking controller");
+    let (initial, plants0) = walking_setup(&robot, &refs);
     let n = initial.ticks();
-    let cases = *initial.cases();
-    let l = initial.pendulum_length();
-    let plants0 = [Plane::Xz, Plane::Yz].map(|plane| {
-        SimPlant::new(
-            PlantParams::from_model(
-                *cases.get(plane, SupportPhase::Double),
-                robot.total_mass(),
-                1e-3,
-            ),
-            &SimSettings::default(),
-        )
-        .expect("plant")
-    });
     // One pass: returns the time of each tick [µs].
     let pass = |wc: &mut WalkingController,
                 plants: &mut [SimPlant; 2],
@@ -107,12 +85,7 @@ fn bench_walk(c: &mut Criterion) {
         let _ = wc.integrate(&robot);
         let el = start.elapsed();
         ticks.push(el.as_secs_f64() * 1e6);
-        let com = wc.imitation().kinematics().com();
-        let d =
-            Rotation2::new(wt.local_yaw).inverse() * (Vector2::new(com.x, com.y) - wt.com_nominal);
-        for (i, p) in plants.iter_mut().enumerate() {
-            let _ = p.advance(d[i] / l);
-        }
+        feed_plants(wc, &wt, plants);
         el
     };
     c.bench_function("humanoid_tick/walking_iktc", |b| {

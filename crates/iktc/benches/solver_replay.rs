@@ -7,37 +7,19 @@
 use std::time::{Duration, Instant};
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use iktc::balance::{Plane, PlantParams, SimPlant, SimSettings, SupportPhase};
 use iktc::limits::AccelerationBox;
-use iktc::model::{jvrc1, ModelOptions};
-use iktc::motion::{builtin_clip, builtin_map};
-use iktc::sim::{imitation_references, ImitateConfig, WalkImitateConfig, WalkingController};
 use iktc::solver::{Method, Solver, SolverSettings};
 use iktc::task::TaskEquation;
-use nalgebra::{DVector, Rotation2, Vector2};
+use nalgebra::DVector;
+
+#[path = "common/walking.rs"]
+mod walking_common;
+use walking_common::{feed_plants, imitation_setup, walking_setup};
 
 /// The (levels, box) of every tick of the default walking imitation run.
 fn record() -> Vec<(Vec<TaskEquation>, AccelerationBox)> {
-    let robot = jvrc1(&ModelOptions::default()).expect("JVRC-1");
-    let clip = builtin_clip("humanoid3d_dance_b").expect("clip");
-    let map = builtin_map("deepmimic_jvrc1").expect("map");
-    let refs =
-        imitation_references(&robot, &clip, &map, &ImitateConfig::default()).expect("references");
-    let cfg = WalkImitateConfig::jvrc1().expect("config");
-    let mut wc = WalkingController::new(&robot, &refs, &cfg).expect("walking controller");
-    let l = wc.pendulum_length();
-    let cases = *wc.cases();
-    let mut plants = [Plane::Xz, Plane::Yz].map(|plane| {
-        SimPlant::new(
-            PlantParams::from_model(
-                *cases.get(plane, SupportPhase::Double),
-                robot.total_mass(),
-                1e-3,
-            ),
-            &SimSettings::default(),
-        )
-        .expect("plant")
-    });
+    let (robot, refs) = imitation_setup();
+    let (mut wc, mut plants) = walking_setup(&robot, &refs);
     let mut out = Vec::with_capacity(wc.ticks());
     for k in 0..wc.ticks() {
         let dev = [plants[0].measure(), plants[1].measure()];
@@ -45,12 +27,7 @@ fn record() -> Vec<(Vec<TaskEquation>, AccelerationBox)> {
         let im = wc.imitation();
         out.push((im.equations().to_vec(), im.acceleration_box().clone()));
         wc.integrate(&robot).expect("integrate");
-        let com = wc.imitation().kinematics().com();
-        let d =
-            Rotation2::new(wt.local_yaw).inverse() * (Vector2::new(com.x, com.y) - wt.com_nominal);
-        for (i, p) in plants.iter_mut().enumerate() {
-            let _ = p.advance(d[i] / l);
-        }
+        feed_plants(&wc, &wt, &mut plants);
     }
     out
 }

@@ -15,12 +15,18 @@ use counting_alloc::allocations;
 #[global_allocator]
 static A: counting_alloc::Counting = counting_alloc::Counting;
 
-#[test]
-fn the_humanoid_tick_allocates_nothing() {
+/// JVRC-1 and the references of the default imitation run.
+fn setup() -> (iktc::model::Robot, iktc::motion::RobotReferences) {
     let robot = jvrc1(&ModelOptions::default()).unwrap();
     let clip = builtin_clip("humanoid3d_dance_b").unwrap();
     let map = builtin_map("deepmimic_jvrc1").unwrap();
     let refs = imitation_references(&robot, &clip, &map, &ImitateConfig::default()).unwrap();
+    (robot, refs)
+}
+
+#[test]
+fn the_humanoid_tick_allocates_nothing() {
+    let (robot, refs) = setup();
     for method in [Method::Iktc, Method::Cascade] {
         let cfg = ImitateConfig {
             method,
@@ -49,10 +55,7 @@ fn the_humanoid_tick_allocates_nothing() {
 
 #[test]
 fn the_walking_tick_allocates_nothing() {
-    let robot = jvrc1(&ModelOptions::default()).unwrap();
-    let clip = builtin_clip("humanoid3d_dance_b").unwrap();
-    let map = builtin_map("deepmimic_jvrc1").unwrap();
-    let refs = imitation_references(&robot, &clip, &map, &ImitateConfig::default()).unwrap();
+    let (robot, refs) = setup();
     let mut wc =
         WalkingController::new(&robot, &refs, &WalkImitateConfig::jvrc1().unwrap()).unwrap();
     let n = wc.ticks();
@@ -88,10 +91,7 @@ fn the_walking_tick_allocates_nothing() {
 /// would see a full row list and stop remembering), and it computes the same ticks.
 #[test]
 fn a_cloned_controller_allocates_nothing_and_matches_the_original() {
-    let robot = jvrc1(&ModelOptions::default()).unwrap();
-    let clip = builtin_clip("humanoid3d_dance_b").unwrap();
-    let map = builtin_map("deepmimic_jvrc1").unwrap();
-    let refs = imitation_references(&robot, &clip, &map, &ImitateConfig::default()).unwrap();
+    let (robot, refs) = setup();
     let mut original = ImitationController::new(&robot, &refs, &ImitateConfig::default()).unwrap();
     let mut clone = original.clone();
     let (mut screened, mut qps) = (0, 0);
