@@ -230,6 +230,10 @@ fn print_summary(r: &ImitateRun) {
         s.position_binding_steps, s.velocity_binding_steps, s.acceleration_binding_steps, s.pelvis_corrected_steps, s.pelvis_corrected_while_narrowed_at_limit
     );
     println!(
+        "the corrected level changed {} times between consecutive ticks, {} of them undone at the next tick",
+        s.level_switches.switches, s.level_switches.flips
+    );
+    println!(
         "foot drift {:.2e} m / {:.2e} rad; COM over the support polygon: {} (min margin {:.3} m); tick median {:.1} µs, p99 {:.1} µs",
         s.foot_drift, s.foot_rotation_drift, s.com_inside_support, s.com_min_margin, s.tick_median_us, s.tick_p99_us
     );

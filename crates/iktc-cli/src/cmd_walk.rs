@@ -99,6 +99,10 @@ pub fn print_walk(with: &WalkRun, without: &WalkRun) {
             "  after the push: peak {:.4} m, damping ratio {:.3}, settling {}; tick median {:.1} µs, p99 {:.1} µs",
             s.push_peak, s.push_damping_ratio, s.push_settling_time.map_or("none".into(), |t| format!("{t:.2} s")), s.tick_median_us, s.tick_p99_us
         );
+        println!(
+            "  corrected {} ticks; the corrected level changed {} times between consecutive ticks, {} of them undone at the next tick",
+            s.corrected_ticks, s.level_switches.switches, s.level_switches.flips
+        );
     }
 }
 

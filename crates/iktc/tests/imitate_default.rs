@@ -172,6 +172,21 @@ fn default_run_respects_limits_and_priorities() {
         gap > 0.05,
         "the pelvis height was never sacrificed ({gap} m)"
     );
+    // The level switches of the summary, counted again tick by tick.
+    let (mut switches, mut flips) = (0, 0);
+    let lv: Vec<usize> = run.steps.iter().map(|s| s.corrected_from).collect();
+    for k in 1..lv.len() {
+        if lv[k - 1] != 0 && lv[k] != 0 && lv[k - 1] != lv[k] {
+            switches += 1;
+            if k + 1 < lv.len() && lv[k + 1] == lv[k - 1] {
+                flips += 1;
+            }
+        }
+    }
+    assert_eq!(
+        (s.level_switches.switches, s.level_switches.flips),
+        (switches, flips)
+    );
 }
 
 #[test]

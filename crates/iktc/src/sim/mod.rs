@@ -3,6 +3,7 @@
 pub mod imitate;
 pub mod margins;
 pub mod planar3r;
+pub mod switches;
 pub mod walk_imitate;
 
 pub use imitate::{
@@ -13,6 +14,7 @@ pub use margins::{dof_margins, median, percentile, DofMargins};
 pub use planar3r::{
     run_planar3r, ArmTask, Planar3rConfig, Planar3rRun, Planar3rStep, Planar3rSummary,
 };
+pub use switches::LevelSwitches;
 pub use walk_imitate::{
     run_walk_imitate, Push, WalkImitateConfig, WalkRun, WalkStep, WalkSummary, WalkTick,
     WalkingController,

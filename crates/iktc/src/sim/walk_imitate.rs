@@ -195,6 +195,8 @@ pub struct WalkSummary {
     pub climbed_ticks: usize,
     /// Ticks with any correction.
     pub corrected_ticks: usize,
+    /// How often the corrected level changed between consecutive corrected ticks.
+    pub level_switches: crate::sim::LevelSwitches,
     /// Median tick time \[µs\].
     pub tick_median_us: f64,
     /// 99th percentile tick time \[µs\].
@@ -741,6 +743,9 @@ fn summarize(
             .filter(|s| s.corrected_from > 0 && s.corrected_from < nt)
             .count(),
         corrected_ticks: steps.iter().filter(|s| s.corrected_from > 0).count(),
+        level_switches: crate::sim::LevelSwitches::count(
+            &steps.iter().map(|s| s.corrected_from).collect::<Vec<_>>(),
+        ),
         tick_median_us: median(&ticks),
         tick_p99_us: percentile(&ticks, 0.99),
     })

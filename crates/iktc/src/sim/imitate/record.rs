@@ -137,6 +137,8 @@ pub struct ImitateSummary {
     pub narrowed_at_limit_steps: usize,
     /// Ticks where the pelvis attitude or height level was corrected.
     pub pelvis_corrected_steps: usize,
+    /// How often the corrected level changed between consecutive corrected ticks.
+    pub level_switches: crate::sim::LevelSwitches,
     /// Ticks where a pelvis level was corrected while a narrowed joint sat on its limit.
     pub pelvis_corrected_while_narrowed_at_limit: usize,
     /// Largest feet error ‖x_d − x‖ while a lower level was corrected.
@@ -421,6 +423,9 @@ pub(crate) fn summarize(
         acceleration_binding_steps,
         narrowed_at_limit_steps: steps.iter().filter(|s| narrowed_at(s)).count(),
         pelvis_corrected_steps: steps.iter().filter(|s| pelvis_corrected(s)).count(),
+        level_switches: crate::sim::LevelSwitches::count(
+            &steps.iter().map(|s| s.corrected_from).collect::<Vec<_>>(),
+        ),
         pelvis_corrected_while_narrowed_at_limit: steps
             .iter()
             .filter(|s| pelvis_corrected(s) && narrowed_at(s))
