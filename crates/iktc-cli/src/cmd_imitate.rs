@@ -609,6 +609,7 @@ fn summary_row(name: &str, r: &ImitateRun) -> Vec<String> {
             "{} ({})",
             s.pelvis_corrected_steps, s.pelvis_corrected_while_narrowed_at_limit
         ),
+        format!("{} ({})", s.level_switches.switches, s.level_switches.flips),
         format!("{:.2} / {}", s.qp_per_step_mean, s.qp_per_step_max),
         format!("{:.0} / {:.0}", s.tick_median_us, s.tick_p99_us),
     ]
@@ -653,6 +654,7 @@ pub fn imitate_section(out: &Path) -> Result<Section> {
             "COM over support (min margin m)",
             "RMS error per level (feet / COM / att. / height / upper)",
             "pelvis corrected ticks (with narrowed joint on limit)",
+            "corrected-level changes (undone at the next tick)",
             "QPs per tick mean / max",
             "tick median / p99 [µs]",
         ]

@@ -537,6 +537,7 @@ pub fn walk_section(out: &Path) -> Result<Section> {
             "push peak [m]",
             "damping ratio",
             "settling [s]",
+            "corrected ticks; level changes (undone next tick)",
             "median / p99 tick [µs]",
         ]
         .map(String::from)
@@ -560,6 +561,10 @@ pub fn walk_section(out: &Path) -> Result<Section> {
             format!("{:.3}", s.push_damping_ratio),
             s.push_settling_time
                 .map_or("none".into(), |t| format!("{t:.2}")),
+            format!(
+                "{}; {} ({})",
+                s.corrected_ticks, s.level_switches.switches, s.level_switches.flips
+            ),
             format!("{:.0} / {:.0}", s.tick_median_us, s.tick_p99_us),
         ]);
     }
