@@ -3,7 +3,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
-use iktc::limits::BoundMethod;
+use iktc::limits::{BoundMethod, OutsideLimits};
 use iktc::model::Robot;
 use iktc::motion::{
     builtin_clip, builtin_map, read_bvh, read_deepmimic, BvhReadOptions, Clip, RetargetMap,
@@ -40,6 +40,10 @@ pub struct Args {
     /// Joint bounds.
     #[arg(long, value_enum, default_value = "viable")]
     pub bounds: BoundsArg,
+    /// Start even if a joint is outside its (narrowed) range, and bring it back at the
+    /// acceleration limit (viable bounds only); without it such a start is an error.
+    #[arg(long)]
+    pub recover: bool,
     /// Narrowed joint ranges [rad]: NAME=lo:hi,NAME=lo:hi; `none` for none. Default (JVRC-1):
     /// L_KNEE=0.55:0.95,L_HIP_R=-0.05:0.05.
     #[arg(long)]
@@ -185,6 +189,12 @@ pub fn run(a: &Args) -> Result<()> {
         dt: a.dt,
         ..ImitateConfig::jvrc1()
     };
+    if a.recover {
+        match &mut cfg.bounds {
+            BoundMethod::Viable(settings) => settings.outside = OutsideLimits::Recover,
+            BoundMethod::Paper => anyhow::bail!("--recover needs --bounds viable"),
+        }
+    }
     if let Some(n) = &a.narrow {
         cfg.narrow = parse_narrow(n)?;
     }
@@ -228,6 +238,10 @@ fn print_summary(r: &ImitateRun) {
     println!(
         "limits binding: position {} ticks, velocity {}, acceleration {}; pelvis corrected {} ticks ({} with a narrowed joint on its limit)",
         s.position_binding_steps, s.velocity_binding_steps, s.acceleration_binding_steps, s.pelvis_corrected_steps, s.pelvis_corrected_while_narrowed_at_limit
+    );
+    println!(
+        "empty boxes {} ticks, fallbacks {} ticks, joints recovering into their range {} ticks",
+        s.empty_box_steps, s.fallback_steps, s.recovering_steps
     );
     println!(
         "the corrected level changed {} times between consecutive ticks, {} of them undone at the next tick",

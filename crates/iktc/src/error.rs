@@ -45,6 +45,24 @@ pub enum Error {
         /// The size that was given.
         got: usize,
     },
+    /// A state (the start of a run) puts a joint outside its limits: its position outside its
+    /// range or its speed above its velocity limit.
+    #[error(
+        "{joint} is outside its limits: {quantity} {value} not in [{lower}, {upper}]; \
+         change the start state or the limits, or ask for recovery (OutsideLimits::Recover)"
+    )]
+    StateOutsideLimits {
+        /// The joint (or dof) name.
+        joint: String,
+        /// Which quantity, with its unit: `position [rad]` or `velocity [rad/s]`.
+        quantity: String,
+        /// Its value.
+        value: f64,
+        /// The lower end of the allowed interval.
+        lower: f64,
+        /// The upper end of the allowed interval.
+        upper: f64,
+    },
     /// A limit has its lower end above its upper end, or is otherwise unusable.
     #[error("invalid limit for {what}: lower {lower} > upper {upper}")]
     InvalidLimit {

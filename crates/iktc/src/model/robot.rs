@@ -165,7 +165,8 @@ impl RobotBuilder {
     ///
     /// Errors: duplicate or unknown names, a link with two parents, no single root, a cycle,
     /// a non-finite number, a limit with lower > upper or a non-positive speed, a zero axis,
-    /// a locked joint that does not exist or is fixed, a mimic that is rejected by the options.
+    /// a locked joint that does not exist or is fixed, a joint locked outside its range
+    /// ([`Error::StateOutsideLimits`]), a mimic that is rejected by the options.
     pub fn build(self, options: &ModelOptions) -> Result<Robot> {
         Robot::from_builder(self, options)
     }
@@ -356,6 +357,16 @@ impl Robot {
                     value: value.to_string(),
                     expected: "a revolute, continuous or prismatic joint (this one is fixed)"
                         .into(),
+                });
+            }
+            let range = b.joints[j].limit;
+            if *value < range.lower || *value > range.upper {
+                return Err(Error::StateOutsideLimits {
+                    joint: name.clone(),
+                    quantity: "locked position [rad or m]".into(),
+                    value: *value,
+                    lower: range.lower,
+                    upper: range.upper,
                 });
             }
             locked.insert(j, *value);

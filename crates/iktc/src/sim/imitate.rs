@@ -21,7 +21,9 @@ pub use support::{support_polygon, SupportSettings};
 use nalgebra::{DVector, Isometry3, Translation3, UnitQuaternion, Vector3, Vector6};
 
 use crate::error::{Error, Result};
-use crate::limits::{compute_box, AccelerationBox, BoundMethod, DofLimits, JointLimits};
+use crate::limits::{
+    compute_box, AccelerationBox, BoundMethod, DofLimits, JointLimits, OutsideLimits,
+};
 use crate::model::{Kinematics, Robot, State};
 use crate::motion::RobotReferences;
 use crate::solver::{Method, SolveReport, Solver, SolverSettings};
@@ -284,7 +286,9 @@ impl ImitationController {
     /// polygon.
     ///
     /// Errors: bad settings, unknown frames or joints, references whose period differs from
-    /// `cfg.dt`, a narrowed range outside the joint's own.
+    /// `cfg.dt`, a narrowed range outside the joint's own, and
+    /// [`Error::StateOutsideLimits`] for a start state (posture, first references) outside the
+    /// (narrowed) limits unless `cfg.bounds` asks for [`OutsideLimits::Recover`].
     pub fn new(robot: &Robot, refs: &RobotReferences, cfg: &ImitateConfig) -> Result<Self> {
         cfg.validate()?;
         refs.validate()?;
@@ -315,7 +319,7 @@ impl ImitationController {
                 d.position_max = n.upper;
             }
         }
-        let limits = JointLimits::new(dofs)?;
+        let limits = JointLimits::new(dofs)?.with_names(robot.dof_names())?;
         // Clamp the joint references into the (narrowed) ranges.
         for (name, track) in refs.joint_names.iter().zip(refs.joints.iter_mut()) {
             let v = robot.joint_v_index(name)?;
@@ -350,6 +354,12 @@ impl ImitationController {
             if let Some(p) = track.position.first() {
                 state.set_joint(robot, name, *p)?;
             }
+        }
+        // A start outside the (narrowed) limits is refused unless recovery was asked for.
+        let mut pos = vec![0.0; robot.nv()];
+        if cfg.bounds.outside_limits() == OutsideLimits::Error {
+            state.dof_positions(robot, &mut pos)?;
+            limits.check_state(&pos, state.qd.as_slice())?;
         }
         let mut kin = Kinematics::new(robot, &state)?;
         let feet_ids = cfg
@@ -430,7 +440,7 @@ impl ImitationController {
             state,
             kin,
             qdd: DVector::zeros(robot.nv()),
-            pos: vec![0.0; robot.nv()],
+            pos,
             upper: [vec![0.0; m], vec![0.0; m], vec![0.0; m]],
             pelvis0,
             feet0,

@@ -13,7 +13,7 @@ use serde::Serialize;
 
 use super::margins::{dof_margins, median, DofMargins};
 use crate::error::{Error, Result};
-use crate::limits::{compute_box, AccelerationBox, BoundMethod, JointLimits};
+use crate::limits::{compute_box, AccelerationBox, BoundMethod, JointLimits, OutsideLimits};
 use crate::model::{planar3r, Kinematics, State};
 use crate::solver::{Method, Solver, SolverSettings};
 use crate::task::{Axes, FrameReference, FrameTask, Gains, Task, TaskStack};
@@ -224,6 +224,11 @@ pub fn run_planar3r(cfg: &Planar3rConfig) -> Result<Planar3rRun> {
     let dims: Vec<usize> = eqs.iter().map(|e| e.dim()).collect();
     let mut solver = Solver::new(robot.nv(), &dims, cfg.solver)?;
     let limits = JointLimits::from_robot(&robot)?;
+    if cfg.bounds.outside_limits() == OutsideLimits::Error {
+        let mut start = vec![0.0; robot.nv()];
+        state.dof_positions(&robot, &mut start)?;
+        limits.check_state(&start, state.qd.as_slice())?;
+    }
     let mut bx = AccelerationBox::new(robot.nv());
     let mut kin = Kinematics::new(&robot, &state)?;
     let mut qdd = DVector::zeros(robot.nv());

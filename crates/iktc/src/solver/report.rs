@@ -37,6 +37,10 @@ pub enum Fallback {
     /// A level of the cascade had no feasible solution; the solution of the level above was
     /// kept, clamped to the box.
     CascadeStoppedAtLevel(usize),
+    /// The box of at least one dof was empty (`b_l > b_u`: the state was outside the limits'
+    /// viable set); those dofs were held to the midpoint of their bounds
+    /// ([`SolveReport::empty_box_dofs`]). A fallback of the method itself replaces this one.
+    EmptyBox,
 }
 
 /// The record of one solve. Sized once, refreshed each tick without allocation.

@@ -127,6 +127,9 @@ impl Solver {
             }
         }
         self.report.empty_box_dofs = empty;
+        if empty > 0 {
+            self.report.fallback = Some(Fallback::EmptyBox);
+        }
         self.report.violation_before = self.violation(&self.q0);
         match method {
             Method::Prioritized => qdd.copy_from(&self.q0),

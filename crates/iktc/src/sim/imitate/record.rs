@@ -64,6 +64,9 @@ pub struct ImitateStep {
     pub qp_solves: usize,
     /// Dofs with an empty box.
     pub empty_dofs: usize,
+    /// Dofs being brought back into their range this tick
+    /// ([`OutsideLimits::Recover`](crate::limits::OutsideLimits)).
+    pub recovering: Vec<usize>,
     /// Whether a fallback was taken.
     pub fallback: bool,
     /// Time of the tick (kinematics, tasks, bounds, solve) \[µs\].
@@ -164,6 +167,8 @@ pub struct ImitateSummary {
     pub empty_box_steps: usize,
     /// Ticks with a fallback.
     pub fallback_steps: usize,
+    /// Ticks in which some joint was being brought back into its range.
+    pub recovering_steps: usize,
     /// Mean QPs per tick.
     pub qp_per_step_mean: f64,
     /// Largest QPs in a tick.
@@ -306,6 +311,7 @@ pub fn run_imitate(
             on_limit,
             qp_solves: rep.qp_solves,
             empty_dofs: rep.empty_box_dofs,
+            recovering: bx.recovering_dofs().collect(),
             fallback: rep.fallback.is_some(),
             tick_us,
         });
@@ -456,6 +462,7 @@ pub(crate) fn summarize(
         levels,
         empty_box_steps: steps.iter().filter(|s| s.empty_dofs > 0).count(),
         fallback_steps: steps.iter().filter(|s| s.fallback).count(),
+        recovering_steps: steps.iter().filter(|s| !s.recovering.is_empty()).count(),
         qp_per_step_mean: steps.iter().map(|s| s.qp_solves as f64).sum::<f64>()
             / steps.len().max(1) as f64,
         qp_per_step_max: steps.iter().map(|s| s.qp_solves).max().unwrap_or(0),
