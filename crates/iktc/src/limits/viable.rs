@@ -267,10 +267,12 @@ pub fn no_reversal_viability_upper(
     (v_star - qd) / dt
 }
 
-/// `v* = min_n (R + aΔt² n(n+1)/2)/(Δt(n+1))` of [`no_reversal_viability_upper`] for `R ≥ 0` \[rad/s\].
+/// `v* = min_n (R + aΔt² n(n+1)/2)/(Δt(n+1))` of [`no_reversal_viability_upper`] for
+/// `R ≥ 0` \[rad/s\].
 fn largest_next_velocity(room: f64, a: f64, dt: f64) -> f64 {
     let step = a * dt * dt;
-    if !(step < f64::INFINITY) {
+    if step == f64::INFINITY {
+        // No acceleration limit (or aΔt² beyond the floating-point range): stop in one step.
         return room / dt;
     }
     let k = ((1.0 + 8.0 * room / step).sqrt() - 1.0) * 0.5;
