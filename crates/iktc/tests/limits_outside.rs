@@ -47,6 +47,12 @@ fn check_state_names_the_joint_its_value_and_its_range() {
             upper: 0.95,
         }
     );
+    match limits.check_state(&[0.0, 0.5], &[0.0, 0.0]) {
+        Err(Error::StateOutsideLimits { value, lower, .. }) => {
+            assert_eq!((value, lower), (0.5, 0.55))
+        }
+        other => panic!("{other:?}"),
+    }
     let text = err.to_string();
     assert!(
         text.contains("L_KNEE") && text.contains("1.2") && text.contains("0.55"),
@@ -208,6 +214,16 @@ fn recovery_acceleration_by_hand() {
     assert_eq!(
         viable::recovery_acceleration(&k, &s, 1.95, -4.0, 0.01),
         Some(0.0)
+    );
+    // Moving in faster than it can brake on q_max (q = 0.96, q̇ = −4, Δt = 0.01): the peak
+    // bound of the virtual limit asks 4²/(2·0.01) = 800 rad/s², capped at a_max = 40.
+    assert_eq!(
+        viable::recovery_acceleration(&k, &s, 0.96, -4.0, 0.01),
+        Some(40.0)
+    );
+    assert_eq!(
+        viable::recovery_acceleration(&k, &s, 0.54, 4.0, 0.01),
+        Some(-40.0)
     );
     // Inside the range: none.
     assert_eq!(viable::recovery_acceleration(&k, &s, 0.7, 0.0, 0.01), None);
