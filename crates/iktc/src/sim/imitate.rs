@@ -24,6 +24,7 @@ use crate::error::{Error, Result};
 use crate::limits::{compute_box, AccelerationBox, BoundMethod, DofLimits, JointLimits};
 use crate::model::{Kinematics, Robot, State};
 use crate::motion::RobotReferences;
+use crate::resources::RunLimits;
 use crate::solver::{Method, SolveReport, Solver, SolverSettings};
 use crate::task::{
     Axes, ComReference, ComTask, FrameReference, FrameTask, Gains, JointTask, Task, TaskStack,
@@ -58,6 +59,8 @@ pub struct ImitateConfig {
     pub bounds: BoundMethod,
     /// Control period Δt \[s\]; must equal the references' period.
     pub dt: f64,
+    /// Range of Δt and largest tick count ([`RunLimits`]).
+    pub run_limits: RunLimits,
     /// CLIK gains of every task (default k_p = 100 s⁻², k_v = 20 s⁻¹, critically damped).
     pub gains: Gains,
     /// Frames of the feet (6D tasks, one level).
@@ -110,6 +113,7 @@ impl ImitateConfig {
             method: Method::Iktc,
             bounds: BoundMethod::viable(),
             dt: 0.005,
+            run_limits: RunLimits::default(),
             gains: Gains {
                 kp: 100.0,
                 kv: 20.0,
@@ -146,9 +150,7 @@ impl ImitateConfig {
             value: value.to_string(),
             expected: expected.into(),
         };
-        if !(self.dt.is_finite() && self.dt > 0.0) {
-            return Err(bad("dt", self.dt, "a finite period > 0 [s]"));
-        }
+        self.run_limits.check_dt("dt", self.dt)?;
         if !(self.reference_margin.is_finite() && self.reference_margin >= 0.0) {
             return Err(bad(
                 "reference_margin",
@@ -248,7 +250,7 @@ pub fn imitation_references(
             }
         }
     }
-    r.resample(cfg.dt)
+    r.resample_with(cfg.dt, &cfg.run_limits)
 }
 
 /// The closed loop of one imitation run: tasks, bounds, solver and state, sized once.
