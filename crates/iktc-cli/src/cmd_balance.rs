@@ -79,7 +79,7 @@ pub fn run(args: BalanceArgs) -> anyhow::Result<()> {
         BalanceCommand::Identify { out, seed } => {
             let r = identify(&out, seed)?;
             for c in &r.comparison {
-                println!(
+                crate::outln!(
                     "{:<32} true {:>10.5}  identified {:>10.5} ± {:.5} {}  ({:+.2} %)",
                     c.name,
                     c.true_value,
@@ -87,18 +87,18 @@ pub fn run(args: BalanceArgs) -> anyhow::Result<()> {
                     c.std_error,
                     c.unit,
                     100.0 * c.relative_error
-                );
+                )?;
             }
-            println!(
+            crate::outln!(
                 "RMS fit error: {:.2} dB, {:.2} deg -> {}",
                 r.identification.rms_magnitude_error_db,
                 r.identification.rms_phase_error_deg,
                 out.join("identify").display()
-            );
+            )?;
         }
         BalanceCommand::Design { out } => {
             let r = design(&out)?;
-            println!(
+            crate::outln!(
                 "K_f = [{:.6}, {:.6}], N = {:.6}; closed-loop IPCJ poles {:.5} ± {:.5}j -> {}",
                 r.continuous.gain[0],
                 r.continuous.gain[1],
@@ -106,12 +106,12 @@ pub fn run(args: BalanceArgs) -> anyhow::Result<()> {
                 r.continuous.closed_loop_poles[0][0],
                 r.continuous.closed_loop_poles[0][1],
                 out.join("design").display()
-            );
+            )?;
         }
         BalanceCommand::Push { phase, out, seed } => {
             let r = push(&out, phase, seed)?;
             for m in &r.metrics {
-                println!(
+                crate::outln!(
                     "{:?}: peak {:.1} -> {:.1} mm, settling {} -> {} s, ζ {:.3} -> {:.3} (designed {:.2}), static gain {:.4} / {:.4} m/rad",
                     m.plane,
                     1e3 * m.open.peak,
@@ -123,12 +123,12 @@ pub fn run(args: BalanceArgs) -> anyhow::Result<()> {
                     m.designed_damping_ratio,
                     m.static_gain_open,
                     m.static_gain_closed
-                );
+                )?;
             }
-            println!(
+            crate::outln!(
                 "-> {}",
                 out.join(format!("push-{}", phase.name())).display()
-            );
+            )?;
         }
     }
     Ok(())
@@ -304,7 +304,7 @@ fn fmt_opt(v: Option<f64>) -> String {
 }
 
 fn write_json<T: Serialize>(path: &Path, value: &T) -> anyhow::Result<()> {
-    let text = serde_json::to_string_pretty(value)?;
+    let text = crate::finite::to_json(&path.display().to_string(), value)?;
     std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))
 }
 

@@ -6,9 +6,10 @@ use anyhow::{Context, Result};
 use iktc::limits::{BoundMethod, OutsideLimits};
 use iktc::model::Robot;
 use iktc::motion::{
-    builtin_clip, builtin_map, read_bvh, read_deepmimic, BvhReadOptions, Clip, RetargetMap,
-    BUILTIN_CLIP_NAMES, BUILTIN_MAP_NAMES,
+    builtin_clip, builtin_map, read_bvh, read_deepmimic_with, BvhReadOptions, Clip,
+    DeepMimicSettings, RetargetMap, BUILTIN_CLIP_NAMES, BUILTIN_MAP_NAMES,
 };
+use iktc::resources::{ReadLimits, RunLimits};
 use iktc::sim::imitate::LEVEL_NAMES;
 use iktc::sim::{imitation_references, run_imitate, ImitateConfig, ImitateRun, NarrowedJoint};
 use iktc::solver::Method;
@@ -64,6 +65,12 @@ pub struct Args {
     /// Output directory.
     #[arg(long, default_value = "out/imitate")]
     pub out: PathBuf,
+    /// Most control ticks of one run (the clip's duration over --dt, or the walk's).
+    #[arg(long, default_value_t = RunLimits::default().max_ticks)]
+    pub max_ticks: usize,
+    /// Longest clip accepted from a file [s].
+    #[arg(long, default_value_t = ReadLimits::default().max_clip_duration)]
+    pub max_clip_duration: f64,
     #[command(flatten)]
     pub walk: crate::cmd_walk::WalkArgs,
 }
@@ -116,7 +123,7 @@ fn parse_posture(s: &str) -> Result<Vec<(String, f64)>> {
 }
 
 /// Loads a clip: built-in name, DeepMimic file or BVH file. Returns the clip and whether it is BVH.
-fn load_clip(spec: &str) -> Result<(Clip, bool)> {
+fn load_clip(spec: &str, limits: &ReadLimits) -> Result<(Clip, bool)> {
     if BUILTIN_CLIP_NAMES.contains(&spec) {
         return Ok((builtin_clip(spec)?, false));
     }
@@ -132,11 +139,23 @@ fn load_clip(spec: &str) -> Result<(Clip, bool)> {
         .is_some_and(|e| e.eq_ignore_ascii_case("bvh"));
     if is_bvh {
         Ok((
-            read_bvh(&text, spec, &BvhReadOptions::default())?.to_clip()?,
+            read_bvh(
+                &text,
+                spec,
+                &BvhReadOptions {
+                    limits: *limits,
+                    ..Default::default()
+                },
+            )?
+            .to_clip()?,
             true,
         ))
     } else {
-        Ok((read_deepmimic(&text, spec)?, false))
+        let settings = DeepMimicSettings {
+            limits: *limits,
+            ..Default::default()
+        };
+        Ok((read_deepmimic_with(&text, spec, &settings)?, false))
     }
 }
 
@@ -181,14 +200,23 @@ pub fn run(a: &Args) -> Result<()> {
         ro.floating = true;
     }
     let robot = load_robot(&a.robot, &ro)?;
-    let (clip, is_bvh) = load_clip(&a.motion)?;
+    let read_limits = ReadLimits {
+        max_clip_duration: a.max_clip_duration,
+        ..ReadLimits::default()
+    };
+    let (clip, is_bvh) = load_clip(&a.motion, &read_limits)?;
     let map = load_map(a.map.as_deref(), is_bvh)?;
     let mut cfg = ImitateConfig {
         method: a.solver.method(),
         bounds: a.bounds.method(),
         dt: a.dt,
+        run_limits: RunLimits {
+            max_ticks: a.max_ticks,
+            ..RunLimits::default()
+        },
         ..ImitateConfig::jvrc1()
     };
+    cfg.run_limits.check_dt("--dt", a.dt)?;
     if a.recover {
         match &mut cfg.bounds {
             BoundMethod::Viable(settings) => settings.outside = OutsideLimits::Recover,
@@ -210,47 +238,48 @@ pub fn run(a: &Args) -> Result<()> {
     let e = Experiment { robot, clip, map };
     if a.walk.walk {
         let (figs, with, without) = crate::cmd_walk::run_walk(&e, &cfg, &a.walk, &a.out)?;
-        crate::cmd_walk::print_walk(&with, &without);
-        println!(
+        crate::cmd_walk::print_walk(&with, &without)?;
+        crate::outln!(
             "wrote {} figures, walk.csv, walk_summary.json and walk_viewer.html to {}",
             figs.len(),
             a.out.display()
-        );
+        )?;
         return Ok(());
     }
     let r = run_experiment(&e, &cfg)?;
     let files = write_imitate(&r, &e, &a.out)?;
-    print_summary(&r);
-    println!(
+    print_summary(&r)?;
+    crate::outln!(
         "wrote {} figures, trajectory.csv, summary.json and viewer.html to {}",
         files.len(),
         a.out.display()
-    );
+    )?;
     Ok(())
 }
 
-fn print_summary(r: &ImitateRun) {
+fn print_summary(r: &ImitateRun) -> std::io::Result<()> {
     let s = &r.summary;
-    println!(
+    crate::outln!(
         "imitation, {} with {} bounds, {} ticks of {} s: worst margins position {:+.2e} rad, velocity {:+.2e} rad/s, acceleration {:+.2e} rad/s²",
         s.solver, s.bounds, s.steps, s.dt, s.worst_position_margin, s.worst_velocity_margin, s.worst_acceleration_margin
-    );
-    println!(
+    )?;
+    crate::outln!(
         "limits binding: position {} ticks, velocity {}, acceleration {}; pelvis corrected {} ticks ({} with a narrowed joint on its limit)",
         s.position_binding_steps, s.velocity_binding_steps, s.acceleration_binding_steps, s.pelvis_corrected_steps, s.pelvis_corrected_while_narrowed_at_limit
-    );
-    println!(
+    )?;
+    crate::outln!(
         "empty boxes {} ticks, fallbacks {} ticks, joints recovering into their range {} ticks",
         s.empty_box_steps, s.fallback_steps, s.recovering_steps
-    );
-    println!(
+    )?;
+    crate::outln!(
         "the corrected level changed {} times between consecutive ticks, {} of them undone at the next tick",
         s.level_switches.switches, s.level_switches.flips
-    );
-    println!(
+    )?;
+    crate::outln!(
         "foot drift {:.2e} m / {:.2e} rad; COM over the support polygon: {} (min margin {:.3} m); tick median {:.1} µs, p99 {:.1} µs",
         s.foot_drift, s.foot_rotation_drift, s.com_inside_support, s.com_min_margin, s.tick_median_us, s.tick_p99_us
-    );
+    )?;
+    Ok(())
 }
 
 /// Writes trajectory.csv, summary.json, the figures and viewer.html; returns the figures
@@ -340,7 +369,10 @@ pub fn write_imitate(r: &ImitateRun, e: &Experiment, dir: &Path) -> Result<Vec<(
         .map(|st| std::iter::once(st.t).chain(st.q.iter().copied()).collect())
         .collect();
     write_csv(&dir.join("joints.csv"), &jh, &jrows)?;
-    std::fs::write(dir.join("summary.json"), serde_json::to_string_pretty(s)?)?;
+    std::fs::write(
+        dir.join("summary.json"),
+        crate::finite::to_json("summary.json", s)?,
+    )?;
     let tag = format!("{} / {} bounds", s.solver.to_uppercase(), s.bounds);
     let t: Vec<f64> = r.steps.iter().map(|st| st.t).collect();
     let col =

@@ -75,7 +75,8 @@ pub fn run_walk(
     w: &WalkArgs,
     dir: &Path,
 ) -> Result<(Figures, WalkRun, WalkRun)> {
-    let refs = retarget(&e.clip, &e.robot, &e.map)?.resample(imitate.dt)?;
+    let refs =
+        retarget(&e.clip, &e.robot, &e.map)?.resample_with(imitate.dt, &imitate.run_limits)?;
     let main = run_walk_imitate(&e.robot, &refs, &config(imitate, w, !w.no_damping)?)?;
     let other = run_walk_imitate(&e.robot, &refs, &config(imitate, w, w.no_damping)?)?;
     let (with, without) = if w.no_damping {
@@ -88,22 +89,23 @@ pub fn run_walk(
 }
 
 /// Prints the two summaries.
-pub fn print_walk(with: &WalkRun, without: &WalkRun) {
+pub fn print_walk(with: &WalkRun, without: &WalkRun) -> std::io::Result<()> {
     for r in [with, without] {
         let s = &r.summary;
-        println!(
+        crate::outln!(
             "walking imitation, damping controller {}: ZMP min margin {:+.4} m (inside: {}), stance feet error {:.2e} m / slip {:.2e} m, worst margins {:+.1e} rad {:+.1e} rad/s {:+.1e} rad/s²",
             if s.damping { "on " } else { "off" }, s.min_zmp_margin, s.zmp_inside, s.max_stance_foot_error, s.max_stance_foot_slip, s.worst_margins[0], s.worst_margins[1], s.worst_margins[2]
-        );
-        println!(
+        )?;
+        crate::outln!(
             "  after the push: peak {:.4} m, damping ratio {:.3}, settling {}; tick median {:.1} µs, p99 {:.1} µs",
             s.push_peak, s.push_damping_ratio, s.push_settling_time.map_or("none".into(), |t| format!("{t:.2} s")), s.tick_median_us, s.tick_p99_us
-        );
-        println!(
+        )?;
+        crate::outln!(
             "  corrected {} ticks; the corrected level changed {} times between consecutive ticks, {} of them undone at the next tick",
             s.corrected_ticks, s.level_switches.switches, s.level_switches.flips
-        );
+        )?;
     }
+    Ok(())
 }
 
 fn col(r: &WalkRun, f: &dyn Fn(&WalkStep) -> f64) -> Vec<f64> {
@@ -189,7 +191,7 @@ pub fn write_walk(
     });
     std::fs::write(
         dir.join("walk_summary.json"),
-        serde_json::to_string_pretty(&summary)?,
+        crate::finite::to_json("walk_summary.json", &summary)?,
     )?;
     let t = col(with, &|s| s.t);
     let mut figs = Vec::new();

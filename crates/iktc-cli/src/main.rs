@@ -1,7 +1,7 @@
 //! The `iktc` command-line tool: argument parsing and output files only; every algorithm lives
 //! in the `iktc` library.
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 
 mod cmd_balance;
 mod cmd_imitate;
@@ -9,6 +9,8 @@ mod cmd_model;
 mod cmd_reproduce;
 mod cmd_run;
 mod cmd_walk;
+mod finite;
+mod out;
 mod robot_arg;
 mod viewer;
 
@@ -37,8 +39,27 @@ enum Command {
     Imitate(cmd_imitate::Args),
 }
 
+/// The command line's grammar, with every option value allowed to be a negative number
+/// (`--dt -0.005` reaches the range check instead of reading as an unknown option `-0`).
+fn command() -> clap::Command {
+    fn negatives(cmd: clap::Command) -> clap::Command {
+        cmd.mut_args(|a| {
+            if a.get_action().takes_values() {
+                a.allow_negative_numbers(true)
+            } else {
+                a
+            }
+        })
+        .mut_subcommands(negatives)
+    }
+    negatives(Cli::command())
+}
+
 fn main() -> std::process::ExitCode {
-    let cli = Cli::parse();
+    let cli = match Cli::from_arg_matches(&command().get_matches()) {
+        Ok(cli) => cli,
+        Err(e) => e.exit(),
+    };
     let result = match cli.command {
         Command::Model(a) => cmd_model::run(&a),
         Command::Run(a) => cmd_run::run(&a),
@@ -48,6 +69,8 @@ fn main() -> std::process::ExitCode {
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,
+        // The reader of our standard output has gone (`| head`): nothing more to say.
+        Err(e) if out::is_broken_pipe(&e) => std::process::ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e:#}");
             std::process::ExitCode::FAILURE

@@ -67,5 +67,9 @@ pub fn load_robot(spec: &str, o: &RobotOptions) -> Result<Robot> {
             BUILTIN_ROBOTS.join(", ")
         );
     }
-    Robot::from_urdf_file(path, &options).with_context(|| format!("loading {spec}"))
+    let robot = Robot::from_urdf_file(path, &options).with_context(|| format!("loading {spec}"))?;
+    for w in robot.warnings() {
+        eprintln!("warning: {w}");
+    }
+    Ok(robot)
 }

@@ -93,6 +93,19 @@ pub enum Error {
         /// What is wrong.
         message: String,
     },
+    /// An input asks for more than a stated maximum (ticks, frames, duration, nesting depth):
+    /// checked before anything is allocated.
+    #[error("{what} = {value} exceeds the limit {limit}; raise it with {option}")]
+    ResourceLimit {
+        /// What is counted or measured.
+        what: String,
+        /// The amount asked for.
+        value: String,
+        /// The stated maximum.
+        limit: String,
+        /// The setting (and CLI option, if any) that raises the maximum.
+        option: String,
+    },
     /// Input data are insufficient for the requested computation (too few points, ...).
     #[error("insufficient data for {what}: {message}")]
     InsufficientData {

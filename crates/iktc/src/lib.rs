@@ -26,6 +26,7 @@
 //! | [`balance`] | the damping controller of Section 4 |
 //! | [`motion`] | motion capture readers, retargeting |
 //! | [`walk`] | footsteps, ZMP preview control, swing feet |
+//! | [`resources`] | stated maxima on what an input may make iktc allocate or run |
 //! | [`sim`] | the 3R arm, the imitation, walking while imitating |
 //!
 //! ## Notation
@@ -50,6 +51,7 @@ pub mod error;
 pub mod limits;
 pub mod model;
 pub mod motion;
+pub mod resources;
 pub mod sim;
 pub mod solver;
 pub mod task;

@@ -127,6 +127,7 @@ pub struct RobotBuilder {
     links: Vec<Link>,
     joints: Vec<JointSpec>,
     frames: Vec<(String, String, Isometry3<f64>)>,
+    warnings: Vec<String>,
 }
 
 impl RobotBuilder {
@@ -161,12 +162,19 @@ impl RobotBuilder {
         self
     }
 
+    /// Records a warning about the description, kept in the model ([`Robot::warnings`]).
+    pub fn warn(&mut self, message: impl Into<String>) {
+        self.warnings.push(message.into());
+    }
+
     /// Validates the description and builds the immutable model.
     ///
     /// Errors: duplicate or unknown names, a link with two parents, no single root, a cycle,
     /// a non-finite number, a limit with lower > upper or a non-positive speed, a zero axis,
     /// a locked joint that does not exist or is fixed, a joint locked outside its range
-    /// ([`Error::StateOutsideLimits`]), a mimic that is rejected by the options.
+    /// ([`Error::StateOutsideLimits`]), a mimic that is rejected by the options, a magnitude
+    /// beyond the plausibility bounds of [`plausible`](super::plausible) (a mass, length,
+    /// inertia, speed or acceleration no robot has).
     pub fn build(self, options: &ModelOptions) -> Result<Robot> {
         Robot::from_builder(self, options)
     }
@@ -192,6 +200,7 @@ pub struct Robot {
     /// For each link: the joint whose child it is (None for the root).
     pub(crate) parent_joint: Vec<Option<usize>>,
     pub(crate) total_mass: f64,
+    pub(crate) warnings: Vec<String>,
 }
 
 fn finite_vec(what: &str, v: &Vector3<f64>) -> Result<()> {
@@ -240,6 +249,7 @@ impl Robot {
                 &format!("inertia of link `{}`", l.name),
                 l.inertia.as_slice(),
             )?;
+            super::plausible::check_link(l)?;
         }
         let link_names = || b.links.iter().map(|l| l.name.clone()).collect::<Vec<_>>();
         let find_link = |name: &str| -> Result<usize> {
@@ -275,6 +285,7 @@ impl Robot {
             parent_of[c] = Some(j);
             children[p].push(j);
             finite_iso(&format!("origin of joint `{}`", s.name), &s.origin)?;
+            super::plausible::check_joint(s)?;
             let l = &s.limit;
             for (what, v) in [("lower", l.lower), ("upper", l.upper)] {
                 if v.is_nan() {
@@ -504,6 +515,7 @@ impl Robot {
                 });
             }
             finite_iso(&format!("offset of frame `{name}`"), offset)?;
+            super::plausible::check_frame(name, offset)?;
             frames.push(Frame {
                 name: name.clone(),
                 link: find_link(link)?,
@@ -522,6 +534,7 @@ impl Robot {
             drive,
             parent_joint,
             total_mass,
+            warnings: b.warnings,
         })
     }
 
@@ -592,6 +605,11 @@ impl Robot {
     /// extra frames.
     pub fn frames(&self) -> &[Frame] {
         &self.frames
+    }
+
+    /// Warnings about the description (e.g. a URDF `effort="0"`): accepted, but worth a word.
+    pub fn warnings(&self) -> &[String] {
+        &self.warnings
     }
 
     /// Total mass \[kg\].

@@ -16,6 +16,7 @@ use serde::Deserialize;
 
 use super::{Clip, JointKind, Pose, Skeleton, SkeletonJoint, UpAxis};
 use crate::error::{Error, Result};
+use crate::resources::ReadLimits;
 
 /// The DeepMimic character (pybullet's `humanoid/humanoid.urdf`), embedded.
 ///
@@ -58,12 +59,15 @@ pub struct DeepMimicSettings {
     /// has neck quaternions of norm down to 0.917 (frames 55–64); the other clips are unit to
     /// 1e-6.
     pub max_quaternion_norm_error: f64,
+    /// Most frames and longest duration accepted.
+    pub limits: ReadLimits,
 }
 
 impl Default for DeepMimicSettings {
     fn default() -> Self {
         Self {
             max_quaternion_norm_error: 0.1,
+            limits: ReadLimits::default(),
         }
     }
 }
@@ -243,7 +247,8 @@ struct MotionFile {
 /// `source_name` names the file in error messages. Errors ([`Error::Parse`], with the line where
 /// known): malformed JSON or a non-numeric value, no `"Frames"`, zero frames, a frame that does
 /// not hold 44 numbers, a non-positive duration (except the last frame's), a quaternion of zero
-/// norm or whose norm is farther from 1 than allowed (naming frame and field).
+/// norm or whose norm is farther from 1 than allowed (naming frame and field); more frames or a
+/// longer clip than [`DeepMimicSettings::limits`] allow ([`Error::ResourceLimit`]).
 pub fn read_deepmimic(text: &str, source_name: &str) -> Result<Clip> {
     read_deepmimic_with(text, source_name, &DeepMimicSettings::default())
 }
@@ -286,6 +291,12 @@ pub fn read_deepmimic_with(
         *slot = (index, *kind);
     }
     let line_of = |frame: usize| frame_lines(text).get(frame).copied().unwrap_or(0);
+    crate::resources::check_count(
+        &format!("frames in {source_name}"),
+        file.frames.len(),
+        settings.limits.max_clip_frames,
+        "ReadLimits::max_clip_frames",
+    )?;
     let n = skeleton.len();
     let mut times = Vec::with_capacity(file.frames.len());
     let mut poses = Vec::with_capacity(file.frames.len());
@@ -351,6 +362,10 @@ pub fn read_deepmimic_with(
         poses.push(pose);
         t += duration;
     }
+    let duration = times.last().copied().unwrap_or(0.0);
+    settings
+        .limits
+        .check_clip(source_name, times.len(), duration)?;
     Clip::new(source_name, skeleton, times, poses, UpAxis::Y)
 }
 

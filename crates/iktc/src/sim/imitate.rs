@@ -26,6 +26,7 @@ use crate::limits::{
 };
 use crate::model::{Kinematics, Robot, State};
 use crate::motion::RobotReferences;
+use crate::resources::RunLimits;
 use crate::solver::{Method, SolveReport, Solver, SolverSettings};
 use crate::task::{
     Axes, ComReference, ComTask, FrameReference, FrameTask, Gains, JointTask, Task, TaskStack,
@@ -60,6 +61,8 @@ pub struct ImitateConfig {
     pub bounds: BoundMethod,
     /// Control period Δt \[s\]; must equal the references' period.
     pub dt: f64,
+    /// Range of Δt and largest tick count ([`RunLimits`]).
+    pub run_limits: RunLimits,
     /// CLIK gains of every task (default k_p = 100 s⁻², k_v = 20 s⁻¹, critically damped).
     pub gains: Gains,
     /// Frames of the feet (6D tasks, one level).
@@ -112,6 +115,7 @@ impl ImitateConfig {
             method: Method::Iktc,
             bounds: BoundMethod::viable(),
             dt: 0.005,
+            run_limits: RunLimits::default(),
             gains: Gains {
                 kp: 100.0,
                 kv: 20.0,
@@ -148,9 +152,7 @@ impl ImitateConfig {
             value: value.to_string(),
             expected: expected.into(),
         };
-        if !(self.dt.is_finite() && self.dt > 0.0) {
-            return Err(bad("dt", self.dt, "a finite period > 0 [s]"));
-        }
+        self.run_limits.check_dt("dt", self.dt)?;
         if !(self.reference_margin.is_finite() && self.reference_margin >= 0.0) {
             return Err(bad(
                 "reference_margin",
@@ -250,7 +252,7 @@ pub fn imitation_references(
             }
         }
     }
-    r.resample(cfg.dt)
+    r.resample_with(cfg.dt, &cfg.run_limits)
 }
 
 /// The closed loop of one imitation run: tasks, bounds, solver and state, sized once.

@@ -15,6 +15,7 @@ use super::margins::{dof_margins, median, DofMargins};
 use crate::error::{Error, Result};
 use crate::limits::{compute_box, AccelerationBox, BoundMethod, JointLimits, OutsideLimits};
 use crate::model::{planar3r, Kinematics, State};
+use crate::resources::RunLimits;
 use crate::solver::{Method, Solver, SolverSettings};
 use crate::task::{Axes, FrameReference, FrameTask, Gains, Task, TaskStack};
 
@@ -59,6 +60,8 @@ pub struct Planar3rConfig {
     pub dt: f64,
     /// Duration \[s\].
     pub duration: f64,
+    /// Range of Δt and largest tick count ([`RunLimits`]).
+    pub run_limits: RunLimits,
     /// Priority order, highest first.
     pub priority: [ArmTask; 3],
     /// CLIK gains of every task.
@@ -74,6 +77,7 @@ impl Default for Planar3rConfig {
             bounds: BoundMethod::viable(),
             dt: 0.005,
             duration: 2.0,
+            run_limits: RunLimits::default(),
             priority: [ArmTask::Py, ArmTask::Px, ArmTask::Theta],
             gains: Gains {
                 kp: 100.0,
@@ -182,13 +186,7 @@ pub fn reference(t: f64) -> ([f64; 3], [f64; 3], [f64; 3]) {
 
 /// Runs the experiment.
 pub fn run_planar3r(cfg: &Planar3rConfig) -> Result<Planar3rRun> {
-    if !(cfg.dt.is_finite() && cfg.dt > 0.0 && cfg.duration.is_finite() && cfg.duration > 0.0) {
-        return Err(Error::InvalidSetting {
-            name: "dt / duration".into(),
-            value: format!("{} / {}", cfg.dt, cfg.duration),
-            expected: "positive, finite times [s]".into(),
-        });
-    }
+    let n_steps = cfg.run_limits.ticks("the 3R run", cfg.duration, cfg.dt)?;
     let mut sorted = cfg.priority.map(|t| t.index());
     sorted.sort();
     if sorted != [0, 1, 2] {
@@ -233,7 +231,6 @@ pub fn run_planar3r(cfg: &Planar3rConfig) -> Result<Planar3rRun> {
     let mut kin = Kinematics::new(&robot, &state)?;
     let mut qdd = DVector::zeros(robot.nv());
     let mut pos = vec![0.0; robot.nv()];
-    let n_steps = (cfg.duration / cfg.dt).round() as usize;
     let mut steps = Vec::with_capacity(n_steps);
     let tip = robot.frame_id("tip")?;
     for k in 0..n_steps {

@@ -317,6 +317,12 @@ impl WalkingController {
                 expected: "two feet: right, then left".into(),
             });
         }
+        // Before the footsteps are planned: the walk lasts at least steps × ssp_duration.
+        cfg.imitate.run_limits.ticks(
+            "the walk",
+            cfg.steps as f64 * cfg.walk.ssp_duration.max(0.0),
+            dt,
+        )?;
         let ctl = ImitationController::new(robot, refs, &cfg.imitate)?;
         // The imitation lists the right foot first, then the left.
         let (r0, l0) = (ctl.feet0()[0], ctl.feet0()[1]);
@@ -344,6 +350,9 @@ impl WalkingController {
             FootstepPlan::forward(cfg.steps, cfg.step_length, &walk)?
         };
         let pattern = WalkingPattern::new(&plan, &walk, &preview)?;
+        cfg.imitate
+            .run_limits
+            .ticks("the walk", pattern.duration(), dt)?;
         let l = com0.z;
         let cases = CaseParams {
             xz_ssp: with_length(&cfg.cases.xz_ssp, l),
