@@ -126,6 +126,12 @@ pub fn run(args: BalanceArgs) -> anyhow::Result<()> {
                 )?;
             }
             crate::outln!(
+                "ZMP outside the support polygon by at most {:.4} m without the controller, {:.4} m with it; {}",
+                r.zmp_excursion_open,
+                r.zmp_excursion_closed,
+                crate::cmd_imitate::health_text(&r.health)
+            )?;
+            crate::outln!(
                 "-> {}",
                 out.join(format!("push-{}", phase.name())).display()
             )?;
@@ -546,12 +552,20 @@ fn push(out: &Path, phase: Phase, seed: u64) -> anyhow::Result<PushResult> {
     struct Summary<'a> {
         scenario: &'a PushScenario,
         metrics: &'a [iktc::balance::PlanePushMetrics; 2],
+        support: &'a [(f64, f64)],
+        zmp_excursion_open: f64,
+        zmp_excursion_closed: f64,
+        health: &'a iktc::sim::HealthReport,
     }
     write_json(
         &dir.join("summary.json"),
         &Summary {
             scenario: &r.scenario,
             metrics: &r.metrics,
+            support: &r.support,
+            zmp_excursion_open: r.zmp_excursion_open,
+            zmp_excursion_closed: r.zmp_excursion_closed,
+            health: &r.health,
         },
     )?;
     Ok(r)

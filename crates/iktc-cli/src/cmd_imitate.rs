@@ -62,6 +62,10 @@ pub struct Args {
     /// Control period [s].
     #[arg(long, default_value_t = 0.005)]
     pub dt: f64,
+    /// Keep running when a run check fails (a foot drifts past its tolerance, the ZMP leaves
+    /// the support polygon) and mark it in the summary, instead of stopping with an error.
+    #[arg(long)]
+    pub keep_going: bool,
     /// Output directory.
     #[arg(long, default_value = "out/imitate")]
     pub out: PathBuf,
@@ -223,6 +227,7 @@ pub fn run(a: &Args) -> Result<()> {
             BoundMethod::Paper => anyhow::bail!("--recover needs --bounds viable"),
         }
     }
+    cfg.health.keep_going = a.keep_going;
     if let Some(n) = &a.narrow {
         cfg.narrow = parse_narrow(n)?;
     }
@@ -276,10 +281,35 @@ fn print_summary(r: &ImitateRun) -> std::io::Result<()> {
         s.level_switches.switches, s.level_switches.flips
     )?;
     crate::outln!(
-        "foot drift {:.2e} m / {:.2e} rad; COM over the support polygon: {} (min margin {:.3} m); tick median {:.1} µs, p99 {:.1} µs",
-        s.foot_drift, s.foot_rotation_drift, s.com_inside_support, s.com_min_margin, s.tick_median_us, s.tick_p99_us
+        "foot drift {:.2e} m / {:.2e} rad; COM over the support polygon: {} (min margin {:.3} m); ZMP min margin {:.3} m; tick median {:.1} µs, p99 {:.1} µs",
+        s.foot_drift, s.foot_rotation_drift, s.com_inside_support, s.com_min_margin, s.zmp_min_margin, s.tick_median_us, s.tick_p99_us
     )?;
+    crate::outln!("{}", health_text(&s.health))?;
     Ok(())
+}
+
+/// The health of a run in words: "healthy", or every failed check with its first and worst
+/// value (runs continued with `--keep-going`).
+pub fn health_text(h: &iktc::sim::HealthReport) -> String {
+    if h.healthy {
+        return "run checks: healthy".into();
+    }
+    let mut s = format!(
+        "run checks: FAILED on {} ticks{} (continued with --keep-going)",
+        h.failed_ticks,
+        if h.completed {
+            ""
+        } else {
+            ", stopped early on a non-finite state"
+        }
+    );
+    for i in &h.issues {
+        s.push_str(&format!(
+            "; {i} (worst {:.4e} at t = {:.4} s, {} ticks)",
+            i.worst_value, i.worst_time, i.ticks
+        ));
+    }
+    s
 }
 
 /// Writes trajectory.csv, summary.json, the figures and viewer.html; returns the figures

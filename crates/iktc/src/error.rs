@@ -3,7 +3,8 @@
 //! Errors are for *bad input*: a malformed file, an unknown name, a non-finite number, a
 //! dimension that does not match, an inconsistent limit or setting. A well-formed problem that
 //! happens to be hard (an infeasible QP, an empty acceleration box) is not an error: it is
-//! reported as a *status* in the solution.
+//! reported as a *status* in the solution. The one exception is [`Error::RunFailed`]: a
+//! scenario run whose robot fell, gave up its feet or diverged stops with it by default.
 
 /// Everything that can be wrong with the input given to iktc.
 ///
@@ -106,6 +107,13 @@ pub enum Error {
         /// The setting (and CLI option, if any) that raises the maximum.
         option: String,
     },
+    /// A scenario run went wrong and was stopped (the feet drifted past their tolerance, the
+    /// state stopped being finite, the ZMP left the support polygon): the one kind of error
+    /// that is not about bad input, because the run's results would be meaningless. Its
+    /// settings ([`crate::sim::HealthSettings::keep_going`]) can ask for the run to continue
+    /// and mark the failure instead.
+    #[error("run failed: {0}")]
+    RunFailed(Box<crate::sim::HealthIssue>),
     /// Input data are insufficient for the requested computation (too few points, ...).
     #[error("insufficient data for {what}: {message}")]
     InsufficientData {

@@ -16,10 +16,11 @@ mod record;
 mod support;
 
 pub use record::{run_imitate, ImitateRun, ImitateStep, ImitateSummary, JointMargin, LevelSummary};
-pub use support::{support_polygon, SupportSettings};
+pub use support::{sole_pose, support_polygon, SupportSettings};
 
 use nalgebra::{DVector, Isometry3, Translation3, UnitQuaternion, Vector3, Vector6};
 
+use super::health::HealthSettings;
 use crate::error::{Error, Result};
 use crate::limits::{
     compute_box, AccelerationBox, BoundMethod, DofLimits, JointLimits, OutsideLimits,
@@ -97,6 +98,9 @@ pub struct ImitateConfig {
     pub on_limit_fraction: f64,
     /// Solver settings.
     pub solver: SolverSettings,
+    /// The run's checks (feet held, state finite, ZMP inside the support polygon) and whether
+    /// a failed one stops the run ([`crate::sim::health`]).
+    pub health: HealthSettings,
 }
 
 impl ImitateConfig {
@@ -142,6 +146,7 @@ impl ImitateConfig {
             on_limit_position: 2e-3,
             on_limit_fraction: 0.01,
             solver: SolverSettings::default(),
+            health: HealthSettings::default(),
         }
     }
 
@@ -207,6 +212,7 @@ impl ImitateConfig {
         self.gains.validate()?;
         self.bounds.validate()?;
         self.support.validate()?;
+        self.health.validate()?;
         self.solver.validate()
     }
 }
@@ -383,10 +389,13 @@ impl ImitationController {
             .iter()
             .map(|f| kin.frame_pose(robot, *f))
             .collect::<Result<Vec<_>>>()?;
-        let polygon = support_polygon(&feet0, &cfg.support);
-        let centre =
-            polygon.iter().fold(Vector3::zeros(), |a, p| a + p) / polygon.len().max(1) as f64;
-        let com_ref = Vector3::new(centre.x, centre.y, kin.com().z);
+        let polygon = support_polygon(&feet0, &cfg.support)?;
+        let corners = polygon.vertices();
+        let centre = corners
+            .iter()
+            .fold((0.0, 0.0), |a, p| (a.0 + p.0, a.1 + p.1));
+        let count = corners.len().max(1) as f64;
+        let com_ref = Vector3::new(centre.0 / count, centre.1 / count, kin.com().z);
         let com_start = kin.com();
         let pelvis_id = robot.frame_id(&cfg.pelvis)?;
         let pelvis0 = kin.frame_pose(robot, pelvis_id)?;

@@ -1,11 +1,13 @@
 //! Scenarios: the paper's experiments as runnable, recorded simulations.
 
+pub mod health;
 pub mod imitate;
 pub mod margins;
 pub mod planar3r;
 pub mod switches;
 pub mod walk_imitate;
 
+pub use health::{HealthCheck, HealthIssue, HealthMonitor, HealthReport, HealthSettings, Verdict};
 pub use imitate::{
     imitation_references, run_imitate, ImitateConfig, ImitateRun, ImitateStep, ImitateSummary,
     ImitationController, NarrowedJoint,
@@ -16,6 +18,6 @@ pub use planar3r::{
 };
 pub use switches::LevelSwitches;
 pub use walk_imitate::{
-    run_walk_imitate, Push, WalkImitateConfig, WalkRun, WalkStep, WalkSummary, WalkTick,
-    WalkingController,
+    run_walk_imitate, Push, PushAxisMetrics, WalkImitateConfig, WalkPushSummary, WalkRun, WalkStep,
+    WalkSummary, WalkTick, WalkingController,
 };
