@@ -64,6 +64,19 @@ pub enum Error {
         /// The upper end of the allowed interval.
         upper: f64,
     },
+    /// A task handle given to a controller other than the one whose builder made it.
+    #[error(
+        "{kind} handle of controller #{owner} given to controller #{controller}: a handle works \
+         only with the controller whose builder returned it (or a clone of that controller)"
+    )]
+    ForeignHandle {
+        /// The kind of task ("frame", "COM", "joints").
+        kind: &'static str,
+        /// The identity of the controller the handle belongs to.
+        owner: u64,
+        /// The identity of the controller it was given to.
+        controller: u64,
+    },
     /// A limit has its lower end above its upper end, or is otherwise unusable.
     #[error("invalid limit for {what}: lower {lower} > upper {upper}")]
     InvalidLimit {

@@ -15,10 +15,13 @@
 //!   generator, and the paper's experiments as scenarios.
 //!
 //! The flow of one control tick is
-//! *state → [`model::Kinematics`] → tasks (plain `J q̈ = h` data) → acceleration box → solver*.
+//! *state → [`model::Kinematics`] → tasks (plain `J q̈ = h` data) → acceleration box → solver*,
+//! held together by a [`Controller`] (built once, stepped once per tick).
 //!
 //! | module | what |
 //! |---|---|
+//! | [`controller`] | one controller: robot, levels of tasks with handles, box and solver, one `step` per tick |
+//! | [`prelude`] | what a user of the controller needs, in one import |
 //! | [`model`] | robot model (URDF or code), state, kinematics |
 //! | [`task`] | frame, COM and joint tasks, the priority stack |
 //! | [`limits`] | joint limits → acceleration box (eq. 14, viable bounds) |
@@ -47,16 +50,19 @@
 
 pub mod balance;
 mod buffer;
+pub mod controller;
 pub mod error;
 pub mod limits;
 pub mod model;
 pub mod motion;
 pub mod resources;
+pub mod prelude;
 pub mod sim;
 pub mod solver;
 pub mod task;
 pub mod walk;
 
+pub use controller::{Controller, ControllerBuilder};
 pub use error::{Error, Result};
 
 /// The README's Rust examples, compiled and run as doctests.

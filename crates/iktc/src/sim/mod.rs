@@ -10,7 +10,7 @@ pub mod walk_imitate;
 pub use health::{HealthCheck, HealthIssue, HealthMonitor, HealthReport, HealthSettings, Verdict};
 pub use imitate::{
     imitation_references, run_imitate, ImitateConfig, ImitateRun, ImitateStep, ImitateSummary,
-    ImitationController, NarrowedJoint,
+    ImitationController, ImitationTasks, NarrowedJoint,
 };
 pub use margins::{dof_margins, median, percentile, DofMargins};
 pub use planar3r::{

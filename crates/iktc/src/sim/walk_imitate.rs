@@ -34,6 +34,7 @@ use crate::balance::{
     analyse_response, BalanceController, BalanceSettings, CaseParams, FullModelParams, Plane,
     PlantParams, ResponseSettings, SimPlant, SimSettings, SupportPhase,
 };
+use crate::controller::FrameHandle;
 use crate::error::{Error, Result};
 use crate::model::{Robot, State};
 use crate::motion::RobotReferences;
@@ -333,6 +334,9 @@ pub struct WalkingController {
     com0: Vector3<f64>,
     blend0: Vector2<f64>,
     com_blend_time: f64,
+    /// The handles of the right and left foot tasks.
+    feet: [FrameHandle; 2],
+    /// Their references of the last tick (right, left).
     feet_refs: [FrameReference; 2],
     dc_prev: Vector2<f64>,
     dcd_prev: Vector2<f64>,
@@ -367,6 +371,7 @@ impl WalkingController {
         let ctl = ImitationController::new(robot, refs, &cfg.imitate)?;
         // The imitation lists the right foot first, then the left.
         let (r0, l0) = (ctl.feet0()[0], ctl.feet0()[1]);
+        let feet = [ctl.tasks().feet[0], ctl.tasks().feet[1]];
         let origin = Vector2::new(
             0.5 * (r0.translation.x + l0.translation.x),
             0.5 * (r0.translation.y + l0.translation.y),
@@ -409,6 +414,7 @@ impl WalkingController {
         );
         Ok(Self {
             feet_refs: [FrameReference::hold(r0), FrameReference::hold(l0)],
+            feet,
             ctl,
             plan,
             pattern,
@@ -526,7 +532,9 @@ impl WalkingController {
         }));
         self.feet_refs[0] = ankle_reference(&s.right, &self.ankle_offset, &origin);
         self.feet_refs[1] = ankle_reference(&s.left, &self.ankle_offset, &origin);
-        self.ctl.set_feet_references(&self.feet_refs)?;
+        for (h, r) in self.feet.iter().zip(&self.feet_refs) {
+            self.ctl.controller_mut().set_frame_reference(*h, *r)?;
+        }
         let rep = self.ctl.tick(robot, k)?;
         Ok(WalkTick {
             sample: s,
