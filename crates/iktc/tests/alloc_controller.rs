@@ -3,7 +3,8 @@
 
 use iktc::prelude::*;
 
-mod counting_alloc;
+mod common;
+use common::alloc as counting_alloc;
 use counting_alloc::allocations;
 
 #[global_allocator]

@@ -1,6 +1,8 @@
 //! The prioritized recursion and the correction map G against independent computations.
 
-mod solver_common;
+mod common;
+use common::rng;
+use common::solver as solver_common;
 use solver_common::*;
 
 use iktc::solver::*;

@@ -1,14 +1,9 @@
 //! Shared helpers for model tests: random trees and finite differences.
-#![allow(dead_code)]
 
 use iktc::model::*;
 use nalgebra::{DMatrix, DVector, Isometry3, Translation3, Unit, UnitQuaternion, Vector3};
-use rand::{Rng, SeedableRng};
+use rand::Rng;
 use rand_chacha::ChaCha8Rng;
-
-pub fn rng(seed: u64) -> ChaCha8Rng {
-    ChaCha8Rng::seed_from_u64(seed)
-}
 
 pub fn rand_vec3(r: &mut ChaCha8Rng, s: f64) -> Vector3<f64> {
     Vector3::new(

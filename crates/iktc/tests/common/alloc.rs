@@ -1,8 +1,7 @@
 //! A global allocator that counts the allocations of the current thread (the test harness may
 //! allocate on its own threads meanwhile). A test binary installs it with
-//! `#[global_allocator] static A: counting_alloc::Counting = counting_alloc::Counting;` and
+//! `#[global_allocator] static A: common::alloc::Counting = common::alloc::Counting;` and
 //! compares [`allocations`] before and after the code under test.
-#![allow(dead_code)]
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;

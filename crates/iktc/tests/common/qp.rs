@@ -1,11 +1,10 @@
 //! Shared helpers of the QP tests: seeded random problems, the clarabel oracle, a KKT check.
-#![allow(dead_code)]
 
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{DefaultSettings, DefaultSolver, IPSolver, SolverStatus, SupportedConeT};
 use iktc::solver::{Hessian, QpProblem, QpReport, QpSettings, QpStatus, QpWorkspace};
 use nalgebra::{DMatrix, DVector};
-use rand::{Rng, SeedableRng};
+use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
 /// An owned QP; `h = None` means `H = I`.
@@ -195,9 +194,7 @@ pub fn clarabel_solve(p: &OwnedQp) -> Verdict {
     }
 }
 
-pub fn rng(seed: u64) -> ChaCha8Rng {
-    ChaCha8Rng::seed_from_u64(seed)
-}
+use super::rng;
 
 fn uniform(rng: &mut ChaCha8Rng, lo: f64, hi: f64) -> f64 {
     rng.random_range(lo..hi)

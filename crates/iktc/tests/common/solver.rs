@@ -1,15 +1,10 @@
 //! Random task hierarchies for solver tests and benchmarks.
-#![allow(dead_code)]
 
 use iktc::limits::AccelerationBox;
 use iktc::task::TaskEquation;
 use nalgebra::{DMatrix, DVector};
-use rand::{Rng, SeedableRng};
+use rand::Rng;
 use rand_chacha::ChaCha8Rng;
-
-pub fn rng(seed: u64) -> ChaCha8Rng {
-    ChaCha8Rng::seed_from_u64(seed)
-}
 
 pub fn random_levels(r: &mut ChaCha8Rng, n: usize, dims: &[usize]) -> Vec<TaskEquation> {
     dims.iter()
