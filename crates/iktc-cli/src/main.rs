@@ -6,6 +6,7 @@ use clap::{Parser, Subcommand};
 mod cmd_balance;
 mod cmd_imitate;
 mod cmd_model;
+mod cmd_profile;
 mod cmd_reproduce;
 mod cmd_run;
 mod cmd_walk;
@@ -35,6 +36,8 @@ enum Command {
     Balance(cmd_balance::BalanceArgs),
     /// Imitate a captured motion with a humanoid (Section 5.3): figures, summary, 3D viewer.
     Imitate(cmd_imitate::Args),
+    /// Robot profiles: print a built-in one, or write a starting one for a URDF.
+    Profile(cmd_profile::Args),
 }
 
 fn main() -> std::process::ExitCode {
@@ -45,6 +48,7 @@ fn main() -> std::process::ExitCode {
         Command::Reproduce(a) => cmd_reproduce::run(&a),
         Command::Balance(a) => cmd_balance::run(a),
         Command::Imitate(a) => cmd_imitate::run(&a),
+        Command::Profile(a) => cmd_profile::run(&a),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

@@ -25,6 +25,7 @@
 //! | [`solver`] | prioritized solution, IKTC, GF, clamp, the dense QP |
 //! | [`balance`] | the damping controller of Section 4 |
 //! | [`motion`] | motion capture readers, retargeting |
+//! | `profile` | robot profiles: feet, pelvis, posture, locks of a robot (features `urdf`, `toml`) |
 //! | [`walk`] | footsteps, ZMP preview control, swing feet |
 //! | [`sim`] | the 3R arm, the imitation, walking while imitating |
 //!
@@ -50,6 +51,8 @@ pub mod error;
 pub mod limits;
 pub mod model;
 pub mod motion;
+#[cfg(all(feature = "urdf", feature = "toml"))]
+pub mod profile;
 pub mod sim;
 pub mod solver;
 pub mod task;
@@ -58,6 +61,6 @@ pub mod walk;
 pub use error::{Error, Result};
 
 /// The README's Rust examples, compiled and run as doctests.
-#[doc = include_str!("../../../README.md")]
 #[cfg(doctest)]
+#[doc = include_str!("../../../README.md")]
 pub struct ReadmeDoctests;

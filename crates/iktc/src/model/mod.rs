@@ -13,9 +13,12 @@ mod kinematics;
 mod robot;
 pub mod spatial;
 mod state;
+#[cfg(feature = "urdf")]
 mod urdf;
 
-pub use builtin::{builtin_robot, jvrc1, planar3r, BUILTIN_ROBOTS, JVRC1_FINGERS, JVRC1_URDF};
+pub use builtin::{builtin_robot, planar3r, BUILTIN_ROBOTS};
+#[cfg(feature = "urdf")]
+pub use builtin::{g1, jvrc1, G1_URDF, JVRC1_FINGERS, JVRC1_URDF};
 pub use joint::{Joint, JointKind, JointLimit, JointRole};
 pub use kinematics::Kinematics;
 pub use robot::{
