@@ -35,7 +35,7 @@ enum Command {
     /// The ZMP damping controller of Section 4: identify, design, push.
     Balance(cmd_balance::BalanceArgs),
     /// Imitate a captured motion with a humanoid (Section 5.3): figures, summary, 3D viewer.
-    Imitate(cmd_imitate::Args),
+    Imitate(Box<cmd_imitate::Args>),
     /// Robot profiles: print a built-in one, or write a starting one for a URDF.
     Profile(cmd_profile::Args),
 }

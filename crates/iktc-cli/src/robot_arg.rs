@@ -265,7 +265,7 @@ fn apply_flags(
         keys.push(("posture".into(), "--posture"));
     }
     if let Some(s) = &f.narrow {
-        p.narrow = parse_narrow(s)?.into_iter().collect();
+        p.narrow = parse_narrow(s)?;
         keys.push(("narrow".into(), "--narrow"));
     }
     Ok(keys)

@@ -30,10 +30,10 @@ pub struct RobotProfile {
     /// at 0.
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub posture: BTreeMap<String, f64>,
-    /// Default narrowed joint ranges \[rad\] (key `narrow`, joint name → `[lower, upper]`),
-    /// inside the joints' own ranges.
-    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
-    pub narrow: BTreeMap<String, [f64; 2]>,
+    /// Default narrowed joint ranges \[rad\] (key `narrow`, joint name → `[lower, upper]`, in
+    /// the file's order), inside the joints' own ranges.
+    #[serde(default, skip_serializing_if = "Vec::is_empty", with = "ordered_map")]
+    pub narrow: Vec<(String, [f64; 2])>,
     /// Acceleration limits (key `acceleration`).
     #[serde(default)]
     pub acceleration: AccelerationProfile,
@@ -172,4 +172,51 @@ pub struct ImitateProfile {
     /// and `bvh`; a map is a built-in map name or a TOML file relative to the profile.
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub maps: BTreeMap<String, String>,
+}
+
+/// A TOML table read and written in document order, as `(key, value)` pairs (the order of
+/// `narrow` is the order of the imitation's figures).
+mod ordered_map {
+    use std::marker::PhantomData;
+
+    use serde::de::{Deserialize, Deserializer, MapAccess, Visitor};
+    use serde::ser::{Serialize, SerializeMap, Serializer};
+
+    pub fn serialize<S: Serializer, V: Serialize>(
+        entries: &[(String, V)],
+        s: S,
+    ) -> Result<S::Ok, S::Error> {
+        let mut m = s.serialize_map(Some(entries.len()))?;
+        for (k, v) in entries {
+            m.serialize_entry(k, v)?;
+        }
+        m.end()
+    }
+
+    struct Entries<V>(PhantomData<V>);
+
+    impl<'de, V: Deserialize<'de>> Visitor<'de> for Entries<V> {
+        type Value = Vec<(String, V)>;
+
+        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+            f.write_str("a table of joint names")
+        }
+
+        fn visit_map<A: MapAccess<'de>>(self, mut a: A) -> Result<Self::Value, A::Error> {
+            let mut out: Vec<(String, V)> = Vec::new();
+            while let Some((k, v)) = a.next_entry::<String, V>()? {
+                if out.iter().any(|(n, _)| *n == k) {
+                    return Err(serde::de::Error::custom(format!("joint `{k}` given twice")));
+                }
+                out.push((k, v));
+            }
+            Ok(out)
+        }
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>, V: Deserialize<'de>>(
+        d: D,
+    ) -> Result<Vec<(String, V)>, D::Error> {
+        d.deserialize_map(Entries(PhantomData))
+    }
 }
