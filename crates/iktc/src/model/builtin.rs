@@ -7,7 +7,9 @@
 use nalgebra::{Isometry3, Matrix3, Translation3, UnitQuaternion, Vector3};
 
 use super::joint::{JointKind, JointLimit};
-use super::robot::{BaseKind, JointSpec, Link, ModelOptions, Robot, RobotBuilder};
+#[cfg(feature = "urdf")]
+use super::robot::BaseKind;
+use super::robot::{JointSpec, Link, ModelOptions, Robot, RobotBuilder};
 use crate::error::{Error, Result};
 
 /// The JVRC-1 URDF (AIST; BSD 2-Clause, see the crate's `data/NOTICE.md`), embedded.
