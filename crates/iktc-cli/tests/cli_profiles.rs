@@ -112,7 +112,7 @@ fn a_bare_urdf_names_the_missing_flag_and_key() {
     let e = stderr(&o);
     assert!(e.contains("--sole") && e.contains("feet.left.sole"), "{e}");
     // With feet and sole, no pelvis.
-    let o = run(&[
+    let with_feet = [
         "imitate",
         "--robot",
         u,
@@ -122,25 +122,12 @@ fn a_bare_urdf_names_the_missing_flag_and_key() {
         "0.17,0.05,0.035",
         "--ankle-height",
         "0.035",
-        "--map",
-        "deepmimic_g1",
-    ]);
+    ];
+    let o = run(&[&with_feet[..], &["--map", "deepmimic_g1"]].concat());
     let e = stderr(&o);
     assert!(e.contains("--pelvis") && e.contains("frames.pelvis"), "{e}");
     // No map: the JVRC-1 map is never applied to another robot.
-    let o = run(&[
-        "imitate",
-        "--robot",
-        u,
-        "--feet",
-        feet,
-        "--sole",
-        "0.17,0.05,0.035",
-        "--ankle-height",
-        "0.035",
-        "--pelvis",
-        "pelvis",
-    ]);
+    let o = run(&[&with_feet[..], &["--pelvis", "pelvis"]].concat());
     let e = stderr(&o);
     assert!(
         e.contains("--map") && e.contains("imitate.maps.deepmimic"),
