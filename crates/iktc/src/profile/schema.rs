@@ -30,8 +30,8 @@ pub struct RobotProfile {
     /// at 0.
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub posture: BTreeMap<String, f64>,
-    /// Default narrowed joint ranges \[rad\] (key `narrow`, joint name → `[lower, upper]`, in
-    /// the file's order), inside the joints' own ranges.
+    /// Default narrowed joint ranges \[rad\] (key `narrow`, joint name → `[lower, upper]`),
+    /// inside the joints' own ranges; in the order the TOML reader gives (sorted by name).
     #[serde(default, skip_serializing_if = "Vec::is_empty", with = "ordered_map")]
     pub narrow: Vec<(String, [f64; 2])>,
     /// Acceleration limits (key `acceleration`).
@@ -174,8 +174,8 @@ pub struct ImitateProfile {
     pub maps: BTreeMap<String, String>,
 }
 
-/// A TOML table read and written in document order, as `(key, value)` pairs (the order of
-/// `narrow` is the order of the imitation's figures).
+/// A TOML table read and written as `(key, value)` pairs in the order the reader gives them
+/// (the TOML reader sorts keys), rejecting a key given twice.
 mod ordered_map {
     use std::marker::PhantomData;
 
