@@ -10,29 +10,35 @@ use iktc::motion::{
     DeepMimicSettings, RetargetMap, BUILTIN_CLIP_NAMES, BUILTIN_MAP_NAMES,
 };
 use iktc::resources::{ReadLimits, RunLimits};
+use iktc::profile::check_map_joints;
 use iktc::sim::imitate::LEVEL_NAMES;
-use iktc::sim::{imitation_references, run_imitate, ImitateConfig, ImitateRun, NarrowedJoint};
+use iktc::sim::{imitation_references, run_imitate, ImitateConfig, ImitateRun};
 use iktc::solver::Method;
 use iktc_report::{write_csv, write_figure, Figure, Panel, Section, Series, Table};
 
 use crate::cmd_run::{BoundsArg, SolverArg};
-use crate::robot_arg::{load_robot, RobotOptions};
+use crate::robot_arg::{resolve_robot, ProfileFlags, ResolvedRobot, RobotOptions};
 use crate::viewer::{write_viewer, Figure3d, ViewerData};
 
 /// Arguments of `iktc imitate`.
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// Robot: a built-in name or a URDF file (with --floating).
+    /// Robot: a built-in profile (jvrc1, g1), a robot profile (.toml) or a URDF file (.urdf,
+    /// floating base; its feet, pelvis and posture from --feet, --sole, --ankle-height,
+    /// --pelvis, --posture).
     #[arg(long, default_value = "jvrc1")]
     pub robot: String,
     #[command(flatten)]
     pub robot_options: RobotOptions,
+    #[command(flatten)]
+    pub profile: ProfileFlags,
     /// Motion: a built-in DeepMimic clip (humanoid3d_dance_a, humanoid3d_dance_b,
     /// humanoid3d_punch, humanoid3d_walk), a DeepMimic motion file or a .bvh file.
     #[arg(long, default_value = "humanoid3d_dance_b")]
     pub motion: String,
-    /// Retargeting map: a built-in name (deepmimic_jvrc1, bvh_jvrc1) or a TOML file; default
-    /// deepmimic_jvrc1 for DeepMimic clips, bvh_jvrc1 for BVH files.
+    /// Retargeting map: a built-in name (deepmimic_jvrc1, bvh_jvrc1, deepmimic_g1) or a TOML
+    /// file; default: the robot profile's map for the motion's format (profile key
+    /// `imitate.maps.deepmimic` or `imitate.maps.bvh`).
     #[arg(long)]
     pub map: Option<String>,
     /// Solver.
@@ -45,20 +51,6 @@ pub struct Args {
     /// acceleration limit (viable bounds only); without it such a start is an error.
     #[arg(long)]
     pub recover: bool,
-    /// Narrowed joint ranges [rad]: NAME=lo:hi,NAME=lo:hi; `none` for none. Default (JVRC-1):
-    /// L_KNEE=0.55:0.95,L_HIP_R=-0.05:0.05.
-    #[arg(long)]
-    pub narrow: Option<String>,
-    /// Foot frames (6D tasks of the first level), comma-separated. Default: r_ankle,l_ankle.
-    #[arg(long, value_delimiter = ',')]
-    pub feet: Vec<String>,
-    /// Pelvis frame (attitude and height tasks). Default: PELVIS_S.
-    #[arg(long)]
-    pub pelvis: Option<String>,
-    /// Initial angles [rad] of joints the motion does not drive: NAME=VALUE,... Default
-    /// (JVRC-1): hips −0.4, knees 0.8, ankles −0.4 rad (pitch); `none` for the zero posture.
-    #[arg(long)]
-    pub posture: Option<String>,
     /// Control period [s].
     #[arg(long, default_value_t = 0.005)]
     pub dt: f64,
@@ -77,53 +69,6 @@ pub struct Args {
     pub max_clip_duration: f64,
     #[command(flatten)]
     pub walk: crate::cmd_walk::WalkArgs,
-}
-
-fn parse_narrow(s: &str) -> Result<Vec<NarrowedJoint>> {
-    if s.trim() == "none" || s.trim().is_empty() {
-        return Ok(Vec::new());
-    }
-    s.split(',')
-        .map(|item| {
-            let (name, range) = item
-                .split_once('=')
-                .with_context(|| format!("--narrow `{item}`: expected NAME=lo:hi"))?;
-            let (lo, hi) = range
-                .split_once(':')
-                .with_context(|| format!("--narrow `{item}`: expected NAME=lo:hi"))?;
-            let lower: f64 = lo
-                .trim()
-                .parse()
-                .with_context(|| format!("--narrow `{item}`: `{lo}` is not a number"))?;
-            let upper: f64 = hi
-                .trim()
-                .parse()
-                .with_context(|| format!("--narrow `{item}`: `{hi}` is not a number"))?;
-            Ok(NarrowedJoint {
-                joint: name.trim().to_string(),
-                lower,
-                upper,
-            })
-        })
-        .collect()
-}
-
-fn parse_posture(s: &str) -> Result<Vec<(String, f64)>> {
-    if s.trim() == "none" || s.trim().is_empty() {
-        return Ok(Vec::new());
-    }
-    s.split(',')
-        .map(|item| {
-            let (name, value) = item
-                .split_once('=')
-                .with_context(|| format!("--posture `{item}`: expected NAME=VALUE"))?;
-            let v: f64 = value
-                .trim()
-                .parse()
-                .with_context(|| format!("--posture `{item}`: `{value}` is not a number"))?;
-            Ok((name.trim().to_string(), v))
-        })
-        .collect()
 }
 
 /// Loads a clip: built-in name, DeepMimic file or BVH file. Returns the clip and whether it is BVH.
@@ -163,22 +108,32 @@ fn load_clip(spec: &str, limits: &ReadLimits) -> Result<(Clip, bool)> {
     }
 }
 
-fn load_map(spec: Option<&str>, is_bvh: bool) -> Result<RetargetMap> {
-    let spec = spec.unwrap_or(if is_bvh {
-        "bvh_jvrc1"
+/// The retargeting map: `--map` if given, else the robot profile's map for the motion's format;
+/// checked against the robot (an unknown joint names the map entry and its source).
+fn load_map(spec: Option<&str>, is_bvh: bool, r: &ResolvedRobot) -> Result<RetargetMap> {
+    let format = if is_bvh { "bvh" } else { "deepmimic" };
+    let Some(spec) = spec else {
+        let profile = r
+            .profile
+            .as_ref()
+            .context("`planar3r` has no profile and cannot imitate a motion")?;
+        return profile
+            .retarget_map(format, &r.robot)
+            .map_err(|e| r.explain(e));
+    };
+    let map = if BUILTIN_MAP_NAMES.contains(&spec) {
+        builtin_map(spec)?
     } else {
-        "deepmimic_jvrc1"
-    });
-    if BUILTIN_MAP_NAMES.contains(&spec) {
-        return Ok(builtin_map(spec)?);
-    }
-    let text = std::fs::read_to_string(spec).with_context(|| {
-        format!(
-            "`{spec}` is neither a built-in map ({}) nor a readable TOML file",
-            BUILTIN_MAP_NAMES.join(", ")
-        )
-    })?;
-    Ok(RetargetMap::from_toml_str(&text, spec)?)
+        let text = std::fs::read_to_string(spec).with_context(|| {
+            format!(
+                "--map `{spec}` is neither a built-in map ({}) nor a readable TOML file",
+                BUILTIN_MAP_NAMES.join(", ")
+            )
+        })?;
+        RetargetMap::from_toml_str(&text, spec)?
+    };
+    check_map_joints(&r.robot, &map).with_context(|| format!("--map `{spec}`"))?;
+    Ok(map)
 }
 
 /// Everything one run needs besides its settings.
@@ -200,26 +155,37 @@ pub fn run_experiment(e: &Experiment, cfg: &ImitateConfig) -> Result<ImitateRun>
 /// Runs `iktc imitate`.
 pub fn run(a: &Args) -> Result<()> {
     let mut ro = a.robot_options.clone();
-    if a.robot != "jvrc1" {
+    let path = std::path::Path::new(&a.robot);
+    if path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("urdf"))
+    {
+        // The imitation moves a free-floating humanoid.
         ro.floating = true;
     }
-    let robot = load_robot(&a.robot, &ro)?;
+    let resolved = resolve_robot(&a.robot, &ro, Some(&a.profile))?;
     let read_limits = ReadLimits {
         max_clip_duration: a.max_clip_duration,
         ..ReadLimits::default()
     };
     let (clip, is_bvh) = load_clip(&a.motion, &read_limits)?;
-    let map = load_map(a.map.as_deref(), is_bvh)?;
-    let mut cfg = ImitateConfig {
-        method: a.solver.method(),
-        bounds: a.bounds.method(),
-        dt: a.dt,
-        run_limits: RunLimits {
-            max_ticks: a.max_ticks,
-            ..RunLimits::default()
-        },
-        ..ImitateConfig::jvrc1()
-    };
+    let map = load_map(a.map.as_deref(), is_bvh, &resolved)?;
+    let profile = resolved
+        .profile
+        .as_ref()
+        .context("`planar3r` has no profile and cannot imitate a motion")?;
+    let mut cfg = profile
+        .imitate_config(ImitateConfig {
+            method: a.solver.method(),
+            bounds: a.bounds.method(),
+            dt: a.dt,
+            run_limits: RunLimits {
+                max_ticks: a.max_ticks,
+                ..RunLimits::default()
+            },
+            ..ImitateConfig::default()
+        })
+        .map_err(|e| resolved.explain(e))?;
     cfg.run_limits.check_dt("--dt", a.dt)?;
     if a.recover {
         match &mut cfg.bounds {
@@ -228,19 +194,11 @@ pub fn run(a: &Args) -> Result<()> {
         }
     }
     cfg.health.keep_going = a.keep_going;
-    if let Some(n) = &a.narrow {
-        cfg.narrow = parse_narrow(n)?;
-    }
-    if !a.feet.is_empty() {
-        cfg.feet = a.feet.iter().map(|f| f.trim().to_string()).collect();
-    }
-    if let Some(p) = &a.pelvis {
-        cfg.pelvis = p.trim().to_string();
-    }
-    if let Some(p) = &a.posture {
-        cfg.initial_posture = parse_posture(p)?;
-    }
-    let e = Experiment { robot, clip, map };
+    let e = Experiment {
+        robot: resolved.robot,
+        clip,
+        map,
+    };
     if a.walk.walk {
         let (figs, with, without) = crate::cmd_walk::run_walk(&e, &cfg, &a.walk, &a.out)?;
         crate::cmd_walk::print_walk(&with, &without)?;

@@ -12,7 +12,7 @@ use crate::robot_arg::{load_robot, RobotOptions};
 /// Arguments of `iktc model`.
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// A built-in robot (jvrc1, planar3r) or the path of a URDF file.
+    /// A built-in robot (jvrc1, g1, planar3r), a robot profile (.toml) or a URDF file.
     pub robot: String,
     #[command(flatten)]
     pub robot_options: RobotOptions,

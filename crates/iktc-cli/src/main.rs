@@ -6,6 +6,7 @@ use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 mod cmd_balance;
 mod cmd_imitate;
 mod cmd_model;
+mod cmd_profile;
 mod cmd_reproduce;
 mod cmd_run;
 mod cmd_walk;
@@ -36,7 +37,9 @@ enum Command {
     /// The ZMP damping controller of Section 4: identify, design, push.
     Balance(cmd_balance::BalanceArgs),
     /// Imitate a captured motion with a humanoid (Section 5.3): figures, summary, 3D viewer.
-    Imitate(cmd_imitate::Args),
+    Imitate(Box<cmd_imitate::Args>),
+    /// Robot profiles: print a built-in one, or write a starting one for a URDF.
+    Profile(cmd_profile::Args),
 }
 
 /// The command line's grammar, with every option value allowed to be a negative number
@@ -66,6 +69,7 @@ fn main() -> std::process::ExitCode {
         Command::Reproduce(a) => cmd_reproduce::run(&a),
         Command::Balance(a) => cmd_balance::run(a),
         Command::Imitate(a) => cmd_imitate::run(&a),
+        Command::Profile(a) => cmd_profile::run(&a),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

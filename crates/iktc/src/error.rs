@@ -135,6 +135,17 @@ pub enum Error {
         /// What was missing.
         message: String,
     },
+    /// A robot profile's key holds a value that does not fit the robot (an unknown frame or
+    /// joint, a glob that matches nothing, a bad number) or a needed key is missing.
+    #[error("profile key `{key}` = `{value}`: {message}")]
+    Profile {
+        /// The key, dotted as in the TOML file (`feet.left.frame`, `lock[0].joints`).
+        key: String,
+        /// The value found, as text (`(missing)` if the key is absent).
+        value: String,
+        /// What is wrong and what would be valid (e.g. the names that exist).
+        message: String,
+    },
 }
 
 /// The result type of the library.

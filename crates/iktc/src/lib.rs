@@ -28,6 +28,7 @@
 //! | [`solver`] | prioritized solution, IKTC, GF, clamp, the dense QP |
 //! | [`balance`] | the damping controller of Section 4 |
 //! | [`motion`] | motion capture readers, retargeting |
+//! | `profile` | robot profiles: feet, pelvis, posture, locks of a robot (features `urdf`, `toml`) |
 //! | [`walk`] | footsteps, ZMP preview control, swing feet |
 //! | [`resources`] | stated maxima on what an input may make iktc allocate or run |
 //! | [`sim`] | the 3R arm, the imitation, walking while imitating |
@@ -57,6 +58,8 @@ pub mod model;
 pub mod motion;
 pub mod resources;
 pub mod prelude;
+#[cfg(all(feature = "urdf", feature = "toml"))]
+pub mod profile;
 pub mod sim;
 pub mod solver;
 pub mod task;
@@ -66,6 +69,6 @@ pub use controller::{Controller, ControllerBuilder};
 pub use error::{Error, Result};
 
 /// The README's Rust examples, compiled and run as doctests.
-#[doc = include_str!("../../../README.md")]
 #[cfg(doctest)]
+#[doc = include_str!("../../../README.md")]
 pub struct ReadmeDoctests;

@@ -7,7 +7,7 @@ use iktc::motion::{
 use iktc::Error;
 use nalgebra::Vector3;
 
-const DATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../data/motions/deepmimic/");
+const DATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/data/motions/deepmimic/");
 
 fn file_text(name: &str) -> String {
     std::fs::read_to_string(format!("{DATA}{name}.txt")).unwrap()

@@ -1,6 +1,6 @@
 //! Reader of DeepMimic motion files and the DeepMimic humanoid skeleton.
 //!
-//! File format (see `data/NOTICE.md`): JSON with a `"Frames"` array; each frame holds 44
+//! File format (see `crates/iktc/data/NOTICE.md`): JSON with a `"Frames"` array; each frame holds 44
 //! numbers: `[duration of the frame \[s\], root position (3) \[m\], root orientation (w, x, y, z),
 //! chest (w, x, y, z), neck, right hip, right knee angle \[rad\], right ankle, right shoulder,
 //! right elbow angle \[rad\], left hip, left knee angle, left ankle, left shoulder, left elbow
@@ -22,7 +22,7 @@ use crate::resources::ReadLimits;
 ///
 /// It is authored at four times human size; see [`DEEPMIMIC_URDF_SCALE`].
 pub const DEEPMIMIC_URDF: &str =
-    include_str!("../../../../data/motions/deepmimic/deepmimic_humanoid.urdf");
+    include_str!("../../data/motions/deepmimic/deepmimic_humanoid.urdf");
 
 /// Length of one URDF unit of [`DEEPMIMIC_URDF`] in metres \[m/unit\].
 ///
@@ -41,10 +41,10 @@ pub const BUILTIN_CLIP_NAMES: [&str; 4] = [
 ];
 
 const BUILTIN_CLIP_TEXTS: [&str; 4] = [
-    include_str!("../../../../data/motions/deepmimic/humanoid3d_dance_a.txt"),
-    include_str!("../../../../data/motions/deepmimic/humanoid3d_dance_b.txt"),
-    include_str!("../../../../data/motions/deepmimic/humanoid3d_punch.txt"),
-    include_str!("../../../../data/motions/deepmimic/humanoid3d_walk.txt"),
+    include_str!("../../data/motions/deepmimic/humanoid3d_dance_a.txt"),
+    include_str!("../../data/motions/deepmimic/humanoid3d_dance_b.txt"),
+    include_str!("../../data/motions/deepmimic/humanoid3d_punch.txt"),
+    include_str!("../../data/motions/deepmimic/humanoid3d_walk.txt"),
 ];
 
 /// Numbers per frame of a DeepMimic motion file.
@@ -398,7 +398,7 @@ fn frame_lines(text: &str) -> Vec<usize> {
     lines
 }
 
-/// One of the four DeepMimic clips shipped with the library (see `data/NOTICE.md`), by name:
+/// One of the four DeepMimic clips shipped with the library (see `crates/iktc/data/NOTICE.md`), by name:
 /// see [`BUILTIN_CLIP_NAMES`]. Unknown names give [`Error::UnknownName`] listing the valid ones.
 pub fn builtin_clip(name: &str) -> Result<Clip> {
     let text = BUILTIN_CLIP_NAMES

@@ -41,6 +41,7 @@ mod angles;
 mod bvh;
 mod clip;
 mod decompose;
+#[cfg(all(feature = "urdf", feature = "json"))]
 mod deepmimic;
 mod retarget;
 mod retarget_map;
@@ -57,13 +58,14 @@ pub use decompose::{
     compose_rotation, decompose_rotation, decompose_rotation_with, rotation_angle,
     DecomposeSettings, Decomposition, DecompositionMethod, MAX_DECOMPOSITION_AXES,
 };
+#[cfg(all(feature = "urdf", feature = "json"))]
 pub use deepmimic::{
     builtin_clip, deepmimic_skeleton, read_deepmimic, read_deepmimic_with, DeepMimicSettings,
     BUILTIN_CLIP_NAMES, DEEPMIMIC_FRAME_LEN, DEEPMIMIC_URDF, DEEPMIMIC_URDF_SCALE,
 };
 pub use retarget::{retarget, Retargeted, RobotReferences, Track};
-pub use retarget_map::{
-    builtin_map, HoldJoint, JointMap, RetargetMap, RootMap, TargetJoint, BUILTIN_MAP_NAMES,
-};
+#[cfg(feature = "toml")]
+pub use retarget_map::{builtin_map, BUILTIN_MAP_NAMES};
+pub use retarget_map::{HoldJoint, JointMap, RetargetMap, RootMap, TargetJoint};
 pub use skeleton::{JointKind, Skeleton, SkeletonJoint};
 pub use spline::CubicSpline;
