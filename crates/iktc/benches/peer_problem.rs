@@ -30,6 +30,14 @@ fn warmed(method: Method, settings: SolverSettings) -> PeerProblem {
 fn variants() -> Vec<(&'static str, Method, SolverSettings)> {
     vec![
         ("iktc", Method::Iktc, SolverSettings::default()),
+        (
+            "iktc_cold",
+            Method::Iktc,
+            SolverSettings {
+                warm_start: false,
+                ..SolverSettings::default()
+            },
+        ),
         ("gf", Method::Cascade, SolverSettings::default()),
     ]
 }
@@ -37,7 +45,7 @@ fn variants() -> Vec<(&'static str, Method, SolverSettings)> {
 fn bench(c: &mut Criterion) {
     let variants = variants();
     let starts: Vec<PeerProblem> = variants.iter().map(|(_, m, s)| warmed(*m, *s)).collect();
-    summary(&starts[0]);
+    summary();
     // Interleaved whole passes of the 2 000 timed steps: median per-step time of each.
     let rounds = 5;
     let mut passes: Vec<Vec<f64>> = vec![Vec::with_capacity(rounds); variants.len()];
@@ -89,7 +97,7 @@ fn bench(c: &mut Criterion) {
 /// What the IKTC run does over the 2 050 steps (from t = 0): corrected levels, QPs, and the
 /// joints that reach a position limit (within `POSITION_REACHED` \[rad\]) or their velocity
 /// limit (|q̇| ≥ (1 − `VELOCITY_REACHED`) v_max).
-fn summary(_warm: &PeerProblem) {
+fn summary() {
     /// A joint this close to a position limit has reached it \[rad\].
     const POSITION_REACHED: f64 = 1e-3;
     /// A joint this close to its velocity limit, as a fraction of it, has reached it \[–\].
@@ -102,6 +110,7 @@ fn summary(_warm: &PeerProblem) {
     let mut closest = vec![f64::INFINITY; nv];
     let mut fastest = vec![0.0_f64; nv];
     let (mut corrected, mut qps, mut infeasible, mut screened) = (vec![0; 5], 0, 0, 0);
+    let (mut warm, mut iterations) = (0, 0);
     let mut uncorrected = 0;
     for _ in 0..WARMUP + TIMED {
         let r = p.step().expect("step");
@@ -112,6 +121,8 @@ fn summary(_warm: &PeerProblem) {
         qps += r.qp_solves;
         infeasible += r.qp_infeasible;
         screened += r.screened_infeasible;
+        warm += r.qp_warm_started;
+        iterations += r.qp_iterations;
         for d in nb..nv {
             let q = p.state.q[d + p.robot.base_nq() - nb];
             let qd = p.state.qd[d];
@@ -122,7 +133,8 @@ fn summary(_warm: &PeerProblem) {
     }
     eprintln!(
         "peer_problem: {} steps: corrected from level (1-based) {:?}, {uncorrected} uncorrected; \
-         {qps} QPs ({infeasible} infeasible), {screened} levels screened",
+         {qps} QPs ({infeasible} infeasible, {warm} warm-started, {iterations} iterations), \
+         {screened} levels screened",
         WARMUP + TIMED,
         corrected
     );
