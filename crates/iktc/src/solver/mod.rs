@@ -13,6 +13,7 @@ mod report;
 mod screen;
 mod settings;
 mod solve;
+mod warm;
 
 pub use hierarchy::Hierarchy;
 pub use report::{Fallback, Method, SolveReport};

@@ -66,6 +66,12 @@ pub struct SolverSettings {
     pub screen: bool,
     /// Where IKTC's climb starts. Default [`Climb::FromLast`].
     pub climb: Climb,
+    /// Before each IKTC correction QP, try the rows active at that level's last optimum: the
+    /// least-norm correction on them is the QP's optimum when its multipliers have the right
+    /// signs and it satisfies every row (see the `warm` module notes in the solver); otherwise
+    /// the QP runs as before. Same answer up to rounding and the QP's feasibility tolerance,
+    /// fewer QP iterations when the same level is corrected tick after tick. Default true.
+    pub warm_start: bool,
     /// Settings of the QPs.
     pub qp: QpSettings,
 }
@@ -79,6 +85,7 @@ impl Default for SolverSettings {
             cascade_regularization: 1e-8,
             screen: true,
             climb: Climb::FromLast,
+            warm_start: true,
             qp: QpSettings::default(),
         }
     }
