@@ -6,8 +6,8 @@ use anyhow::{Context, Result};
 use iktc::limits::BoundMethod;
 use iktc::model::Robot;
 use iktc::motion::{
-    builtin_clip, builtin_map, read_bvh, read_deepmimic, BvhReadOptions, Clip, RetargetMap,
-    BUILTIN_CLIP_NAMES, BUILTIN_MAP_NAMES,
+    builtin_clip, builtin_map, Clip, MotionFormat, RetargetMap, BUILTIN_CLIP_NAMES,
+    BUILTIN_MAP_NAMES,
 };
 use iktc::sim::imitate::LEVEL_NAMES;
 use iktc::sim::{imitation_references, run_imitate, ImitateConfig, ImitateRun, NarrowedJoint};
@@ -27,9 +27,12 @@ pub struct Args {
     #[command(flatten)]
     pub robot_options: RobotOptions,
     /// Motion: a built-in DeepMimic clip (humanoid3d_dance_a, humanoid3d_dance_b,
-    /// humanoid3d_punch, humanoid3d_walk), a DeepMimic motion file or a .bvh file.
+    /// humanoid3d_punch, humanoid3d_walk) or a skeleton motion file (.bvh, .amc, DeepMimic),
+    /// its format detected from its content and extension.
     #[arg(long, default_value = "humanoid3d_dance_b")]
     pub motion: String,
+    #[command(flatten)]
+    pub motion_options: crate::cmd_map::MotionArgs,
     /// Retargeting map: a built-in name (deepmimic_jvrc1, bvh_jvrc1) or a TOML file; default
     /// deepmimic_jvrc1 for DeepMimic clips, bvh_jvrc1 for BVH files.
     #[arg(long)]
@@ -111,29 +114,26 @@ fn parse_posture(s: &str) -> Result<Vec<(String, f64)>> {
         .collect()
 }
 
-/// Loads a clip: built-in name, DeepMimic file or BVH file. Returns the clip and whether it is BVH.
-fn load_clip(spec: &str) -> Result<(Clip, bool)> {
+/// Loads a clip: a built-in name or a skeleton motion file (in metres, units and up axis given
+/// or decided). Returns the clip and whether it is not DeepMimic (BVH, ASF/AMC).
+fn load_clip(spec: &str, options: &crate::cmd_map::MotionArgs) -> Result<(Clip, bool)> {
     if BUILTIN_CLIP_NAMES.contains(&spec) {
         return Ok((builtin_clip(spec)?, false));
     }
-    let path = Path::new(spec);
-    let text = std::fs::read_to_string(path).with_context(|| {
-        format!(
-            "`{spec}` is neither a built-in clip ({}) nor a readable file",
+    if !Path::new(spec).is_file() {
+        anyhow::bail!(
+            "`{spec}` is neither a built-in clip ({}) nor a file",
             BUILTIN_CLIP_NAMES.join(", ")
-        )
-    })?;
-    let is_bvh = path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("bvh"));
-    if is_bvh {
-        Ok((
-            read_bvh(&text, spec, &BvhReadOptions::default())?.to_clip()?,
-            true,
-        ))
-    } else {
-        Ok((read_deepmimic(&text, spec)?, false))
+        );
     }
+    let motion = crate::cmd_map::load(Path::new(spec), options, None)?;
+    let clip = motion.clip().with_context(|| {
+        format!(
+            "`{spec}` holds marker trajectories ({}); the joint-angle imitation needs a skeleton",
+            motion.format.name()
+        )
+    })??;
+    Ok((clip, motion.format != MotionFormat::DeepMimic))
 }
 
 fn load_map(spec: Option<&str>, is_bvh: bool) -> Result<RetargetMap> {
@@ -177,7 +177,7 @@ pub fn run(a: &Args) -> Result<()> {
         ro.floating = true;
     }
     let robot = load_robot(&a.robot, &ro)?;
-    let (clip, is_bvh) = load_clip(&a.motion)?;
+    let (clip, is_bvh) = load_clip(&a.motion, &a.motion_options)?;
     let map = load_map(a.map.as_deref(), is_bvh)?;
     let mut cfg = ImitateConfig {
         method: a.solver.method(),

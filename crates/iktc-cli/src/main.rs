@@ -5,6 +5,7 @@ use clap::{Parser, Subcommand};
 
 mod cmd_balance;
 mod cmd_imitate;
+mod cmd_map;
 mod cmd_model;
 mod cmd_reproduce;
 mod cmd_run;
@@ -34,7 +35,9 @@ enum Command {
     /// The ZMP damping controller of Section 4: identify, design, push.
     Balance(cmd_balance::BalanceArgs),
     /// Imitate a captured motion with a humanoid (Section 5.3): figures, summary, 3D viewer.
-    Imitate(cmd_imitate::Args),
+    Imitate(Box<cmd_imitate::Args>),
+    /// Print a built-in map, or find the body points of a motion file and write a body map.
+    Map(cmd_map::Args),
 }
 
 fn main() -> std::process::ExitCode {
@@ -45,6 +48,7 @@ fn main() -> std::process::ExitCode {
         Command::Reproduce(a) => cmd_reproduce::run(&a),
         Command::Balance(a) => cmd_balance::run(a),
         Command::Imitate(a) => cmd_imitate::run(&a),
+        Command::Map(a) => cmd_map::run(&a),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

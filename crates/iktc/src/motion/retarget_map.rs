@@ -54,6 +54,19 @@ pub fn builtin_map(name: &str) -> Result<RetargetMap> {
     }
 }
 
+/// The TOML text of a built-in map (see [`builtin_map`]), to print or edit.
+pub fn builtin_map_text(name: &str) -> Result<&'static str> {
+    BUILTIN_MAP_NAMES
+        .iter()
+        .position(|n| *n == name)
+        .map(|i| BUILTIN_MAP_TEXTS[i])
+        .ok_or_else(|| Error::UnknownName {
+            kind: "built-in retargeting map",
+            name: name.into(),
+            valid: BUILTIN_MAP_NAMES.iter().map(|s| s.to_string()).collect(),
+        })
+}
+
 /// One robot joint driven by a decomposed source rotation:
 /// `q = offset + sign · scale · θ` \[rad\], `θ` the decomposed angle about this joint's axis.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
