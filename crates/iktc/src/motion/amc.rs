@@ -71,14 +71,8 @@ pub fn read_amc(text: &str, source: &str, asf: &Asf, frame_rate: f64) -> Result<
         frames.push(asf.pose(&root, &bones, skeleton.len(), degrees));
         Ok(())
     };
-    let mut last_line = 0;
-    for (i, raw) in text.lines().enumerate() {
-        let line = i + 1;
-        last_line = line;
-        let l = raw.trim();
-        if l.is_empty() || l.starts_with('#') {
-            continue;
-        }
+    let last_line = text.lines().count();
+    for (line, l) in super::asf::acclaim_lines(text) {
         if l.starts_with(':') {
             match l.to_ascii_uppercase().as_str() {
                 ":DEGREES" => degrees = true,

@@ -78,6 +78,14 @@ fn axis_index(c: char) -> Option<usize> {
     }
 }
 
+/// The lines of an ASF or AMC file that are not blank or `#` comments: (1-based line, trimmed).
+pub(crate) fn acclaim_lines(text: &str) -> impl Iterator<Item = (usize, &str)> {
+    text.lines()
+        .enumerate()
+        .map(|(i, l)| (i + 1, l.trim()))
+        .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'))
+}
+
 struct Parser<'a> {
     source: &'a str,
 }
@@ -167,14 +175,8 @@ pub fn read_asf(text: &str, source: &str) -> Result<Asf> {
     let mut current: Option<RawBone> = None;
     let mut hierarchy_seen = false;
     let mut in_limits = false;
-    let mut last_line = 0;
-    for (i, raw) in text.lines().enumerate() {
-        let line = i + 1;
-        last_line = line;
-        let l = raw.trim();
-        if l.is_empty() || l.starts_with('#') {
-            continue;
-        }
+    let last_line = text.lines().count();
+    for (line, l) in acclaim_lines(text) {
         let tokens: Vec<&str> = l.split_whitespace().collect();
         let key = tokens[0].to_ascii_lowercase();
         if key.starts_with(':') {

@@ -74,6 +74,20 @@ pub struct BodyMap {
     pub points: Vec<MappedPoint>,
 }
 
+/// A TOML error as [`Error::Parse`] with the 1-based line of its span (0 if unknown).
+pub(crate) fn toml_error(text: &str, source_name: &str, e: &toml::de::Error) -> Error {
+    let line = e
+        .span()
+        .and_then(|s| text.get(..s.start))
+        .map(|head| head.matches('\n').count() + 1)
+        .unwrap_or(0);
+    Error::Parse {
+        source_name: source_name.into(),
+        line,
+        message: e.message().to_string(),
+    }
+}
+
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct MapFile {
@@ -141,18 +155,7 @@ impl BodyMap {
 
     /// Parses a map file (see the module documentation); `source_name` names it in errors.
     pub fn from_toml_str(text: &str, source_name: &str) -> Result<Self> {
-        let file: MapFile = toml::from_str(text).map_err(|e| {
-            let line = e
-                .span()
-                .and_then(|s| text.get(..s.start))
-                .map(|head| head.matches('\n').count() + 1)
-                .unwrap_or(0);
-            Error::Parse {
-                source_name: source_name.into(),
-                line,
-                message: e.message().to_string(),
-            }
-        })?;
+        let file: MapFile = toml::from_str(text).map_err(|e| toml_error(text, source_name, &e))?;
         let mut points = Vec::with_capacity(file.points.len());
         for (key, source) in file.points {
             points.push(MappedPoint {

@@ -379,6 +379,11 @@ fn read_content(
     })
 }
 
+/// `head − (left ankle + right ankle)/2` from a point lookup, if all three are found.
+fn ankles_to_head(at: impl Fn(BodyPoint) -> Option<Vector3<f64>>) -> Option<Vector3<f64>> {
+    Some(at(BodyPoint::Head)? - (at(BodyPoint::LeftAnkle)? + at(BodyPoint::RightAnkle)?) / 2.0)
+}
+
 /// The ankles-to-head vector (if the body map gives them) and all rest points.
 type RestMeasure = (Option<Vector3<f64>>, Vec<Vector3<f64>>);
 
@@ -395,15 +400,7 @@ fn rest_measure(content: &MotionContent, map: Option<&BodyMap>) -> Result<RestMe
                 Some(PointSource::Joint(name)) => skeleton.index_of(name).ok().map(|j| all[j]),
                 _ => None,
             };
-            let v = match (
-                at(BodyPoint::Head),
-                at(BodyPoint::LeftAnkle),
-                at(BodyPoint::RightAnkle),
-            ) {
-                (Some(h), Some(l), Some(r)) => Some(h - (l + r) / 2.0),
-                _ => None,
-            };
-            Ok((v, all))
+            Ok((ankles_to_head(at), all))
         }
         MotionContent::Markers(m) => {
             let f = m.most_complete_frame();
@@ -424,15 +421,7 @@ fn rest_measure(content: &MotionContent, map: Option<&BodyMap>) -> Result<RestMe
                     .collect();
                 (!pts.is_empty()).then(|| pts.iter().sum::<Vector3<f64>>() / pts.len() as f64)
             };
-            let v = match (
-                at(BodyPoint::Head),
-                at(BodyPoint::LeftAnkle),
-                at(BodyPoint::RightAnkle),
-            ) {
-                (Some(h), Some(l), Some(r)) => Some(h - (l + r) / 2.0),
-                _ => None,
-            };
-            Ok((v, all))
+            Ok((ankles_to_head(at), all))
         }
     }
 }

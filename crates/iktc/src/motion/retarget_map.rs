@@ -194,18 +194,8 @@ impl RetargetMap {
     /// not a proper rotation, a joint map with 0 or more than 3 targets, a sign other than ±1,
     /// a non-finite number, a robot joint named twice.
     pub fn from_toml_str(text: &str, source_name: &str) -> Result<Self> {
-        let file: MapFile = toml::from_str(text).map_err(|e| {
-            let line = e
-                .span()
-                .and_then(|s| text.get(..s.start))
-                .map(|head| head.matches('\n').count() + 1)
-                .unwrap_or(0);
-            Error::Parse {
-                source_name: source_name.into(),
-                line,
-                message: e.message().to_string(),
-            }
-        })?;
+        let file: MapFile =
+            toml::from_str(text).map_err(|e| super::body_map::toml_error(text, source_name, &e))?;
         let b = Matrix3::from_fn(|r, c| file.basis[r][c]);
         let invalid = |name: String, value: String, expected: &str| Error::InvalidSetting {
             name: format!("{source_name}: {name}"),
