@@ -112,7 +112,10 @@ pub fn run(a: &Args) -> Result<()> {
                 None => None,
             };
             let m = load(motion, options, given)?;
-            let body_map = m.body_map.clone()?;
+            let mut body_map = m.body_map.clone()?;
+            if let Some(stem) = motion.file_stem() {
+                body_map.name = stem.to_string_lossy().to_string();
+            }
             let keypoints = m.keypoints(iktc::motion::DEFAULT_MAX_GAP)?;
             println!("{}", keypoints.summary());
             let text = body_map.to_toml_string();
