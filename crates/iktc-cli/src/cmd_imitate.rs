@@ -6,10 +6,10 @@ use anyhow::{Context, Result};
 use iktc::limits::{BoundMethod, OutsideLimits};
 use iktc::model::Robot;
 use iktc::motion::{
-    builtin_clip, builtin_map, read_bvh, read_deepmimic_with, BvhReadOptions, Clip,
-    DeepMimicSettings, RetargetMap, BUILTIN_CLIP_NAMES, BUILTIN_MAP_NAMES,
+    builtin_clip, builtin_map, Clip, MotionFormat, RetargetMap, BUILTIN_CLIP_NAMES,
+    BUILTIN_MAP_NAMES,
 };
-use iktc::resources::{ReadLimits, RunLimits};
+use iktc::resources::RunLimits;
 use iktc::profile::check_map_joints;
 use iktc::sim::imitate::LEVEL_NAMES;
 use iktc::sim::{imitation_references, run_imitate, ImitateConfig, ImitateRun};
@@ -33,9 +33,12 @@ pub struct Args {
     #[command(flatten)]
     pub profile: ProfileFlags,
     /// Motion: a built-in DeepMimic clip (humanoid3d_dance_a, humanoid3d_dance_b,
-    /// humanoid3d_punch, humanoid3d_walk), a DeepMimic motion file or a .bvh file.
+    /// humanoid3d_punch, humanoid3d_walk) or a skeleton motion file (.bvh, .amc, DeepMimic),
+    /// its format detected from its content and extension.
     #[arg(long, default_value = "humanoid3d_dance_b")]
     pub motion: String,
+    #[command(flatten)]
+    pub motion_options: crate::cmd_map::MotionArgs,
     /// Retargeting map: a built-in name (deepmimic_jvrc1, bvh_jvrc1, deepmimic_g1) or a TOML
     /// file; default: the robot profile's map for the motion's format (profile key
     /// `imitate.maps.deepmimic` or `imitate.maps.bvh`).
@@ -64,48 +67,30 @@ pub struct Args {
     /// Most control ticks of one run (the clip's duration over --dt, or the walk's).
     #[arg(long, default_value_t = RunLimits::default().max_ticks)]
     pub max_ticks: usize,
-    /// Longest clip accepted from a file [s].
-    #[arg(long, default_value_t = ReadLimits::default().max_clip_duration)]
-    pub max_clip_duration: f64,
     #[command(flatten)]
     pub walk: crate::cmd_walk::WalkArgs,
 }
 
-/// Loads a clip: built-in name, DeepMimic file or BVH file. Returns the clip and whether it is BVH.
-fn load_clip(spec: &str, limits: &ReadLimits) -> Result<(Clip, bool)> {
+/// Loads a clip: a built-in name or a skeleton motion file (in metres, units and up axis given
+/// or decided). Returns the clip and whether it is not DeepMimic (BVH, ASF/AMC).
+fn load_clip(spec: &str, options: &crate::cmd_map::MotionArgs) -> Result<(Clip, bool)> {
     if BUILTIN_CLIP_NAMES.contains(&spec) {
         return Ok((builtin_clip(spec)?, false));
     }
-    let path = Path::new(spec);
-    let text = std::fs::read_to_string(path).with_context(|| {
-        format!(
-            "`{spec}` is neither a built-in clip ({}) nor a readable file",
+    if !Path::new(spec).is_file() {
+        anyhow::bail!(
+            "`{spec}` is neither a built-in clip ({}) nor a file",
             BUILTIN_CLIP_NAMES.join(", ")
-        )
-    })?;
-    let is_bvh = path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("bvh"));
-    if is_bvh {
-        Ok((
-            read_bvh(
-                &text,
-                spec,
-                &BvhReadOptions {
-                    limits: *limits,
-                    ..Default::default()
-                },
-            )?
-            .to_clip()?,
-            true,
-        ))
-    } else {
-        let settings = DeepMimicSettings {
-            limits: *limits,
-            ..Default::default()
-        };
-        Ok((read_deepmimic_with(&text, spec, &settings)?, false))
+        );
     }
+    let motion = crate::cmd_map::load(Path::new(spec), options, None)?;
+    let clip = motion.clip().with_context(|| {
+        format!(
+            "`{spec}` holds marker trajectories ({}); the joint-angle imitation needs a skeleton",
+            motion.format.name()
+        )
+    })??;
+    Ok((clip, motion.format != MotionFormat::DeepMimic))
 }
 
 /// The retargeting map: `--map` if given, else the robot profile's map for the motion's format;
@@ -164,11 +149,7 @@ pub fn run(a: &Args) -> Result<()> {
         ro.floating = true;
     }
     let resolved = resolve_robot(&a.robot, &ro, Some(&a.profile))?;
-    let read_limits = ReadLimits {
-        max_clip_duration: a.max_clip_duration,
-        ..ReadLimits::default()
-    };
-    let (clip, is_bvh) = load_clip(&a.motion, &read_limits)?;
+    let (clip, is_bvh) = load_clip(&a.motion, &a.motion_options)?;
     let map = load_map(a.map.as_deref(), is_bvh, &resolved)?;
     let profile = resolved
         .profile

@@ -5,6 +5,7 @@ use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 
 mod cmd_balance;
 mod cmd_imitate;
+mod cmd_map;
 mod cmd_model;
 mod cmd_profile;
 mod cmd_reproduce;
@@ -40,6 +41,8 @@ enum Command {
     Imitate(Box<cmd_imitate::Args>),
     /// Robot profiles: print a built-in one, or write a starting one for a URDF.
     Profile(cmd_profile::Args),
+    /// Print a built-in map, or find the body points of a motion file and write a body map.
+    Map(cmd_map::Args),
 }
 
 /// The command line's grammar, with every option value allowed to be a negative number
@@ -70,6 +73,7 @@ fn main() -> std::process::ExitCode {
         Command::Balance(a) => cmd_balance::run(a),
         Command::Imitate(a) => cmd_imitate::run(&a),
         Command::Profile(a) => cmd_profile::run(&a),
+        Command::Map(a) => cmd_map::run(&a),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

@@ -61,6 +61,19 @@ pub fn builtin_map(name: &str) -> Result<RetargetMap> {
     }
 }
 
+/// The TOML text of a built-in map (see [`builtin_map`]), to print or edit.
+pub fn builtin_map_text(name: &str) -> Result<&'static str> {
+    BUILTIN_MAP_NAMES
+        .iter()
+        .position(|n| *n == name)
+        .map(|i| BUILTIN_MAP_TEXTS[i])
+        .ok_or_else(|| Error::UnknownName {
+            kind: "built-in retargeting map",
+            name: name.into(),
+            valid: BUILTIN_MAP_NAMES.iter().map(|s| s.to_string()).collect(),
+        })
+}
+
 /// One robot joint driven by a decomposed source rotation:
 /// `q = offset + sign · scale · θ` \[rad\], `θ` the decomposed angle about this joint's axis.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
@@ -191,18 +204,8 @@ impl RetargetMap {
     /// a non-finite number, a robot joint named twice.
     #[cfg(feature = "toml")]
     pub fn from_toml_str(text: &str, source_name: &str) -> Result<Self> {
-        let file: MapFile = toml::from_str(text).map_err(|e| {
-            let line = e
-                .span()
-                .and_then(|s| text.get(..s.start))
-                .map(|head| head.matches('\n').count() + 1)
-                .unwrap_or(0);
-            Error::Parse {
-                source_name: source_name.into(),
-                line,
-                message: e.message().to_string(),
-            }
-        })?;
+        let file: MapFile =
+            toml::from_str(text).map_err(|e| super::body_map::toml_error(text, source_name, &e))?;
         let b = Matrix3::from_fn(|r, c| file.basis[r][c]);
         let invalid = |name: String, value: String, expected: &str| Error::InvalidSetting {
             name: format!("{source_name}: {name}"),
