@@ -56,8 +56,12 @@ pub fn compute_box(
     Ok(())
 }
 
-/// The interval of one dof: the intersection of its sources, or the recovery acceleration
-/// when the method asks for recovery and the dof is outside its range.
+/// The interval of one dof: the intersection of its sources; the recovery acceleration when
+/// the method asks for recovery and the dof is outside its range; for
+/// [`BoundMethod::Viable`] and a zero-width range, the single acceleration `−q̇/Δt` that
+/// stops the joint within the step (its only viable state is at rest on the range, where
+/// this is 0; off it by a solver tolerance, stopping keeps the deviation from growing, which
+/// the bounds of a widened range would not).
 fn resolve(
     dof: &DofLimits,
     method: &BoundMethod,
@@ -77,6 +81,16 @@ fn resolve(
                     dropped: DroppedSources::default(),
                 };
             }
+        }
+        if dof.position_min == dof.position_max {
+            let stop = -qd / dt;
+            return DofBounds {
+                lower: stop,
+                upper: stop,
+                lower_source: BoundSource::Position,
+                upper_source: BoundSource::Position,
+                dropped: DroppedSources::default(),
+            };
         }
     }
     intersect(sources, method)

@@ -76,7 +76,9 @@
 //!
 //! No ratio of the limits matters: a range narrower than `a_max Δt²`, `v_max < a_max Δt`, a
 //! zero-width range (its only viable state is at rest on it, and its box is `{0}`: the joint is
-//! held, as if locked) and any `Δt` are covered, so no control period needs to be refused.
+//! held, as if locked; [`compute_box`](super::compute_box) then gives `{−q̇/Δt}`, which is the
+//! same at rest and keeps a solver's tolerance from building up into an oscillation) and any
+//! `Δt` are covered, so no control period needs to be refused.
 //! The braking curve is kept where it is invariant because it brakes later than `D`
 //! (by up to `a_stop Δt²/8` of distance): the motions of the default runs do not change.
 //!
