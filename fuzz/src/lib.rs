@@ -8,8 +8,11 @@
 use iktc::model::{planar3r, BaseKind, Kinematics, ModelOptions, Robot, StateConfig};
 use iktc::motion::{read_bvh, read_deepmimic, BvhReadOptions, RetargetMap};
 
+/// The entry point of one fuzz target.
+pub type Entry = fn(&[u8]);
+
 /// Every fuzz target by name, for the replay test.
-pub const TARGETS: [(&str, fn(&[u8])); 5] = [
+pub const TARGETS: [(&str, Entry); 5] = [
     ("urdf", urdf),
     ("bvh", bvh),
     ("deepmimic", deepmimic),
