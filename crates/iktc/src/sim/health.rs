@@ -101,7 +101,7 @@ pub enum HealthCheck {
 pub struct HealthIssue {
     /// The check.
     pub check: HealthCheck,
-    /// The quantity, with its unit (e.g. "position error of foot r_ankle [m]").
+    /// The quantity, with its unit (e.g. "position error of foot r_ankle \[m\]").
     pub quantity: String,
     /// Time of the first failure \[s\].
     pub time: f64,

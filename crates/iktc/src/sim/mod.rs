@@ -4,6 +4,7 @@ pub mod health;
 pub mod imitate;
 pub mod margins;
 pub mod planar3r;
+pub mod sweep;
 pub mod switches;
 pub mod walk_imitate;
 

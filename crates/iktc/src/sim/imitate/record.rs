@@ -12,7 +12,7 @@ use crate::model::{JointLimit, Robot};
 use crate::motion::RobotReferences;
 use crate::sim::health::{HealthMonitor, HealthReport, Verdict};
 use crate::sim::margins::{dof_margins, median, percentile};
-use crate::solver::Method;
+use crate::solver::{Fallback, Method};
 
 /// One recorded tick (state at its start, command applied over it).
 #[derive(Debug, Clone, Serialize)]
@@ -75,6 +75,9 @@ pub struct ImitateStep {
     pub recovering: Vec<usize>,
     /// Whether a fallback was taken.
     pub fallback: bool,
+    /// Which fallback, if any.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fallback_kind: Option<Fallback>,
     /// Time of the tick (kinematics, tasks, bounds, solve) \[µs\].
     pub tick_us: f64,
 }
@@ -181,6 +184,10 @@ pub struct ImitateSummary {
     pub fallback_steps: usize,
     /// Ticks in which some joint was being brought back into its range.
     pub recovering_steps: usize,
+    /// Ticks with a fallback, by kind: "empty_box" (the acceleration box was empty on some
+    /// dof), "clamped_to_box" (IKTC found no level to correct),
+    /// "cascade_stopped_at_level_N" (GF: level N, 1-based, had no feasible solution).
+    pub fallbacks_by_kind: std::collections::BTreeMap<String, usize>,
     /// Mean QPs per tick.
     pub qp_per_step_mean: f64,
     /// Largest QPs in a tick.
@@ -373,6 +380,7 @@ pub fn run_imitate(
             empty_dofs: rep.empty_box_dofs,
             recovering: bx.recovering_dofs().collect(),
             fallback: rep.fallback.is_some(),
+            fallback_kind: rep.fallback,
             tick_us,
         });
         ctl.integrate(robot)?;
@@ -535,10 +543,26 @@ pub(crate) fn summarize(
         empty_box_steps: steps.iter().filter(|s| s.empty_dofs > 0).count(),
         fallback_steps: steps.iter().filter(|s| s.fallback).count(),
         recovering_steps: steps.iter().filter(|s| !s.recovering.is_empty()).count(),
+        fallbacks_by_kind: steps.iter().filter_map(|s| s.fallback_kind).fold(
+            Default::default(),
+            |mut m, f| {
+                *m.entry(fallback_name(f)).or_insert(0) += 1;
+                m
+            },
+        ),
         qp_per_step_mean: steps.iter().map(|s| s.qp_solves as f64).sum::<f64>()
             / steps.len().max(1) as f64,
         qp_per_step_max: steps.iter().map(|s| s.qp_solves).max().unwrap_or(0),
         tick_median_us: median(&ticks),
         tick_p99_us: percentile(&ticks, 0.99),
+    }
+}
+
+/// The name of a fallback kind in summaries (levels 1-based).
+pub fn fallback_name(f: Fallback) -> String {
+    match f {
+        Fallback::ClampedToBox => "clamped_to_box".into(),
+        Fallback::CascadeStoppedAtLevel(l) => format!("cascade_stopped_at_level_{}", l + 1),
+        Fallback::EmptyBox => "empty_box".into(),
     }
 }
