@@ -4,8 +4,8 @@
 
 use iktc::balance::{
     design_discrete, identify, measure_zmp, DampingController, DiscreteSettings, FootSensor,
-    FrequencyData, FullModelParams, IdentifySettings, IpcjParams, PoleSpec, ZmpSettings,
-    ZmpStatus, STANDARD_GRAVITY,
+    FrequencyData, FullModelParams, IdentifySettings, IpcjParams, PoleSpec, ZmpSettings, ZmpStatus,
+    STANDARD_GRAVITY,
 };
 use pyo3::prelude::*;
 use pyo3::types::PyDict;

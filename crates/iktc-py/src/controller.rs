@@ -13,6 +13,9 @@ use crate::convert::{array, matrix, pose, vector, vector3, vector_or_zeros};
 use crate::robot::PyRobot;
 use crate::{to_py, IktcError};
 
+/// One level's equation as numpy arrays: (J, h).
+type Equation<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>);
+
 /// A handle to a frame task of one controller.
 #[pyclass(name = "FrameHandle", module = "iktc", frozen)]
 #[derive(Clone, Copy)]
@@ -153,9 +156,11 @@ impl PyControllerBuilder {
             Some(kv) => Gains { kp, kv },
             None => Gains::critical(kp),
         };
-        let mut settings = iktc::controller::ControllerSettings::default();
-        settings.method = parse_method(method)?;
-        settings.bounds = parse_bounds(bounds)?;
+        let settings = iktc::controller::ControllerSettings {
+            method: parse_method(method)?,
+            bounds: parse_bounds(bounds)?,
+            ..Default::default()
+        };
         b.gains(gains).settings(settings);
         Ok(Self { inner: Some(b) })
     }
@@ -170,7 +175,10 @@ impl PyControllerBuilder {
     #[pyo3(signature = (frame, axes="all"))]
     fn frame(&mut self, frame: &str, axes: &str) -> PyResult<PyFrameHandle> {
         let axes = parse_axes(axes)?;
-        self.get()?.frame(frame, axes).map(PyFrameHandle).map_err(to_py)
+        self.get()?
+            .frame(frame, axes)
+            .map(PyFrameHandle)
+            .map_err(to_py)
     }
 
     /// Adds a COM task on `axes` (letters of "xyz").
@@ -223,7 +231,11 @@ pub struct PyController {
 }
 
 impl PyController {
-    fn load(&mut self, q: &PyReadwriteArray1<'_, f64>, v: &PyReadwriteArray1<'_, f64>) -> PyResult<()> {
+    fn load(
+        &mut self,
+        q: &PyReadwriteArray1<'_, f64>,
+        v: &PyReadwriteArray1<'_, f64>,
+    ) -> PyResult<()> {
         let (nq, nv) = (self.inner.robot().nq(), self.inner.robot().nv());
         let qs = q
             .as_slice()
@@ -265,7 +277,7 @@ impl PyController {
         self.load(&q, &v)?;
         let (inner, state) = (&mut self.inner, &mut self.state);
         let report = py
-            .detach(|| inner.step(state, dt).map(|r| PySolveReport::from(r)))
+            .detach(|| inner.step(state, dt).map(PySolveReport::from))
             .map_err(to_py)?;
         q.as_slice_mut()
             .map_err(|_| IktcError::new_err("q: not writable"))?
@@ -293,15 +305,12 @@ impl PyController {
     /// Solves the prepared problem; q̈ is then `controller.qdd` (q and v are not advanced).
     fn solve(&mut self, py: Python<'_>) -> PyResult<PySolveReport> {
         let inner = &mut self.inner;
-        py.detach(|| inner.solve().map(|r| PySolveReport::from(r)))
+        py.detach(|| inner.solve().map(PySolveReport::from))
             .map_err(to_py)
     }
 
     /// The prepared equations J_i q̈ = h_i, one (J, h) pair of numpy arrays per level.
-    fn equations<'py>(
-        &self,
-        py: Python<'py>,
-    ) -> Vec<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>)> {
+    fn equations<'py>(&self, py: Python<'py>) -> Vec<Equation<'py>> {
         self.inner
             .equations()
             .iter()
@@ -434,8 +443,16 @@ impl From<&SolveReport> for PySolveReport {
         Self {
             method: r.method.name().to_string(),
             corrected_from: r.corrected_from,
-            corrections: r.corrections.iter().map(|c| c.as_slice().to_vec()).collect(),
-            task_errors: r.task_errors.iter().map(|c| c.as_slice().to_vec()).collect(),
+            corrections: r
+                .corrections
+                .iter()
+                .map(|c| c.as_slice().to_vec())
+                .collect(),
+            task_errors: r
+                .task_errors
+                .iter()
+                .map(|c| c.as_slice().to_vec())
+                .collect(),
             ranks: r.ranks.clone(),
             qp_solves: r.qp_solves,
             qp_infeasible: r.qp_infeasible,

@@ -8,9 +8,9 @@ use crate::IktcError;
 
 /// A length-`n` float vector from a Python sequence or array; `what` names it in errors.
 pub(crate) fn vector(x: &Bound<'_, PyAny>, n: usize, what: &str) -> PyResult<Vec<f64>> {
-    let v: Vec<f64> = x.extract().map_err(|_| {
-        IktcError::new_err(format!("{what}: expected a sequence of {n} numbers"))
-    })?;
+    let v: Vec<f64> = x
+        .extract()
+        .map_err(|_| IktcError::new_err(format!("{what}: expected a sequence of {n} numbers")))?;
     if v.len() != n {
         return Err(IktcError::new_err(format!(
             "dimension mismatch in {what}: expected {n}, got {}",
@@ -51,7 +51,7 @@ pub(crate) fn pose(
     let p = vector3(position, "position")?;
     let q = vector(quaternion, 4, "orientation quaternion (x, y, z, w)")?;
     let norm = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]).sqrt();
-    if !(norm > 0.0) {
+    if norm.is_nan() || norm <= 0.0 {
         return Err(IktcError::new_err(
             "orientation quaternion (x, y, z, w) is zero: expected a unit quaternion",
         ));
@@ -63,7 +63,9 @@ pub(crate) fn pose(
 /// A 4 × 4 homogeneous matrix of a pose.
 pub(crate) fn pose_matrix<'py>(py: Python<'py>, p: &Isometry3<f64>) -> Bound<'py, PyArray2<f64>> {
     let m = p.to_homogeneous();
-    let rows: Vec<Vec<f64>> = (0..4).map(|i| (0..4).map(|j| m[(i, j)]).collect()).collect();
+    let rows: Vec<Vec<f64>> = (0..4)
+        .map(|i| (0..4).map(|j| m[(i, j)]).collect())
+        .collect();
     // Always 4 rows of 4: from_vec2 cannot fail here.
     PyArray2::from_vec2(py, &rows).unwrap_or_else(|_| PyArray2::zeros(py, [4, 4], false))
 }

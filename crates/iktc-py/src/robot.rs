@@ -109,23 +109,15 @@ impl PyRobot {
 
     /// Per velocity dof (base entries unbounded): (lower [rad], upper [rad], velocity [rad/s],
     /// acceleration [rad/s²]) as four numpy arrays of length nv.
-    fn limits<'py>(
-        &self,
-        py: Python<'py>,
-    ) -> (
-        Bound<'py, PyArray1<f64>>,
-        Bound<'py, PyArray1<f64>>,
-        Bound<'py, PyArray1<f64>>,
-        Bound<'py, PyArray1<f64>>,
-    ) {
+    fn limits<'py>(&self, py: Python<'py>) -> [Bound<'py, PyArray1<f64>>; 4] {
         let l = self.robot.dof_limits();
         let pick = |f: fn(&iktc::model::JointLimit) -> f64| l.iter().map(f).collect::<Vec<_>>();
-        (
+        [
             array(py, &pick(|x| x.lower)),
             array(py, &pick(|x| x.upper)),
             array(py, &pick(|x| x.velocity)),
             array(py, &pick(|x| x.acceleration)),
-        )
+        ]
     }
 
     /// The neutral configuration: (q, v) as numpy arrays (base at the origin, joints at 0).
@@ -187,7 +179,11 @@ impl PyRobot {
 
 impl PyRobot {
     /// A state at configuration `q` (v = 0).
-    pub(crate) fn state(&self, q: &Bound<'_, PyAny>, v: Option<&Bound<'_, PyAny>>) -> PyResult<State> {
+    pub(crate) fn state(
+        &self,
+        q: &Bound<'_, PyAny>,
+        v: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<State> {
         let mut s = State::neutral(&self.robot);
         let qv = vector(q, self.robot.nq(), "q")?;
         s.q.as_mut_slice().copy_from_slice(&qv);
