@@ -96,7 +96,8 @@ pub struct LevelSummary {
     pub rms_error: f64,
     /// Ticks where this level was corrected.
     pub corrected_steps: usize,
-    /// First and last time it was corrected \[s\] (NaN if never).
+    /// First and last time it was corrected \[s\] (NaN if never; written as `null`).
+    #[serde(serialize_with = "nan_as_null")]
     pub corrected_span: [f64; 2],
 }
 
@@ -462,4 +463,10 @@ pub(crate) fn summarize(
         tick_median_us: median(&ticks),
         tick_p99_us: percentile(&ticks, 0.99),
     }
+}
+
+/// A span that never happened (NaN) is written as `null`, not as a number.
+fn nan_as_null<S: serde::Serializer>(v: &[f64; 2], s: S) -> std::result::Result<S::Ok, S::Error> {
+    use serde::Serialize;
+    v.map(|x| (!x.is_nan()).then_some(x)).serialize(s)
 }
