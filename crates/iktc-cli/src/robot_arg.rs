@@ -335,7 +335,7 @@ pub fn resolve_robot(
         .robot()
         .map_err(|e| explain(&source, &flag_keys, e))?;
     for w in robot.warnings() {
-        eprintln!("warning: {source}: {w}");
+        eprintln!("warning: {w}");
     }
     Ok(ResolvedRobot {
         profile: Some(profile),
