@@ -56,7 +56,7 @@ pub fn intersect(sources: &DofBoundSources, method: &BoundMethod) -> DofBounds {
             dropped.viability = true;
             bounds = intersect_kept(sources, position_source, dropped);
         }
-        if dropped.acceleration && std::env::var("IKTC_OLD").is_err() {
+        if dropped.acceleration {
             bounds = closest_to_acceleration_limit(bounds, sources);
         }
     }
