@@ -610,6 +610,19 @@ fn summary_row(name: &str, r: &ImitateRun) -> Vec<String> {
             s.pelvis_corrected_steps, s.pelvis_corrected_while_narrowed_at_limit
         ),
         format!("{} ({})", s.level_switches.switches, s.level_switches.flips),
+        s.narrowed_smoothness
+            .iter()
+            .map(|j| {
+                format!(
+                    "{} {:.0} / {:.0} ({:.0} %)",
+                    j.joint,
+                    j.smoothness.rms_jerk,
+                    j.smoothness.max_jerk,
+                    100.0 * j.smoothness.reversal_share
+                )
+            })
+            .collect::<Vec<_>>()
+            .join("; "),
         format!("{:.2} / {}", s.qp_per_step_mean, s.qp_per_step_max),
         format!("{:.0} / {:.0}", s.tick_median_us, s.tick_p99_us),
     ]
@@ -655,6 +668,7 @@ pub fn imitate_section(out: &Path) -> Result<Section> {
             "RMS error per level (feet / COM / att. / height / upper)",
             "pelvis corrected ticks (with narrowed joint on limit)",
             "corrected-level changes (undone at the next tick)",
+            "narrowed joints: RMS / max jerk [rad/s³] (ticks where q̈'s change reverses)",
             "QPs per tick mean / max",
             "tick median / p99 [µs]",
         ]

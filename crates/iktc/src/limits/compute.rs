@@ -7,6 +7,7 @@ use super::intersect::{intersect, DofBounds};
 use super::joint_limits::{DofLimits, JointLimits};
 use super::method::BoundMethod;
 use super::paper::paper_sources;
+use super::quiet::quiet_sources;
 use super::source::DofBoundSources;
 use super::viable::viable_sources;
 
@@ -87,6 +88,7 @@ fn sources_unchecked(
     match method {
         BoundMethod::Paper => paper_sources(dof, q, qd, dt),
         BoundMethod::Viable(settings) => viable_sources(dof, settings, q, qd, dt),
+        BoundMethod::Quiet(settings) => quiet_sources(dof, settings, q, qd, dt),
     }
 }
 

@@ -3,6 +3,7 @@
 pub mod imitate;
 pub mod margins;
 pub mod planar3r;
+pub mod smoothness;
 pub mod switches;
 pub mod walk_imitate;
 
@@ -14,6 +15,7 @@ pub use margins::{dof_margins, median, percentile, DofMargins};
 pub use planar3r::{
     run_planar3r, ArmTask, Planar3rConfig, Planar3rRun, Planar3rStep, Planar3rSummary,
 };
+pub use smoothness::{DofSmoothness, JointSmoothness};
 pub use switches::LevelSwitches;
 pub use walk_imitate::{
     run_walk_imitate, Push, WalkImitateConfig, WalkRun, WalkStep, WalkSummary, WalkTick,
