@@ -538,6 +538,7 @@ pub fn walk_section(out: &Path) -> Result<Section> {
             "damping ratio",
             "settling [s]",
             "corrected ticks; level changes (undone next tick)",
+            "worst joint: RMS jerk [rad/s³] (share of ticks where q̈'s change reverses)",
             "median / p99 tick [µs]",
         ]
         .map(String::from)
@@ -564,6 +565,11 @@ pub fn walk_section(out: &Path) -> Result<Section> {
             format!(
                 "{}; {} ({})",
                 s.corrected_ticks, s.level_switches.switches, s.level_switches.flips
+            ),
+            format!(
+                "{:.0} ({:.0} %)",
+                s.smoothness_worst.rms_jerk,
+                100.0 * s.smoothness_worst.reversal_share
             ),
             format!("{:.0} / {:.0}", s.tick_median_us, s.tick_p99_us),
         ]);

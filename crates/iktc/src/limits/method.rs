@@ -24,16 +24,17 @@ pub enum BoundMethod {
 }
 
 impl Default for BoundMethod {
-    /// [`BoundMethod::Viable`] with default settings: the safe one.
+    /// [`BoundMethod::Quiet`] with default settings: safe in discrete time, a box that never
+    /// empties from a quietly viable state, and rest on a limit without chatter.
     fn default() -> Self {
-        Self::Viable(ViableSettings::default())
+        Self::Quiet(ViableSettings::default())
     }
 }
 
 impl BoundMethod {
     /// [`BoundMethod::Viable`] with default settings.
     pub fn viable() -> Self {
-        Self::default()
+        Self::Viable(ViableSettings::default())
     }
 
     /// [`BoundMethod::Quiet`] with default settings.

@@ -72,7 +72,7 @@ impl Default for Planar3rConfig {
     fn default() -> Self {
         Self {
             method: Method::Iktc,
-            bounds: BoundMethod::viable(),
+            bounds: BoundMethod::quiet(),
             dt: 0.005,
             duration: 2.0,
             priority: [ArmTask::Py, ArmTask::Px, ArmTask::Theta],
