@@ -187,7 +187,7 @@ fn multi_dof_box_under_a_pushing_policy() {
         })
         .collect();
     let limits = JointLimits::new(dofs.clone()).unwrap();
-    let method = BoundMethod::default();
+    let method = BoundMethod::viable();
     let dt = 0.005;
     let mut q: Vec<f64> = dofs
         .iter()

@@ -69,9 +69,8 @@
 
 use super::joint_limits::DofLimits;
 use super::method::ViableSettings;
-use super::source::{DofBoundSources, SourceBounds};
-use super::velocity::{velocity_lower, velocity_upper};
-use super::viable::{position_lower, position_upper};
+use super::source::DofBoundSources;
+use super::viable::viable_sources;
 
 /// The shortest distance in which a joint moving toward a limit at `q̇ ≥ 0` \[rad/s\] comes to
 /// rest at a tick, braking at most `a_stop` \[rad/s²\] per step of `Δt` \[s\]:
@@ -89,7 +88,8 @@ pub fn quiet_stopping_distance(qd: f64, braking_acceleration: f64, dt: f64) -> f
 /// Upper quiet-viability bound \[rad/s²\]: the largest `q̈` after which the joint can still
 /// come to rest at a tick at or before `q_max`, braking at most `a_stop` per step
 /// (`b = a_stop s⁺ − q̇/Δt`, module docs). `d = max(q_max − q, 0)` as in
-/// [`position_upper`]; `+inf` when `q_max = +inf` or `a_stop = +inf`.
+/// [`position_upper`](super::viable::position_upper); `+inf` when `q_max = +inf` or
+/// `a_stop = +inf`.
 ///
 /// `q` \[rad\], `qd` \[rad/s\], `position_max` \[rad\], `braking_acceleration` = `a_stop`
 /// \[rad/s²\], `dt` \[s\].
@@ -137,9 +137,10 @@ pub fn quiet_viability_lower(
     -quiet_viability_upper(-q, -qd, -position_min, braking_acceleration, dt)
 }
 
-/// All sources of the quiet bounds for one dof \[rad/s²\]: acceleration `±a_max`, velocity
-/// `(±v_max − q̇)/Δt`, position with in-step peak (as [`viable`](super::viable)), and the
-/// quiet viability bound with `a_stop = braking_fraction · a_max` in the viability slot.
+/// All sources of the quiet bounds for one dof \[rad/s²\]: those of
+/// [`viable_sources`] (acceleration `±a_max`, velocity `(±v_max − q̇)/Δt`, position with in-step
+/// peak) with the quiet viability bound, `a_stop = braking_fraction · a_max`, in the viability
+/// slot.
 ///
 /// Inputs are not validated here; [`compute_box`](super::compute_box) does that.
 /// `q` \[rad\], `qd` \[rad/s\], `dt` \[s\].
@@ -150,22 +151,11 @@ pub fn quiet_sources(
     qd: f64,
     dt: f64,
 ) -> DofBoundSources {
-    let a_max = limits.acceleration_max;
-    let a_stop = settings.braking_fraction * a_max;
-    DofBoundSources {
-        lower: SourceBounds {
-            acceleration: -a_max,
-            velocity: velocity_lower(qd, limits.velocity_max, dt),
-            position: position_lower(q, qd, limits.position_min, dt),
-            viability: quiet_viability_lower(q, qd, limits.position_min, a_stop, dt),
-        },
-        upper: SourceBounds {
-            acceleration: a_max,
-            velocity: velocity_upper(qd, limits.velocity_max, dt),
-            position: position_upper(q, qd, limits.position_max, dt),
-            viability: quiet_viability_upper(q, qd, limits.position_max, a_stop, dt),
-        },
-    }
+    let a_stop = settings.braking_fraction * limits.acceleration_max;
+    let mut sources = viable_sources(limits, settings, q, qd, dt);
+    sources.lower.viability = quiet_viability_lower(q, qd, limits.position_min, a_stop, dt);
+    sources.upper.viability = quiet_viability_upper(q, qd, limits.position_max, a_stop, dt);
+    sources
 }
 
 #[cfg(test)]
