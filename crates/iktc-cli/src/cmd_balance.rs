@@ -79,7 +79,7 @@ pub fn run(args: BalanceArgs) -> anyhow::Result<()> {
         BalanceCommand::Identify { out, seed } => {
             let r = identify(&out, seed)?;
             for c in &r.comparison {
-                println!(
+                crate::outln!(
                     "{:<32} true {:>10.5}  identified {:>10.5} ± {:.5} {}  ({:+.2} %)",
                     c.name,
                     c.true_value,
@@ -87,18 +87,18 @@ pub fn run(args: BalanceArgs) -> anyhow::Result<()> {
                     c.std_error,
                     c.unit,
                     100.0 * c.relative_error
-                );
+                )?;
             }
-            println!(
+            crate::outln!(
                 "RMS fit error: {:.2} dB, {:.2} deg -> {}",
                 r.identification.rms_magnitude_error_db,
                 r.identification.rms_phase_error_deg,
                 out.join("identify").display()
-            );
+            )?;
         }
         BalanceCommand::Design { out } => {
             let r = design(&out)?;
-            println!(
+            crate::outln!(
                 "K_f = [{:.6}, {:.6}], N = {:.6}; closed-loop IPCJ poles {:.5} ± {:.5}j -> {}",
                 r.continuous.gain[0],
                 r.continuous.gain[1],
@@ -106,12 +106,12 @@ pub fn run(args: BalanceArgs) -> anyhow::Result<()> {
                 r.continuous.closed_loop_poles[0][0],
                 r.continuous.closed_loop_poles[0][1],
                 out.join("design").display()
-            );
+            )?;
         }
         BalanceCommand::Push { phase, out, seed } => {
             let r = push(&out, phase, seed)?;
             for m in &r.metrics {
-                println!(
+                crate::outln!(
                     "{:?}: peak {:.1} -> {:.1} mm, settling {} -> {} s, ζ {:.3} -> {:.3} (designed {:.2}), static gain {:.4} / {:.4} m/rad",
                     m.plane,
                     1e3 * m.open.peak,
@@ -123,12 +123,18 @@ pub fn run(args: BalanceArgs) -> anyhow::Result<()> {
                     m.designed_damping_ratio,
                     m.static_gain_open,
                     m.static_gain_closed
-                );
+                )?;
             }
-            println!(
+            crate::outln!(
+                "ZMP outside the support polygon by at most {:.4} m without the controller, {:.4} m with it; {}",
+                r.zmp_excursion_open,
+                r.zmp_excursion_closed,
+                crate::cmd_imitate::health_text(&r.health)
+            )?;
+            crate::outln!(
                 "-> {}",
                 out.join(format!("push-{}", phase.name())).display()
-            );
+            )?;
         }
     }
     Ok(())
@@ -304,7 +310,7 @@ fn fmt_opt(v: Option<f64>) -> String {
 }
 
 fn write_json<T: Serialize>(path: &Path, value: &T) -> anyhow::Result<()> {
-    let text = serde_json::to_string_pretty(value)?;
+    let text = crate::finite::to_json(&path.display().to_string(), value)?;
     std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))
 }
 
@@ -546,12 +552,20 @@ fn push(out: &Path, phase: Phase, seed: u64) -> anyhow::Result<PushResult> {
     struct Summary<'a> {
         scenario: &'a PushScenario,
         metrics: &'a [iktc::balance::PlanePushMetrics; 2],
+        support: &'a [(f64, f64)],
+        zmp_excursion_open: f64,
+        zmp_excursion_closed: f64,
+        health: &'a iktc::sim::HealthReport,
     }
     write_json(
         &dir.join("summary.json"),
         &Summary {
             scenario: &r.scenario,
             metrics: &r.metrics,
+            support: &r.support,
+            zmp_excursion_open: r.zmp_excursion_open,
+            zmp_excursion_closed: r.zmp_excursion_closed,
+            health: &r.health,
         },
     )?;
     Ok(r)

@@ -3,35 +3,45 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
-use iktc::limits::BoundMethod;
+use iktc::limits::{BoundMethod, OutsideLimits};
 use iktc::model::Robot;
 use iktc::motion::{
-    builtin_clip, builtin_map, read_bvh, read_deepmimic, BvhReadOptions, Clip, RetargetMap,
-    BUILTIN_CLIP_NAMES, BUILTIN_MAP_NAMES,
+    builtin_clip, builtin_map, Clip, MotionFormat, RetargetMap, BUILTIN_CLIP_NAMES,
+    BUILTIN_MAP_NAMES,
 };
+use iktc::resources::RunLimits;
+use iktc::profile::check_map_joints;
 use iktc::sim::imitate::LEVEL_NAMES;
-use iktc::sim::{imitation_references, run_imitate, ImitateConfig, ImitateRun, NarrowedJoint};
+use iktc::sim::{imitation_references, run_imitate, ImitateConfig, ImitateRun};
 use iktc::solver::Method;
 use iktc_report::{write_csv, write_figure, Figure, Panel, Section, Series, Table};
 
 use crate::cmd_run::{BoundsArg, SolverArg};
-use crate::robot_arg::{load_robot, RobotOptions};
+use crate::robot_arg::{resolve_robot, ProfileFlags, ResolvedRobot, RobotOptions};
 use crate::viewer::{write_viewer, Figure3d, ViewerData};
 
 /// Arguments of `iktc imitate`.
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// Robot: a built-in name or a URDF file (with --floating).
+    /// Robot: a built-in profile (jvrc1, g1), a robot profile (.toml) or a URDF file (.urdf,
+    /// floating base; its feet, pelvis and posture from --feet, --sole, --ankle-height,
+    /// --pelvis, --posture).
     #[arg(long, default_value = "jvrc1")]
     pub robot: String,
     #[command(flatten)]
     pub robot_options: RobotOptions,
+    #[command(flatten)]
+    pub profile: ProfileFlags,
     /// Motion: a built-in DeepMimic clip (humanoid3d_dance_a, humanoid3d_dance_b,
-    /// humanoid3d_punch, humanoid3d_walk), a DeepMimic motion file or a .bvh file.
+    /// humanoid3d_punch, humanoid3d_walk) or a skeleton motion file (.bvh, .amc, DeepMimic),
+    /// its format detected from its content and extension.
     #[arg(long, default_value = "humanoid3d_dance_b")]
     pub motion: String,
-    /// Retargeting map: a built-in name (deepmimic_jvrc1, bvh_jvrc1) or a TOML file; default
-    /// deepmimic_jvrc1 for DeepMimic clips, bvh_jvrc1 for BVH files.
+    #[command(flatten)]
+    pub motion_options: crate::cmd_map::MotionArgs,
+    /// Retargeting map: a built-in name (deepmimic_jvrc1, bvh_jvrc1, deepmimic_g1) or a TOML
+    /// file; default: the robot profile's map for the motion's format (profile key
+    /// `imitate.maps.deepmimic` or `imitate.maps.bvh`).
     #[arg(long)]
     pub map: Option<String>,
     /// Solver.
@@ -40,118 +50,75 @@ pub struct Args {
     /// Joint bounds.
     #[arg(long, value_enum, default_value = "quiet")]
     pub bounds: BoundsArg,
-    /// Narrowed joint ranges [rad]: NAME=lo:hi,NAME=lo:hi; `none` for none. Default (JVRC-1):
-    /// L_KNEE=0.55:0.95,L_HIP_R=-0.05:0.05.
+    /// Start even if a joint is outside its (narrowed) range, and bring it back at the
+    /// acceleration limit (viable bounds only); without it such a start is an error.
     #[arg(long)]
-    pub narrow: Option<String>,
-    /// Foot frames (6D tasks of the first level), comma-separated. Default: r_ankle,l_ankle.
-    #[arg(long, value_delimiter = ',')]
-    pub feet: Vec<String>,
-    /// Pelvis frame (attitude and height tasks). Default: PELVIS_S.
-    #[arg(long)]
-    pub pelvis: Option<String>,
-    /// Initial angles [rad] of joints the motion does not drive: NAME=VALUE,... Default
-    /// (JVRC-1): hips −0.4, knees 0.8, ankles −0.4 rad (pitch); `none` for the zero posture.
-    #[arg(long)]
-    pub posture: Option<String>,
+    pub recover: bool,
     /// Control period [s].
     #[arg(long, default_value_t = 0.005)]
     pub dt: f64,
+    /// Keep running when a run check fails (a foot drifts past its tolerance, the ZMP leaves
+    /// the support polygon) and mark it in the summary, instead of stopping with an error.
+    #[arg(long)]
+    pub keep_going: bool,
     /// Output directory.
     #[arg(long, default_value = "out/imitate")]
     pub out: PathBuf,
+    /// Most control ticks of one run (the clip's duration over --dt, or the walk's).
+    #[arg(long, default_value_t = RunLimits::default().max_ticks)]
+    pub max_ticks: usize,
     #[command(flatten)]
     pub walk: crate::cmd_walk::WalkArgs,
 }
 
-fn parse_narrow(s: &str) -> Result<Vec<NarrowedJoint>> {
-    if s.trim() == "none" || s.trim().is_empty() {
-        return Ok(Vec::new());
-    }
-    s.split(',')
-        .map(|item| {
-            let (name, range) = item
-                .split_once('=')
-                .with_context(|| format!("--narrow `{item}`: expected NAME=lo:hi"))?;
-            let (lo, hi) = range
-                .split_once(':')
-                .with_context(|| format!("--narrow `{item}`: expected NAME=lo:hi"))?;
-            let lower: f64 = lo
-                .trim()
-                .parse()
-                .with_context(|| format!("--narrow `{item}`: `{lo}` is not a number"))?;
-            let upper: f64 = hi
-                .trim()
-                .parse()
-                .with_context(|| format!("--narrow `{item}`: `{hi}` is not a number"))?;
-            Ok(NarrowedJoint {
-                joint: name.trim().to_string(),
-                lower,
-                upper,
-            })
-        })
-        .collect()
-}
-
-fn parse_posture(s: &str) -> Result<Vec<(String, f64)>> {
-    if s.trim() == "none" || s.trim().is_empty() {
-        return Ok(Vec::new());
-    }
-    s.split(',')
-        .map(|item| {
-            let (name, value) = item
-                .split_once('=')
-                .with_context(|| format!("--posture `{item}`: expected NAME=VALUE"))?;
-            let v: f64 = value
-                .trim()
-                .parse()
-                .with_context(|| format!("--posture `{item}`: `{value}` is not a number"))?;
-            Ok((name.trim().to_string(), v))
-        })
-        .collect()
-}
-
-/// Loads a clip: built-in name, DeepMimic file or BVH file. Returns the clip and whether it is BVH.
-fn load_clip(spec: &str) -> Result<(Clip, bool)> {
+/// Loads a clip: a built-in name or a skeleton motion file (in metres, units and up axis given
+/// or decided). Returns the clip and whether it is not DeepMimic (BVH, ASF/AMC).
+fn load_clip(spec: &str, options: &crate::cmd_map::MotionArgs) -> Result<(Clip, bool)> {
     if BUILTIN_CLIP_NAMES.contains(&spec) {
         return Ok((builtin_clip(spec)?, false));
     }
-    let path = Path::new(spec);
-    let text = std::fs::read_to_string(path).with_context(|| {
-        format!(
-            "`{spec}` is neither a built-in clip ({}) nor a readable file",
+    if !Path::new(spec).is_file() {
+        anyhow::bail!(
+            "`{spec}` is neither a built-in clip ({}) nor a file",
             BUILTIN_CLIP_NAMES.join(", ")
-        )
-    })?;
-    let is_bvh = path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("bvh"));
-    if is_bvh {
-        Ok((
-            read_bvh(&text, spec, &BvhReadOptions::default())?.to_clip()?,
-            true,
-        ))
-    } else {
-        Ok((read_deepmimic(&text, spec)?, false))
+        );
     }
+    let motion = crate::cmd_map::load(Path::new(spec), options, None)?;
+    let clip = motion.clip().with_context(|| {
+        format!(
+            "`{spec}` holds marker trajectories ({}); the joint-angle imitation needs a skeleton",
+            motion.format.name()
+        )
+    })??;
+    Ok((clip, motion.format != MotionFormat::DeepMimic))
 }
 
-fn load_map(spec: Option<&str>, is_bvh: bool) -> Result<RetargetMap> {
-    let spec = spec.unwrap_or(if is_bvh {
-        "bvh_jvrc1"
+/// The retargeting map: `--map` if given, else the robot profile's map for the motion's format;
+/// checked against the robot (an unknown joint names the map entry and its source).
+fn load_map(spec: Option<&str>, is_bvh: bool, r: &ResolvedRobot) -> Result<RetargetMap> {
+    let format = if is_bvh { "bvh" } else { "deepmimic" };
+    let Some(spec) = spec else {
+        let profile = r
+            .profile
+            .as_ref()
+            .context("`planar3r` has no profile and cannot imitate a motion")?;
+        return profile
+            .retarget_map(format, &r.robot)
+            .map_err(|e| r.explain(e));
+    };
+    let map = if BUILTIN_MAP_NAMES.contains(&spec) {
+        builtin_map(spec)?
     } else {
-        "deepmimic_jvrc1"
-    });
-    if BUILTIN_MAP_NAMES.contains(&spec) {
-        return Ok(builtin_map(spec)?);
-    }
-    let text = std::fs::read_to_string(spec).with_context(|| {
-        format!(
-            "`{spec}` is neither a built-in map ({}) nor a readable TOML file",
-            BUILTIN_MAP_NAMES.join(", ")
-        )
-    })?;
-    Ok(RetargetMap::from_toml_str(&text, spec)?)
+        let text = std::fs::read_to_string(spec).with_context(|| {
+            format!(
+                "--map `{spec}` is neither a built-in map ({}) nor a readable TOML file",
+                BUILTIN_MAP_NAMES.join(", ")
+            )
+        })?;
+        RetargetMap::from_toml_str(&text, spec)?
+    };
+    check_map_joints(&r.robot, &map).with_context(|| format!("--map `{spec}`"))?;
+    Ok(map)
 }
 
 /// Everything one run needs besides its settings.
@@ -173,70 +140,115 @@ pub fn run_experiment(e: &Experiment, cfg: &ImitateConfig) -> Result<ImitateRun>
 /// Runs `iktc imitate`.
 pub fn run(a: &Args) -> Result<()> {
     let mut ro = a.robot_options.clone();
-    if a.robot != "jvrc1" {
+    let path = std::path::Path::new(&a.robot);
+    if path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("urdf"))
+    {
+        // The imitation moves a free-floating humanoid.
         ro.floating = true;
     }
-    let robot = load_robot(&a.robot, &ro)?;
-    let (clip, is_bvh) = load_clip(&a.motion)?;
-    let map = load_map(a.map.as_deref(), is_bvh)?;
-    let mut cfg = ImitateConfig {
-        method: a.solver.method(),
-        bounds: a.bounds.method(),
-        dt: a.dt,
-        ..ImitateConfig::jvrc1()
+    let resolved = resolve_robot(&a.robot, &ro, Some(&a.profile))?;
+    let (clip, is_bvh) = load_clip(&a.motion, &a.motion_options)?;
+    let map = load_map(a.map.as_deref(), is_bvh, &resolved)?;
+    let profile = resolved
+        .profile
+        .as_ref()
+        .context("`planar3r` has no profile and cannot imitate a motion")?;
+    let mut cfg = profile
+        .imitate_config(ImitateConfig {
+            method: a.solver.method(),
+            bounds: a.bounds.method(),
+            dt: a.dt,
+            run_limits: RunLimits {
+                max_ticks: a.max_ticks,
+                ..RunLimits::default()
+            },
+            ..ImitateConfig::default()
+        })
+        .map_err(|e| resolved.explain(e))?;
+    cfg.run_limits.check_dt("--dt", a.dt)?;
+    if a.recover {
+        match &mut cfg.bounds {
+            BoundMethod::Viable(settings) => settings.outside = OutsideLimits::Recover,
+            BoundMethod::Paper => anyhow::bail!("--recover needs --bounds viable"),
+        }
+    }
+    cfg.health.keep_going = a.keep_going;
+    let e = Experiment {
+        robot: resolved.robot,
+        clip,
+        map,
     };
-    if let Some(n) = &a.narrow {
-        cfg.narrow = parse_narrow(n)?;
-    }
-    if !a.feet.is_empty() {
-        cfg.feet = a.feet.iter().map(|f| f.trim().to_string()).collect();
-    }
-    if let Some(p) = &a.pelvis {
-        cfg.pelvis = p.trim().to_string();
-    }
-    if let Some(p) = &a.posture {
-        cfg.initial_posture = parse_posture(p)?;
-    }
-    let e = Experiment { robot, clip, map };
     if a.walk.walk {
         let (figs, with, without) = crate::cmd_walk::run_walk(&e, &cfg, &a.walk, &a.out)?;
-        crate::cmd_walk::print_walk(&with, &without);
-        println!(
+        crate::cmd_walk::print_walk(&with, &without)?;
+        crate::outln!(
             "wrote {} figures, walk.csv, walk_summary.json and walk_viewer.html to {}",
             figs.len(),
             a.out.display()
-        );
+        )?;
         return Ok(());
     }
     let r = run_experiment(&e, &cfg)?;
     let files = write_imitate(&r, &e, &a.out)?;
-    print_summary(&r);
-    println!(
+    print_summary(&r)?;
+    crate::outln!(
         "wrote {} figures, trajectory.csv, summary.json and viewer.html to {}",
         files.len(),
         a.out.display()
-    );
+    )?;
     Ok(())
 }
 
-fn print_summary(r: &ImitateRun) {
+fn print_summary(r: &ImitateRun) -> std::io::Result<()> {
     let s = &r.summary;
-    println!(
+    crate::outln!(
         "imitation, {} with {} bounds, {} ticks of {} s: worst margins position {:+.2e} rad, velocity {:+.2e} rad/s, acceleration {:+.2e} rad/s²",
         s.solver, s.bounds, s.steps, s.dt, s.worst_position_margin, s.worst_velocity_margin, s.worst_acceleration_margin
-    );
-    println!(
+    )?;
+    crate::outln!(
         "limits binding: position {} ticks, velocity {}, acceleration {}; pelvis corrected {} ticks ({} with a narrowed joint on its limit)",
         s.position_binding_steps, s.velocity_binding_steps, s.acceleration_binding_steps, s.pelvis_corrected_steps, s.pelvis_corrected_while_narrowed_at_limit
-    );
-    println!(
+    )?;
+    crate::outln!(
+        "empty boxes {} ticks, fallbacks {} ticks, joints recovering into their range {} ticks",
+        s.empty_box_steps, s.fallback_steps, s.recovering_steps
+    )?;
+    crate::outln!(
         "the corrected level changed {} times between consecutive ticks, {} of them undone at the next tick",
         s.level_switches.switches, s.level_switches.flips
+    )?;
+    crate::outln!(
+        "foot drift {:.2e} m / {:.2e} rad; COM over the support polygon: {} (min margin {:.3} m); ZMP min margin {:.3} m; tick median {:.1} µs, p99 {:.1} µs",
+        s.foot_drift, s.foot_rotation_drift, s.com_inside_support, s.com_min_margin, s.zmp_min_margin, s.tick_median_us, s.tick_p99_us
+    )?;
+    crate::outln!("{}", health_text(&s.health))?;
+    Ok(())
+}
+
+/// The health of a run in words: "healthy", or every failed check with its first and worst
+/// value (runs continued with `--keep-going`).
+pub fn health_text(h: &iktc::sim::HealthReport) -> String {
+    if h.healthy {
+        return "run checks: healthy".into();
+    }
+    let mut s = format!(
+        "run checks: FAILED on {} ticks{} (continued with --keep-going)",
+        h.failed_ticks,
+        if h.completed {
+            ""
+        } else {
+            ", stopped early on a non-finite state"
+        }
     );
-    println!(
-        "foot drift {:.2e} m / {:.2e} rad; COM over the support polygon: {} (min margin {:.3} m); tick median {:.1} µs, p99 {:.1} µs",
-        s.foot_drift, s.foot_rotation_drift, s.com_inside_support, s.com_min_margin, s.tick_median_us, s.tick_p99_us
-    );
+    for i in &h.issues {
+        s.push_str(&format!(
+            "; {i} (worst {:.4e} at t = {:.4} s, {} ticks)",
+            i.worst_value, i.worst_time, i.ticks
+        ));
+    }
+    s
 }
 
 /// Writes trajectory.csv, summary.json, the figures and viewer.html; returns the figures
@@ -326,7 +338,10 @@ pub fn write_imitate(r: &ImitateRun, e: &Experiment, dir: &Path) -> Result<Vec<(
         .map(|st| std::iter::once(st.t).chain(st.q.iter().copied()).collect())
         .collect();
     write_csv(&dir.join("joints.csv"), &jh, &jrows)?;
-    std::fs::write(dir.join("summary.json"), serde_json::to_string_pretty(s)?)?;
+    std::fs::write(
+        dir.join("summary.json"),
+        crate::finite::to_json("summary.json", s)?,
+    )?;
     let tag = format!("{} / {} bounds", s.solver.to_uppercase(), s.bounds);
     let t: Vec<f64> = r.steps.iter().map(|st| st.t).collect();
     let col =

@@ -1,19 +1,18 @@
 //! `iktc model ROBOT`: what a model contains, and its kinematics at a given configuration.
 
-use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use anyhow::{Context, Result};
-use iktc::model::{BaseKind, JointRole, Kinematics, Robot, State};
-use nalgebra::{DMatrix, Isometry3, Quaternion, Translation3, UnitQuaternion};
-use serde::{Deserialize, Serialize};
+use iktc::model::{BaseKind, JointRole, Kinematics, Robot, State, StateConfig};
+use nalgebra::{DMatrix, Isometry3};
+use serde::Serialize;
 
 use crate::robot_arg::{load_robot, RobotOptions};
 
 /// Arguments of `iktc model`.
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// A built-in robot (jvrc1, planar3r) or the path of a URDF file.
+    /// A built-in robot (jvrc1, g1, planar3r), a robot profile (.toml) or a URDF file.
     pub robot: String,
     #[command(flatten)]
     pub robot_options: RobotOptions,
@@ -31,48 +30,32 @@ pub struct Args {
     pub com_jacobian: bool,
 }
 
-/// The `--config` file.
-#[derive(Deserialize, Debug, Default)]
-#[serde(deny_unknown_fields)]
-pub struct ConfigFile {
-    /// Joint positions \[rad or m\] by name; missing joints stay at the neutral value.
-    #[serde(default)]
-    pub joints: BTreeMap<String, f64>,
-    /// Floating-base pose.
-    pub base: Option<BasePose>,
-    /// Joint rates \[rad/s or m/s\] by name.
-    #[serde(default)]
-    pub velocities: BTreeMap<String, f64>,
-    /// Base body twist (vx, vy, vz \[m/s\], wx, wy, wz \[rad/s\], base axes).
-    pub base_velocity: Option<[f64; 6]>,
-}
-
-/// A base pose in a config file.
-#[derive(Deserialize, Debug)]
-#[serde(deny_unknown_fields)]
-pub struct BasePose {
-    /// Position \[m\].
-    pub position: [f64; 3],
-    /// Unit quaternion (x, y, z, w).
-    #[serde(default = "identity_quat")]
-    pub orientation: [f64; 4],
-}
-
-fn identity_quat() -> [f64; 4] {
-    [0.0, 0.0, 0.0, 1.0]
-}
-
 #[derive(Serialize)]
 struct JointOut {
     name: String,
     r#type: &'static str,
     q_index: usize,
     v_index: usize,
+    #[serde(serialize_with = "unbounded")]
     lower: f64,
+    #[serde(serialize_with = "unbounded")]
     upper: f64,
+    #[serde(serialize_with = "unbounded")]
     velocity: f64,
+    #[serde(serialize_with = "unbounded")]
     acceleration: f64,
+    #[serde(serialize_with = "unbounded")]
     effort: f64,
+}
+
+/// An unbounded limit (±∞) is written as `null`; NaN stays a number, for the output check to
+/// refuse.
+fn unbounded<S: serde::Serializer>(v: &f64, s: S) -> Result<S::Ok, S::Error> {
+    if v.is_infinite() {
+        s.serialize_none()
+    } else {
+        s.serialize_f64(*v)
+    }
 }
 
 #[derive(Serialize)]
@@ -87,6 +70,8 @@ struct Summary {
     locked: Vec<(String, f64)>,
     mimic: Vec<Mimic>,
     frames: Vec<String>,
+    /// What the description has that is accepted but worth a word (e.g. URDF `effort="0"`).
+    warnings: Vec<String>,
     #[serde(skip_serializing_if = "Option::is_none")]
     state: Option<StateOut>,
 }
@@ -143,54 +128,17 @@ fn pose_out(name: &str, t: &Isometry3<f64>) -> PoseOut {
     }
 }
 
-/// Builds a state from a config file.
-pub fn state_from_config(robot: &Robot, cfg: &ConfigFile) -> Result<State> {
-    let mut s = State::neutral(robot);
-    for (n, v) in &cfg.joints {
-        s.set_joint(robot, n, *v)?;
-    }
-    if let Some(b) = &cfg.base {
-        let [x, y, z, w] = b.orientation;
-        let q = Quaternion::new(w, x, y, z);
-        let n = q.norm();
-        if !(n.is_finite() && (n - 1.0).abs() < iktc::model::QUATERNION_NORM_TOLERANCE) {
-            anyhow::bail!(
-                "base orientation {:?} is not a unit quaternion (x, y, z, w): norm {n}",
-                b.orientation
-            );
-        }
-        let pose = Isometry3::from_parts(
-            Translation3::new(b.position[0], b.position[1], b.position[2]),
-            UnitQuaternion::from_quaternion(q),
-        );
-        s.set_base_pose(robot, &pose)?;
-    }
-    for (n, v) in &cfg.velocities {
-        iktc::error::check_finite(|| format!("velocity of `{n}`"), *v)?;
-        s.qd[robot.joint_v_index(n)?] = *v;
-    }
-    if let Some(v) = cfg.base_velocity {
-        if robot.base() != BaseKind::Floating {
-            anyhow::bail!("base_velocity given, but the robot has a fixed base");
-        }
-        iktc::error::check_all_finite("base_velocity", &v)?;
-        for (k, x) in v.iter().enumerate() {
-            s.qd[k] = *x;
-        }
-    }
-    s.validate(robot)?;
-    Ok(s)
-}
-
-/// Reads a config file, JSON or TOML by extension.
-pub fn read_config(path: &std::path::Path) -> Result<ConfigFile> {
+/// Reads a config file, JSON or TOML by extension, and the state it describes on `robot`.
+pub fn state_from_file(robot: &Robot, path: &std::path::Path) -> Result<State> {
     let text =
         std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-    if path.extension().and_then(|e| e.to_str()) == Some("toml") {
-        toml::from_str(&text).with_context(|| format!("parsing {} as TOML", path.display()))
+    let name = path.display().to_string();
+    let cfg = if path.extension().and_then(|e| e.to_str()) == Some("toml") {
+        StateConfig::from_toml_str(&text, &name)?
     } else {
-        serde_json::from_str(&text).with_context(|| format!("parsing {} as JSON", path.display()))
-    }
+        StateConfig::from_json_str(&text, &name)?
+    };
+    Ok(cfg.state(robot)?)
 }
 
 /// Runs `iktc model`.
@@ -233,6 +181,7 @@ pub fn run(a: &Args) -> Result<()> {
         total_mass: robot.total_mass(),
         com_neutral: kin0.com().into(),
         joints: summary_joints,
+        warnings: robot.warnings().to_vec(),
         locked: robot
             .joints()
             .iter()
@@ -262,8 +211,7 @@ pub fn run(a: &Args) -> Result<()> {
         state: None,
     };
     if let Some(path) = &a.config {
-        let cfg = read_config(path)?;
-        let s = state_from_config(&robot, &cfg)?;
+        let s = state_from_file(&robot, path)?;
         let kin = Kinematics::new(&robot, &s)?;
         let mut jacobians = Vec::new();
         let mut j6 = DMatrix::zeros(6, robot.nv());
@@ -305,9 +253,9 @@ pub fn run(a: &Args) -> Result<()> {
         });
     }
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&summary)?);
+        crate::outln!("{}", crate::finite::to_json("model summary", &summary)?)?;
     } else {
-        print_text(&summary);
+        print_text(&summary)?;
     }
     Ok(())
 }
@@ -320,22 +268,38 @@ fn fmt_lim(v: f64) -> String {
     }
 }
 
-fn print_text(s: &Summary) {
-    println!(
+fn print_text(s: &Summary) -> std::io::Result<()> {
+    crate::outln!(
         "robot {}: {:?} base, nq = {}, nv = {}",
-        s.name, s.base, s.nq, s.nv
-    );
-    println!(
+        s.name,
+        s.base,
+        s.nq,
+        s.nv
+    )?;
+    for w in &s.warnings {
+        crate::outln!("warning: {w}")?;
+    }
+    crate::outln!(
         "total mass {:.3} kg; COM at the neutral pose ({:.4}, {:.4}, {:.4}) m",
-        s.total_mass, s.com_neutral[0], s.com_neutral[1], s.com_neutral[2]
-    );
-    println!();
-    println!(
+        s.total_mass,
+        s.com_neutral[0],
+        s.com_neutral[1],
+        s.com_neutral[2]
+    )?;
+    crate::outln!()?;
+    crate::outln!(
         "{:>4} {:>4}  {:<16} {:<10} {:>9} {:>9} {:>9} {:>10}",
-        "q", "v", "joint", "type", "lower", "upper", "vel max", "acc max"
-    );
+        "q",
+        "v",
+        "joint",
+        "type",
+        "lower",
+        "upper",
+        "vel max",
+        "acc max"
+    )?;
     for j in &s.joints {
-        println!(
+        crate::outln!(
             "{:>4} {:>4}  {:<16} {:<10} {:>9} {:>9} {:>9} {:>10}",
             j.q_index,
             j.v_index,
@@ -345,54 +309,57 @@ fn print_text(s: &Summary) {
             fmt_lim(j.upper),
             fmt_lim(j.velocity),
             fmt_lim(j.acceleration)
-        );
+        )?;
     }
-    println!("(units: rad, rad/s, rad/s² for revolute joints; m, m/s, m/s² for prismatic; - = unbounded)");
+    crate::outln!("(units: rad, rad/s, rad/s² for revolute joints; m, m/s, m/s² for prismatic; - = unbounded)")?;
     if !s.locked.is_empty() {
-        println!();
-        println!(
+        crate::outln!()?;
+        crate::outln!(
             "locked: {}",
             s.locked
                 .iter()
                 .map(|(n, v)| format!("{n}={v}"))
                 .collect::<Vec<_>>()
                 .join(", ")
-        );
+        )?;
     }
     if !s.mimic.is_empty() {
-        println!(
+        crate::outln!(
             "mimic (followed): {}",
             s.mimic
                 .iter()
                 .map(|m| format!("{} = {}·{} + {}", m.name, m.multiplier, m.master, m.offset))
                 .collect::<Vec<_>>()
                 .join(", ")
-        );
+        )?;
     }
     if let Some(st) = &s.state {
-        println!();
-        println!(
+        crate::outln!()?;
+        crate::outln!(
             "at the configuration given: COM ({:.4}, {:.4}, {:.4}) m",
-            st.com[0], st.com[1], st.com[2]
-        );
+            st.com[0],
+            st.com[1],
+            st.com[2]
+        )?;
         for l in &st.links {
-            println!("  {:<20} p = ({:>8.4}, {:>8.4}, {:>8.4})  q(xyzw) = ({:>7.4}, {:>7.4}, {:>7.4}, {:>7.4})", l.name, l.position[0], l.position[1], l.position[2], l.orientation[0], l.orientation[1], l.orientation[2], l.orientation[3]);
+            crate::outln!("  {:<20} p = ({:>8.4}, {:>8.4}, {:>8.4})  q(xyzw) = ({:>7.4}, {:>7.4}, {:>7.4}, {:>7.4})", l.name, l.position[0], l.position[1], l.position[2], l.orientation[0], l.orientation[1], l.orientation[2], l.orientation[3])?;
         }
         for j in st.jacobians.iter().chain(st.com_jacobian.iter()) {
-            println!(
+            crate::outln!(
                 "Jacobian of {} (rows vx vy vz wx wy wz, world axes):",
                 j.frame
-            );
+            )?;
             for r in &j.jacobian {
-                println!(
+                crate::outln!(
                     "  {}",
                     r.iter()
                         .map(|v| format!("{v:>8.4}"))
                         .collect::<Vec<_>>()
                         .join(" ")
-                );
+                )?;
             }
-            println!("  drift J̇q̇ = {:?}", j.drift);
+            crate::outln!("  drift J̇q̇ = {:?}", j.drift)?;
         }
     }
+    Ok(())
 }

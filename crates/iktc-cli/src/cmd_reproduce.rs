@@ -27,6 +27,6 @@ pub fn run(a: &Args) -> Result<()> {
     eprintln!("running the walking imitation with the damping controller (Sections 4 and 5.3)…");
     report = report.section(crate::cmd_walk::walk_section(&a.out)?);
     let path = write_report(&report, &a.out)?;
-    println!("report: {}", path.display());
+    crate::outln!("report: {}", path.display())?;
     Ok(())
 }

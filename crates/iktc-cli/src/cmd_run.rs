@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use iktc::limits::BoundMethod;
+use iktc::resources::RunLimits;
 use iktc::sim::{run_planar3r, ArmTask, Planar3rConfig, Planar3rRun};
 use iktc::solver::Method;
 use iktc_report::{write_csv, write_figure, Figure, Panel, Section, Series, Table};
@@ -81,6 +82,9 @@ pub struct Args {
     /// Output directory.
     #[arg(long, default_value = "out/planar3r")]
     pub out: PathBuf,
+    /// Most control ticks of the run (its duration over --dt).
+    #[arg(long, default_value_t = RunLimits::default().max_ticks)]
+    pub max_ticks: usize,
 }
 
 fn parse_task(s: &str) -> Result<ArmTask> {
@@ -104,7 +108,11 @@ pub fn run(a: &Args) -> Result<()> {
     let cfg = Planar3rConfig {
         method: a.solver.method(),
         bounds: a.bounds.method(),
-        dt: a.dt,
+        dt: RunLimits::default().check_dt("--dt", a.dt)?,
+        run_limits: RunLimits {
+            max_ticks: a.max_ticks,
+            ..RunLimits::default()
+        },
         priority: [
             parse_task(&a.priority[0])?,
             parse_task(&a.priority[1])?,
@@ -115,15 +123,15 @@ pub fn run(a: &Args) -> Result<()> {
     let r = run_planar3r(&cfg)?;
     let files = write_run(&r, &a.out)?;
     let s = &r.summary;
-    println!(
+    crate::outln!(
         "3R arm, {} with {} bounds, Δt = {} s: worst position margin {:+.3e} rad, velocity {:+.3e} rad/s, acceleration {:+.3e} rad/s²",
         s.solver, s.bounds, s.dt, s.worst_position_margin, s.worst_velocity_margin, s.worst_acceleration_margin
-    );
-    println!(
+    )?;
+    crate::outln!(
         "final errors Px {:+.2e} m, Py {:+.2e} m, theta3 {:+.2} deg; q1 min {:.3} deg; QPs/step ≤ {}; median tick {:.1} µs",
         s.final_error[0], s.final_error[1], s.final_error[2].to_degrees(), s.min_q1.to_degrees(), s.qp_per_step_max, s.tick_median_us
-    );
-    println!("wrote {} files to {}", files.len() + 2, a.out.display());
+    )?;
+    crate::outln!("wrote {} files to {}", files.len() + 2, a.out.display())?;
     Ok(())
 }
 
@@ -183,7 +191,7 @@ pub fn write_run(r: &Planar3rRun, dir: &Path) -> Result<Vec<(String, String)>> {
     write_csv(&dir.join("trajectory.csv"), &header, &rows)?;
     std::fs::write(
         dir.join("summary.json"),
-        serde_json::to_string_pretty(&r.summary)?,
+        crate::finite::to_json("summary.json", &r.summary)?,
     )?;
     let tag = format!(
         "{} / {} bounds",

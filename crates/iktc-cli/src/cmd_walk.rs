@@ -6,7 +6,10 @@ use std::path::Path;
 
 use anyhow::{Context, Result};
 use iktc::motion::retarget;
-use iktc::sim::{run_walk_imitate, ImitateConfig, Push, WalkImitateConfig, WalkRun, WalkStep};
+use iktc::sim::{
+    run_walk_imitate, ImitateConfig, Push, PushAxisMetrics, WalkImitateConfig, WalkRun, WalkStep,
+    WalkSummary,
+};
 use iktc_report::{write_csv, write_figure, Figure, Panel, Section, Series, Table};
 
 use crate::cmd_imitate::Experiment;
@@ -75,7 +78,8 @@ pub fn run_walk(
     w: &WalkArgs,
     dir: &Path,
 ) -> Result<(Figures, WalkRun, WalkRun)> {
-    let refs = retarget(&e.clip, &e.robot, &e.map)?.resample(imitate.dt)?;
+    let refs =
+        retarget(&e.clip, &e.robot, &e.map)?.resample_with(imitate.dt, &imitate.run_limits)?;
     let main = run_walk_imitate(&e.robot, &refs, &config(imitate, w, !w.no_damping)?)?;
     let other = run_walk_imitate(&e.robot, &refs, &config(imitate, w, w.no_damping)?)?;
     let (with, without) = if w.no_damping {
@@ -88,22 +92,61 @@ pub fn run_walk(
 }
 
 /// Prints the two summaries.
-pub fn print_walk(with: &WalkRun, without: &WalkRun) {
+pub fn print_walk(with: &WalkRun, without: &WalkRun) -> std::io::Result<()> {
     for r in [with, without] {
         let s = &r.summary;
-        println!(
+        crate::outln!(
             "walking imitation, damping controller {}: ZMP min margin {:+.4} m (inside: {}), stance feet error {:.2e} m / slip {:.2e} m, worst margins {:+.1e} rad {:+.1e} rad/s {:+.1e} rad/s²",
             if s.damping { "on " } else { "off" }, s.min_zmp_margin, s.zmp_inside, s.max_stance_foot_error, s.max_stance_foot_slip, s.worst_margins[0], s.worst_margins[1], s.worst_margins[2]
-        );
-        println!(
-            "  after the push: peak {:.4} m, damping ratio {:.3}, settling {}; tick median {:.1} µs, p99 {:.1} µs",
-            s.push_peak, s.push_damping_ratio, s.push_settling_time.map_or("none".into(), |t| format!("{t:.2} s")), s.tick_median_us, s.tick_p99_us
-        );
-        println!(
+        )?;
+        match &s.push {
+            Some(p) => crate::outln!(
+                "  after the push: x̃ {}; ỹ {}; ZMP outside the support polygon by at most {:.4} m",
+                axis_text(&p.x),
+                axis_text(&p.y),
+                p.zmp_excursion
+            )?,
+            None => crate::outln!("  no push")?,
+        }
+        crate::outln!(
+            "  tick median {:.1} µs, p99 {:.1} µs; {}",
+            s.tick_median_us,
+            s.tick_p99_us,
+            crate::cmd_imitate::health_text(&s.health)
+        )?;
+        crate::outln!(
             "  corrected {} ticks; the corrected level changed {} times between consecutive ticks, {} of them undone at the next tick",
             s.corrected_ticks, s.level_switches.switches, s.level_switches.flips
-        );
+        )?;
     }
+    Ok(())
+}
+
+fn ratio_text(m: &PushAxisMetrics) -> String {
+    m.damping_ratio
+        .map_or("not fitted (within the noise)".into(), |z| {
+            format!("{z:.3}")
+        })
+}
+
+fn settling_text(m: &PushAxisMetrics) -> String {
+    m.settling_time
+        .map_or("not settled".into(), |t| format!("{t:.2}"))
+}
+
+/// One axis of a push response in words.
+fn axis_text(m: &PushAxisMetrics) -> String {
+    format!(
+        "peak {:.4} m, damping ratio {}, settling {}",
+        m.peak,
+        ratio_text(m),
+        m.settling_time
+            .map_or("never (not settled)".into(), |t| format!("{t:.2} s"))
+    )
+}
+
+fn damping_text(s: &WalkSummary) -> String {
+    s.push.map_or("(no push)".into(), |p| ratio_text(&p.x))
 }
 
 fn col(r: &WalkRun, f: &dyn Fn(&WalkStep) -> f64) -> Vec<f64> {
@@ -189,7 +232,7 @@ pub fn write_walk(
     });
     std::fs::write(
         dir.join("walk_summary.json"),
-        serde_json::to_string_pretty(&summary)?,
+        crate::finite::to_json("walk_summary.json", &summary)?,
     )?;
     let t = col(with, &|s| s.t);
     let mut figs = Vec::new();
@@ -263,8 +306,8 @@ pub fn write_walk(
     );
     write_figure(&fig, dir, "walk_zmp")?;
     figs.push(("walk_zmp.svg".into(), format!(
-        "ZMP: reference, measured with and without the damping controller, and the support polygon; damping ratio after the push {:.2} with, {:.3} without",
-        with.summary.push_damping_ratio, without.summary.push_damping_ratio
+        "ZMP: reference, measured with and without the damping controller, and the support polygon; damping ratio after the push (x̃) {} with, {} without",
+        damping_text(&with.summary), damping_text(&without.summary)
     )));
     // Footsteps from above.
     let mut top = Panel::new("Footsteps from above", "x [m]", "y [m]").equal_aspect();
@@ -534,9 +577,11 @@ pub fn walk_section(out: &Path) -> Result<Section> {
             "ZMP inside",
             "stance foot error / slip [m]",
             "worst margins",
-            "push peak [m]",
-            "damping ratio",
-            "settling [s]",
+            "push peak x̃ / ỹ [m]",
+            "damping ratio x̃ / ỹ",
+            "settling x̃ / ỹ [s]",
+            "ZMP outside after the push [m]",
+            "health",
             "corrected ticks; level changes (undone next tick)",
             "worst joint: RMS jerk [rad/s³] (share of ticks where q̈'s change reverses)",
             "median / p99 tick [µs]",
@@ -558,10 +603,18 @@ pub fn walk_section(out: &Path) -> Result<Section> {
                 "{:+.0e} / {:+.0e} / {:+.0e}",
                 s.worst_margins[0], s.worst_margins[1], s.worst_margins[2]
             ),
-            format!("{:.4}", s.push_peak),
-            format!("{:.3}", s.push_damping_ratio),
-            s.push_settling_time
-                .map_or("none".into(), |t| format!("{t:.2}")),
+            s.push.map_or("no push".into(), |p| {
+                format!("{:.4} / {:.4}", p.x.peak, p.y.peak)
+            }),
+            s.push.map_or("–".into(), |p| {
+                format!("{} / {}", ratio_text(&p.x), ratio_text(&p.y))
+            }),
+            s.push.map_or("–".into(), |p| {
+                format!("{} / {}", settling_text(&p.x), settling_text(&p.y))
+            }),
+            s.push
+                .map_or("–".into(), |p| format!("{:.4}", p.zmp_excursion)),
+            crate::cmd_imitate::health_text(&s.health),
             format!(
                 "{}; {} ({})",
                 s.corrected_ticks, s.level_switches.switches, s.level_switches.flips

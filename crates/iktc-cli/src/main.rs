@@ -1,14 +1,18 @@
 //! The `iktc` command-line tool: argument parsing and output files only; every algorithm lives
 //! in the `iktc` library.
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 
 mod cmd_balance;
 mod cmd_imitate;
+mod cmd_map;
 mod cmd_model;
+mod cmd_profile;
 mod cmd_reproduce;
 mod cmd_run;
 mod cmd_walk;
+mod finite;
+mod out;
 mod robot_arg;
 mod viewer;
 
@@ -34,20 +38,47 @@ enum Command {
     /// The ZMP damping controller of Section 4: identify, design, push.
     Balance(cmd_balance::BalanceArgs),
     /// Imitate a captured motion with a humanoid (Section 5.3): figures, summary, 3D viewer.
-    Imitate(cmd_imitate::Args),
+    Imitate(Box<cmd_imitate::Args>),
+    /// Robot profiles: print a built-in one, or write a starting one for a URDF.
+    Profile(cmd_profile::Args),
+    /// Print a built-in map, or find the body points of a motion file and write a body map.
+    Map(cmd_map::Args),
+}
+
+/// The command line's grammar, with every option value allowed to be a negative number
+/// (`--dt -0.005` reaches the range check instead of reading as an unknown option `-0`).
+fn command() -> clap::Command {
+    fn negatives(cmd: clap::Command) -> clap::Command {
+        cmd.mut_args(|a| {
+            if a.get_action().takes_values() {
+                a.allow_negative_numbers(true)
+            } else {
+                a
+            }
+        })
+        .mut_subcommands(negatives)
+    }
+    negatives(Cli::command())
 }
 
 fn main() -> std::process::ExitCode {
-    let cli = Cli::parse();
+    let cli = match Cli::from_arg_matches(&command().get_matches()) {
+        Ok(cli) => cli,
+        Err(e) => e.exit(),
+    };
     let result = match cli.command {
         Command::Model(a) => cmd_model::run(&a),
         Command::Run(a) => cmd_run::run(&a),
         Command::Reproduce(a) => cmd_reproduce::run(&a),
         Command::Balance(a) => cmd_balance::run(a),
         Command::Imitate(a) => cmd_imitate::run(&a),
+        Command::Profile(a) => cmd_profile::run(&a),
+        Command::Map(a) => cmd_map::run(&a),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,
+        // The reader of our standard output has gone (`| head`): nothing more to say.
+        Err(e) if out::is_broken_pipe(&e) => std::process::ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e:#}");
             std::process::ExitCode::FAILURE

@@ -1,30 +1,79 @@
-//! Turning a `ROBOT` argument (a built-in name or a URDF path) into a model.
+//! Turning a `--robot NAME|profile.toml|robot.urdf` argument and the profile flags into a robot
+//! profile and its model. Every error names its source: the flag, or the profile key (and the
+//! profile it is in) that produced a wrong or missing value.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
-use iktc::model::{builtin_robot, jvrc1, BaseKind, ModelOptions, Robot, BUILTIN_ROBOTS};
+use iktc::model::{builtin_robot, BaseKind, Robot};
+use iktc::profile::{
+    Feet, Foot, LockRule, ProfileOrigin, RobotProfile, Sole, BUILTIN_PROFILES, MISSING,
+};
 
-/// Options shared by every command that loads a robot.
-#[derive(clap::Args, Debug, Clone)]
+/// Robot-level options of every command that loads a robot; they override the profile.
+#[derive(clap::Args, Debug, Clone, Default)]
 pub struct RobotOptions {
-    /// Give a URDF a floating base (built-in robots have their own: jvrc1 floating, planar3r fixed).
+    /// Floating base (profile key `base`); a URDF without a profile is fixed otherwise.
     #[arg(long)]
     pub floating: bool,
-    /// Lock a joint at a value [rad or m]: NAME=VALUE (repeatable, or comma-separated).
+    /// Lock joints at a value [rad or m]: PATTERN=VALUE, PATTERN a glob (`*` any run, `?` one
+    /// character), e.g. `*_FINGER_*=0` (repeatable, or comma-separated; profile key `lock`).
     #[arg(long = "lock", value_delimiter = ',')]
     pub lock: Vec<String>,
-    /// Acceleration limit of a joint [rad/s² or m/s²]: NAME=VALUE (repeatable, or comma-separated).
+    /// Acceleration limit of a joint [rad/s² or m/s²]: NAME=VALUE (repeatable, or
+    /// comma-separated; profile key `acceleration.limits`).
     #[arg(long = "accel", value_delimiter = ',')]
     pub accel: Vec<String>,
-    /// Default acceleration limit as a multiple of the velocity limit [1/s].
-    #[arg(long, default_value_t = 10.0)]
-    pub accel_per_velocity: f64,
+    /// Default acceleration limit as a multiple of the velocity limit [1/s] (profile key
+    /// `acceleration.per_velocity`; default 10).
+    #[arg(long)]
+    pub accel_per_velocity: Option<f64>,
 }
 
-fn parse_pairs(what: &str, items: &[String]) -> Result<Vec<(String, f64)>> {
+/// Profile fields a standing robot needs (feet, pelvis, posture, narrowed ranges); each flag
+/// overrides its profile key, and gives it for a URDF without a profile.
+#[derive(clap::Args, Debug, Clone, Default)]
+pub struct ProfileFlags {
+    /// Foot frames RIGHT,LEFT (profile keys `feet.right.frame`, `feet.left.frame`).
+    #[arg(long = "feet", value_delimiter = ',')]
+    pub feet: Vec<String>,
+    /// Sole rectangle LENGTH,WIDTH[,OFFSET_X] in the foot frame [m] (profile keys
+    /// `feet.*.sole`).
+    #[arg(long)]
+    pub sole: Option<String>,
+    /// Height of the foot frames above the soles [m] (profile keys `feet.*.ankle_height`).
+    #[arg(long)]
+    pub ankle_height: Option<f64>,
+    /// Pelvis frame (profile key `frames.pelvis`).
+    #[arg(long)]
+    pub pelvis: Option<String>,
+    /// Initial joint angles [rad]: NAME=VALUE,...; `none` for the zero posture (profile key
+    /// `posture`).
+    #[arg(long)]
+    pub posture: Option<String>,
+    /// Narrowed joint ranges [rad]: NAME=lo:hi,...; `none` for none (profile key `narrow`).
+    #[arg(long)]
+    pub narrow: Option<String>,
+}
+
+/// A resolved `--robot`: its profile (none for the built-in planar 3R arm), the model, and
+/// where each profile key came from (for the errors).
+pub struct ResolvedRobot {
+    /// The profile, with the flags applied.
+    pub profile: Option<RobotProfile>,
+    /// The model.
+    pub robot: Robot,
+    /// What the profile is: `built-in profile `g1``, `profile file x.toml`, `URDF x.urdf`.
+    pub source: String,
+    /// Profile key prefixes set by flags, with the flag.
+    pub flag_keys: Vec<(String, &'static str)>,
+}
+
+/// Parses `NAME=VALUE` items (`what` names the flag in errors).
+pub fn parse_pairs(what: &str, items: &[String]) -> Result<Vec<(String, f64)>> {
     items
         .iter()
+        .filter(|s| !s.trim().is_empty())
         .map(|s| {
             let (n, v) = s
                 .split_once('=')
@@ -38,34 +87,265 @@ fn parse_pairs(what: &str, items: &[String]) -> Result<Vec<(String, f64)>> {
         .collect()
 }
 
-/// Loads a built-in robot by name or a URDF file by path.
-pub fn load_robot(spec: &str, o: &RobotOptions) -> Result<Robot> {
-    let options = ModelOptions {
-        base: if o.floating {
-            BaseKind::Floating
-        } else {
-            BaseKind::Fixed
-        },
-        locked: parse_pairs("--lock", &o.lock)?,
-        acceleration_limits: parse_pairs("--accel", &o.accel)?,
-        acceleration_per_velocity: o.accel_per_velocity,
-        ..Default::default()
-    };
-    if BUILTIN_ROBOTS.contains(&spec) {
-        if spec == "jvrc1" {
-            return Ok(jvrc1(&options)?);
-        }
-        if !o.lock.is_empty() || !o.accel.is_empty() {
-            anyhow::bail!("--lock and --accel apply to jvrc1 and URDF files, not to `{spec}`");
-        }
-        return Ok(builtin_robot(spec)?);
+fn parse_narrow(s: &str) -> Result<Vec<(String, [f64; 2])>> {
+    if s.trim() == "none" || s.trim().is_empty() {
+        return Ok(Vec::new());
+    }
+    s.split(',')
+        .map(|item| {
+            let bad = || format!("--narrow `{item}`: expected NAME=lo:hi with numbers [rad]");
+            let (name, range) = item.split_once('=').with_context(bad)?;
+            let (lo, hi) = range.split_once(':').with_context(bad)?;
+            let lower: f64 = lo.trim().parse().with_context(bad)?;
+            let upper: f64 = hi.trim().parse().with_context(bad)?;
+            Ok((name.trim().to_string(), [lower, upper]))
+        })
+        .collect()
+}
+
+fn parse_sole(s: &str) -> Result<Sole> {
+    let bad = || format!("--sole `{s}`: expected LENGTH,WIDTH[,OFFSET_X] in metres");
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|x| x.trim().parse::<f64>())
+        .collect::<std::result::Result<_, _>>()
+        .with_context(bad)?;
+    match v[..] {
+        [length, width] => Ok(Sole {
+            length,
+            width,
+            offset_x: 0.0,
+        }),
+        [length, width, offset_x] => Ok(Sole {
+            length,
+            width,
+            offset_x,
+        }),
+        _ => Err(anyhow::anyhow!(bad())),
+    }
+}
+
+/// The profile a `--robot` names, before flags: built-in, file, or an empty one for a URDF.
+fn base_profile(spec: &str) -> Result<(RobotProfile, String)> {
+    if BUILTIN_PROFILES.contains(&spec) {
+        return Ok((
+            RobotProfile::builtin(spec)?,
+            format!("built-in profile `{spec}`"),
+        ));
     }
     let path = Path::new(spec);
-    if !path.exists() {
-        anyhow::bail!(
-            "`{spec}` is neither a built-in robot ({}) nor an existing URDF file",
-            BUILTIN_ROBOTS.join(", ")
-        );
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    if ext.as_deref() == Some("toml") {
+        let p = RobotProfile::load(path).with_context(|| format!("loading profile {spec}"))?;
+        return Ok((p, format!("profile file {spec}")));
     }
-    Robot::from_urdf_file(path, &options).with_context(|| format!("loading {spec}"))
+    if ext.as_deref() == Some("urdf") || (path.is_file() && ext.as_deref() != Some("toml")) {
+        let name = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "robot".into());
+        let p = RobotProfile {
+            name,
+            urdf: spec.to_string(),
+            base: BaseKind::Fixed,
+            lock: Vec::new(),
+            feet: None,
+            frames: Default::default(),
+            posture: Default::default(),
+            narrow: Default::default(),
+            acceleration: Default::default(),
+            imitate: Default::default(),
+            origin: ProfileOrigin::Directory(PathBuf::new()),
+        };
+        return Ok((p, format!("URDF {spec}")));
+    }
+    anyhow::bail!(
+        "--robot `{spec}` is neither a built-in robot ({}, planar3r) nor a profile (.toml) nor a URDF file (.urdf)",
+        BUILTIN_PROFILES.join(", ")
+    )
+}
+
+/// Applies the flags to `p`; returns the key prefixes they set.
+fn apply_flags(
+    p: &mut RobotProfile,
+    o: &RobotOptions,
+    f: Option<&ProfileFlags>,
+) -> Result<Vec<(String, &'static str)>> {
+    let mut keys: Vec<(String, &'static str)> = Vec::new();
+    if o.floating {
+        p.base = BaseKind::Floating;
+        keys.push(("base".into(), "--floating"));
+    }
+    let first_flag_lock = p.lock.len();
+    for (pattern, value) in parse_pairs("--lock", &o.lock)? {
+        p.lock.push(LockRule {
+            joints: pattern,
+            value,
+        });
+    }
+    for i in first_flag_lock..p.lock.len() {
+        keys.push((format!("lock[{i}]"), "--lock"));
+    }
+    for (n, v) in parse_pairs("--accel", &o.accel)? {
+        keys.push((format!("acceleration.limits.{n}"), "--accel"));
+        p.acceleration.limits.insert(n, v);
+    }
+    if let Some(r) = o.accel_per_velocity {
+        p.acceleration.per_velocity = r;
+        keys.push(("acceleration.per_velocity".into(), "--accel-per-velocity"));
+    }
+    let Some(f) = f else {
+        return Ok(keys);
+    };
+    if !f.feet.is_empty() {
+        let [right, left] = &f.feet[..] else {
+            anyhow::bail!(
+                "--feet `{}`: expected two foot frames RIGHT,LEFT (profile keys `feet.right.frame`, `feet.left.frame`)",
+                f.feet.join(",")
+            );
+        };
+        let (right, left) = (right.trim().to_string(), left.trim().to_string());
+        match &mut p.feet {
+            Some(feet) => {
+                feet.right.frame = right;
+                feet.left.frame = left;
+            }
+            None => {
+                let sole = f.sole.as_deref().map(parse_sole).transpose()?.with_context(|| {
+                    "--feet is given but not the sole: pass --sole LENGTH,WIDTH[,OFFSET_X] [m] (profile keys `feet.left.sole`, `feet.right.sole`)"
+                })?;
+                let ankle_height = f.ankle_height.with_context(|| {
+                    "--feet is given but not the ankle height: pass --ankle-height H [m] (profile keys `feet.left.ankle_height`, `feet.right.ankle_height`)"
+                })?;
+                let foot = |frame| Foot {
+                    frame,
+                    ankle_height,
+                    sole,
+                };
+                p.feet = Some(Feet {
+                    left: foot(left),
+                    right: foot(right),
+                });
+            }
+        }
+        keys.push(("feet.right.frame".into(), "--feet"));
+        keys.push(("feet.left.frame".into(), "--feet"));
+    }
+    if let Some(feet) = &mut p.feet {
+        if let Some(s) = &f.sole {
+            let sole = parse_sole(s)?;
+            feet.left.sole = sole;
+            feet.right.sole = sole;
+            keys.push(("feet.left.sole".into(), "--sole"));
+            keys.push(("feet.right.sole".into(), "--sole"));
+        }
+        if let Some(h) = f.ankle_height {
+            feet.left.ankle_height = h;
+            feet.right.ankle_height = h;
+            keys.push(("feet.left.ankle_height".into(), "--ankle-height"));
+            keys.push(("feet.right.ankle_height".into(), "--ankle-height"));
+        }
+    } else if f.sole.is_some() || f.ankle_height.is_some() {
+        anyhow::bail!("--sole and --ankle-height need the foot frames: pass --feet RIGHT,LEFT (profile keys `feet.right.frame`, `feet.left.frame`)");
+    }
+    if let Some(pelvis) = &f.pelvis {
+        p.frames.pelvis = Some(pelvis.trim().to_string());
+        keys.push(("frames.pelvis".into(), "--pelvis"));
+    }
+    if let Some(s) = &f.posture {
+        let items: Vec<String> = if s.trim() == "none" {
+            Vec::new()
+        } else {
+            s.split(',').map(String::from).collect()
+        };
+        p.posture = parse_pairs("--posture", &items)?.into_iter().collect();
+        keys.push(("posture".into(), "--posture"));
+    }
+    if let Some(s) = &f.narrow {
+        p.narrow = parse_narrow(s)?;
+        keys.push(("narrow".into(), "--narrow"));
+    }
+    Ok(keys)
+}
+
+/// The flag that gives each profile key a command needs, for a missing key.
+const FLAG_OF_KEY: [(&str, &str); 5] = [
+    (
+        "feet",
+        "--feet RIGHT,LEFT --sole LENGTH,WIDTH[,OFFSET_X] --ankle-height H",
+    ),
+    ("frames.pelvis", "--pelvis FRAME"),
+    ("imitate.maps", "--map NAME|FILE"),
+    ("posture", "--posture NAME=VALUE,..."),
+    ("narrow", "--narrow NAME=lo:hi,..."),
+];
+
+impl ResolvedRobot {
+    /// Explains a library error: for a profile key, the flag that set it (or that would set
+    /// it, when it is missing) and the profile it is in.
+    pub fn explain(&self, e: iktc::Error) -> anyhow::Error {
+        explain(&self.source, &self.flag_keys, e)
+    }
+}
+
+fn explain(source: &str, flag_keys: &[(String, &'static str)], e: iktc::Error) -> anyhow::Error {
+    let iktc::Error::Profile { key, value, .. } = &e else {
+        return e.into();
+    };
+    let under = |prefix: &str| key == prefix || key.starts_with(&format!("{prefix}."));
+    if let Some((_, flag)) = flag_keys.iter().find(|(k, _)| under(k)) {
+        return anyhow::anyhow!("{flag}: {e}");
+    }
+    if value == MISSING {
+        if let Some((_, flag)) = FLAG_OF_KEY.iter().find(|(k, _)| under(k)) {
+            return anyhow::anyhow!("{source}: {e}; set the key or pass {flag}");
+        }
+    }
+    anyhow::anyhow!("{source}: {e}")
+}
+
+/// Resolves `--robot` (a built-in profile name, `planar3r`, a profile file or a URDF file)
+/// with the robot options and, for commands that use them, the profile flags.
+pub fn resolve_robot(
+    spec: &str,
+    o: &RobotOptions,
+    flags: Option<&ProfileFlags>,
+) -> Result<ResolvedRobot> {
+    if spec == "planar3r" {
+        if !o.lock.is_empty() || !o.accel.is_empty() || o.floating || o.accel_per_velocity.is_some()
+        {
+            anyhow::bail!("--floating, --lock and --accel apply to robots with a URDF, not to the built-in `planar3r`");
+        }
+        return Ok(ResolvedRobot {
+            profile: None,
+            robot: builtin_robot(spec)?,
+            source: "built-in robot `planar3r`".into(),
+            flag_keys: Vec::new(),
+        });
+    }
+    let (mut profile, source) = base_profile(spec)?;
+    let flag_keys = apply_flags(&mut profile, o, flags)?;
+    profile
+        .check_values()
+        .map_err(|e| explain(&source, &flag_keys, e))?;
+    let robot = profile
+        .robot()
+        .map_err(|e| explain(&source, &flag_keys, e))?;
+    for w in robot.warnings() {
+        eprintln!("warning: {source}: {w}");
+    }
+    Ok(ResolvedRobot {
+        profile: Some(profile),
+        robot,
+        source,
+        flag_keys,
+    })
+}
+
+/// Loads a robot (see [`resolve_robot`]) without the profile flags.
+pub fn load_robot(spec: &str, o: &RobotOptions) -> Result<Robot> {
+    Ok(resolve_robot(spec, o, None)?.robot)
 }

@@ -183,6 +183,7 @@ requestAnimationFrame(step);
 /// Renders the page.
 pub fn render_viewer(data: &ViewerData) -> Result<String> {
     // `</` inside the JSON would end the script element early.
+    crate::finite::check("viewer data", data)?;
     let json = serde_json::to_string(data)?.replace("</", "<\\/");
     Ok(TEMPLATE.replace("__DATA__", &json))
 }

@@ -17,9 +17,9 @@ fn csv_cell(s: &str) -> String {
 /// Writes a CSV file: one header line, then one line per row, comma separated.
 ///
 /// Numbers are written in Rust's shortest round-trip form (reading them back with
-/// `str::parse::<f64>` gives the same value); NaN and infinities are written as `NaN`, `inf`
-/// and `-inf`. Every row must have as many values as `header` has names, otherwise
-/// [`ReportError::Invalid`] is returned and nothing is written. The parent directory is created
+/// `str::parse::<f64>` gives the same value). Every row must have as many values as `header`
+/// has names and every value must be finite (a NaN or an infinity is a run gone wrong, not
+/// data), otherwise [`ReportError::Invalid`] names the row and column and nothing is written. The parent directory is created
 /// if needed.
 pub fn write_csv(path: &Path, header: &[String], rows: &[Vec<f64>]) -> Result<(), ReportError> {
     if header.is_empty() {
@@ -39,6 +39,16 @@ pub fn write_csv(path: &Path, header: &[String], rows: &[Vec<f64>]) -> Result<()
             row.len(),
             header.len()
         )));
+    }
+    for (i, row) in rows.iter().enumerate() {
+        if let Some(j) = row.iter().position(|v| !v.is_finite()) {
+            return Err(ReportError::invalid(format!(
+                "CSV {}: row {i}, column `{}` is {}; expected finite numbers only",
+                path.display(),
+                header[j],
+                row[j]
+            )));
+        }
     }
     if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
         std::fs::create_dir_all(parent).map_err(|e| ReportError::io(parent, e))?;

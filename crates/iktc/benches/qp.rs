@@ -8,15 +8,17 @@
 //!
 //! Run: `cargo bench -p iktc --bench qp -- --warm-up-time 1 --measurement-time 3`.
 
-#[path = "../tests/qp_common/mod.rs"]
-mod qp_common;
+#[path = "../tests/common/mod.rs"]
+mod common;
+use common::qp as qp_common;
+use common::rng;
 
 use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use iktc::solver::{QpSettings, QpStatus, QpWorkspace};
 use nalgebra::{DMatrix, DVector};
-use qp_common::{clarabel_solve, random_spd, rng, OwnedQp, Verdict};
+use qp_common::{clarabel_solve, random_spd, OwnedQp, Verdict};
 use rand::Rng;
 
 /// The IKTC correction QP: `min ½‖Δh‖²  s.t.  l ≤ G Δh ≤ u`, `G` 38 × 20, with `violated` rows

@@ -45,6 +45,13 @@ fn bench(c: &mut Criterion) {
                 ..SolverSettings::default()
             },
         ),
+        (
+            "cold",
+            SolverSettings {
+                warm_start: false,
+                ..SolverSettings::default()
+            },
+        ),
     ];
     // Interleaved passes: the variants take turns over the whole sequence, so that the
     // machine's slow spells hit all of them alike; the median pass of each, per tick.
@@ -77,7 +84,7 @@ fn bench(c: &mut Criterion) {
     }
     let mut group = c.benchmark_group("solver_replay");
     for (name, settings) in variants {
-        let mut totals = (0, 0, 0);
+        let mut totals = (0, 0, 0, 0);
         {
             let mut s = Solver::new(n, &dims, settings).expect("solver");
             let mut q = DVector::zeros(n);
@@ -86,12 +93,14 @@ fn bench(c: &mut Criterion) {
                 totals.0 += r.qp_solves;
                 totals.1 += r.qp_iterations;
                 totals.2 += r.screened_infeasible;
+                totals.3 += r.qp_warm_started;
             }
         }
         eprintln!(
-            "solver_replay/{name}: {} ticks, {} QPs, {} QP iterations, {} levels screened",
+            "solver_replay/{name}: {} ticks, {} QPs ({} warm-started), {} QP iterations, {} levels screened",
             seq.len(),
             totals.0,
+            totals.3,
             totals.1,
             totals.2
         );

@@ -2,8 +2,10 @@
 //! JVRC-1-sized problem (38 dofs, the five levels of Table 1: 12, 2, 3, 1, 20), with random but
 //! reproducible Jacobians, with and without an active correction.
 
-#[path = "../tests/solver_common.rs"]
-mod solver_common;
+#[path = "../tests/common/mod.rs"]
+mod common;
+use common::rng;
+use common::solver as solver_common;
 use solver_common::*;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};

@@ -3,7 +3,8 @@
 //! Errors are for *bad input*: a malformed file, an unknown name, a non-finite number, a
 //! dimension that does not match, an inconsistent limit or setting. A well-formed problem that
 //! happens to be hard (an infeasible QP, an empty acceleration box) is not an error: it is
-//! reported as a *status* in the solution.
+//! reported as a *status* in the solution. The one exception is [`Error::RunFailed`]: a
+//! scenario run whose robot fell, gave up its feet or diverged stops with it by default.
 
 /// Everything that can be wrong with the input given to iktc.
 ///
@@ -45,6 +46,37 @@ pub enum Error {
         /// The size that was given.
         got: usize,
     },
+    /// A state (the start of a run) puts a joint outside its limits: its position outside its
+    /// range or its speed above its velocity limit.
+    #[error(
+        "{joint} is outside its limits: {quantity} {value} not in [{lower}, {upper}]; \
+         change the start state or the limits, or ask for recovery (OutsideLimits::Recover)"
+    )]
+    StateOutsideLimits {
+        /// The joint (or dof) name.
+        joint: String,
+        /// Which quantity, with its unit: `position [rad]` or `velocity [rad/s]`.
+        quantity: String,
+        /// Its value.
+        value: f64,
+        /// The lower end of the allowed interval.
+        lower: f64,
+        /// The upper end of the allowed interval.
+        upper: f64,
+    },
+    /// A task handle given to a controller other than the one whose builder made it.
+    #[error(
+        "{kind} handle of controller #{owner} given to controller #{controller}: a handle works \
+         only with the controller whose builder returned it (or a clone of that controller)"
+    )]
+    ForeignHandle {
+        /// The kind of task ("frame", "COM", "joints").
+        kind: &'static str,
+        /// The identity of the controller the handle belongs to.
+        owner: u64,
+        /// The identity of the controller it was given to.
+        controller: u64,
+    },
     /// A limit has its lower end above its upper end, or is otherwise unusable.
     #[error("invalid limit for {what}: lower {lower} > upper {upper}")]
     InvalidLimit {
@@ -75,12 +107,43 @@ pub enum Error {
         /// What is wrong.
         message: String,
     },
+    /// An input asks for more than a stated maximum (ticks, frames, duration, nesting depth):
+    /// checked before anything is allocated.
+    #[error("{what} = {value} exceeds the limit {limit}; raise it with {option}")]
+    ResourceLimit {
+        /// What is counted or measured.
+        what: String,
+        /// The amount asked for.
+        value: String,
+        /// The stated maximum.
+        limit: String,
+        /// The setting (and CLI option, if any) that raises the maximum.
+        option: String,
+    },
+    /// A scenario run went wrong and was stopped (the feet drifted past their tolerance, the
+    /// state stopped being finite, the ZMP left the support polygon): the one kind of error
+    /// that is not about bad input, because the run's results would be meaningless. Its
+    /// settings ([`crate::sim::HealthSettings::keep_going`]) can ask for the run to continue
+    /// and mark the failure instead.
+    #[error("run failed: {0}")]
+    RunFailed(Box<crate::sim::HealthIssue>),
     /// Input data are insufficient for the requested computation (too few points, ...).
     #[error("insufficient data for {what}: {message}")]
     InsufficientData {
         /// Which computation.
         what: String,
         /// What was missing.
+        message: String,
+    },
+    /// A robot profile's key holds a value that does not fit the robot (an unknown frame or
+    /// joint, a glob that matches nothing, a bad number) or a needed key is missing.
+    #[error("profile key `{key}` = `{value}`: {message}")]
+    Profile {
+        /// The key, dotted as in the TOML file (`feet.left.frame`, `lock[0].joints`).
+        key: String,
+        /// The value found, as text (`(missing)` if the key is absent).
+        value: String,
+        /// What is wrong and what would be valid (e.g. the names that exist).
         message: String,
     },
 }

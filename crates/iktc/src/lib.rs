@@ -15,17 +15,22 @@
 //!   generator, and the paper's experiments as scenarios.
 //!
 //! The flow of one control tick is
-//! *state → [`model::Kinematics`] → tasks (plain `J q̈ = h` data) → acceleration box → solver*.
+//! *state → [`model::Kinematics`] → tasks (plain `J q̈ = h` data) → acceleration box → solver*,
+//! held together by a [`Controller`] (built once, stepped once per tick).
 //!
 //! | module | what |
 //! |---|---|
+//! | [`controller`] | one controller: robot, levels of tasks with handles, box and solver, one `step` per tick |
+//! | [`prelude`] | what a user of the controller needs, in one import |
 //! | [`model`] | robot model (URDF or code), state, kinematics |
 //! | [`task`] | frame, COM and joint tasks, the priority stack |
 //! | [`limits`] | joint limits → acceleration box (eq. 14, viable bounds) |
 //! | [`solver`] | prioritized solution, IKTC, GF, clamp, the dense QP |
 //! | [`balance`] | the damping controller of Section 4 |
 //! | [`motion`] | motion capture readers, retargeting |
+//! | `profile` | robot profiles: feet, pelvis, posture, locks of a robot (features `urdf`, `toml`) |
 //! | [`walk`] | footsteps, ZMP preview control, swing feet |
+//! | [`resources`] | stated maxima on what an input may make iktc allocate or run |
 //! | [`sim`] | the 3R arm, the imitation, walking while imitating |
 //!
 //! ## Notation
@@ -46,18 +51,24 @@
 
 pub mod balance;
 mod buffer;
+pub mod controller;
 pub mod error;
 pub mod limits;
 pub mod model;
 pub mod motion;
+pub mod resources;
+pub mod prelude;
+#[cfg(all(feature = "urdf", feature = "toml"))]
+pub mod profile;
 pub mod sim;
 pub mod solver;
 pub mod task;
 pub mod walk;
 
+pub use controller::{Controller, ControllerBuilder};
 pub use error::{Error, Result};
 
 /// The README's Rust examples, compiled and run as doctests.
-#[doc = include_str!("../../../README.md")]
 #[cfg(doctest)]
+#[doc = include_str!("../../../README.md")]
 pub struct ReadmeDoctests;

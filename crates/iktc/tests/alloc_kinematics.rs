@@ -5,7 +5,8 @@ use iktc::model::*;
 use iktc::task::*;
 use nalgebra::DMatrix;
 
-mod counting_alloc;
+mod common;
+use common::alloc as counting_alloc;
 use counting_alloc::allocations as count;
 
 #[global_allocator]

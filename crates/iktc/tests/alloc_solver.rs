@@ -1,12 +1,14 @@
 //! The solvers allocate nothing per tick (counting global allocator, own test binary).
 
-mod solver_common;
+mod common;
+use common::rng;
+use common::solver as solver_common;
 use solver_common::*;
 
 use iktc::solver::*;
 use nalgebra::DVector;
 
-mod counting_alloc;
+use common::alloc as counting_alloc;
 use counting_alloc::allocations as count;
 
 #[global_allocator]

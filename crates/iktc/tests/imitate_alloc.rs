@@ -9,7 +9,8 @@ use iktc::sim::{
 };
 use iktc::solver::Method;
 
-mod counting_alloc;
+mod common;
+use common::alloc as counting_alloc;
 use counting_alloc::allocations;
 
 #[global_allocator]

@@ -1,6 +1,8 @@
 //! Kinematics against finite differences and closed forms.
 
-mod common_model;
+mod common;
+use common::model as common_model;
+use common::rng;
 use common_model::*;
 
 use iktc::model::*;

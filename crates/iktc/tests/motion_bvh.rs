@@ -13,6 +13,7 @@ fn metres() -> BvhReadOptions {
     BvhReadOptions {
         length_unit: LengthUnit::Metres,
         up_axis: UpAxis::Y,
+        ..Default::default()
     }
 }
 
@@ -325,6 +326,7 @@ Frame Time: 0.0083333
         let read_opts = BvhReadOptions {
             length_unit: unit,
             up_axis: UpAxis::Y,
+            ..Default::default()
         };
         let x = read_bvh(&full, "x", &read_opts).unwrap();
         let written = write_bvh(

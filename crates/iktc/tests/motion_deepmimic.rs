@@ -7,7 +7,7 @@ use iktc::motion::{
 use iktc::Error;
 use nalgebra::Vector3;
 
-const DATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../data/motions/deepmimic/");
+const DATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/data/motions/deepmimic/");
 
 fn file_text(name: &str) -> String {
     std::fs::read_to_string(format!("{DATA}{name}.txt")).unwrap()
@@ -273,6 +273,7 @@ fn quaternion_norm_tolerance_is_a_setting() {
     let text = file_text("humanoid3d_punch");
     let strict = DeepMimicSettings {
         max_quaternion_norm_error: 0.05,
+        ..Default::default()
     };
     let (line, msg) = parse_error(read_deepmimic_with(&text, "punch", &strict));
     assert!(msg.contains("frame 57") && msg.contains("`neck`"), "{msg}");
@@ -285,7 +286,8 @@ fn quaternion_norm_tolerance_is_a_setting() {
         }
     }
     assert!(DeepMimicSettings {
-        max_quaternion_norm_error: 1.5
+        max_quaternion_norm_error: 1.5,
+        ..Default::default()
     }
     .validate()
     .is_err());

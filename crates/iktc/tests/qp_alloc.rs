@@ -3,13 +3,14 @@
 //! A counting global allocator (`counting_alloc`) wraps the system one; it is per test binary,
 //! hence this file.
 
-mod qp_common;
+use common::qp as qp_common;
 
 use iktc::solver::{QpSettings, QpStatus, QpWorkspace};
 use nalgebra::DVector;
 use qp_common::{random_problem_sized, Kind, LARGE};
 
-mod counting_alloc;
+mod common;
+use common::alloc as counting_alloc;
 use counting_alloc::allocations;
 
 #[global_allocator]

@@ -1,11 +1,13 @@
 //! The QP solver on problems with known answers (closed forms, hand computations) and KKT
 //! conditions checked directly on many seeded random solutions, without an oracle.
 
-mod qp_common;
+mod common;
+use common::qp as qp_common;
+use common::rng;
 
 use iktc::solver::{Hessian, QpConstraint, QpProblem, QpSettings, QpStatus, QpWorkspace};
 use nalgebra::{DMatrix, DVector};
-use qp_common::{kkt, random_problem_sized, random_spd, rng, solve, Kind, LARGE, SMALL};
+use qp_common::{kkt, random_problem_sized, random_spd, solve, Kind, LARGE, SMALL};
 use rand::Rng;
 
 /// Agreement with closed forms computed by nalgebra's LU/Cholesky: rounding of two different

@@ -1,7 +1,8 @@
 //! The dual active-set QP solver against an independent oracle (clarabel, an interior-point
 //! solver) on seeded random problems of varied sizes and kinds.
 
-mod qp_common;
+mod common;
+use common::qp as qp_common;
 
 use iktc::solver::{QpConstraint, QpSettings, QpStatus};
 use nalgebra::DVector;

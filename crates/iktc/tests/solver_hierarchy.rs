@@ -1,6 +1,8 @@
 //! The prioritized recursion and the correction map G against independent computations.
 
-mod solver_common;
+mod common;
+use common::rng;
+use common::solver as solver_common;
 use solver_common::*;
 
 use iktc::solver::*;
@@ -33,20 +35,66 @@ fn projectors_above(levels: &[TaskEquation]) -> Vec<DMatrix<f64>> {
 /// the stacked Jacobian of the levels above, N = I − A⁺A (the meaning of eq. 7), by SVD with a
 /// relative rank threshold.
 fn reference_solution(levels: &[TaskEquation], lambda: f64) -> DVector<f64> {
+    reference_solution_damped(levels, |_| lambda * lambda)
+}
+
+/// As [`reference_solution`], with level i's λ² given by `lambda2(J̄_i)`.
+fn reference_solution_damped(
+    levels: &[TaskEquation],
+    lambda2: impl Fn(&DMatrix<f64>) -> f64,
+) -> DVector<f64> {
     let n = levels[0].nv();
     let mut q = DVector::zeros(n);
     for (l, na) in levels.iter().zip(projectors_above(levels)) {
         let jb = &l.jacobian * &na;
-        let pinv = if lambda == 0.0 {
+        let l2 = lambda2(&jb);
+        let pinv = if l2 == 0.0 {
             jb.clone().pseudo_inverse(1e-9).unwrap()
         } else {
             let m = l.dim();
-            let s = &jb * jb.transpose() + DMatrix::identity(m, m) * (lambda * lambda);
+            let s = &jb * jb.transpose() + DMatrix::identity(m, m) * l2;
             jb.transpose() * s.try_inverse().unwrap()
         };
         q += &pinv * (&l.rhs - &l.jacobian * &q);
     }
     q
+}
+
+/// The last kept pivot |R_rr| of the column-pivoted QR of J̄ᵀ (n × m), by Gram–Schmidt: each
+/// step takes the row of J̄ whose part orthogonal to the rows already taken is longest; that
+/// length is |R_jj|. Pivots at or below `rank_threshold` are dropped. 0 when nothing is kept.
+fn last_kept_pivot(jb: &DMatrix<f64>, rank_threshold: f64) -> f64 {
+    let mut rest: Vec<DVector<f64>> = jb.row_iter().map(|r| r.transpose()).collect();
+    let mut last = 0.0;
+    while !rest.is_empty() {
+        let (best, norm) = rest
+            .iter()
+            .enumerate()
+            .map(|(i, v)| (i, v.norm()))
+            .fold((0, -1.0), |a, b| if b.1 > a.1 { b } else { a });
+        if norm <= rank_threshold {
+            break;
+        }
+        last = norm;
+        let u = rest.swap_remove(best) / norm;
+        for v in rest.iter_mut() {
+            let d = u.dot(v);
+            *v -= &u * d;
+        }
+    }
+    last
+}
+
+/// λ² of [`Damping::Adaptive`] as its documentation states it: with σ the smallest kept
+/// singular value, estimated by the last kept pivot of the pivoted QR,
+/// λ² = (1 − (σ/ε)²) λ_max² when σ < ε, else 0.
+fn adaptive_lambda2(jb: &DMatrix<f64>, max: f64, threshold: f64, rank_threshold: f64) -> f64 {
+    let sigma = last_kept_pivot(jb, rank_threshold);
+    if sigma < threshold {
+        (1.0 - (sigma / threshold).powi(2)) * max * max
+    } else {
+        0.0
+    }
 }
 
 /// Round-off of O(n) sums of O(1) products, amplified by the conditioning of random
@@ -118,6 +166,55 @@ fn damped_recursion_matches_the_dls_formula() {
 }
 
 #[test]
+fn adaptive_damping_matches_its_formula() {
+    // Level 2's second row is its first plus δ times a random row: the smaller δ, the closer
+    // the level is to a singularity (σ ≈ δ). With ε = 0.5 some levels are damped, others not.
+    let (max, threshold) = (0.3, 0.5);
+    let settings = SolverSettings {
+        damping: Damping::Adaptive { max, threshold },
+        ..Default::default()
+    };
+    let mut r = rng(26);
+    let (mut damped, mut undamped) = (0, 0);
+    for case in 0..120 {
+        let n = 8 + case % 8;
+        let dims = [2, 2, 2];
+        let mut levels = random_levels(&mut r, n, &dims);
+        let delta = [1e-3, 1e-2, 0.1, 0.3, 1.0][case % 5];
+        let row = levels[1].jacobian.row(0) + levels[1].jacobian.row(1) * delta;
+        levels[1].jacobian.set_row(1, &row);
+        let mut h = Hierarchy::new(n, &dims);
+        let mut q = DVector::zeros(n);
+        h.solve(&levels, &settings, &mut q).unwrap();
+        let rank = settings.rank_threshold;
+        let want =
+            reference_solution_damped(&levels, |jb| adaptive_lambda2(jb, max, threshold, rank));
+        let err = (&q - &want).norm() / (1.0 + want.norm());
+        assert!(err < REL_TOL, "case {case} (δ = {delta}): {err}");
+        // The damping must matter where it applies: the undamped solution is elsewhere.
+        let plain = reference_solution(&levels, 0.0);
+        let moved = (&plain - &want).norm() / (1.0 + want.norm());
+        let any_damped = projectors_above(&levels)
+            .iter()
+            .zip(&levels)
+            .any(|(na, l)| adaptive_lambda2(&(&l.jacobian * na), max, threshold, rank) > 0.0);
+        if any_damped {
+            damped += 1;
+            assert!(
+                moved > 1e3 * REL_TOL,
+                "case {case}: damping changed nothing"
+            );
+        } else {
+            undamped += 1;
+        }
+    }
+    assert!(
+        damped > 30 && undamped > 10,
+        "{damped} damped, {undamped} undamped cases"
+    );
+}
+
+#[test]
 fn rank_deficient_levels_are_handled() {
     // Level 2 repeats a row of level 1 (algorithmic singularity) and adds a new one.
     let mut r = rng(23);
@@ -141,7 +238,8 @@ fn g_is_the_derivative_of_the_solution_with_respect_to_h() {
     // Algorithm 1: the solution is affine in the right-hand sides; column j of g_i is the
     // change of q̈ when h_i moves by e_j (eq. 20), measured by re-running the recursion.
     // Damping depends on the Jacobians only, so the solution stays affine in h with any
-    // damping rule: cases cycle through none, fixed and the default (adaptive).
+    // damping rule: cases cycle through none, fixed and adaptive (with a region ε wide enough
+    // that random levels fall in it).
     let mut r = rng(24);
     for case in 0..30 {
         let n = 10 + case % 10;
@@ -151,7 +249,10 @@ fn g_is_the_derivative_of_the_solution_with_respect_to_h() {
             damping: match case % 3 {
                 0 => Damping::None,
                 1 => Damping::Fixed(0.2),
-                _ => SolverSettings::default().damping,
+                _ => Damping::Adaptive {
+                    max: 0.2,
+                    threshold: 2.0,
+                },
             },
             ..Default::default()
         };

@@ -1,6 +1,8 @@
 //! IKTC, the cascade (GF) and clamping on random problems.
 
-mod solver_common;
+mod common;
+use common::rng;
+use common::solver as solver_common;
 use solver_common::*;
 
 use iktc::solver::*;

@@ -46,7 +46,8 @@ pub use poly::Polynomial;
 pub use response::{analyse_response, ResponseMetrics, ResponseSettings};
 pub use scenario::{
     run_design, run_identify, run_push, BodeSeries, DesignResult, DesignScenario, IdentifyResult,
-    IdentifyScenario, ParameterComparison, PlanePushMetrics, PushResult, PushScenario, RootLocus,
+    IdentifyScenario, ParameterComparison, PlanePushMetrics, PushResult, PushScenario, PushSupport,
+    RootLocus,
 };
 pub use sim::{NoiseSource, PlantParams, SimPlant, SimSettings};
 pub use sweep::{sine_sweep, SweepSettings};

@@ -19,6 +19,8 @@ use super::response::{analyse_response, ResponseMetrics, ResponseSettings};
 use super::sim::{PlantParams, SimPlant, SimSettings};
 use super::sweep::{sine_sweep, SweepSettings};
 use crate::error::Result;
+use crate::sim::health::{HealthMonitor, HealthReport, HealthSettings, Verdict};
+use crate::walk::{Pose2, SupportPolygon};
 
 /// Bode data for plotting: frequency \[Hz\], magnitude \[dB re 1 m/rad\], phase \[deg\].
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -365,6 +367,65 @@ pub struct PushScenario {
     pub static_step: f64,
     /// Length of the static-gain runs \[s\]; the gain is the mean over their last third.
     pub static_duration: f64,
+    /// The feet, for the support polygon the ZMP must stay in.
+    pub support: PushSupport,
+    /// The run checks: the ZMP of either run (with or without the controller) leaving the
+    /// support polygon by more than [`HealthSettings::zmp_tolerance`] stops the scenario with
+    /// [`crate::Error::RunFailed`], unless [`HealthSettings::keep_going`].
+    pub health: HealthSettings,
+}
+
+/// The feet under the pushed robot. The measured ZMP `(x̃, ỹ)` is its deviation from the
+/// nominal ZMP in the local frame of Figure 11, which sits at the centre of the support: in
+/// single support the stance sole's centre, in double support the midpoint between the soles.
+/// The support polygon in that frame is the stance sole (SSP) or the hull of both soles at
+/// `ỹ = ±foot_separation/2` (DSP), [`SupportPolygon`].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct PushSupport {
+    /// Sole length along x̃ \[m\].
+    pub sole_length: f64,
+    /// Sole width along ỹ \[m\].
+    pub sole_width: f64,
+    /// Distance between the sole centres along ỹ \[m\].
+    pub foot_separation: f64,
+}
+
+impl Default for PushSupport {
+    /// JVRC-1's nominal sole (0.2 × 0.1 m) and stance (0.19 m between the feet).
+    fn default() -> Self {
+        Self {
+            sole_length: 0.2,
+            sole_width: 0.1,
+            foot_separation: 0.19,
+        }
+    }
+}
+
+impl PushSupport {
+    /// The support polygon in the local frame for `phase`. Errors: sizes not finite and > 0.
+    pub fn polygon(&self, phase: SupportPhase) -> Result<SupportPolygon> {
+        for (name, v) in [
+            ("PushSupport::sole_length [m]", self.sole_length),
+            ("PushSupport::sole_width [m]", self.sole_width),
+            ("PushSupport::foot_separation [m]", self.foot_separation),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(invalid(name, v, "finite and > 0"));
+            }
+        }
+        let (l, w, d) = (self.sole_length, self.sole_width, self.foot_separation);
+        let mut p = SupportPolygon::default();
+        match phase {
+            SupportPhase::Single => p.set_sole(&Pose2::new(0.0, 0.0, 0.0), l, w),
+            SupportPhase::Double => p.set_hull_of_soles(
+                &Pose2::new(0.0, 0.5 * d, 0.0),
+                &Pose2::new(0.0, -0.5 * d, 0.0),
+                l,
+                w,
+            ),
+        }
+        Ok(p)
+    }
 }
 
 impl PushScenario {
@@ -391,6 +452,8 @@ impl PushScenario {
             },
             static_step: 0.01,
             static_duration: 30.0,
+            support: PushSupport::default(),
+            health: HealthSettings::default(),
         })
     }
 
@@ -406,6 +469,8 @@ impl PushScenario {
         self.sim.validate()?;
         self.response.validate()?;
         self.closed_loop_response.validate()?;
+        self.health.validate()?;
+        self.support.polygon(self.phase)?;
         if (self.sim.control_period - self.controller.discrete.control_period).abs() > 0.0 {
             return Err(invalid(
                 "PushScenario::sim.control_period [s]",
@@ -475,6 +540,15 @@ pub struct PushResult {
     pub com_offset: [Vec<f64>; 2],
     /// Per-plane metrics `[x̃z̃, ỹz̃]`.
     pub metrics: [PlanePushMetrics; 2],
+    /// The support polygon in the local frame, counter-clockwise \[m\].
+    pub support: Vec<(f64, f64)>,
+    /// Without the controller: largest distance of the ZMP outside the support polygon
+    /// \[m\] (0: it stayed inside).
+    pub zmp_excursion_open: f64,
+    /// With the controller: the same \[m\].
+    pub zmp_excursion_closed: f64,
+    /// The checks of both runs (the ZMP inside the support polygon, the ZMP finite).
+    pub health: HealthReport,
 }
 
 /// Runs the push test with and without the controller, and the static-gain runs.
@@ -519,6 +593,32 @@ pub fn run_push(s: &PushScenario) -> Result<PushResult> {
             sims[i].advance(out.u[i])?;
         }
     }
+    let polygon = s.support.polygon(s.phase)?;
+    let mut health = HealthMonitor::new(s.health)?;
+    let mut excursion = [0.0f64; 2];
+    for (run, (zmp, frame)) in [
+        (
+            &zmp_open,
+            "local frame of Fig. 11, run without the controller",
+        ),
+        (
+            &zmp_closed,
+            "local frame of Fig. 11, run with the controller",
+        ),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        for (k, (x, y)) in zmp[0].iter().zip(&zmp[1]).enumerate() {
+            let t = k as f64 * dt;
+            if health.check_finite(t, "measured ZMP [m]", &[], &[*x, *y])? == Verdict::Stop {
+                break;
+            }
+            health.check_support(t, &polygon, (*x, *y), "ZMP", frame)?;
+            health.end_tick();
+            excursion[run] = excursion[run].max(-polygon.margin((*x, *y)));
+        }
+    }
     let t_push = k_push as f64 * dt;
     let mut metrics = Vec::with_capacity(2);
     for (i, plane) in Plane::BOTH.iter().enumerate() {
@@ -559,6 +659,10 @@ pub fn run_push(s: &PushScenario) -> Result<PushResult> {
         zmp_closed,
         com_offset,
         metrics,
+        support: polygon.vertices().to_vec(),
+        zmp_excursion_open: excursion[0],
+        zmp_excursion_closed: excursion[1],
+        health: health.report(),
     })
 }
 

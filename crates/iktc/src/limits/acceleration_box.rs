@@ -66,6 +66,16 @@ impl AccelerationBox {
             .map(|(i, _)| i)
     }
 
+    /// The indices of the dofs being brought back into their range
+    /// ([`BoundSource::Recovery`], under [`OutsideLimits::Recover`](super::OutsideLimits)).
+    pub fn recovering_dofs(&self) -> impl Iterator<Item = usize> + '_ {
+        self.lower_source
+            .iter()
+            .enumerate()
+            .filter(|(_, s)| **s == BoundSource::Recovery)
+            .map(|(i, _)| i)
+    }
+
     /// Whether any dof had a source dropped by conflict resolution.
     pub fn any_dropped(&self) -> bool {
         self.dropped.iter().any(DroppedSources::any)

@@ -5,17 +5,19 @@ use crate::error::{check_all_finite, check_dim, check_finite, Error, Result};
 use super::acceleration_box::AccelerationBox;
 use super::intersect::{intersect, DofBounds};
 use super::joint_limits::{DofLimits, JointLimits};
-use super::method::BoundMethod;
+use super::method::{BoundMethod, OutsideLimits};
 use super::paper::paper_sources;
 use super::quiet::quiet_sources;
-use super::source::DofBoundSources;
-use super::viable::viable_sources;
+use super::source::{BoundSource, DofBoundSources, DroppedSources};
+use super::viable::{recovery_acceleration, viable_sources};
 
 /// Computes the acceleration box `b_l ≤ q̈ ≤ b_u` (paper eqs. 13–14) for one control period.
 ///
 /// For each dof `i` the sources of bound are computed separately ([`paper_sources`] for
 /// [`BoundMethod::Paper`], eq. 14; [`viable_sources`] for [`BoundMethod::Viable`], errata §3.1
 /// after Del Prete, RA-L 2018), then intersected with conflict resolution ([`intersect`]).
+/// With [`OutsideLimits::Recover`] a dof outside its position range gets the single
+/// recovery acceleration instead ([`BoundSource::Recovery`] on both sides).
 /// Everything is written into `out`, including every source value, the binding source of each
 /// side and the dropped sources. An empty box is a status ([`AccelerationBox::is_empty`]), not
 /// an error. Allocates nothing.
@@ -50,9 +52,49 @@ pub fn compute_box(
 
     for (i, ((dof, &q), &qd)) in limits.dofs().iter().zip(position).zip(velocity).enumerate() {
         let sources = sources_unchecked(dof, method, q, qd, dt);
-        out.set(i, sources, intersect(&sources, method));
+        out.set(i, sources, resolve(dof, method, &sources, q, qd, dt));
     }
     Ok(())
+}
+
+/// The interval of one dof: the intersection of its sources; the recovery acceleration when
+/// the method asks for recovery and the dof is outside its range; for
+/// [`BoundMethod::Viable`] or [`BoundMethod::Quiet`] and a zero-width range, the single acceleration `−q̇/Δt` that
+/// stops the joint within the step (its only viable state is at rest on the range, where
+/// this is 0; off it by a solver tolerance, stopping keeps the deviation from growing, which
+/// the bounds of a widened range would not).
+fn resolve(
+    dof: &DofLimits,
+    method: &BoundMethod,
+    sources: &DofBoundSources,
+    q: f64,
+    qd: f64,
+    dt: f64,
+) -> DofBounds {
+    if let BoundMethod::Viable(settings) | BoundMethod::Quiet(settings) = method {
+        if settings.outside == OutsideLimits::Recover {
+            if let Some(x) = recovery_acceleration(dof, settings, q, qd, dt) {
+                return DofBounds {
+                    lower: x,
+                    upper: x,
+                    lower_source: BoundSource::Recovery,
+                    upper_source: BoundSource::Recovery,
+                    dropped: DroppedSources::default(),
+                };
+            }
+        }
+        if dof.position_min == dof.position_max {
+            let stop = -qd / dt;
+            return DofBounds {
+                lower: stop,
+                upper: stop,
+                lower_source: BoundSource::Position,
+                upper_source: BoundSource::Position,
+                dropped: DroppedSources::default(),
+            };
+        }
+    }
+    intersect(sources, method)
 }
 
 /// The sources and the resolved interval of a single dof; the one-dof version of
@@ -75,7 +117,7 @@ pub fn compute_dof(
     check_finite(|| "position".to_string(), q)?;
     check_finite(|| "velocity".to_string(), qd)?;
     let sources = sources_unchecked(limits, method, q, qd, dt);
-    Ok((sources, intersect(&sources, method)))
+    Ok((sources, resolve(limits, method, &sources, q, qd, dt)))
 }
 
 fn sources_unchecked(

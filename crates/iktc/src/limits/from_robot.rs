@@ -6,9 +6,10 @@ use crate::model::Robot;
 
 impl JointLimits {
     /// One [`DofLimits`] per velocity coordinate of `robot`: unlimited for the floating base,
-    /// then each active joint's position range \[rad or m\], velocity and acceleration limits.
+    /// then each active joint's position range \[rad or m\], velocity and acceleration limits;
+    /// the dofs are named as in [`Robot::dof_names`].
     pub fn from_robot(robot: &Robot) -> Result<JointLimits> {
-        JointLimits::new(
+        let limits = JointLimits::new(
             robot
                 .dof_limits()
                 .iter()
@@ -19,6 +20,7 @@ impl JointLimits {
                     acceleration_max: l.acceleration,
                 })
                 .collect(),
-        )
+        )?;
+        limits.with_names(robot.dof_names())
     }
 }

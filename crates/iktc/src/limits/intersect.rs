@@ -28,10 +28,14 @@ impl DofBounds {
 /// Intersects the sources of one dof: `b_u = min` and `b_l = max` over the sources.
 ///
 /// * [`BoundMethod::Paper`]: eq. (14) as printed; an empty interval stays empty.
-/// * [`BoundMethod::Viable`] and [`BoundMethod::Quiet`]: if `b_l > b_u`, the acceleration limit is dropped (both sides)
-///   and the intersection redone; if still empty, the viability bound is dropped too. The
-///   position and velocity bounds are never dropped: if they conflict, the interval is
-///   returned empty, with the sources that conflict (errata §3.1).
+/// * [`BoundMethod::Viable`] and [`BoundMethod::Quiet`]: if `b_l > b_u`, the acceleration limit is dropped and the
+///   intersection `[L, U]` of the other sources is redone; the interval is then the part of
+///   `[L, U]` closest to `[−a_max, a_max]`: `[max(L, min(−a_max, U)), min(U, max(a_max, L))]`,
+///   a single point (`U` or `L`) when the two do not overlap, so the acceleration limit is
+///   exceeded by the least amount (from a viable state only by rounding, see
+///   [`viable`](super::viable)); [`DroppedSources::acceleration`] says whether it is. If
+///   `[L, U]` is still empty, the viability bound is dropped too. The position and velocity bounds are never dropped: if they conflict, the interval
+///   is returned empty, with the sources that conflict (errata §3.1).
 ///
 /// The binding source of a side is the one attaining the bound among those kept; on a tie the
 /// first of position, viability, velocity, acceleration is named. A side with no finite bound
@@ -52,8 +56,40 @@ pub fn intersect(sources: &DofBoundSources, method: &BoundMethod) -> DofBounds {
             dropped.viability = true;
             bounds = intersect_kept(sources, position_source, dropped);
         }
+        if dropped.acceleration && std::env::var("IKTC_OLD").is_err() {
+            bounds = closest_to_acceleration_limit(bounds, sources);
+        }
     }
     bounds
+}
+
+/// The part of a non-empty `[L, U]` closest to `[−a_max, a_max]` (see [`intersect`]); an empty
+/// interval is returned unchanged.
+fn closest_to_acceleration_limit(relaxed: DofBounds, sources: &DofBoundSources) -> DofBounds {
+    if relaxed.is_empty() {
+        return relaxed;
+    }
+    let (acc_lower, acc_upper) = (sources.lower.acceleration, sources.upper.acceleration);
+    let mut out = relaxed;
+    // Lower: max(L, min(−a_max, U)).
+    if acc_lower > relaxed.upper {
+        out.lower = relaxed.upper;
+        out.lower_source = relaxed.upper_source;
+    } else if acc_lower > relaxed.lower {
+        out.lower = acc_lower;
+        out.lower_source = BoundSource::Acceleration;
+    }
+    // Upper: min(U, max(a_max, L)).
+    if acc_upper < relaxed.lower {
+        out.upper = relaxed.lower;
+        out.upper_source = relaxed.lower_source;
+    } else if acc_upper < relaxed.upper {
+        out.upper = acc_upper;
+        out.upper_source = BoundSource::Acceleration;
+    }
+    // Dropped only if the acceleration limit is actually exceeded.
+    out.dropped.acceleration = out.lower < acc_lower || out.upper > acc_upper;
+    out
 }
 
 fn intersect_kept(

@@ -1,6 +1,6 @@
 //! The limits of each velocity degree of freedom: position range, velocity and acceleration.
 
-use crate::error::{Error, Result};
+use crate::error::{check_all_finite, check_dim, Error, Result};
 
 use super::integrator::StepExtremes;
 
@@ -99,6 +99,8 @@ impl DofLimits {
 #[derive(Debug, Clone, PartialEq)]
 pub struct JointLimits {
     dofs: Vec<DofLimits>,
+    /// One name per dof, for errors (`dof[i]` unless named).
+    names: Vec<String>,
 }
 
 impl JointLimits {
@@ -110,14 +112,83 @@ impl JointLimits {
         for (i, dof) in dofs.iter().enumerate() {
             dof.validate(&format!("dof[{i}]"))?;
         }
-        Ok(Self { dofs })
+        let names = default_names(dofs.len());
+        Ok(Self { dofs, names })
     }
 
     /// `nv` degrees of freedom without any limit.
     pub fn unlimited(nv: usize) -> Self {
         Self {
             dofs: vec![DofLimits::unlimited(); nv],
+            names: default_names(nv),
         }
+    }
+
+    /// Names the dofs (e.g. the joint names), for the errors of [`check_state`](Self::check_state).
+    ///
+    /// # Errors
+    /// [`Error::DimensionMismatch`] unless there is one name per dof.
+    pub fn with_names(mut self, names: Vec<String>) -> Result<Self> {
+        check_dim(
+            "JointLimits names (one per dof)",
+            self.dofs.len(),
+            names.len(),
+        )?;
+        self.names = names;
+        Ok(self)
+    }
+
+    /// The name of dof `index` (`dof[i]` unless named with [`with_names`](Self::with_names)).
+    pub fn name(&self, index: usize) -> Option<&str> {
+        self.names.get(index).map(String::as_str)
+    }
+
+    /// Checks that a state lies inside the limits: every position in its range
+    /// `q_min ≤ q ≤ q_max` \[rad or m\] and every speed `|q̇| ≤ v_max` \[rad/s or m/s\]. A run
+    /// calls this on its start state unless it is asked to recover
+    /// ([`OutsideLimits`](super::OutsideLimits)): from such a state at rest the viable bounds
+    /// keep every limit (see [`viable`](super::viable)). A state moving toward a limit faster
+    /// than it can brake is inside these limits yet not viable; runs start at rest.
+    ///
+    /// `positions`: one entry per velocity dof (as for [`compute_box`](super::compute_box));
+    /// `velocities`: `q̇`.
+    ///
+    /// # Errors
+    /// [`Error::StateOutsideLimits`] for the first dof outside, naming it, its value and its
+    /// interval; [`Error::DimensionMismatch`] / [`Error::NonFinite`] for bad input.
+    pub fn check_state(&self, positions: &[f64], velocities: &[f64]) -> Result<()> {
+        let nv = self.dofs.len();
+        check_dim("positions (one per velocity dof)", nv, positions.len())?;
+        check_dim("velocities (one per velocity dof)", nv, velocities.len())?;
+        check_all_finite("positions", positions)?;
+        check_all_finite("velocities", velocities)?;
+        for (i, ((dof, &q), &qd)) in self.dofs.iter().zip(positions).zip(velocities).enumerate() {
+            let outside =
+                |quantity: &str, value: f64, lower: f64, upper: f64| Error::StateOutsideLimits {
+                    joint: self.names.get(i).cloned().unwrap_or_default(),
+                    quantity: quantity.to_string(),
+                    value,
+                    lower,
+                    upper,
+                };
+            if q < dof.position_min || q > dof.position_max {
+                return Err(outside(
+                    "position [rad or m]",
+                    q,
+                    dof.position_min,
+                    dof.position_max,
+                ));
+            }
+            if qd.abs() > dof.velocity_max {
+                return Err(outside(
+                    "velocity [rad/s or m/s]",
+                    qd,
+                    -dof.velocity_max,
+                    dof.velocity_max,
+                ));
+            }
+        }
+        Ok(())
     }
 
     /// The number of velocity degrees of freedom `nv`.
@@ -157,4 +228,8 @@ impl JointLimits {
             }),
         }
     }
+}
+
+fn default_names(nv: usize) -> Vec<String> {
+    (0..nv).map(|i| format!("dof[{i}]")).collect()
 }

@@ -61,6 +61,32 @@ impl BoundMethod {
             Self::Viable(settings) | Self::Quiet(settings) => settings.validate(),
         }
     }
+
+    /// What a run does with a state outside the limits at its start: the setting of
+    /// [`ViableSettings::outside`]; always [`OutsideLimits::Error`] for [`BoundMethod::Paper`]
+    /// (the paper's bound has no recovery).
+    pub fn outside_limits(&self) -> OutsideLimits {
+        match self {
+            Self::Paper => OutsideLimits::Error,
+            Self::Viable(settings) | Self::Quiet(settings) => settings.outside,
+        }
+    }
+}
+
+/// What to do with a joint whose position is outside its range (a posture, a lock, a narrowed
+/// range or a URDF range that excludes the start state).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum OutsideLimits {
+    /// Refuse: a run checks its start state with
+    /// [`JointLimits::check_state`](super::JointLimits::check_state) and stops with
+    /// [`Error::StateOutsideLimits`] naming the joint, its value and its range.
+    #[default]
+    Error,
+    /// Recover: while a joint is outside its range, its box is the single acceleration of
+    /// [`recovery_acceleration`](super::viable::recovery_acceleration) (toward the range at the
+    /// acceleration limit, arriving at rest on the range's end, no other limit crossed), with
+    /// [`BoundSource::Recovery`](super::BoundSource::Recovery) as the source of both sides.
+    Recover,
 }
 
 /// Settings of [`BoundMethod::Viable`] and [`BoundMethod::Quiet`].
@@ -77,12 +103,15 @@ pub struct ViableSettings {
     /// gently, trading some reachable speed near the range ends for that authority. Too small
     /// a fraction makes the joint crawl toward its limits.
     pub braking_fraction: f64,
+    /// What to do with a joint outside its position range (default: refuse at the start).
+    pub outside: OutsideLimits,
 }
 
 impl Default for ViableSettings {
     fn default() -> Self {
         Self {
             braking_fraction: 0.5,
+            outside: OutsideLimits::Error,
         }
     }
 }

@@ -6,13 +6,16 @@
 //! | method | formula | discrete-time safe |
 //! |---|---|---|
 //! | [`BoundMethod::Paper`] | Proposition 3.1, eq. (14), as printed ([`paper`]) | no: the box can empty and the joint overshoot (errata §3.1) |
-//! | [`BoundMethod::Viable`] | position with in-step peak, exact velocity, viability at the next state, `±a_max`; Del Prete, IEEE RA-L 2018 ([`viable`]) | yes, from a viable state |
+//! | [`BoundMethod::Viable`] | position with in-step peak, exact velocity, viability (discrete stopping distance) at the next state, `±a_max`; after Del Prete, IEEE RA-L 2018 ([`viable`]) | yes, from a viable state, for every `Δt` and ratio of the limits (proof in [`viable`]) |
 //! | [`BoundMethod::Quiet`] | as `Viable`, with a discrete braking profile that ends at rest at a tick ([`quiet`]) | yes, from a quietly viable state; the box never empties and a joint pushed into a limit rests on it with `q̈ = 0` |
 //!
 //! Each source of bound (acceleration, velocity, position, viability) is computed separately,
-//! as in TSID, then intersected ([`intersect`]). When the sources of `Viable` conflict, the
-//! acceleration limit is dropped first, then viability; position and velocity are kept, and if
-//! they conflict the box is reported empty. The [`AccelerationBox`] records every source value,
+//! as in TSID, then intersected ([`intersect`]). From a viable state the sources of `Viable`
+//! never conflict (beyond rounding); from any other state the acceleration limit is dropped
+//! first (exceeded by the least amount), then viability; position and velocity are kept, and
+//! if they conflict the box is reported empty. A run checks its start state
+//! ([`JointLimits::check_state`]) or, with [`OutsideLimits::Recover`], brings joints outside
+//! their range back ([`BoundSource::Recovery`]). The [`AccelerationBox`] records every source value,
 //! the source that binds each side and what was dropped, so the caller can see why a joint is
 //! constrained.
 //!
@@ -56,7 +59,7 @@ pub use compute::{compute_box, compute_dof};
 pub use integrator::{integrate_constant_acceleration, peak_in_step, StepExtremes};
 pub use intersect::{intersect, DofBounds};
 pub use joint_limits::{DofLimits, JointLimits};
-pub use method::{BoundMethod, ViableSettings};
+pub use method::{BoundMethod, OutsideLimits, ViableSettings};
 pub use paper::paper_sources;
 pub use quiet::quiet_sources;
 pub use source::{BoundSource, DofBoundSources, DroppedSources, SourceBounds};

@@ -19,6 +19,10 @@ pub enum BoundSource {
     /// The third term of the paper's eq. (14), `(±√(2 a_max d) − q̇)/Δt`, used by
     /// [`BoundMethod::Paper`](super::BoundMethod).
     PaperPosition,
+    /// The joint is outside its position range and being brought back
+    /// ([`OutsideLimits::Recover`](super::OutsideLimits)): both sides are the recovery
+    /// acceleration of [`recovery_acceleration`](super::viable::recovery_acceleration).
+    Recovery,
 }
 
 /// Which sources conflict resolution removed for one dof (both sides).

@@ -8,14 +8,22 @@
 //!   state without allocation.
 
 mod builtin;
+mod config;
 mod joint;
 mod kinematics;
+pub mod plausible;
 mod robot;
 pub mod spatial;
 mod state;
+#[cfg(feature = "urdf")]
 mod urdf;
+#[cfg(feature = "urdf")]
+mod urdf_check;
 
-pub use builtin::{builtin_robot, jvrc1, planar3r, BUILTIN_ROBOTS, JVRC1_FINGERS, JVRC1_URDF};
+pub use builtin::{builtin_robot, planar3r, BUILTIN_ROBOTS};
+#[cfg(feature = "urdf")]
+pub use builtin::{g1, jvrc1, G1_URDF, JVRC1_FINGERS, JVRC1_URDF};
+pub use config::{BasePose, StateConfig, MAX_CONFIG_MAGNITUDE};
 pub use joint::{Joint, JointKind, JointLimit, JointRole};
 pub use kinematics::Kinematics;
 pub use robot::{

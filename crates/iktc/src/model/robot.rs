@@ -127,6 +127,7 @@ pub struct RobotBuilder {
     links: Vec<Link>,
     joints: Vec<JointSpec>,
     frames: Vec<(String, String, Isometry3<f64>)>,
+    warnings: Vec<String>,
 }
 
 impl RobotBuilder {
@@ -161,11 +162,19 @@ impl RobotBuilder {
         self
     }
 
+    /// Records a warning about the description, kept in the model ([`Robot::warnings`]).
+    pub fn warn(&mut self, message: impl Into<String>) {
+        self.warnings.push(message.into());
+    }
+
     /// Validates the description and builds the immutable model.
     ///
     /// Errors: duplicate or unknown names, a link with two parents, no single root, a cycle,
     /// a non-finite number, a limit with lower > upper or a non-positive speed, a zero axis,
-    /// a locked joint that does not exist or is fixed, a mimic that is rejected by the options.
+    /// a locked joint that does not exist or is fixed, a joint locked outside its range
+    /// ([`Error::StateOutsideLimits`]), a mimic that is rejected by the options, a magnitude
+    /// beyond the plausibility bounds of [`plausible`](super::plausible) (a mass, length,
+    /// inertia, speed or acceleration no robot has).
     pub fn build(self, options: &ModelOptions) -> Result<Robot> {
         Robot::from_builder(self, options)
     }
@@ -191,6 +200,7 @@ pub struct Robot {
     /// For each link: the joint whose child it is (None for the root).
     pub(crate) parent_joint: Vec<Option<usize>>,
     pub(crate) total_mass: f64,
+    pub(crate) warnings: Vec<String>,
 }
 
 fn finite_vec(what: &str, v: &Vector3<f64>) -> Result<()> {
@@ -239,6 +249,7 @@ impl Robot {
                 &format!("inertia of link `{}`", l.name),
                 l.inertia.as_slice(),
             )?;
+            super::plausible::check_link(l)?;
         }
         let link_names = || b.links.iter().map(|l| l.name.clone()).collect::<Vec<_>>();
         let find_link = |name: &str| -> Result<usize> {
@@ -274,6 +285,7 @@ impl Robot {
             parent_of[c] = Some(j);
             children[p].push(j);
             finite_iso(&format!("origin of joint `{}`", s.name), &s.origin)?;
+            super::plausible::check_joint(s)?;
             let l = &s.limit;
             for (what, v) in [("lower", l.lower), ("upper", l.upper)] {
                 if v.is_nan() {
@@ -356,6 +368,16 @@ impl Robot {
                     value: value.to_string(),
                     expected: "a revolute, continuous or prismatic joint (this one is fixed)"
                         .into(),
+                });
+            }
+            let range = b.joints[j].limit;
+            if *value < range.lower || *value > range.upper {
+                return Err(Error::StateOutsideLimits {
+                    joint: name.clone(),
+                    quantity: "locked position [rad or m]".into(),
+                    value: *value,
+                    lower: range.lower,
+                    upper: range.upper,
                 });
             }
             locked.insert(j, *value);
@@ -493,6 +515,7 @@ impl Robot {
                 });
             }
             finite_iso(&format!("offset of frame `{name}`"), offset)?;
+            super::plausible::check_frame(name, offset)?;
             frames.push(Frame {
                 name: name.clone(),
                 link: find_link(link)?,
@@ -511,6 +534,7 @@ impl Robot {
             drive,
             parent_joint,
             total_mass,
+            warnings: b.warnings,
         })
     }
 
@@ -581,6 +605,11 @@ impl Robot {
     /// extra frames.
     pub fn frames(&self) -> &[Frame] {
         &self.frames
+    }
+
+    /// Warnings about the description (e.g. a URDF `effort="0"`): accepted, but worth a word.
+    pub fn warnings(&self) -> &[String] {
+        &self.warnings
     }
 
     /// Total mass \[kg\].

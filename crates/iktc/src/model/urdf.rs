@@ -2,9 +2,13 @@
 
 use nalgebra::{Isometry3, Matrix3, Translation3, Unit, UnitQuaternion, Vector3};
 
+use std::collections::HashMap;
+
 use super::joint::{JointKind, JointLimit};
 use super::robot::{JointSpec, Link, ModelOptions, Robot, RobotBuilder};
+use super::urdf_check::{check_raw, RawJoint};
 use crate::error::{Error, Result};
+use crate::resources::ReadLimits;
 
 fn pose(p: &urdf_rs::Pose) -> Isometry3<f64> {
     Isometry3::from_parts(
@@ -15,7 +19,7 @@ fn pose(p: &urdf_rs::Pose) -> Isometry3<f64> {
 }
 
 /// Turns a parsed URDF into a builder (links, joints; no model options applied yet).
-fn builder_from_urdf(u: &urdf_rs::Robot) -> Result<RobotBuilder> {
+fn builder_from_urdf(u: &urdf_rs::Robot, raw: &HashMap<String, RawJoint>) -> Result<RobotBuilder> {
     let mut b = RobotBuilder::new(u.name.clone());
     for l in &u.links {
         let origin = pose(&l.inertial.origin);
@@ -42,12 +46,17 @@ fn builder_from_urdf(u: &urdf_rs::Robot) -> Result<RobotBuilder> {
                 message: format!("joint `{}` has a zero axis", j.name),
             })
         };
-        let l = &j.limit;
-        // A velocity of 0 is what URDF parsers give for a missing value: read it as "none".
-        let velocity = if l.velocity > 0.0 {
-            l.velocity
+        let raw = raw.get(&j.name).cloned().unwrap_or_default();
+        let movable = matches!(
+            j.joint_type,
+            urdf_rs::JointType::Revolute
+                | urdf_rs::JointType::Prismatic
+                | urdf_rs::JointType::Continuous
+        );
+        let l = if movable {
+            checked_limit(j, &raw, &mut b)?
         } else {
-            f64::INFINITY
+            JointLimit::UNBOUNDED
         };
         let (kind, lower, upper) = match j.joint_type {
             urdf_rs::JointType::Revolute => (JointKind::Revolute { axis: axis()? }, l.lower, l.upper),
@@ -73,21 +82,7 @@ fn builder_from_urdf(u: &urdf_rs::Robot) -> Result<RobotBuilder> {
             child: j.child.link.clone(),
             origin: pose(&j.origin),
             kind,
-            limit: JointLimit {
-                lower,
-                upper,
-                velocity,
-                acceleration: if l.acceleration > 0.0 {
-                    l.acceleration
-                } else {
-                    f64::INFINITY
-                },
-                effort: if l.effort >= 0.0 {
-                    l.effort
-                } else {
-                    f64::INFINITY
-                },
-            },
+            limit: JointLimit { lower, upper, ..l },
             mimic: j.mimic.as_ref().map(|m| {
                 (
                     m.joint.clone(),
@@ -100,18 +95,153 @@ fn builder_from_urdf(u: &urdf_rs::Robot) -> Result<RobotBuilder> {
     Ok(b)
 }
 
+/// The units of a joint's position and velocity, for messages.
+fn units(j: &urdf_rs::Joint) -> (&'static str, &'static str) {
+    match j.joint_type {
+        urdf_rs::JointType::Prismatic => ("m", "m/s"),
+        _ => ("rad", "rad/s"),
+    }
+}
+
+/// The checked limits of a revolute, continuous or prismatic joint (see
+/// [`Robot::from_urdf_str_with`]); warnings go to the builder.
+fn checked_limit(j: &urdf_rs::Joint, raw: &RawJoint, b: &mut RobotBuilder) -> Result<JointLimit> {
+    let l = &j.limit;
+    let (pos_unit, vel_unit) = units(j);
+    let bad = |attr: &str, value: f64, expected: String| Error::Urdf {
+        message: format!(
+            "joint `{}`: <limit {attr}=\"{}\">: expected {expected}",
+            j.name,
+            raw.limit_attr(attr)
+                .map_or_else(|| value.to_string(), str::to_string)
+        ),
+    };
+    let continuous = matches!(j.joint_type, urdf_rs::JointType::Continuous);
+    if raw.limit.is_none() && !continuous {
+        return Err(Error::Urdf {
+            message: format!(
+                "joint `{}` ({:?}) has no <limit>; URDF requires one, with lower, upper, effort and velocity, for revolute and prismatic joints",
+                j.name, j.joint_type
+            ),
+        });
+    }
+    let mut limit = JointLimit::UNBOUNDED;
+    if !continuous {
+        for (attr, v) in [("lower", l.lower), ("upper", l.upper)] {
+            if !v.is_finite() {
+                return Err(bad(
+                    attr,
+                    v,
+                    format!("a finite position [{pos_unit}] (an unbounded revolute joint is type=\"continuous\")"),
+                ));
+            }
+        }
+        if l.lower > l.upper {
+            return Err(Error::InvalidLimit {
+                what: format!("joint `{}` (URDF <limit lower upper>)", j.name),
+                lower: l.lower,
+                upper: l.upper,
+            });
+        }
+        if l.lower == l.upper {
+            return Err(Error::Urdf {
+                message: format!(
+                    "joint `{}` ({:?}) has the zero-width range [{}, {}] {pos_unit} (lower and upper default to 0 when missing); a joint that must not move is type=\"fixed\" or locked (ModelOptions::locked, --lock)",
+                    j.name, j.joint_type, l.lower, l.upper
+                ),
+            });
+        }
+        limit.lower = l.lower;
+        limit.upper = l.upper;
+    }
+    if raw.limit.is_some() {
+        match raw.limit_attr("velocity") {
+            Some(_) if !(l.velocity.is_finite() && l.velocity > 0.0) => {
+                return Err(bad(
+                    "velocity",
+                    l.velocity,
+                    format!("a finite velocity limit > 0 [{vel_unit}] (a joint that must not move is type=\"fixed\" or locked with --lock)"),
+                ))
+            }
+            Some(_) => limit.velocity = l.velocity,
+            None => b.warn(format!(
+                "joint `{}`: <limit> has no velocity; read as unbounded (URDF 1.2), so its acceleration limit comes from ModelOptions::fallback_acceleration",
+                j.name
+            )),
+        }
+        if raw.limit_attr("effort").is_some() {
+            if !(l.effort.is_finite() && l.effort >= 0.0) {
+                return Err(bad(
+                    "effort",
+                    l.effort,
+                    "a finite effort limit >= 0 [N·m or N]".into(),
+                ));
+            }
+            if l.effort == 0.0 {
+                b.warn(format!(
+                    "joint `{}`: <limit effort=\"0\">: URDF allows it; iktc is kinematic and does not use efforts",
+                    j.name
+                ));
+            }
+            limit.effort = l.effort;
+        }
+        if raw.limit_attr("acceleration").is_some() {
+            if !(l.acceleration.is_finite() && l.acceleration > 0.0) {
+                return Err(bad(
+                    "acceleration",
+                    l.acceleration,
+                    format!("a finite acceleration limit > 0 [{vel_unit}²]"),
+                ));
+            }
+            limit.acceleration = l.acceleration;
+        }
+    }
+    Ok(limit)
+}
+
 impl Robot {
     /// Reads a robot from URDF text (revolute, continuous, prismatic and fixed joints).
     ///
     /// A malformed document, an unsupported joint type, an inconsistent tree or a bad number is
     /// an [`Error`]; see [`RobotBuilder::build`].
+    ///
+    /// Every `<limit>` is checked (see [`Robot::from_urdf_str_with`]), with the default
+    /// [`ReadLimits`].
     pub fn from_urdf_str(text: &str, options: &ModelOptions) -> Result<Robot> {
+        Self::from_urdf_str_with(text, options, &ReadLimits::default())
+    }
+
+    /// [`Robot::from_urdf_str`] with explicit [`ReadLimits`] (the XML nesting depth).
+    ///
+    /// What is checked beyond the XML and the tree (each an [`Error`] naming the joint or link,
+    /// the attribute, its value and what was expected):
+    ///
+    /// * the nesting depth (at most [`ReadLimits::max_xml_depth`]), before the document is
+    ///   parsed into a tree;
+    /// * the elements inside each `<joint>` and `<inertial>` and the attributes of `<limit>`:
+    ///   an unknown one (a misspelling) is an error;
+    /// * a revolute or prismatic joint needs a `<limit>` (URDF requires it) with a range
+    ///   `lower < upper` (a zero-width range is an error: make the joint fixed or lock it);
+    /// * `velocity` must be finite and > 0 (0 or a negative value would mean a joint that
+    ///   cannot move); a missing velocity (URDF ≥ 1.2 reads it as unbounded) is accepted with a
+    ///   warning;
+    /// * `effort` must be finite and ≥ 0; URDF allows 0 (many exporters write it for "unknown"),
+    ///   and iktc, being kinematic, does not use efforts: `effort="0"` is accepted with a
+    ///   warning ([`Robot::warnings`]);
+    /// * `acceleration` (URDF 1.2), when written, must be finite and > 0;
+    /// * masses, inertias and origins: see [`RobotBuilder::build`].
+    pub fn from_urdf_str_with(
+        text: &str,
+        options: &ModelOptions,
+        limits: &ReadLimits,
+    ) -> Result<Robot> {
         // The XML parser rejects a trailing NUL, which some exported files carry.
         let text = text.trim_end_matches('\0');
+        let raw = check_raw(text, limits)?;
         let u = urdf_rs::read_from_string(text).map_err(|e| Error::Urdf {
             message: format!("cannot parse the URDF: {e}"),
         })?;
-        builder_from_urdf(&u)?.build(options)
+        builder_from_urdf(&u, &raw)?.build(options)
     }
 
     /// Reads a robot from a URDF file.

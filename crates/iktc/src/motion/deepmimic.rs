@@ -1,6 +1,6 @@
 //! Reader of DeepMimic motion files and the DeepMimic humanoid skeleton.
 //!
-//! File format (see `data/NOTICE.md`): JSON with a `"Frames"` array; each frame holds 44
+//! File format (see `crates/iktc/data/NOTICE.md`): JSON with a `"Frames"` array; each frame holds 44
 //! numbers: `[duration of the frame \[s\], root position (3) \[m\], root orientation (w, x, y, z),
 //! chest (w, x, y, z), neck, right hip, right knee angle \[rad\], right ankle, right shoulder,
 //! right elbow angle \[rad\], left hip, left knee angle, left ankle, left shoulder, left elbow
@@ -16,12 +16,13 @@ use serde::Deserialize;
 
 use super::{Clip, JointKind, Pose, Skeleton, SkeletonJoint, UpAxis};
 use crate::error::{Error, Result};
+use crate::resources::ReadLimits;
 
 /// The DeepMimic character (pybullet's `humanoid/humanoid.urdf`), embedded.
 ///
 /// It is authored at four times human size; see [`DEEPMIMIC_URDF_SCALE`].
 pub const DEEPMIMIC_URDF: &str =
-    include_str!("../../../../data/motions/deepmimic/deepmimic_humanoid.urdf");
+    include_str!("../../data/motions/deepmimic/deepmimic_humanoid.urdf");
 
 /// Length of one URDF unit of [`DEEPMIMIC_URDF`] in metres \[m/unit\].
 ///
@@ -40,10 +41,10 @@ pub const BUILTIN_CLIP_NAMES: [&str; 4] = [
 ];
 
 const BUILTIN_CLIP_TEXTS: [&str; 4] = [
-    include_str!("../../../../data/motions/deepmimic/humanoid3d_dance_a.txt"),
-    include_str!("../../../../data/motions/deepmimic/humanoid3d_dance_b.txt"),
-    include_str!("../../../../data/motions/deepmimic/humanoid3d_punch.txt"),
-    include_str!("../../../../data/motions/deepmimic/humanoid3d_walk.txt"),
+    include_str!("../../data/motions/deepmimic/humanoid3d_dance_a.txt"),
+    include_str!("../../data/motions/deepmimic/humanoid3d_dance_b.txt"),
+    include_str!("../../data/motions/deepmimic/humanoid3d_punch.txt"),
+    include_str!("../../data/motions/deepmimic/humanoid3d_walk.txt"),
 ];
 
 /// Numbers per frame of a DeepMimic motion file.
@@ -58,12 +59,15 @@ pub struct DeepMimicSettings {
     /// has neck quaternions of norm down to 0.917 (frames 55–64); the other clips are unit to
     /// 1e-6.
     pub max_quaternion_norm_error: f64,
+    /// Most frames and longest duration accepted.
+    pub limits: ReadLimits,
 }
 
 impl Default for DeepMimicSettings {
     fn default() -> Self {
         Self {
             max_quaternion_norm_error: 0.1,
+            limits: ReadLimits::default(),
         }
     }
 }
@@ -243,7 +247,8 @@ struct MotionFile {
 /// `source_name` names the file in error messages. Errors ([`Error::Parse`], with the line where
 /// known): malformed JSON or a non-numeric value, no `"Frames"`, zero frames, a frame that does
 /// not hold 44 numbers, a non-positive duration (except the last frame's), a quaternion of zero
-/// norm or whose norm is farther from 1 than allowed (naming frame and field).
+/// norm or whose norm is farther from 1 than allowed (naming frame and field); more frames or a
+/// longer clip than [`DeepMimicSettings::limits`] allow ([`Error::ResourceLimit`]).
 pub fn read_deepmimic(text: &str, source_name: &str) -> Result<Clip> {
     read_deepmimic_with(text, source_name, &DeepMimicSettings::default())
 }
@@ -286,6 +291,12 @@ pub fn read_deepmimic_with(
         *slot = (index, *kind);
     }
     let line_of = |frame: usize| frame_lines(text).get(frame).copied().unwrap_or(0);
+    crate::resources::check_count(
+        &format!("frames in {source_name}"),
+        file.frames.len(),
+        settings.limits.max_clip_frames,
+        "ReadLimits::max_clip_frames",
+    )?;
     let n = skeleton.len();
     let mut times = Vec::with_capacity(file.frames.len());
     let mut poses = Vec::with_capacity(file.frames.len());
@@ -351,6 +362,10 @@ pub fn read_deepmimic_with(
         poses.push(pose);
         t += duration;
     }
+    let duration = times.last().copied().unwrap_or(0.0);
+    settings
+        .limits
+        .check_clip(source_name, times.len(), duration)?;
     Clip::new(source_name, skeleton, times, poses, UpAxis::Y)
 }
 
@@ -383,7 +398,7 @@ fn frame_lines(text: &str) -> Vec<usize> {
     lines
 }
 
-/// One of the four DeepMimic clips shipped with the library (see `data/NOTICE.md`), by name:
+/// One of the four DeepMimic clips shipped with the library (see `crates/iktc/data/NOTICE.md`), by name:
 /// see [`BUILTIN_CLIP_NAMES`]. Unknown names give [`Error::UnknownName`] listing the valid ones.
 pub fn builtin_clip(name: &str) -> Result<Clip> {
     let text = BUILTIN_CLIP_NAMES

@@ -8,6 +8,11 @@
 //!   (Y-up; convert with [`Clip::to_z_up`] / [`y_up_to_z_up`]).
 //! * [`read_bvh`], [`write_bvh`], [`BvhClip`] — Biovision hierarchy files with any hierarchy
 //!   and channel order, in centimetres, metres or any length unit.
+//! * [`load_motion`] — any motion file (BVH, ASF/AMC, DeepMimic, C3D, points CSV), its format
+//!   detected, its units and up axis given or decided ([`Units`], [`UpChoice`]), its body
+//!   points recognised without a map ([`recognise_skeleton`], [`recognise_markers`], or a
+//!   [`BodyMap`] TOML), reduced to [`Keypoints`]: named body points per frame in metres, Z up.
+//! * [`read_asf`], [`read_amc`], [`read_c3d`], [`read_points_csv`] — the readers behind it.
 //! * [`decompose_rotation`] — a rotation as a product of rotations about 1–3 given joint axes
 //!   (generalised Euler / Davenport angles in closed form, least squares otherwise).
 //! * [`retarget`], [`RetargetMap`], [`builtin_map`] — a clip to robot joint, pelvis height and
@@ -37,33 +42,68 @@
 //! # Ok::<(), iktc::Error>(())
 //! ```
 
+mod amc;
 mod angles;
+mod asf;
+mod body_map;
+mod body_point;
 mod bvh;
+mod c3d;
 mod clip;
 mod decompose;
+#[cfg(all(feature = "urdf", feature = "json"))]
 mod deepmimic;
+mod keypoints;
+mod load;
+mod markers;
+mod names;
+mod points_csv;
+mod recognise;
 mod retarget;
 mod retarget_map;
+mod shape;
 mod skeleton;
 mod spline;
+mod units;
 
+pub use amc::{read_amc, AMC_DEFAULT_RATE};
 pub use angles::{nearest_equivalent, unwrap_track, wrap_to_pi};
+pub use asf::{read_asf, Asf, AsfBone, AsfDof};
+pub use body_map::{BodyMap, FoundBy, MappedPoint, PointSource};
+pub use body_point::{BodyPoint, Side};
 pub use bvh::{
     bvh_rotation, read_bvh, write_bvh, write_clip_bvh, BvhChannel, BvhClip, BvhExportOptions,
     BvhJoint, BvhReadOptions, BvhWriteOptions, LengthUnit, RotationOrder,
 };
+pub use c3d::read_c3d;
 pub use clip::{y_up_to_z_up, Clip, Pose, UpAxis};
 pub use decompose::{
     compose_rotation, decompose_rotation, decompose_rotation_with, rotation_angle,
     DecomposeSettings, Decomposition, DecompositionMethod, MAX_DECOMPOSITION_AXES,
 };
+#[cfg(all(feature = "urdf", feature = "json"))]
 pub use deepmimic::{
     builtin_clip, deepmimic_skeleton, read_deepmimic, read_deepmimic_with, DeepMimicSettings,
     BUILTIN_CLIP_NAMES, DEEPMIMIC_FRAME_LEN, DEEPMIMIC_URDF, DEEPMIMIC_URDF_SCALE,
 };
-pub use retarget::{retarget, Retargeted, RobotReferences, Track};
-pub use retarget_map::{
-    builtin_map, HoldJoint, JointMap, RetargetMap, RootMap, TargetJoint, BUILTIN_MAP_NAMES,
+pub use keypoints::{clip_keypoints, marker_keypoints, Keypoints};
+pub use load::{
+    detect_format, find_asf, load_motion, motion_from_content, scale_clip, Motion, MotionContent,
+    MotionFormat, MotionOptions,
 };
+pub use markers::{FilledGap, MarkerSet, DEFAULT_MAX_GAP};
+pub use points_csv::read_points_csv;
+pub use recognise::{
+    builtin_body_map, recognise_markers, recognise_skeleton, BUILTIN_BODY_MAP_NAMES,
+};
+pub use retarget::{retarget, Retargeted, RobotReferences, Track};
+#[cfg(feature = "toml")]
+pub use retarget_map::{builtin_map, builtin_map_text, BUILTIN_MAP_NAMES};
+pub use retarget_map::{HoldJoint, JointMap, RetargetMap, RootMap, TargetJoint};
+pub use shape::MIN_LIMB_JOINTS;
 pub use skeleton::{JointKind, Skeleton, SkeletonJoint};
 pub use spline::CubicSpline;
+pub use units::{
+    decide_units, decide_up, to_z_up, unit_name, Units, UnitsDecision, UpChoice, UpDecision,
+    CMU_METRES_PER_UNIT, HUMAN_HEIGHT_MAX, HUMAN_HEIGHT_MIN,
+};

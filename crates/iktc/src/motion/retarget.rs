@@ -11,6 +11,7 @@ use super::spline::CubicSpline;
 use super::Clip;
 use crate::error::{check_finite, Error, Result};
 use crate::model::{JointKind, Kinematics, Robot, State};
+use crate::resources::RunLimits;
 
 /// Robot references at the clip's frame times (before resampling).
 #[derive(Debug, Clone, PartialEq)]
@@ -369,17 +370,22 @@ impl Retargeted {
     /// `a_2 = Rz(ψ) e_y`, `a_3 = Rz(ψ) Ry(θ) e_x`, its angular velocity is
     /// `ω = ψ̇ a_1 + θ̇ a_2 + φ̇ a_3` and its angular acceleration
     /// `ω̇ = ψ̈ a_1 + θ̈ a_2 + φ̈ a_3 + (ψ̇ a_1) × (θ̇ a_2) + (ψ̇ a_1 + θ̇ a_2) × (φ̇ a_3)`.
+    ///
+    /// With the default [`RunLimits`]; see [`Retargeted::resample_with`].
     pub fn resample(&self, dt: f64) -> Result<RobotReferences> {
-        if !(dt.is_finite() && dt > 0.0) {
-            return Err(Error::InvalidSetting {
-                name: "resampling period".into(),
-                value: dt.to_string(),
-                expected: "a finite period > 0 [s]".into(),
-            });
-        }
+        self.resample_with(dt, &RunLimits::default())
+    }
+
+    /// [`Retargeted::resample`] with explicit [`RunLimits`]: `dt` must be in their range and the
+    /// number of samples at most their `max_ticks` (checked before anything is allocated).
+    pub fn resample_with(&self, dt: f64, limits: &RunLimits) -> Result<RobotReferences> {
         let t0 = self.times.first().copied().unwrap_or(0.0);
         let duration = self.times.last().copied().unwrap_or(0.0) - t0;
-        let n = (duration / dt + 1e-9).floor() as usize + 1;
+        limits.ticks("the resampled clip", duration, dt)?;
+        // The 1e-9 [–] absorbs the rounding of `duration / dt` when the clip's duration is a
+        // whole number of periods, so that its last instant is kept.
+        let n = ((duration / dt + 1e-9).floor() as usize).saturating_add(1);
+        limits.check_ticks("the resampled clip", n)?;
         let times: Vec<f64> = (0..n).map(|k| k as f64 * dt).collect();
         let abs: Vec<f64> = times.iter().map(|t| t + t0).collect();
         let spline = |v: &[f64]| -> Result<Track> {

@@ -26,23 +26,30 @@
 //! value = 0.0
 //! ```
 
-use nalgebra::{Matrix3, Rotation3, Vector3};
+#[cfg(feature = "toml")]
+use nalgebra::Matrix3;
+use nalgebra::{Rotation3, Vector3};
 use serde::Deserialize;
 
+#[cfg(feature = "toml")]
 use crate::error::{Error, Result};
 
 /// Names accepted by [`builtin_map`].
-pub const BUILTIN_MAP_NAMES: [&str; 2] = ["deepmimic_jvrc1", "bvh_jvrc1"];
+#[cfg(feature = "toml")]
+pub const BUILTIN_MAP_NAMES: [&str; 3] = ["deepmimic_jvrc1", "bvh_jvrc1", "deepmimic_g1"];
 
-const BUILTIN_MAP_TEXTS: [&str; 2] = [
-    include_str!("maps/deepmimic_jvrc1.toml"),
-    include_str!("maps/bvh_jvrc1.toml"),
+#[cfg(feature = "toml")]
+const BUILTIN_MAP_TEXTS: [&str; 3] = [
+    include_str!("../../data/maps/deepmimic_jvrc1.toml"),
+    include_str!("../../data/maps/bvh_jvrc1.toml"),
+    include_str!("../../data/maps/deepmimic_g1.toml"),
 ];
 
-/// A built-in map by name: `deepmimic_jvrc1` (the DeepMimic character of
-/// [`builtin_clip`](super::builtin_clip) onto JVRC-1) or `bvh_jvrc1` (a BVH skeleton with the
-/// common `Hips / Spine / Neck / LeftArm / LeftForeArm …` naming, Y-up, facing +Z, T-pose rest,
-/// onto JVRC-1).
+/// A built-in map by name: `deepmimic_jvrc1` (the DeepMimic character of the built-in clips
+/// onto JVRC-1), `bvh_jvrc1` (a BVH skeleton with the common `Hips / Spine / Neck / LeftArm /
+/// LeftForeArm …` naming, Y-up, facing +Z, T-pose rest, onto JVRC-1) or `deepmimic_g1` (the
+/// DeepMimic character onto the Unitree G1).
+#[cfg(feature = "toml")]
 pub fn builtin_map(name: &str) -> Result<RetargetMap> {
     match BUILTIN_MAP_NAMES.iter().position(|n| *n == name) {
         Some(i) => RetargetMap::from_toml_str(BUILTIN_MAP_TEXTS[i], name),
@@ -52,6 +59,19 @@ pub fn builtin_map(name: &str) -> Result<RetargetMap> {
             valid: BUILTIN_MAP_NAMES.iter().map(|s| s.to_string()).collect(),
         }),
     }
+}
+
+/// The TOML text of a built-in map (see [`builtin_map`]), to print or edit.
+pub fn builtin_map_text(name: &str) -> Result<&'static str> {
+    BUILTIN_MAP_NAMES
+        .iter()
+        .position(|n| *n == name)
+        .map(|i| BUILTIN_MAP_TEXTS[i])
+        .ok_or_else(|| Error::UnknownName {
+            kind: "built-in retargeting map",
+            name: name.into(),
+            valid: BUILTIN_MAP_NAMES.iter().map(|s| s.to_string()).collect(),
+        })
 }
 
 /// One robot joint driven by a decomposed source rotation:
@@ -141,6 +161,7 @@ pub struct HoldJoint {
     pub value: f64,
 }
 
+#[cfg(feature = "toml")]
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct MapFile {
@@ -172,6 +193,7 @@ pub struct RetargetMap {
 }
 
 /// Largest `‖BᵀB − I‖` accepted for a basis \[–\] (the file's numbers are typed by hand).
+#[cfg(feature = "toml")]
 const BASIS_TOLERANCE: f64 = 1e-6;
 
 impl RetargetMap {
@@ -180,19 +202,10 @@ impl RetargetMap {
     /// Errors: malformed TOML or unknown keys ([`Error::Parse`] with the line), a basis that is
     /// not a proper rotation, a joint map with 0 or more than 3 targets, a sign other than ±1,
     /// a non-finite number, a robot joint named twice.
+    #[cfg(feature = "toml")]
     pub fn from_toml_str(text: &str, source_name: &str) -> Result<Self> {
-        let file: MapFile = toml::from_str(text).map_err(|e| {
-            let line = e
-                .span()
-                .and_then(|s| text.get(..s.start))
-                .map(|head| head.matches('\n').count() + 1)
-                .unwrap_or(0);
-            Error::Parse {
-                source_name: source_name.into(),
-                line,
-                message: e.message().to_string(),
-            }
-        })?;
+        let file: MapFile =
+            toml::from_str(text).map_err(|e| super::body_map::toml_error(text, source_name, &e))?;
         let b = Matrix3::from_fn(|r, c| file.basis[r][c]);
         let invalid = |name: String, value: String, expected: &str| Error::InvalidSetting {
             name: format!("{source_name}: {name}"),

@@ -16,18 +16,21 @@ mod record;
 mod support;
 
 pub use record::{run_imitate, ImitateRun, ImitateStep, ImitateSummary, JointMargin, LevelSummary};
-pub use support::{support_polygon, SupportSettings};
+pub use support::{sole_pose, support_polygon, SupportSettings};
 
 use nalgebra::{DVector, Isometry3, Translation3, UnitQuaternion, Vector3, Vector6};
 
-use crate::error::{Error, Result};
-use crate::limits::{compute_box, AccelerationBox, BoundMethod, DofLimits, JointLimits};
+use super::health::HealthSettings;
+use crate::controller::{
+    ComHandle, Controller, ControllerBuilder, ControllerSettings, FrameHandle, JointsHandle,
+};
+use crate::error::{check_dim, Error, Result};
+use crate::limits::{AccelerationBox, BoundMethod, DofLimits, JointLimits, OutsideLimits};
 use crate::model::{Kinematics, Robot, State};
 use crate::motion::RobotReferences;
-use crate::solver::{Method, SolveReport, Solver, SolverSettings};
-use crate::task::{
-    Axes, ComReference, ComTask, FrameReference, FrameTask, Gains, JointTask, Task, TaskStack,
-};
+use crate::resources::RunLimits;
+use crate::solver::{Method, SolveReport, SolverSettings};
+use crate::task::{Axes, ComReference, FrameReference, Gains, TaskEquation};
 
 /// Names of the five levels, in priority order.
 pub const LEVEL_NAMES: [&str; 5] = [
@@ -58,6 +61,8 @@ pub struct ImitateConfig {
     pub bounds: BoundMethod,
     /// Control period Δt \[s\]; must equal the references' period.
     pub dt: f64,
+    /// Range of Δt and largest tick count ([`RunLimits`]).
+    pub run_limits: RunLimits,
     /// CLIK gains of every task (default k_p = 100 s⁻², k_v = 20 s⁻¹, critically damped).
     pub gains: Gains,
     /// Frames of the feet (6D tasks, one level).
@@ -92,6 +97,9 @@ pub struct ImitateConfig {
     pub on_limit_fraction: f64,
     /// Solver settings.
     pub solver: SolverSettings,
+    /// The run's checks (feet held, state finite, ZMP inside the support polygon) and whether
+    /// a failed one stops the run ([`crate::sim::health`]).
+    pub health: HealthSettings,
 }
 
 impl ImitateConfig {
@@ -112,6 +120,7 @@ impl ImitateConfig {
             method: Method::Iktc,
             bounds: BoundMethod::quiet(),
             dt: 0.005,
+            run_limits: RunLimits::default(),
             gains: Gains {
                 kp: 100.0,
                 kv: 20.0,
@@ -141,6 +150,7 @@ impl ImitateConfig {
                 level_hold: 3,
                 ..SolverSettings::default()
             },
+            health: HealthSettings::default(),
         }
     }
 
@@ -151,9 +161,7 @@ impl ImitateConfig {
             value: value.to_string(),
             expected: expected.into(),
         };
-        if !(self.dt.is_finite() && self.dt > 0.0) {
-            return Err(bad("dt", self.dt, "a finite period > 0 [s]"));
-        }
+        self.run_limits.check_dt("dt", self.dt)?;
         if !(self.reference_margin.is_finite() && self.reference_margin >= 0.0) {
             return Err(bad(
                 "reference_margin",
@@ -208,6 +216,7 @@ impl ImitateConfig {
         self.gains.validate()?;
         self.bounds.validate()?;
         self.support.validate()?;
+        self.health.validate()?;
         self.solver.validate()
     }
 }
@@ -253,25 +262,33 @@ pub fn imitation_references(
             }
         }
     }
-    r.resample(cfg.dt)
+    r.resample_with(cfg.dt, &cfg.run_limits)
 }
 
-/// The closed loop of one imitation run: tasks, bounds, solver and state, sized once.
+/// The handles of the tasks of Table 1 in an imitation's [`Controller`].
+#[derive(Debug, Clone)]
+pub struct ImitationTasks {
+    /// The feet, 6D each, in the order of [`ImitateConfig::feet`] (level 1).
+    pub feet: Vec<FrameHandle>,
+    /// The COM in the horizontal plane (level 2).
+    pub com: ComHandle,
+    /// The pelvis attitude (level 3).
+    pub pelvis_attitude: FrameHandle,
+    /// The pelvis height (level 4).
+    pub pelvis_height: FrameHandle,
+    /// The upper-body joints, one row per reference joint (level 5).
+    pub upper_body: JointsHandle,
+}
+
+/// The closed loop of one imitation run: a [`Controller`] with the stack of Table 1, its
+/// references and its state, sized once.
 #[derive(Debug, Clone)]
 pub struct ImitationController {
-    method: Method,
-    bounds: BoundMethod,
+    ctl: Controller,
+    tasks: ImitationTasks,
     dt: f64,
     refs: RobotReferences,
-    limits: JointLimits,
-    stack: TaskStack,
-    eqs: Vec<crate::task::TaskEquation>,
-    solver: Solver,
-    bx: AccelerationBox,
     state: State,
-    kin: Kinematics,
-    qdd: DVector<f64>,
-    pos: Vec<f64>,
     upper: [Vec<f64>; 3],
     pelvis0: Isometry3<f64>,
     feet0: Vec<Isometry3<f64>>,
@@ -289,7 +306,9 @@ impl ImitationController {
     /// polygon.
     ///
     /// Errors: bad settings, unknown frames or joints, references whose period differs from
-    /// `cfg.dt`, a narrowed range outside the joint's own.
+    /// `cfg.dt`, a narrowed range outside the joint's own, and
+    /// [`Error::StateOutsideLimits`] for a start state (posture, first references) outside the
+    /// (narrowed) limits unless `cfg.bounds` asks for [`OutsideLimits::Recover`].
     pub fn new(robot: &Robot, refs: &RobotReferences, cfg: &ImitateConfig) -> Result<Self> {
         cfg.validate()?;
         refs.validate()?;
@@ -320,7 +339,7 @@ impl ImitationController {
                 d.position_max = n.upper;
             }
         }
-        let limits = JointLimits::new(dofs)?;
+        let limits = JointLimits::new(dofs)?.with_names(robot.dof_names())?;
         // Clamp the joint references into the (narrowed) ranges.
         for (name, track) in refs.joint_names.iter().zip(refs.joints.iter_mut()) {
             let v = robot.joint_v_index(name)?;
@@ -356,6 +375,12 @@ impl ImitationController {
                 state.set_joint(robot, name, *p)?;
             }
         }
+        // A start outside the (narrowed) limits is refused unless recovery was asked for.
+        let mut pos = vec![0.0; robot.nv()];
+        if cfg.bounds.outside_limits() == OutsideLimits::Error {
+            state.dof_positions(robot, &mut pos)?;
+            limits.check_state(&pos, state.qd.as_slice())?;
+        }
         let mut kin = Kinematics::new(robot, &state)?;
         let feet_ids = cfg
             .feet
@@ -376,66 +401,51 @@ impl ImitationController {
             .iter()
             .map(|f| kin.frame_pose(robot, *f))
             .collect::<Result<Vec<_>>>()?;
-        let polygon = support_polygon(&feet0, &cfg.support);
-        let centre =
-            polygon.iter().fold(Vector3::zeros(), |a, p| a + p) / polygon.len().max(1) as f64;
-        let com_ref = Vector3::new(centre.x, centre.y, kin.com().z);
+        let polygon = support_polygon(&feet0, &cfg.support)?;
+        let corners = polygon.vertices();
+        let centre = corners
+            .iter()
+            .fold((0.0, 0.0), |a, p| (a.0 + p.0, a.1 + p.1));
+        let count = corners.len().max(1) as f64;
+        let com_ref = Vector3::new(centre.0 / count, centre.1 / count, kin.com().z);
         let com_start = kin.com();
         let pelvis_id = robot.frame_id(&cfg.pelvis)?;
         let pelvis0 = kin.frame_pose(robot, pelvis_id)?;
-        // Tasks.
-        let g = cfg.gains;
-        let mut stack = TaskStack::default();
-        let mut feet_tasks = Vec::new();
-        for (f, pose) in cfg.feet.iter().zip(&feet0) {
-            let mut t = FrameTask::new(robot, f, Axes::ALL, g)?;
-            t.set_reference(FrameReference::hold(*pose))?;
-            feet_tasks.push(Task::Frame(t));
-        }
-        stack.push(LEVEL_NAMES[0], feet_tasks);
-        let mut com = ComTask::new(robot, [true, true, false], g)?;
-        com.set_reference(ComReference {
-            position: com_start,
-            velocity: Vector3::zeros(),
-            acceleration: Vector3::zeros(),
-        })?;
-        stack.push(LEVEL_NAMES[1], vec![Task::Com(com)]);
-        stack.push(
-            LEVEL_NAMES[2],
-            vec![Task::Frame(FrameTask::new(
-                robot,
-                &cfg.pelvis,
-                Axes::ORIENTATION,
-                g,
-            )?)],
-        );
-        stack.push(
-            LEVEL_NAMES[3],
-            vec![Task::Frame(FrameTask::new(robot, &cfg.pelvis, Axes::Z, g)?)],
-        );
+        // Tasks, each created holding where the robot stands.
+        let mut b = ControllerBuilder::new(std::sync::Arc::new(robot.clone()), &state)?;
+        b.gains(cfg.gains)
+            .limits(limits)
+            .settings(ControllerSettings {
+                method: cfg.method,
+                bounds: cfg.bounds,
+                solver: cfg.solver,
+            });
+        b.level(LEVEL_NAMES[0]);
+        let feet = cfg
+            .feet
+            .iter()
+            .map(|f| b.frame(f, Axes::ALL))
+            .collect::<Result<Vec<_>>>()?;
+        let com = b.level(LEVEL_NAMES[1]).com([true, true, false])?;
+        let pelvis_attitude = b
+            .level(LEVEL_NAMES[2])
+            .frame(&cfg.pelvis, Axes::ORIENTATION)?;
+        let pelvis_height = b.level(LEVEL_NAMES[3]).frame(&cfg.pelvis, Axes::Z)?;
         let names: Vec<&str> = refs.joint_names.iter().map(|s| s.as_str()).collect();
-        stack.push(
-            LEVEL_NAMES[4],
-            vec![Task::Joint(JointTask::new(robot, &names, g)?)],
-        );
-        let eqs = stack.equations(robot);
-        let dims: Vec<usize> = eqs.iter().map(|e| e.dim()).collect();
-        let solver = Solver::new(robot.nv(), &dims, cfg.solver)?;
+        let upper_body = b.level(LEVEL_NAMES[4]).joints(&names)?;
         let m = refs.joint_names.len();
         Ok(Self {
-            method: cfg.method,
-            bounds: cfg.bounds,
+            ctl: b.build()?,
+            tasks: ImitationTasks {
+                feet,
+                com,
+                pelvis_attitude,
+                pelvis_height,
+                upper_body,
+            },
             dt: cfg.dt,
             refs,
-            limits,
-            stack,
-            eqs,
-            solver,
-            bx: AccelerationBox::new(robot.nv()),
             state,
-            kin,
-            qdd: DVector::zeros(robot.nv()),
-            pos: vec![0.0; robot.nv()],
             upper: [vec![0.0; m], vec![0.0; m], vec![0.0; m]],
             pelvis0,
             feet0,
@@ -452,9 +462,9 @@ impl ImitationController {
     /// [`ImitationController::qdd`] and not yet applied (see [`ImitationController::integrate`]).
     /// Allocates nothing.
     pub fn tick(&mut self, robot: &Robot, k: usize) -> Result<&SolveReport> {
+        self.check_robot(robot)?;
         let k = k.min(self.refs.len().saturating_sub(1));
         self.tick = k;
-        self.kin.update(robot, &self.state)?;
         let r = &self.refs;
         let attitude = r.attitude.get(k).copied().unwrap_or_default() * self.pelvis0.rotation;
         let w = r.angular_velocity.get(k).copied().unwrap_or_default();
@@ -471,60 +481,45 @@ impl ImitationController {
             Some(c) => c,
             None => self.com_reference_at(k as f64 * self.dt),
         };
-        for (li, level) in self.stack.levels.iter_mut().enumerate() {
-            for task in level.tasks.iter_mut() {
-                match (li, task) {
-                    (1, Task::Com(c)) => c.set_reference(com)?,
-                    (2, Task::Frame(f)) => f.set_reference(FrameReference {
-                        pose: Isometry3::from_parts(self.pelvis0.translation, attitude),
-                        velocity: Vector6::new(0.0, 0.0, 0.0, w.x, w.y, w.z),
-                        acceleration: Vector6::new(0.0, 0.0, 0.0, wd.x, wd.y, wd.z),
-                    })?,
-                    (3, Task::Frame(f)) => f.set_reference(FrameReference {
-                        pose: Isometry3::from_parts(
-                            Translation3::new(
-                                self.pelvis0.translation.x,
-                                self.pelvis0.translation.y,
-                                z,
-                            ),
-                            UnitQuaternion::identity(),
-                        ),
-                        velocity: Vector6::new(0.0, 0.0, zd, 0.0, 0.0, 0.0),
-                        acceleration: Vector6::new(0.0, 0.0, zdd, 0.0, 0.0, 0.0),
-                    })?,
-                    (4, Task::Joint(j)) => {
-                        j.set_reference(&self.upper[0], &self.upper[1], &self.upper[2])?
-                    }
-                    _ => {}
-                }
-            }
-        }
-        self.stack
-            .linearize(robot, &self.kin, &self.state, &mut self.eqs)?;
-        self.state.dof_positions(robot, &mut self.pos)?;
-        compute_box(
-            &self.limits,
-            &self.bounds,
-            &self.pos,
-            self.state.qd.as_slice(),
-            self.dt,
-            &mut self.bx,
+        let t = &self.tasks;
+        self.ctl.set_com_reference(t.com, com)?;
+        self.ctl.set_frame_reference(
+            t.pelvis_attitude,
+            FrameReference {
+                pose: Isometry3::from_parts(self.pelvis0.translation, attitude),
+                velocity: Vector6::new(0.0, 0.0, 0.0, w.x, w.y, w.z),
+                acceleration: Vector6::new(0.0, 0.0, 0.0, wd.x, wd.y, wd.z),
+            },
         )?;
-        self.solver
-            .solve(self.method, &self.eqs, &self.bx, &mut self.qdd)
+        self.ctl.set_frame_reference(
+            t.pelvis_height,
+            FrameReference {
+                pose: Isometry3::from_parts(
+                    Translation3::new(self.pelvis0.translation.x, self.pelvis0.translation.y, z),
+                    UnitQuaternion::identity(),
+                ),
+                velocity: Vector6::new(0.0, 0.0, zd, 0.0, 0.0, 0.0),
+                acceleration: Vector6::new(0.0, 0.0, zdd, 0.0, 0.0, 0.0),
+            },
+        )?;
+        self.ctl.set_joints_reference(
+            t.upper_body,
+            &self.upper[0],
+            &self.upper[1],
+            &self.upper[2],
+        )?;
+        self.ctl.prepare(&self.state, self.dt)?;
+        self.ctl.solve()
     }
 
     /// Replaces the references of the feet tasks (level 1), one per foot in the order of
     /// [`ImitateConfig::feet`]: a walking pattern moves the feet this way. Allocates nothing.
     pub fn set_feet_references(&mut self, refs: &[FrameReference]) -> Result<()> {
-        let Some(level) = self.stack.levels.first_mut() else {
-            return Ok(());
-        };
-        crate::error::check_dim("feet references", level.tasks.len(), refs.len())?;
-        for (task, r) in level.tasks.iter_mut().zip(refs) {
-            if let Task::Frame(f) = task {
-                f.set_reference(*r)?;
-            }
+        if refs.len() != self.tasks.feet.len() {
+            check_dim("feet references", self.tasks.feet.len(), refs.len())?;
+        }
+        for (h, r) in self.tasks.feet.iter().zip(refs) {
+            self.ctl.set_frame_reference(*h, *r)?;
         }
         Ok(())
     }
@@ -536,8 +531,37 @@ impl ImitationController {
     }
 
     /// Applies the last q̈ over Δt (constant acceleration).
+    ///
+    /// Errors: no tick solved since the last integration, or another robot.
     pub fn integrate(&mut self, robot: &Robot) -> Result<()> {
-        self.state.integrate(robot, &self.qdd, self.dt)
+        self.check_robot(robot)?;
+        self.ctl.integrate(&mut self.state)
+    }
+
+    /// The controller owns a copy of the robot it was built for; `robot` must have its sizes.
+    fn check_robot(&self, robot: &Robot) -> Result<()> {
+        let own = self.ctl.robot();
+        if robot.nv() != own.nv() || robot.nq() != own.nq() {
+            check_dim("velocity dofs of the robot", own.nv(), robot.nv())?;
+            check_dim("position coordinates of the robot", own.nq(), robot.nq())?;
+        }
+        Ok(())
+    }
+
+    /// The controller (stack, equations, box, solver) with the tasks of Table 1.
+    pub fn controller(&self) -> &Controller {
+        &self.ctl
+    }
+
+    /// The controller, to set a task's reference or gains through [`Self::tasks`]; the tick
+    /// overwrites every reference but the feet's.
+    pub fn controller_mut(&mut self) -> &mut Controller {
+        &mut self.ctl
+    }
+
+    /// The handles of the tasks of Table 1.
+    pub fn tasks(&self) -> &ImitationTasks {
+        &self.tasks
     }
 
     /// The state (at the start of the next tick once integrated).
@@ -547,32 +571,32 @@ impl ImitationController {
 
     /// Kinematics at the state of the last tick.
     pub fn kinematics(&self) -> &Kinematics {
-        &self.kin
+        self.ctl.kinematics()
     }
 
     /// The task equations of the last tick (errors `x_d − x` per level).
-    pub fn equations(&self) -> &[crate::task::TaskEquation] {
-        &self.eqs
+    pub fn equations(&self) -> &[TaskEquation] {
+        self.ctl.equations()
     }
 
     /// The acceleration box of the last tick.
     pub fn acceleration_box(&self) -> &AccelerationBox {
-        &self.bx
+        self.ctl.bounds()
     }
 
     /// q̈ of the last tick \[rad/s²\] (base: \[m/s²\], \[rad/s²\]).
     pub fn qdd(&self) -> &DVector<f64> {
-        &self.qdd
+        self.ctl.qdd()
     }
 
     /// Dof positions of the last tick \[rad\] (base entries 0).
     pub fn dof_positions(&self) -> &[f64] {
-        &self.pos
+        self.ctl.dof_positions()
     }
 
     /// The limits used (narrowed).
     pub fn limits(&self) -> &JointLimits {
-        &self.limits
+        self.ctl.limits()
     }
 
     /// The references (joint references clamped into the ranges).
@@ -620,7 +644,7 @@ impl ImitationController {
 
     /// The solver's report of the last tick.
     pub fn report(&self) -> &SolveReport {
-        self.solver.report()
+        self.ctl.report()
     }
 
     /// Reference index of the last tick.
@@ -630,6 +654,6 @@ impl ImitationController {
 
     /// Level sizes m_i in priority order.
     pub fn level_dims(&self) -> Vec<usize> {
-        self.eqs.iter().map(|e| e.dim()).collect()
+        self.ctl.level_dims().collect()
     }
 }

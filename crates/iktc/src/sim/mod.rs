@@ -1,15 +1,18 @@
 //! Scenarios: the paper's experiments as runnable, recorded simulations.
 
+pub mod health;
 pub mod imitate;
 pub mod margins;
 pub mod planar3r;
 pub mod smoothness;
+pub mod sweep;
 pub mod switches;
 pub mod walk_imitate;
 
+pub use health::{HealthCheck, HealthIssue, HealthMonitor, HealthReport, HealthSettings, Verdict};
 pub use imitate::{
     imitation_references, run_imitate, ImitateConfig, ImitateRun, ImitateStep, ImitateSummary,
-    ImitationController, NarrowedJoint,
+    ImitationController, ImitationTasks, NarrowedJoint,
 };
 pub use margins::{dof_margins, median, percentile, DofMargins};
 pub use planar3r::{
@@ -18,6 +21,6 @@ pub use planar3r::{
 pub use smoothness::{DofSmoothness, JointSmoothness};
 pub use switches::LevelSwitches;
 pub use walk_imitate::{
-    run_walk_imitate, Push, WalkImitateConfig, WalkRun, WalkStep, WalkSummary, WalkTick,
-    WalkingController,
+    run_walk_imitate, Push, PushAxisMetrics, WalkImitateConfig, WalkPushSummary, WalkRun, WalkStep,
+    WalkSummary, WalkTick, WalkingController,
 };

@@ -13,11 +13,13 @@ use serde::Serialize;
 
 use super::margins::{dof_margins, median, DofMargins};
 use super::smoothness::{joints_smoothness, JointSmoothness};
+use crate::controller::{ControllerBuilder, ControllerSettings};
 use crate::error::{Error, Result};
-use crate::limits::{compute_box, AccelerationBox, BoundMethod, JointLimits};
-use crate::model::{planar3r, Kinematics, State};
-use crate::solver::{Method, Solver, SolverSettings};
-use crate::task::{Axes, FrameReference, FrameTask, Gains, Task, TaskStack};
+use crate::limits::{BoundMethod, JointLimits, OutsideLimits};
+use crate::model::{planar3r, State};
+use crate::resources::RunLimits;
+use crate::solver::{Method, SolverSettings};
+use crate::task::{Axes, FrameReference, Gains};
 
 /// One of the three tasks of the experiment.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, serde::Deserialize)]
@@ -60,6 +62,8 @@ pub struct Planar3rConfig {
     pub dt: f64,
     /// Duration \[s\].
     pub duration: f64,
+    /// Range of Δt and largest tick count ([`RunLimits`]).
+    pub run_limits: RunLimits,
     /// Priority order, highest first.
     pub priority: [ArmTask; 3],
     /// CLIK gains of every task.
@@ -75,6 +79,7 @@ impl Default for Planar3rConfig {
             bounds: BoundMethod::quiet(),
             dt: 0.005,
             duration: 2.0,
+            run_limits: RunLimits::default(),
             priority: [ArmTask::Py, ArmTask::Px, ArmTask::Theta],
             gains: Gains {
                 kp: 100.0,
@@ -191,13 +196,7 @@ pub fn reference(t: f64) -> ([f64; 3], [f64; 3], [f64; 3]) {
 
 /// Runs the experiment.
 pub fn run_planar3r(cfg: &Planar3rConfig) -> Result<Planar3rRun> {
-    if !(cfg.dt.is_finite() && cfg.dt > 0.0 && cfg.duration.is_finite() && cfg.duration > 0.0) {
-        return Err(Error::InvalidSetting {
-            name: "dt / duration".into(),
-            value: format!("{} / {}", cfg.dt, cfg.duration),
-            expected: "positive, finite times [s]".into(),
-        });
-    }
+    let n_steps = cfg.run_limits.ticks("the 3R run", cfg.duration, cfg.dt)?;
     let mut sorted = cfg.priority.map(|t| t.index());
     sorted.sort();
     if sorted != [0, 1, 2] {
@@ -211,7 +210,13 @@ pub fn run_planar3r(cfg: &Planar3rConfig) -> Result<Planar3rRun> {
     let deg = std::f64::consts::PI / 180.0;
     let mut state = State::neutral(&robot);
     state.q = DVector::from_vec(vec![90.0 * deg, -90.0 * deg, 90.0 * deg]);
-    let mut stack = TaskStack::default();
+    let mut b = ControllerBuilder::new(robot.clone(), &state)?;
+    b.gains(cfg.gains).settings(ControllerSettings {
+        method: cfg.method,
+        bounds: cfg.bounds,
+        solver: cfg.solver,
+    });
+    let mut tasks = Vec::with_capacity(3);
     for t in cfg.priority {
         let mut axes = [false; 6];
         axes[match t {
@@ -219,32 +224,21 @@ pub fn run_planar3r(cfg: &Planar3rConfig) -> Result<Planar3rRun> {
             ArmTask::Py => 1,
             ArmTask::Theta => 5,
         }] = true;
-        stack.push(
-            t.name(),
-            vec![Task::Frame(FrameTask::new(
-                &robot,
-                "tip",
-                Axes(axes),
-                cfg.gains,
-            )?)],
-        );
+        tasks.push(b.level(t.name()).frame("tip", Axes(axes))?);
     }
-    let mut eqs = stack.equations(&robot);
-    let dims: Vec<usize> = eqs.iter().map(|e| e.dim()).collect();
-    let mut solver = Solver::new(robot.nv(), &dims, cfg.solver)?;
-    let limits = JointLimits::from_robot(&robot)?;
-    let mut bx = AccelerationBox::new(robot.nv());
-    let mut kin = Kinematics::new(&robot, &state)?;
-    let mut qdd = DVector::zeros(robot.nv());
-    let mut pos = vec![0.0; robot.nv()];
-    let n_steps = (cfg.duration / cfg.dt).round() as usize;
+    if cfg.bounds.outside_limits() == OutsideLimits::Error {
+        let limits = JointLimits::from_robot(&robot)?;
+        let mut start = vec![0.0; robot.nv()];
+        state.dof_positions(&robot, &mut start)?;
+        limits.check_state(&start, state.qd.as_slice())?;
+    }
+    let mut ctl = b.build()?;
     let mut steps = Vec::with_capacity(n_steps);
     let tip = robot.frame_id("tip")?;
     for k in 0..n_steps {
         let t = k as f64 * cfg.dt;
         let (x, xd, xdd) = reference(t);
         let start = Instant::now();
-        kin.update(&robot, &state)?;
         let pose = Isometry3::from_parts(
             Translation3::new(x[0], x[1], 0.0),
             UnitQuaternion::from_axis_angle(&Vector3::z_axis(), x[2]),
@@ -254,35 +248,25 @@ pub fn run_planar3r(cfg: &Planar3rConfig) -> Result<Planar3rRun> {
             velocity: Vector6::new(xd[0], xd[1], 0.0, 0.0, 0.0, xd[2]),
             acceleration: Vector6::new(xdd[0], xdd[1], 0.0, 0.0, 0.0, xdd[2]),
         };
-        for level in stack.levels.iter_mut() {
-            for task in level.tasks.iter_mut() {
-                if let Task::Frame(f) = task {
-                    f.set_reference(r)?;
-                }
-            }
+        for h in &tasks {
+            ctl.set_frame_reference(*h, r)?;
         }
-        stack.linearize(&robot, &kin, &state, &mut eqs)?;
-        state.dof_positions(&robot, &mut pos)?;
-        compute_box(
-            &limits,
-            &cfg.bounds,
-            &pos,
-            state.qd.as_slice(),
-            cfg.dt,
-            &mut bx,
-        )?;
-        let rep = solver.solve(cfg.method, &eqs, &bx, &mut qdd)?;
+        ctl.prepare(&state, cfg.dt)?;
+        let rep = ctl.solve()?;
         let tick_us = start.elapsed().as_secs_f64() * 1e6;
-        let tp = kin.frame_pose(&robot, tip)?;
+        let (corrected_from, qp_solves, empty_dofs) =
+            (rep.corrected_from, rep.qp_solves, rep.empty_box_dofs);
+        let mut correction = [0.0; 3];
+        for (lvl, t) in cfg.priority.iter().enumerate() {
+            correction[t.index()] = rep.corrections[lvl][0];
+        }
+        let tp = ctl.kinematics().frame_pose(&robot, tip)?;
         let value = [
             tp.translation.x,
             tp.translation.y,
             state.q[0] + state.q[1] + state.q[2],
         ];
-        let mut correction = [0.0; 3];
-        for (lvl, t) in cfg.priority.iter().enumerate() {
-            correction[t.index()] = rep.corrections[lvl][0];
-        }
+        let (qdd, bx) = (ctl.qdd(), ctl.bounds());
         steps.push(Planar3rStep {
             t,
             q: [state.q[0], state.q[1], state.q[2]],
@@ -294,12 +278,12 @@ pub fn run_planar3r(cfg: &Planar3rConfig) -> Result<Planar3rRun> {
             value,
             error: [x[0] - value[0], x[1] - value[1], x[2] - value[2]],
             correction,
-            corrected_from: rep.corrected_from.map_or(0, |l| l + 1),
-            qp_solves: rep.qp_solves,
-            empty_dofs: rep.empty_box_dofs,
+            corrected_from: corrected_from.map_or(0, |l| l + 1),
+            qp_solves,
+            empty_dofs,
             tick_us,
         });
-        state.integrate(&robot, &qdd, cfg.dt)?;
+        ctl.integrate(&mut state)?;
     }
     let summary = summarize(cfg, &robot, &steps);
     Ok(Planar3rRun { steps, summary })

@@ -27,12 +27,14 @@ use std::time::Instant;
 use nalgebra::{Isometry3, Rotation2, Translation3, UnitQuaternion, Vector2, Vector3, Vector6};
 use serde::Serialize;
 
+use super::health::{HealthMonitor, HealthReport, Verdict};
 use super::imitate::{ImitateConfig, ImitationController};
 use super::margins::{dof_margins, median, percentile, DofMargins};
 use crate::balance::{
     analyse_response, BalanceController, BalanceSettings, CaseParams, FullModelParams, Plane,
     PlantParams, ResponseSettings, SimPlant, SimSettings, SupportPhase,
 };
+use crate::controller::FrameHandle;
 use crate::error::{Error, Result};
 use crate::model::{Robot, State};
 use crate::motion::RobotReferences;
@@ -189,12 +191,13 @@ pub struct WalkSummary {
     pub worst_margins: [f64; 3],
     /// Margins of every joint (narrowed ranges).
     pub margins: Vec<(String, DofMargins)>,
-    /// Peak |ZMP deviation| after the push (x̃) \[m\].
-    pub push_peak: f64,
-    /// Damping ratio measured from the ZMP deviation after the push (x̃) \[–\].
-    pub push_damping_ratio: f64,
-    /// Settling time of the ZMP deviation after the push (x̃) \[s\], if it settled.
-    pub push_settling_time: Option<f64>,
+    /// The response to the push, in both horizontal directions; absent (`None`, left out
+    /// of the JSON) without a push.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub push: Option<WalkPushSummary>,
+    /// The run's checks: feet on their references, state finite, measured ZMP inside the
+    /// support polygon.
+    pub health: HealthReport,
     /// Ticks whose correction started above the lowest level.
     pub climbed_ticks: usize,
     /// Ticks with any correction.
@@ -209,6 +212,45 @@ pub struct WalkSummary {
     pub tick_median_us: f64,
     /// 99th percentile tick time \[µs\].
     pub tick_p99_us: f64,
+}
+
+/// The response of the measured ZMP deviation along one horizontal axis of the local frame
+/// of Figure 11 after a push ([`analyse_response`]).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct PushAxisMetrics {
+    /// Largest |deviation| after the push \[m\].
+    pub peak: f64,
+    /// Time of the peak after the push \[s\].
+    pub peak_time: f64,
+    /// Time after the push from which the deviation stays in its settling band \[s\];
+    /// absent (left out of the JSON) if it never settles within the run.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub settling_time: Option<f64>,
+    /// Damping ratio of the fitted dominant mode \[–\]; absent (left out of the JSON) when
+    /// the peak stays within the noise floor (`noise_sigmas` standard deviations of the
+    /// sensor noise): there is no response to fit.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub damping_ratio: Option<f64>,
+    /// Natural frequency of the fitted mode \[rad/s\]; absent as the damping ratio.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub natural_frequency: Option<f64>,
+}
+
+/// The response to a push during the walk.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct WalkPushSummary {
+    /// The push.
+    pub push: Push,
+    /// Along the local x̃ axis (forward).
+    pub x: PushAxisMetrics,
+    /// Along the local ỹ axis (left).
+    pub y: PushAxisMetrics,
+    /// Smallest signed distance of the measured ZMP inside the support polygon from the
+    /// push on \[m\].
+    pub zmp_min_margin: f64,
+    /// Largest distance of the measured ZMP outside the support polygon from the push on
+    /// \[m\] (0: it stayed inside).
+    pub zmp_excursion: f64,
 }
 
 /// A whole run.
@@ -300,6 +342,9 @@ pub struct WalkingController {
     com0: Vector3<f64>,
     blend0: Vector2<f64>,
     com_blend_time: f64,
+    /// The handles of the right and left foot tasks.
+    feet: [FrameHandle; 2],
+    /// Their references of the last tick (right, left).
     feet_refs: [FrameReference; 2],
     dc_prev: Vector2<f64>,
     dcd_prev: Vector2<f64>,
@@ -325,9 +370,16 @@ impl WalkingController {
                 expected: "two feet: right, then left".into(),
             });
         }
+        // Before the footsteps are planned: the walk lasts at least steps × ssp_duration.
+        cfg.imitate.run_limits.ticks(
+            "the walk",
+            cfg.steps as f64 * cfg.walk.ssp_duration.max(0.0),
+            dt,
+        )?;
         let ctl = ImitationController::new(robot, refs, &cfg.imitate)?;
         // The imitation lists the right foot first, then the left.
         let (r0, l0) = (ctl.feet0()[0], ctl.feet0()[1]);
+        let feet = [ctl.tasks().feet[0], ctl.tasks().feet[1]];
         let origin = Vector2::new(
             0.5 * (r0.translation.x + l0.translation.x),
             0.5 * (r0.translation.y + l0.translation.y),
@@ -352,6 +404,9 @@ impl WalkingController {
             FootstepPlan::forward(cfg.steps, cfg.step_length, &walk)?
         };
         let pattern = WalkingPattern::new(&plan, &walk, &preview)?;
+        cfg.imitate
+            .run_limits
+            .ticks("the walk", pattern.duration(), dt)?;
         let l = com0.z;
         let cases = CaseParams {
             xz_ssp: with_length(&cfg.cases.xz_ssp, l),
@@ -367,6 +422,7 @@ impl WalkingController {
         );
         Ok(Self {
             feet_refs: [FrameReference::hold(r0), FrameReference::hold(l0)],
+            feet,
             ctl,
             plan,
             pattern,
@@ -484,7 +540,9 @@ impl WalkingController {
         }));
         self.feet_refs[0] = ankle_reference(&s.right, &self.ankle_offset, &origin);
         self.feet_refs[1] = ankle_reference(&s.left, &self.ankle_offset, &origin);
-        self.ctl.set_feet_references(&self.feet_refs)?;
+        for (h, r) in self.feet.iter().zip(&self.feet_refs) {
+            self.ctl.controller_mut().set_frame_reference(*h, *r)?;
+        }
         let rep = self.ctl.tick(robot, k)?;
         Ok(WalkTick {
             sample: s,
@@ -504,7 +562,14 @@ impl WalkingController {
     }
 }
 
-/// Runs the walking imitation on the simulated compliant robot.
+/// Runs the walking imitation on the simulated compliant robot, each tick checked by a
+/// [`HealthMonitor`] with the imitation's [`ImitateConfig::health`]: each foot's ankle
+/// (position \[m\] and rotation \[rad\]) against its reference from the walking pattern, the
+/// state and the measured ZMP finite, and the measured ZMP inside the pattern's support
+/// polygon ([`WalkingPattern::support_polygon_into`]).
+///
+/// Errors: bad settings or references, and [`Error::RunFailed`] when a check fails (unless
+/// [`crate::sim::HealthSettings::keep_going`]; see [`crate::sim::health`]).
 pub fn run_walk_imitate(
     robot: &Robot,
     refs: &RobotReferences,
@@ -542,6 +607,8 @@ pub fn run_walk_imitate(
     let mut polygon = SupportPolygon::default();
     let mut last_phase = SupportPhase::Double;
     let push_tick = cfg.push.map(|p| (p.time / dt).round() as usize);
+    let mut health = HealthMonitor::new(cfg.imitate.health)?;
+    let dof_names = robot.dof_names();
     for k in 0..n {
         let t = k as f64 * dt;
         // Measured ZMP deviation of the simulated robot, local frame.
@@ -578,19 +645,53 @@ pub fn run_walk_imitate(
             s.zmp_model.0 + origin.x + zdev.x,
             s.zmp_model.1 + origin.y + zdev.y,
         );
+        let state: &State = ctl.state();
+        let mut verdict = Verdict::Continue;
+        for (what, values) in [
+            ("joint position q [rad]", ctl.dof_positions()),
+            ("velocity q̇ [rad/s]", state.qd.as_slice()),
+            ("commanded acceleration q̈ [rad/s²]", ctl.qdd().as_slice()),
+            ("COM [m]", com.as_slice()),
+            ("measured ZMP [m]", &[zm.0, zm.1][..]),
+        ] {
+            if verdict == Verdict::Continue {
+                verdict = health.check_finite(t, what, &dof_names, values)?;
+            }
+        }
+        if verdict == Verdict::Stop {
+            break;
+        }
         wc.pattern().support_polygon_into(t, &mut polygon)?;
         let zmp_margin = polygon.margin((zm.0 - origin.x, zm.1 - origin.y));
         let mut feet = [[0.0; 3]; 2];
-        for (slot, id) in feet.iter_mut().zip([feet_ids[1], feet_ids[0]]) {
-            let p = kin.frame_pose(robot, id)?.translation.vector;
+        let frefs = wc.feet_references();
+        for ((slot, id), (r, name)) in feet.iter_mut().zip([feet_ids[1], feet_ids[0]]).zip(
+            frefs
+                .iter()
+                .zip([&cfg.imitate.feet[1], &cfg.imitate.feet[0]]),
+        ) {
+            let pose = kin.frame_pose(robot, id)?;
+            let p = pose.translation.vector;
             *slot = [p.x, p.y, p.z];
+            health.check_foot(
+                t,
+                name,
+                (p - r.pose.translation.vector).norm(),
+                pose.rotation.angle_to(&r.pose.rotation),
+            )?;
         }
+        health.check_support(
+            t,
+            &polygon,
+            (zm.0 - origin.x, zm.1 - origin.y),
+            "measured ZMP",
+            "world axes, origin between the initial ankles",
+        )?;
+        health.end_tick();
         let fr = |r: &FrameReference| {
             let p = r.pose.translation.vector;
             [p.x, p.y, p.z]
         };
-        let frefs = wc.feet_references();
-        let state: &State = ctl.state();
         steps.push(WalkStep {
             t,
             phase: phase_code(s.phase),
@@ -653,7 +754,7 @@ pub fn run_walk_imitate(
         .iter()
         .map(|p| (p.start, p.end, phase_code(p.phase)))
         .collect();
-    let summary = summarize(robot, cfg, ctl, &steps, pattern.duration())?;
+    let summary = summarize(robot, cfg, ctl, &steps, pattern.duration(), health.report())?;
     Ok(WalkRun {
         steps,
         footsteps,
@@ -668,6 +769,7 @@ fn summarize(
     ctl: &ImitationController,
     steps: &[WalkStep],
     duration: f64,
+    health: HealthReport,
 ) -> Result<WalkSummary> {
     let dt = cfg.imitate.dt;
     let names = robot.dof_names();
@@ -722,14 +824,11 @@ fn summarize(
         .iter()
         .map(|s| s.zmp_margin)
         .fold(f64::INFINITY, f64::min);
-    let (push_peak, push_damping_ratio, push_settling_time) = match cfg.push {
-        Some(p) => {
-            let t: Vec<f64> = steps.iter().map(|s| s.t).collect();
-            let y: Vec<f64> = steps.iter().map(|s| s.zmp_deviation[0]).collect();
-            let m = analyse_response(&t, &y, p.time, cfg.noise_std, &ResponseSettings::default())?;
-            (m.peak, m.damping_ratio, m.settling_time)
+    let push = match cfg.push {
+        Some(p) if steps.last().is_some_and(|s| s.t > p.time) => {
+            Some(push_summary(steps, p, cfg.noise_std)?)
         }
-        None => (0.0, 0.0, None),
+        _ => None,
     };
     let ticks: Vec<f64> = steps.iter().map(|s| s.tick_us).collect();
     let nt = ctl.level_dims().len();
@@ -750,9 +849,8 @@ fn summarize(
         max_stance_foot_slip: max_slip,
         worst_margins: worst,
         margins,
-        push_peak,
-        push_damping_ratio,
-        push_settling_time,
+        push,
+        health,
         climbed_ticks: steps
             .iter()
             .filter(|s| s.corrected_from > 0 && s.corrected_from < nt)
@@ -765,5 +863,36 @@ fn summarize(
         smoothness,
         tick_median_us: median(&ticks),
         tick_p99_us: percentile(&ticks, 0.99),
+    })
+}
+
+/// The response to push `p` along both axes of the local frame, and the ZMP's excursion
+/// outside the support polygon from the push on.
+fn push_summary(steps: &[WalkStep], p: Push, noise_std: f64) -> Result<WalkPushSummary> {
+    let settings = ResponseSettings::default();
+    let t: Vec<f64> = steps.iter().map(|s| s.t).collect();
+    let axis = |i: usize| -> Result<PushAxisMetrics> {
+        let y: Vec<f64> = steps.iter().map(|s| s.zmp_deviation[i]).collect();
+        let m = analyse_response(&t, &y, p.time, noise_std, &settings)?;
+        let fitted = m.peak > settings.noise_sigmas * noise_std;
+        Ok(PushAxisMetrics {
+            peak: m.peak,
+            peak_time: m.peak_time,
+            settling_time: m.settling_time,
+            damping_ratio: fitted.then_some(m.damping_ratio),
+            natural_frequency: fitted.then_some(m.natural_frequency),
+        })
+    };
+    let zmp_min_margin = steps
+        .iter()
+        .filter(|s| s.t >= p.time)
+        .map(|s| s.zmp_margin)
+        .fold(f64::INFINITY, f64::min);
+    Ok(WalkPushSummary {
+        push: p,
+        x: axis(0)?,
+        y: axis(1)?,
+        zmp_min_margin,
+        zmp_excursion: (-zmp_min_margin).max(0.0),
     })
 }

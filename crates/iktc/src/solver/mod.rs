@@ -15,6 +15,7 @@ mod report;
 mod screen;
 mod settings;
 mod solve;
+mod warm;
 
 pub use hierarchy::Hierarchy;
 pub use report::{Fallback, Method, SolveReport};

@@ -206,16 +206,10 @@ impl Reflectors {
             s -= 4;
             let b = self.block(s);
             let w = &mut scratch[..4 * nc];
-            w.fill(0.0);
-            for t in b.s..b.end {
-                let yrow = &y[t * nc..(t + 1) * nc];
-                for j in 0..4 {
-                    let vj = vs[(b.s + j) * n + t];
-                    if vj != 0.0 {
-                        axpy(vj, yrow, &mut w[j * nc..(j + 1) * nc]);
-                    }
-                }
-            }
+            let len = b.end - b.s;
+            let v: [&[f64]; 4] = std::array::from_fn(|j| &vs[(b.s + j) * n + b.s..][..len]);
+            let rows = &mut y[b.s * nc..b.end * nc];
+            block_products(v, rows, nc, w);
             for j in (0..4).rev() {
                 let (head, tail) = w.split_at_mut((j + 1) * nc);
                 let fj = &mut head[j * nc..];
@@ -225,15 +219,7 @@ impl Reflectors {
                 let tau = b.tau[j];
                 fj.iter_mut().for_each(|x| *x *= tau);
             }
-            for t in b.s..b.end {
-                let yrow = &mut y[t * nc..(t + 1) * nc];
-                for j in 0..4 {
-                    let vj = vs[(b.s + j) * n + t];
-                    if vj != 0.0 {
-                        axpy(-vj, &w[j * nc..(j + 1) * nc], yrow);
-                    }
-                }
-            }
+            block_update(v, w, nc, rows);
         }
         for s in (0..s).rev() {
             let w = &mut scratch[..nc];
@@ -250,6 +236,78 @@ impl Reflectors {
                     axpy(-tau * va, w, &mut y[(s + a) * nc..(s + a + 1) * nc]);
                 }
             }
+        }
+    }
+}
+
+/// Columns per register block of [`block_products`] and [`block_update`]: four accumulators of
+/// four columns each fit the sixteen vector registers of x86-64 (two lanes each) with room to
+/// spare.
+const CHUNK: usize = 4;
+
+/// W_j = Σ_t v_j\[t\] Y\[t, :\] for the four reflectors of a block (`rows`: row-major, `nc`
+/// columns, one row per coordinate of the block's support; `w`: four rows of `nc`). Each W_j
+/// entry sums over t in order from 0, as one axpy per row would; the columns are taken
+/// [`CHUNK`] at a time so that the sums stay in registers.
+fn block_products(v: [&[f64]; 4], rows: &[f64], nc: usize, w: &mut [f64]) {
+    let len = v[0].len();
+    let full = nc / CHUNK * CHUNK;
+    for c0 in (0..full).step_by(CHUNK) {
+        let mut acc = [[0.0_f64; CHUNK]; 4];
+        for t in 0..len {
+            let yr: [f64; CHUNK] = std::array::from_fn(|l| rows[t * nc + c0 + l]);
+            for j in 0..4 {
+                let a = v[j][t];
+                for l in 0..CHUNK {
+                    acc[j][l] += a * yr[l];
+                }
+            }
+        }
+        for j in 0..4 {
+            w[j * nc + c0..j * nc + c0 + CHUNK].copy_from_slice(&acc[j]);
+        }
+    }
+    for c in full..nc {
+        let mut acc = [0.0_f64; 4];
+        for t in 0..len {
+            let yv = rows[t * nc + c];
+            for j in 0..4 {
+                acc[j] += v[j][t] * yv;
+            }
+        }
+        for j in 0..4 {
+            w[j * nc + c] = acc[j];
+        }
+    }
+}
+
+/// Y\[t, :\] ← Y\[t, :\] − v_0\[t\] F_0 − v_1\[t\] F_1 − v_2\[t\] F_2 − v_3\[t\] F_3, subtracted in
+/// that order (`f`: four rows of `nc`), [`CHUNK`] columns at a time.
+fn block_update(v: [&[f64]; 4], f: &[f64], nc: usize, rows: &mut [f64]) {
+    let len = v[0].len();
+    let full = nc / CHUNK * CHUNK;
+    for c0 in (0..full).step_by(CHUNK) {
+        let fr: [[f64; CHUNK]; 4] =
+            std::array::from_fn(|j| std::array::from_fn(|l| f[j * nc + c0 + l]));
+        for t in 0..len {
+            let yr = &mut rows[t * nc + c0..t * nc + c0 + CHUNK];
+            let a: [f64; 4] = std::array::from_fn(|j| v[j][t]);
+            for l in 0..CHUNK {
+                let mut x = yr[l];
+                for j in 0..4 {
+                    x -= a[j] * fr[j][l];
+                }
+                yr[l] = x;
+            }
+        }
+    }
+    for c in full..nc {
+        for t in 0..len {
+            let mut x = rows[t * nc + c];
+            for j in 0..4 {
+                x -= v[j][t] * f[j * nc + c];
+            }
+            rows[t * nc + c] = x;
         }
     }
 }

@@ -37,6 +37,10 @@ pub enum Fallback {
     /// A level of the cascade had no feasible solution; the solution of the level above was
     /// kept, clamped to the box.
     CascadeStoppedAtLevel(usize),
+    /// The box of at least one dof was empty (`b_l > b_u`: the state was outside the limits'
+    /// viable set); those dofs were held to the midpoint of their bounds
+    /// ([`SolveReport::empty_box_dofs`]). A fallback of the method itself replaces this one.
+    EmptyBox,
 }
 
 /// The record of one solve. Sized once, refreshed each tick without allocation.
@@ -69,6 +73,11 @@ pub struct SolveReport {
     /// [`SolverSettings::screen`](super::SolverSettings::screen)). Each such level also counts
     /// as a feasibility check, not as a QP.
     pub screened_infeasible: usize,
+    /// IKTC QPs settled by the warm start, without active-set iterations: the rows active at
+    /// the level's last optimum gave the optimum (see
+    /// [`SolverSettings::warm_start`](super::SolverSettings::warm_start)). Counted in
+    /// `qp_solves` too.
+    pub qp_warm_started: usize,
     /// Active-set iterations over all QPs.
     pub qp_iterations: usize,
     /// Dofs whose box was empty (b_l > b_u); they were given the midpoint, the least possible
@@ -96,6 +105,7 @@ impl SolveReport {
             qp_solves: 0,
             qp_infeasible: 0,
             screened_infeasible: 0,
+            qp_warm_started: 0,
             qp_iterations: 0,
             empty_box_dofs: 0,
             violation_before: 0.0,
@@ -114,6 +124,7 @@ impl SolveReport {
         self.qp_solves = 0;
         self.qp_infeasible = 0;
         self.screened_infeasible = 0;
+        self.qp_warm_started = 0;
         self.qp_iterations = 0;
         self.empty_box_dofs = 0;
         self.violation_before = 0.0;

@@ -80,6 +80,12 @@ pub struct SolverSettings {
     /// `Δt/r` once they let it. Smaller values push more gently and recover more slowly; 1 is
     /// IKTC as printed. GF and clamp are not affected. Default 1.
     pub rebase_release: f64,
+    /// Before each IKTC correction QP, try the rows active at that level's last optimum: the
+    /// least-norm correction on them is the QP's optimum when its multipliers have the right
+    /// signs and it satisfies every row (see the `warm` module notes in the solver); otherwise
+    /// the QP runs as before. Same answer up to rounding and the QP's feasibility tolerance,
+    /// fewer QP iterations when the same level is corrected tick after tick. Default true.
+    pub warm_start: bool,
     /// Settings of the QPs.
     pub qp: QpSettings,
 }
@@ -95,6 +101,7 @@ impl Default for SolverSettings {
             climb: Climb::FromLast,
             level_hold: 1,
             rebase_release: 1.0,
+            warm_start: true,
             qp: QpSettings::default(),
         }
     }

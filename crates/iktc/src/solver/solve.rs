@@ -9,6 +9,7 @@ use super::rebase::Rebase;
 use super::report::{Fallback, Method, SolveReport};
 use super::screen::Screen;
 use super::settings::{Climb, SolverSettings};
+use super::warm::WarmStart;
 use crate::error::{check_dim, Result};
 use crate::limits::AccelerationBox;
 use crate::task::TaskEquation;
@@ -16,9 +17,11 @@ use crate::task::TaskEquation;
 /// Solves a task hierarchy under an acceleration box. Made once for given level sizes; each
 /// [`Solver::solve`] allocates nothing.
 ///
-/// The solver remembers, from one solve to the next, the level IKTC last corrected from and
-/// the rows of each level's last infeasible QP ([`Climb`], [`SolverSettings::screen`]). That
-/// history changes how many QPs a solve runs, never its result.
+/// The solver remembers, from one solve to the next, the level IKTC last corrected from, the
+/// rows of each level's last infeasible QP and the rows active at each level's last optimum
+/// ([`Climb`], [`SolverSettings::screen`], [`SolverSettings::warm_start`]). That history
+/// changes how many QPs and QP iterations a solve runs, never its result (up to rounding and
+/// the QP's feasibility tolerance).
 #[derive(Debug, Clone)]
 pub struct Solver {
     settings: SolverSettings,
@@ -41,6 +44,8 @@ pub struct Solver {
     hold: LevelHold,
     /// The re-based demands ([`SolverSettings::rebase_release`]).
     rebase: Rebase,
+    /// The active sets of the last optima, tried before each correction QP.
+    warm: WarmStart,
     // Cascade buffers.
     h: DMatrix<f64>,
     c: Vec<f64>,
@@ -76,6 +81,7 @@ impl Solver {
             screen: Screen::new(dims.len(), total),
             hold: LevelHold::default(),
             rebase: Rebase::new(nv, dims),
+            warm: WarmStart::new(dims.len(), total, nv),
             h: DMatrix::zeros(nv, nv),
             c: vec![0.0; nv],
             a_eq: DMatrix::zeros(total.max(1), nv),
@@ -184,6 +190,9 @@ impl Solver {
             }
         }
         self.report.empty_box_dofs = empty;
+        if empty > 0 {
+            self.report.fallback = Some(Fallback::EmptyBox);
+        }
         self.report.violation_before = self.violation(&self.q0);
         match method {
             Method::Prioritized => qdd.copy_from(&self.q0),
@@ -319,6 +328,20 @@ impl Solver {
             return Ok(false);
         }
         let g = self.hierarchy.g().columns(off, ma);
+        if self.settings.warm_start
+            && self.warm.solve(
+                i,
+                &g,
+                &self.qp_lo,
+                &self.qp_hi,
+                self.settings.qp.feasibility_tolerance,
+                self.xs[i].as_mut_slice(),
+            )
+        {
+            self.report.qp_solves += 1;
+            self.report.qp_warm_started += 1;
+            return Ok(true);
+        }
         if self.settings.screen
             && self.screen.proves_infeasible(
                 i,
@@ -346,8 +369,10 @@ impl Solver {
         self.report.qp_solves += 1;
         self.report.qp_iterations += rep.iterations;
         if rep.status == QpStatus::Optimal {
+            self.warm.remember(i, self.qp.active_set());
             Ok(true)
         } else {
+            self.warm.forget(i);
             self.report.qp_infeasible += 1;
             let failed = match rep.status {
                 QpStatus::Infeasible { constraint } => Some(constraint),

@@ -17,6 +17,17 @@ pub struct ComReference {
     pub acceleration: Vector3<f64>,
 }
 
+impl ComReference {
+    /// A COM position \[m\] held still (zero velocity and acceleration).
+    pub fn hold(position: Vector3<f64>) -> Self {
+        Self {
+            position,
+            velocity: Vector3::zeros(),
+            acceleration: Vector3::zeros(),
+        }
+    }
+}
+
 /// COM task: the selected rows of J_c q̈ = c̈_d + k_v(ċ_d − ċ) + k_p(c_d − c) − J̇_c q̇.
 #[derive(Debug, Clone)]
 pub struct ComTask {

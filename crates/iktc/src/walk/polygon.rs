@@ -36,6 +36,19 @@ pub fn sole_corners(pose: &Pose2, length: f64, width: f64) -> [(f64, f64); 4] {
     ]
 }
 
+/// One edge of a [`SupportPolygon`] and a point's signed distance to it.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct PolygonEdge {
+    /// First vertex (counter-clockwise order) \[m\].
+    pub start: (f64, f64),
+    /// Second vertex \[m\].
+    pub end: (f64, f64),
+    /// Unit normal pointing out of the polygon \[–\].
+    pub outward_normal: (f64, f64),
+    /// Signed distance of the point to the edge's line \[m\]: positive inside.
+    pub margin: f64,
+}
+
 fn cross(o: (f64, f64), a: (f64, f64), b: (f64, f64)) -> f64 {
     (a.0 - o.0) * (b.1 - o.1) - (a.1 - o.1) * (b.0 - o.0)
 }
@@ -91,20 +104,34 @@ impl SupportPolygon {
     /// (for an outside point, a lower bound on the distance's magnitude: the largest
     /// violation of one edge's half-plane). `−∞` for an empty polygon.
     pub fn margin(&self, p: (f64, f64)) -> f64 {
+        self.closest_edge(p).map_or(f64::NEG_INFINITY, |e| e.margin)
+    }
+
+    /// The edge whose half-plane `p` is least inside (most outside): the edge that
+    /// [`SupportPolygon::margin`] measures against. For the counter-clockwise edge `a → b` of
+    /// length `L`, the signed distance is `((b − a) × (p − a)) / L` (positive on the inner,
+    /// left side) and the outward normal is `(b_y − a_y, −(b_x − a_x)) / L`. `None` for a
+    /// polygon without an edge of positive length (a single foot's rectangle always has one).
+    pub fn closest_edge(&self, p: (f64, f64)) -> Option<PolygonEdge> {
         let v = self.vertices();
-        let mut m = f64::INFINITY;
-        if v.is_empty() {
-            return f64::NEG_INFINITY;
-        }
+        let mut best: Option<PolygonEdge> = None;
         for i in 0..v.len() {
             let a = v[i];
             let b = v[(i + 1) % v.len()];
             let len = (b.0 - a.0).hypot(b.1 - a.1);
             if len > 0.0 {
-                m = m.min(cross(a, b, p) / len);
+                let margin = cross(a, b, p) / len;
+                if best.is_none_or(|e| margin < e.margin) {
+                    best = Some(PolygonEdge {
+                        start: a,
+                        end: b,
+                        outward_normal: ((b.1 - a.1) / len, -(b.0 - a.0) / len),
+                        margin,
+                    });
+                }
             }
         }
-        m
+        best
     }
 
     /// Whether `p` is inside the polygon shrunk by `margin` \[m\] (`margin ≥ 0` shrinks).

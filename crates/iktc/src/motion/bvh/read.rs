@@ -21,7 +21,8 @@ use crate::error::{Error, Result};
 /// Errors are [`Error::Parse`] naming `source_name` and the 1-based line: missing `{` or `}`,
 /// an unknown keyword or channel name, a `CHANNELS` count that does not match the names, a
 /// non-numeric or non-finite value, a frame line with fewer or more values than channels, zero
-/// frames, more or fewer frame lines than `Frames:` says, a file that ends early.
+/// frames, more or fewer frame lines than `Frames:` says, a file that ends early, more frames or
+/// a longer duration (`Frame Time` × (frames − 1)) than [`BvhReadOptions::limits`] allow.
 pub fn read_bvh(text: &str, source_name: &str, options: &BvhReadOptions) -> Result<BvhClip> {
     options.length_unit.validate()?;
     Reader::new(text, source_name).read(options)
@@ -155,6 +156,14 @@ impl<'a> Reader<'a> {
                 format!("Frame Time {frame_time} s; expected > 0"),
             ));
         }
+        options
+            .limits
+            .check_clip(
+                self.source_name,
+                frame_count,
+                frame_time * (frame_count - 1) as f64,
+            )
+            .map_err(|e| self.error(time_line, e.to_string()))?;
         // Reserve no more than the text can hold (at least two bytes per value).
         let capacity = frame_count
             .saturating_mul(channel_count)

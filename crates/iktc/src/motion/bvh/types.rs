@@ -6,6 +6,7 @@ use nalgebra::Vector3;
 
 use crate::error::{Error, Result};
 use crate::motion::UpAxis;
+use crate::resources::ReadLimits;
 
 /// One BVH motion channel.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -351,6 +352,9 @@ pub struct BvhReadOptions {
     pub length_unit: LengthUnit,
     /// Which axis is up in the file's world (default Y).
     pub up_axis: UpAxis,
+    /// Most frames and longest duration accepted, checked on the header before the frames are
+    /// read.
+    pub limits: ReadLimits,
 }
 
 /// Options of [`write_bvh`](super::write_bvh).

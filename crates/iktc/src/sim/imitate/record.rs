@@ -2,16 +2,17 @@
 
 use std::time::Instant;
 
-use nalgebra::UnitQuaternion;
+use nalgebra::{DMatrix, UnitQuaternion};
 use serde::Serialize;
 
-use super::support::{polygon_margin, support_polygon};
+use super::support::support_polygon;
 use super::{ImitateConfig, ImitationController, NarrowedJoint, LEVEL_NAMES};
 use crate::error::Result;
 use crate::model::{JointLimit, Robot};
 use crate::motion::RobotReferences;
+use crate::sim::health::{HealthMonitor, HealthReport, Verdict};
 use crate::sim::margins::{dof_margins, median, percentile};
-use crate::solver::Method;
+use crate::solver::{Fallback, Method};
 
 /// One recorded tick (state at its start, command applied over it).
 #[derive(Debug, Clone, Serialize)]
@@ -48,6 +49,11 @@ pub struct ImitateStep {
     /// Signed distance from the COM's ground projection to the support polygon's edge \[m\]
     /// (positive inside).
     pub com_margin: f64,
+    /// ZMP of the commanded motion on the ground \[m\] (cart-table model, see
+    /// [`run_imitate`]).
+    pub zmp: [f64; 2],
+    /// Signed distance from the ZMP to the support polygon's edge \[m\] (positive inside).
+    pub zmp_margin: f64,
     /// Desired pelvis height \[m\].
     pub pelvis_height_desired: f64,
     /// Pelvis height \[m\].
@@ -64,8 +70,14 @@ pub struct ImitateStep {
     pub qp_solves: usize,
     /// Dofs with an empty box.
     pub empty_dofs: usize,
+    /// Dofs being brought back into their range this tick
+    /// ([`OutsideLimits::Recover`](crate::limits::OutsideLimits)).
+    pub recovering: Vec<usize>,
     /// Whether a fallback was taken.
     pub fallback: bool,
+    /// Which fallback, if any.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fallback_kind: Option<Fallback>,
     /// Time of the tick (kinematics, tasks, bounds, solve) \[µs\].
     pub tick_us: f64,
 }
@@ -96,8 +108,10 @@ pub struct LevelSummary {
     pub rms_error: f64,
     /// Ticks where this level was corrected.
     pub corrected_steps: usize,
-    /// First and last time it was corrected \[s\] (NaN if never).
-    pub corrected_span: [f64; 2],
+    /// First and last time it was corrected \[s\]; absent (`None`, left out of the JSON)
+    /// if it never was.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub corrected_span: Option<[f64; 2]>,
 }
 
 /// The run's summary (`summary.json`).
@@ -162,12 +176,22 @@ pub struct ImitateSummary {
     pub com_inside_support: bool,
     /// Smallest COM margin to the polygon edge \[m\].
     pub com_min_margin: f64,
+    /// Smallest ZMP margin to the polygon edge \[m\] (negative: the ZMP left the polygon).
+    pub zmp_min_margin: f64,
+    /// The run's checks: feet held, state finite, ZMP inside the support polygon.
+    pub health: HealthReport,
     /// Tracking per level.
     pub levels: Vec<LevelSummary>,
     /// Ticks with an empty box.
     pub empty_box_steps: usize,
     /// Ticks with a fallback.
     pub fallback_steps: usize,
+    /// Ticks in which some joint was being brought back into its range.
+    pub recovering_steps: usize,
+    /// Ticks with a fallback, by kind: "empty_box" (the acceleration box was empty on some
+    /// dof), "clamped_to_box" (IKTC found no level to correct),
+    /// "cascade_stopped_at_level_N" (GF: level N, 1-based, had no feasible solution).
+    pub fallbacks_by_kind: std::collections::BTreeMap<String, usize>,
     /// Mean QPs per tick.
     pub qp_per_step_mean: f64,
     /// Largest QPs in a tick.
@@ -202,7 +226,24 @@ fn rpy(q: &UnitQuaternion<f64>) -> [f64; 3] {
     [r, p, y]
 }
 
-/// Runs the experiment: [`ImitationController::new`], then one tick per reference sample.
+/// Runs the experiment: [`ImitationController::new`], then one tick per reference sample,
+/// each checked by a [`HealthMonitor`] with [`ImitateConfig::health`]:
+///
+/// * the feet: position and rotation of each foot frame against its initial (held) pose;
+/// * the state: q, q̇, the commanded q̈ and the COM finite (and q, q̇ again after integration);
+/// * the COM's ground projection inside the support polygon of the initial feet (the static
+///   balance criterion). The imitation is kinematic — no contact forces, no dynamics — so the
+///   ZMP is only recorded, not checked: its cart-table value for the commanded motion,
+///   `p_xy = c_xy − c_z c̈_xy / (g + c̈_z)` with `c̈ = J_c q̈ + J̇_c q̇` (the COM Jacobian and
+///   drift of [`crate::model::Kinematics`], `g` = [`crate::balance::STANDARD_GRAVITY`],
+///   ground z = 0), leaves the polygon by up to 2.7 m for 25 ticks (0.10–0.34 s) of the
+///   default run, where the commanded q̈ of the start-up transient is far beyond what feet
+///   on the ground could carry.
+///
+/// Errors: bad settings or references, and [`crate::Error::RunFailed`] when a check fails
+/// (unless [`crate::sim::HealthSettings::keep_going`]: the run then goes on and the summary's
+/// [`HealthReport`] lists the failures; a non-finite state ends the run there, the steps
+/// recorded so far all finite).
 pub fn run_imitate(
     robot: &Robot,
     refs: &RobotReferences,
@@ -230,11 +271,15 @@ pub fn run_imitate(
         .map(|f| robot.frame_id(f))
         .collect::<Result<Vec<_>>>()?;
     let pelvis = robot.frame_id(&cfg.pelvis)?;
-    let polygon = support_polygon(ctl.feet0(), &cfg.support);
+    let polygon = support_polygon(ctl.feet0(), &cfg.support)?;
     let pos_tol = cfg.on_limit_position;
     let frac = cfg.on_limit_fraction;
+    let mut health = HealthMonitor::new(cfg.health)?;
+    let dof_names = robot.dof_names();
+    let mut com_jacobian = DMatrix::zeros(3, nv);
     let mut steps = Vec::with_capacity(n);
     for k in 0..n {
+        let t = k as f64 * cfg.dt;
         let start = Instant::now();
         ctl.tick(robot, k)?;
         let tick_us = start.elapsed().as_secs_f64() * 1e6;
@@ -251,14 +296,39 @@ pub fn run_imitate(
             level_error[i] = e.error.norm();
             correction[i] = rep.corrections.get(i).map_or(0.0, |c| c.norm());
         }
+        let com = kin.com();
+        let mut verdict = Verdict::Continue;
+        for (what, values) in [
+            ("joint position q [rad]", ctl.dof_positions()),
+            ("velocity q̇ [rad/s]", state.qd.as_slice()),
+            ("commanded acceleration q̈ [rad/s²]", ctl.qdd().as_slice()),
+            ("COM [m]", com.as_slice()),
+        ] {
+            if verdict == Verdict::Continue {
+                verdict = health.check_finite(t, what, &dof_names, values)?;
+            }
+        }
+        if verdict == Verdict::Stop {
+            break;
+        }
         let mut foot_drift = 0.0f64;
         let mut foot_rotation_drift = 0.0f64;
-        for (id, p0) in feet_ids.iter().zip(ctl.feet0()) {
+        for ((id, p0), name) in feet_ids.iter().zip(ctl.feet0()).zip(&cfg.feet) {
             let p = kin.frame_pose(robot, *id)?;
-            foot_drift = foot_drift.max((p.translation.vector - p0.translation.vector).norm());
-            foot_rotation_drift = foot_rotation_drift.max(p.rotation.angle_to(&p0.rotation));
+            let (dp, dr) = (
+                (p.translation.vector - p0.translation.vector).norm(),
+                p.rotation.angle_to(&p0.rotation),
+            );
+            health.check_foot(t, name, dp, dr)?;
+            foot_drift = foot_drift.max(dp);
+            foot_rotation_drift = foot_rotation_drift.max(dr);
         }
-        let com = kin.com();
+        kin.com_jacobian(robot, &mut com_jacobian)?;
+        let cdd = &com_jacobian * ctl.qdd() + kin.com_drift();
+        let lever = com.z / (crate::balance::STANDARD_GRAVITY + cdd.z);
+        let zmp = [com.x - lever * cdd.x, com.y - lever * cdd.y];
+        health.check_support(t, &polygon, (com.x, com.y), "COM", "world axes")?;
+        health.end_tick();
         let pp = kin.frame_pose(robot, pelvis)?;
         let r = ctl.references();
         let kk = k.min(r.len().saturating_sub(1));
@@ -278,7 +348,7 @@ pub fn run_imitate(
         }
         let bx = ctl.acceleration_box();
         steps.push(ImitateStep {
-            t: k as f64 * cfg.dt,
+            t,
             box_lower: bx.lower.as_slice().to_vec(),
             box_upper: bx.upper.as_slice().to_vec(),
             q,
@@ -297,7 +367,9 @@ pub fn run_imitate(
             foot_drift,
             foot_rotation_drift,
             com: [com.x, com.y, com.z],
-            com_margin: polygon_margin(&polygon, &com),
+            com_margin: polygon.margin((com.x, com.y)),
+            zmp,
+            zmp_margin: polygon.margin((zmp[0], zmp[1])),
             pelvis_height_desired: ctl.pelvis0().translation.z + r.height.position[kk],
             pelvis_height: pp.translation.z,
             pelvis_rpy_desired: rpy(&desired_att),
@@ -310,20 +382,28 @@ pub fn run_imitate(
             on_limit,
             qp_solves: rep.qp_solves,
             empty_dofs: rep.empty_box_dofs,
+            recovering: bx.recovering_dofs().collect(),
             fallback: rep.fallback.is_some(),
+            fallback_kind: rep.fallback,
             tick_us,
         });
         ctl.integrate(robot)?;
     }
-    let dof_names = robot.dof_names();
-    let summary = summarize(robot, cfg, &steps, &limits, &ctl.level_dims());
+    let summary = summarize(
+        robot,
+        cfg,
+        &steps,
+        &limits,
+        &ctl.level_dims(),
+        health.report(),
+    );
     Ok(ImitateRun {
         steps,
         summary,
         dof_names,
         limits,
         references: ctl.references().clone(),
-        support: polygon.iter().map(|p| [p.x, p.y, p.z]).collect(),
+        support: polygon.vertices().iter().map(|p| [p.0, p.1, 0.0]).collect(),
     })
 }
 
@@ -334,6 +414,7 @@ pub(crate) fn summarize(
     steps: &[ImitateStep],
     limits: &[JointLimit],
     level_dims: &[usize],
+    health: HealthReport,
 ) -> ImitateSummary {
     let names = robot.dof_names();
     let nb = robot.base_nv();
@@ -395,10 +476,10 @@ pub(crate) fn summarize(
                 rms_error: (errs.iter().map(|e| e * e).sum::<f64>() / errs.len().max(1) as f64)
                     .sqrt(),
                 corrected_steps: corrected.len(),
-                corrected_span: [
-                    corrected.first().copied().unwrap_or(f64::NAN),
-                    corrected.last().copied().unwrap_or(f64::NAN),
-                ],
+                corrected_span: corrected
+                    .first()
+                    .zip(corrected.last())
+                    .map(|(a, b)| [*a, *b]),
             }
         })
         .collect();
@@ -467,13 +548,35 @@ pub(crate) fn summarize(
             .fold(0.0, f64::max),
         com_inside_support: com_min_margin > 0.0,
         com_min_margin,
+        zmp_min_margin: steps
+            .iter()
+            .map(|s| s.zmp_margin)
+            .fold(f64::INFINITY, f64::min),
+        health,
         levels,
         empty_box_steps: steps.iter().filter(|s| s.empty_dofs > 0).count(),
         fallback_steps: steps.iter().filter(|s| s.fallback).count(),
+        recovering_steps: steps.iter().filter(|s| !s.recovering.is_empty()).count(),
+        fallbacks_by_kind: steps.iter().filter_map(|s| s.fallback_kind).fold(
+            Default::default(),
+            |mut m, f| {
+                *m.entry(fallback_name(f)).or_insert(0) += 1;
+                m
+            },
+        ),
         qp_per_step_mean: steps.iter().map(|s| s.qp_solves as f64).sum::<f64>()
             / steps.len().max(1) as f64,
         qp_per_step_max: steps.iter().map(|s| s.qp_solves).max().unwrap_or(0),
         tick_median_us: median(&ticks),
         tick_p99_us: percentile(&ticks, 0.99),
+    }
+}
+
+/// The name of a fallback kind in summaries (levels 1-based).
+pub fn fallback_name(f: Fallback) -> String {
+    match f {
+        Fallback::ClampedToBox => "clamped_to_box".into(),
+        Fallback::CascadeStoppedAtLevel(l) => format!("cascade_stopped_at_level_{}", l + 1),
+        Fallback::EmptyBox => "empty_box".into(),
     }
 }

@@ -1,6 +1,8 @@
 //! Foot soles and the support polygon of a double-support stance.
 
-use nalgebra::{Isometry3, Point3, Vector3};
+use nalgebra::{Isometry3, Point3};
+
+use crate::walk::{Pose2, SupportPolygon};
 
 use crate::error::{Error, Result};
 
@@ -54,76 +56,37 @@ impl SupportSettings {
         }
         Ok(())
     }
-
-    /// The four sole corners \[m\] of a foot whose ankle frame has pose `ankle`, world axes.
-    pub fn sole_corners(&self, ankle: &Isometry3<f64>) -> [Vector3<f64>; 4] {
-        let (l, w) = (0.5 * self.sole_length, 0.5 * self.sole_width);
-        let x0 = self.sole_offset_x;
-        let z = -self.ankle_height;
-        [(x0 + l, w), (x0 - l, w), (x0 - l, -w), (x0 + l, -w)]
-            .map(|(x, y)| (ankle * Point3::new(x, y, z)).coords)
-    }
 }
 
-/// The support polygon of feet at poses `feet`: the convex hull (counter-clockwise, seen from
-/// above, Andrew's monotone chain) of the sole corners projected on the ground (z = 0) \[m\].
-pub fn support_polygon(feet: &[Isometry3<f64>], settings: &SupportSettings) -> Vec<Vector3<f64>> {
-    let mut pts: Vec<(f64, f64)> = feet
-        .iter()
-        .flat_map(|f| settings.sole_corners(f))
-        .map(|c| (c.x, c.y))
-        .filter(|(x, y)| x.is_finite() && y.is_finite())
-        .collect();
-    pts.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
-    pts.dedup();
-    if pts.len() < 3 {
-        return pts.iter().map(|(x, y)| Vector3::new(*x, *y, 0.0)).collect();
-    }
-    let cross = |o: (f64, f64), a: (f64, f64), b: (f64, f64)| {
-        (a.0 - o.0) * (b.1 - o.1) - (a.1 - o.1) * (b.0 - o.0)
-    };
-    let mut hull: Vec<(f64, f64)> = Vec::with_capacity(2 * pts.len());
-    for pass in 0..2 {
-        let start = hull.len();
-        let iter: Box<dyn Iterator<Item = &(f64, f64)>> = if pass == 0 {
-            Box::new(pts.iter())
-        } else {
-            Box::new(pts.iter().rev())
-        };
-        for p in iter {
-            while hull.len() >= start + 2
-                && cross(hull[hull.len() - 2], hull[hull.len() - 1], *p) <= 0.0
-            {
-                hull.pop();
-            }
-            hull.push(*p);
-        }
-        hull.pop();
-    }
-    hull.iter()
-        .map(|(x, y)| Vector3::new(*x, *y, 0.0))
-        .collect()
+/// The sole of the foot whose ankle frame has pose `ankle`, on the ground: the centre of its
+/// rectangle (`ankle · (sole_offset_x, 0, −ankle_height)` projected on z = 0) \[m\] and the
+/// heading of the foot's x axis, `atan2(R₂₁, R₁₁)` \[rad\] (the feet are held flat).
+pub fn sole_pose(ankle: &Isometry3<f64>, settings: &SupportSettings) -> Pose2 {
+    let c = ankle * Point3::new(settings.sole_offset_x, 0.0, -settings.ankle_height);
+    let r = ankle.rotation.to_rotation_matrix();
+    Pose2::new(c.x, c.y, r[(1, 0)].atan2(r[(0, 0)]))
 }
 
-/// Signed distance \[m\] from the ground projection of `p` to the boundary of the convex
-/// counter-clockwise polygon `hull`: positive inside, negative outside (−∞ for fewer than 3
-/// vertices).
-pub fn polygon_margin(hull: &[Vector3<f64>], p: &Vector3<f64>) -> f64 {
-    if hull.len() < 3 {
-        return f64::NEG_INFINITY;
-    }
-    let mut margin = f64::INFINITY;
-    for i in 0..hull.len() {
-        let a = hull[i];
-        let b = hull[(i + 1) % hull.len()];
-        let e = (b - a).xy();
-        let len = e.norm();
-        if len == 0.0 {
-            continue;
+/// The support polygon of one or two feet at poses `feet` (ankle frames): the convex hull of
+/// their sole rectangles on the ground, [`SupportPolygon::set_hull_of_soles`] (foot yaw
+/// included). Errors: no foot, or more than two.
+pub fn support_polygon(
+    feet: &[Isometry3<f64>],
+    settings: &SupportSettings,
+) -> Result<SupportPolygon> {
+    let (l, w) = (settings.sole_length, settings.sole_width);
+    let mut p = SupportPolygon::default();
+    match feet {
+        [a] => p.set_sole(&sole_pose(a, settings), l, w),
+        [a, b] => p.set_hull_of_soles(&sole_pose(a, settings), &sole_pose(b, settings), l, w),
+        _ => {
+            return Err(Error::InvalidSetting {
+                name: "feet".into(),
+                value: format!("{} frames", feet.len()),
+                expected: "one or two foot frames (the support polygon is the hull of their soles)"
+                    .into(),
+            })
         }
-        // Inward normal of a counter-clockwise edge: (−e_y, e_x).
-        let d = ((p.xy() - a.xy()).perp(&e)) / len;
-        margin = margin.min(-d);
     }
-    margin
+    Ok(p)
 }

@@ -1,0 +1,142 @@
+//! `iktc map`: print a built-in map; find the body points of a motion file and write them as an
+//! editable body map. Also the motion-file options shared with `iktc imitate`.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+use iktc::motion::{
+    builtin_body_map, builtin_map_text, load_motion, BodyMap, Motion, MotionOptions,
+    BUILTIN_BODY_MAP_NAMES, BUILTIN_MAP_NAMES,
+};
+
+/// How a motion file is read: units, up axis, skeleton.
+#[derive(clap::Args, Debug, Clone)]
+pub struct MotionArgs {
+    /// Length unit of the motion file: m, cm, mm, inch, cmu (1/0.45 inch) or auto (decided
+    /// from the subject's standing height, 1.2–2.1 m).
+    #[arg(long, default_value = "auto")]
+    pub units: String,
+    /// Up axis of the motion file: y, z or auto (decided from the rest pose, ankles to head).
+    #[arg(long, default_value = "auto")]
+    pub up: String,
+    /// ASF skeleton of an AMC motion (default: the .asf beside it with the same stem, else the
+    /// only .asf in its folder).
+    #[arg(long)]
+    pub skeleton: Option<PathBuf>,
+    /// Longest clip accepted from a file [s].
+    #[arg(long, default_value_t = iktc::resources::ReadLimits::default().max_clip_duration)]
+    pub max_clip_duration: f64,
+}
+
+/// Reads a motion file with these options (and a body map, if given) and prints what was
+/// decided.
+pub fn load(path: &Path, args: &MotionArgs, body_map: Option<BodyMap>) -> Result<Motion> {
+    let options = MotionOptions {
+        units: args.units.parse()?,
+        up: args.up.parse()?,
+        skeleton: args.skeleton.clone(),
+        body_map,
+        limits: iktc::resources::ReadLimits {
+            max_clip_duration: args.max_clip_duration,
+            ..iktc::resources::ReadLimits::default()
+        },
+        ..MotionOptions::default()
+    };
+    let m = load_motion(path, &options)
+        .with_context(|| format!("reading the motion `{}`", path.display()))?;
+    println!(
+        "motion {} ({}): units {}; up {}",
+        m.source,
+        m.format.name(),
+        m.units,
+        m.up
+    );
+    Ok(m)
+}
+
+/// Arguments of `iktc map`.
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    #[command(subcommand)]
+    pub command: MapCommand,
+}
+
+/// The `iktc map` subcommands.
+#[derive(clap::Subcommand, Debug)]
+pub enum MapCommand {
+    /// Print a built-in map: a retargeting map (deepmimic_jvrc1, bvh_jvrc1) or a body map
+    /// (plug_in_gait, deepmimic).
+    Show {
+        /// The map's name.
+        name: String,
+    },
+    /// Find the body points of a motion file (or check a body map against it), print them
+    /// and write them as an editable body map.
+    Init {
+        /// The motion file (.bvh, .amc, .asf, DeepMimic, .c3d, .csv).
+        #[arg(long)]
+        motion: PathBuf,
+        #[command(flatten)]
+        options: MotionArgs,
+        /// A body map to check instead of recognising the body points.
+        #[arg(long)]
+        map: Option<PathBuf>,
+        /// Where to write the map. Default: `<motion stem>.map.toml` in the current folder.
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
+}
+
+/// Runs `iktc map`.
+pub fn run(a: &Args) -> Result<()> {
+    match &a.command {
+        MapCommand::Show { name } => {
+            if BUILTIN_MAP_NAMES.contains(&name.as_str()) {
+                print!("{}", builtin_map_text(name)?);
+            } else if BUILTIN_BODY_MAP_NAMES.contains(&name.as_str()) {
+                print!("{}", builtin_body_map(name)?.to_toml_string());
+            } else {
+                anyhow::bail!(
+                    "no built-in map `{name}`; retargeting maps: {}; body maps: {}",
+                    BUILTIN_MAP_NAMES.join(", "),
+                    BUILTIN_BODY_MAP_NAMES.join(", ")
+                );
+            }
+            Ok(())
+        }
+        MapCommand::Init {
+            motion,
+            options,
+            map,
+            out,
+        } => {
+            let given = match map {
+                Some(p) => {
+                    let text = std::fs::read_to_string(p)
+                        .with_context(|| format!("reading the body map `{}`", p.display()))?;
+                    Some(BodyMap::from_toml_str(&text, &p.display().to_string())?)
+                }
+                None => None,
+            };
+            let m = load(motion, options, given)?;
+            let mut body_map = m.body_map.clone()?;
+            if let Some(stem) = motion.file_stem() {
+                body_map.name = stem.to_string_lossy().to_string();
+            }
+            let keypoints = m.keypoints(iktc::motion::DEFAULT_MAX_GAP)?;
+            println!("{}", keypoints.summary());
+            let text = body_map.to_toml_string();
+            print!("{text}");
+            let out = out.clone().unwrap_or_else(|| {
+                let stem = motion
+                    .file_stem()
+                    .map(|s| s.to_string_lossy().to_string())
+                    .unwrap_or_else(|| "motion".to_string());
+                PathBuf::from(format!("{stem}.map.toml"))
+            });
+            std::fs::write(&out, text).with_context(|| format!("writing `{}`", out.display()))?;
+            println!("wrote {}", out.display());
+            Ok(())
+        }
+    }
+}

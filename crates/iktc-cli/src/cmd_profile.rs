@@ -1,0 +1,79 @@
+//! `iktc profile`: print a built-in robot profile, or write a starting one for a URDF.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+use iktc::profile::{builtin_profile_text, init_profile_toml};
+
+/// Arguments of `iktc profile`.
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    #[command(subcommand)]
+    pub command: ProfileCommand,
+}
+
+/// What `iktc profile` does.
+#[derive(clap::Subcommand, Debug)]
+pub enum ProfileCommand {
+    /// Print a built-in profile (jvrc1, g1) as TOML.
+    Show {
+        /// The built-in profile's name.
+        name: String,
+    },
+    /// Write a starting profile for a URDF: feet, pelvis, torso, head and hands guessed from
+    /// its tree, each guess marked `# guessed`.
+    Init {
+        /// The URDF file.
+        urdf: PathBuf,
+        /// Write the profile to this file (its `urdf` key relative to the file's directory)
+        /// instead of standard output.
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
+}
+
+/// The URDF's path as the profile at `out` should name it: relative to the profile's directory
+/// when the URDF lies under it, else absolute.
+fn urdf_key(urdf: &Path, out: Option<&Path>) -> Result<String> {
+    let Some(out) = out else {
+        return Ok(urdf.display().to_string());
+    };
+    let dir = out
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let abs_urdf = urdf
+        .canonicalize()
+        .with_context(|| format!("reading {}", urdf.display()))?;
+    let abs_dir = dir
+        .canonicalize()
+        .with_context(|| format!("the output directory {}", dir.display()))?;
+    Ok(match abs_urdf.strip_prefix(&abs_dir) {
+        Ok(rel) => rel.display().to_string(),
+        Err(_) => abs_urdf.display().to_string(),
+    })
+}
+
+/// Runs `iktc profile`.
+pub fn run(a: &Args) -> Result<()> {
+    match &a.command {
+        ProfileCommand::Show { name } => {
+            print!("{}", builtin_profile_text(name)?);
+            Ok(())
+        }
+        ProfileCommand::Init { urdf, out } => {
+            let text = std::fs::read_to_string(urdf)
+                .with_context(|| format!("reading {}", urdf.display()))?;
+            let toml = init_profile_toml(&text, &urdf_key(urdf, out.as_deref())?)?;
+            match out {
+                Some(path) => {
+                    std::fs::write(path, toml)
+                        .with_context(|| format!("writing {}", path.display()))?;
+                    println!("wrote {}", path.display());
+                }
+                None => print!("{toml}"),
+            }
+            Ok(())
+        }
+    }
+}

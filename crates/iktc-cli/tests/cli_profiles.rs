@@ -1,0 +1,253 @@
+//! `--robot NAME|profile.toml|robot.urdf`: the G1 imitates (and walks) from its built-in
+//! profile within its limits; errors name the flag or profile key that caused them;
+//! `iktc profile show` prints a profile that parses back; `iktc profile init` writes one.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn iktc() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_iktc"))
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("iktc-cli-profiles-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn run(args: &[&str]) -> Output {
+    iktc().args(args).output().unwrap()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn json(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+/// Largest violation of a limit a run may show [rad, rad/s, rad/s²]: rounding only.
+const LIMIT_SLACK: f64 = 1e-9;
+
+/// The G1's URDF copied alone into a fresh directory (no profile next to it).
+fn bare_g1_urdf(dir: &Path) -> PathBuf {
+    let src = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../iktc/data/robots/g1/g1_29dof_rev_1_0.urdf"
+    );
+    let dst = dir.join("g1.urdf");
+    std::fs::copy(src, &dst).unwrap();
+    dst
+}
+
+#[test]
+fn g1_imitates_the_default_clip_within_its_limits() {
+    let out = tmp("g1");
+    let o = iktc()
+        .args(["imitate", "--robot", "g1", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let s = json(&out.join("summary.json"));
+    for k in [
+        "worst_position_margin",
+        "worst_velocity_margin",
+        "worst_acceleration_margin",
+    ] {
+        let m = s[k].as_f64().unwrap();
+        assert!(m <= LIMIT_SLACK, "{k} = {m} (> 0: exceeded)");
+    }
+    assert_eq!(s["nv"].as_u64(), Some(35));
+    assert!(s["foot_drift"].as_f64().unwrap() < 1e-3);
+    let viewer = std::fs::read_to_string(out.join("viewer.html")).unwrap();
+    assert!(
+        viewer.contains("\"g1_29dof_rev_1_0\""),
+        "the viewer shows the G1"
+    );
+}
+
+#[test]
+fn g1_walks_while_imitating_within_its_limits() {
+    let out = tmp("g1walk");
+    let o = iktc()
+        .args(["imitate", "--walk", "--robot", "g1", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let s = json(&out.join("walk_summary.json"));
+    for run in ["with_damping", "without_damping"] {
+        let r = &s[run];
+        for m in r["worst_margins"].as_array().unwrap() {
+            assert!(m.as_f64().unwrap() <= LIMIT_SLACK, "{}", r["worst_margins"]);
+        }
+    }
+    assert!(out.join("walk_viewer.html").exists());
+}
+
+#[test]
+fn a_bare_urdf_names_the_missing_flag_and_key() {
+    let dir = tmp("bare");
+    let urdf = bare_g1_urdf(&dir);
+    let u = urdf.to_str().unwrap();
+    // No feet: the flag and the profile key to set.
+    let o = run(&[
+        "imitate",
+        "--robot",
+        u,
+        "--map",
+        "deepmimic_g1",
+        "--out",
+        "/nonexistent",
+    ]);
+    assert!(!o.status.success());
+    let e = stderr(&o);
+    assert!(e.contains("--feet") && e.contains("`feet`"), "{e}");
+    // With feet but no sole.
+    let feet = "right_ankle_roll_link,left_ankle_roll_link";
+    let o = run(&["imitate", "--robot", u, "--feet", feet]);
+    let e = stderr(&o);
+    assert!(e.contains("--sole") && e.contains("feet.left.sole"), "{e}");
+    // With feet and sole, no pelvis.
+    let with_feet = [
+        "imitate",
+        "--robot",
+        u,
+        "--feet",
+        feet,
+        "--sole",
+        "0.17,0.05,0.035",
+        "--ankle-height",
+        "0.035",
+    ];
+    let o = run(&[&with_feet[..], &["--map", "deepmimic_g1"]].concat());
+    let e = stderr(&o);
+    assert!(e.contains("--pelvis") && e.contains("frames.pelvis"), "{e}");
+    // No map: the JVRC-1 map is never applied to another robot.
+    let o = run(&[&with_feet[..], &["--pelvis", "pelvis"]].concat());
+    let e = stderr(&o);
+    assert!(
+        e.contains("--map") && e.contains("imitate.maps.deepmimic"),
+        "{e}"
+    );
+    assert!(!e.contains("WAIST_Y"), "{e}");
+}
+
+#[test]
+fn a_wrong_name_from_a_flag_names_the_flag_the_key_and_the_valid_names() {
+    let dir = tmp("flag");
+    let urdf = bare_g1_urdf(&dir);
+    let u = urdf.to_str().unwrap();
+    let common = [
+        "imitate",
+        "--robot",
+        u,
+        "--feet",
+        "right_ankle_roll_link,left_ankle_roll_link",
+        "--sole",
+        "0.17,0.05,0.035",
+        "--ankle-height",
+        "0.035",
+        "--map",
+        "deepmimic_g1",
+    ];
+    for (flag, value, key, valid) in [
+        ("--pelvis", "PELVIS_S", "frames.pelvis", "torso_link"),
+        (
+            "--posture",
+            "R_HIP_P=0.1",
+            "posture.R_HIP_P",
+            "left_knee_joint",
+        ),
+        (
+            "--narrow",
+            "L_KNEE=0.1:0.2",
+            "narrow.L_KNEE",
+            "left_knee_joint",
+        ),
+        (
+            "--lock",
+            "*_FINGER_*=0",
+            "lock[0].joints",
+            "left_knee_joint",
+        ),
+    ] {
+        let mut args: Vec<&str> = common.to_vec();
+        if flag != "--pelvis" {
+            args.extend(["--pelvis", "pelvis"]);
+        }
+        args.extend([flag, value]);
+        let o = run(&args);
+        assert!(!o.status.success());
+        let e = stderr(&o);
+        assert!(
+            e.contains(&format!("{flag}: profile key `{key}`")),
+            "{flag}: {e}"
+        );
+        assert!(e.contains(valid), "{flag}: {e}");
+    }
+    // The map entry that produced an unknown joint.
+    let mut args: Vec<&str> = common.to_vec();
+    args.extend(["--pelvis", "pelvis"]);
+    let n = args.len();
+    args[n - 3] = "deepmimic_jvrc1";
+    let o = run(&args);
+    let e = stderr(&o);
+    assert!(
+        e.contains("--map `deepmimic_jvrc1`")
+            && e.contains("entry `chest`")
+            && e.contains("WAIST_Y"),
+        "{e}"
+    );
+}
+
+#[test]
+fn profile_show_prints_a_profile_that_parses_back() {
+    for name in ["jvrc1", "g1"] {
+        let o = run(&["profile", "show", name]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let dir = tmp(&format!("show-{name}"));
+        // Next to a copy of the data it names, the printed profile loads and builds.
+        let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("../iktc/data");
+        let profiles = dir.join("profiles");
+        std::fs::create_dir_all(&profiles).unwrap();
+        let robots = dir.join("robots").join(name);
+        std::fs::create_dir_all(&robots).unwrap();
+        for e in std::fs::read_dir(data.join("robots").join(name)).unwrap() {
+            let e = e.unwrap();
+            std::fs::copy(e.path(), robots.join(e.file_name())).unwrap();
+        }
+        let file = profiles.join(format!("{name}.toml"));
+        std::fs::write(&file, &o.stdout).unwrap();
+        let loaded = iktc::profile::RobotProfile::load(&file).unwrap();
+        assert_eq!(loaded, iktc::profile::RobotProfile::builtin(name).unwrap());
+        let m = run(&["model", file.to_str().unwrap(), "--json"]);
+        assert!(m.status.success(), "{}", stderr(&m));
+    }
+}
+
+#[test]
+fn profile_init_writes_a_profile_the_commands_accept() {
+    let dir = tmp("init");
+    let urdf = bare_g1_urdf(&dir);
+    let file = dir.join("g1.toml");
+    let o = iktc()
+        .args(["profile", "init"])
+        .arg(&urdf)
+        .arg("--out")
+        .arg(&file)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(&file).unwrap();
+    assert!(text.contains("# guessed"));
+    let p = iktc::profile::RobotProfile::load(&file).unwrap();
+    assert_eq!(p.urdf, "g1.urdf");
+    let m = run(&["model", file.to_str().unwrap(), "--json"]);
+    assert!(m.status.success(), "{}", stderr(&m));
+    let s: serde_json::Value = serde_json::from_slice(&m.stdout).unwrap();
+    assert_eq!(s["nv"].as_u64(), Some(35));
+}

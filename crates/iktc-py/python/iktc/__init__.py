@@ -1,0 +1,48 @@
+"""iktc: inverse kinematic control of humanoids under joint constraints (Kim & Oh), in Rust.
+
+Quick start::
+
+    import iktc
+    robot = iktc.Robot("jvrc1")
+    q, v = robot.neutral()
+    b = iktc.ControllerBuilder(robot, q, kp=100.0)
+    b.level("feet"); b.frame("r_ankle"); b.frame("l_ankle")
+    b.level("com"); com = b.com("xy")
+    ctrl = b.build()
+    ctrl.set_com_reference(com, robot.com(q) + [0.02, 0.0, 0.0])
+    report = ctrl.step(q, v, 0.005)     # q and v advanced in place
+
+Every error of the library is raised as ``iktc.IktcError`` (a ``ValueError``) with the
+library's message.
+"""
+from ._iktc import (
+    __version__,
+    IktcError,
+    Robot,
+    ControllerBuilder,
+    Controller,
+    FrameHandle,
+    ComHandle,
+    JointsHandle,
+    SolveReport,
+    PlaneModel,
+    DampingController,
+    measure_zmp,
+    identify,
+)
+
+__all__ = [
+    "__version__",
+    "IktcError",
+    "Robot",
+    "ControllerBuilder",
+    "Controller",
+    "FrameHandle",
+    "ComHandle",
+    "JointsHandle",
+    "SolveReport",
+    "PlaneModel",
+    "DampingController",
+    "measure_zmp",
+    "identify",
+]

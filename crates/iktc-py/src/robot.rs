@@ -1,0 +1,204 @@
+//! `iktc.Robot`: an immutable robot model from a built-in name or a URDF file.
+
+use std::sync::Arc;
+
+use iktc::model::{builtin_robot, BaseKind, Kinematics, ModelOptions, Robot, State};
+use numpy::{PyArray1, PyArray2};
+use pyo3::prelude::*;
+
+use crate::convert::{array, matrix, pose_matrix, vector};
+use crate::to_py;
+
+/// A robot model (immutable).
+///
+/// `Robot("jvrc1")` loads a built-in robot; `Robot("path/to/robot.urdf", floating=True,
+/// lock={"finger_joint": 0.0}, accel={"knee": 30.0})` reads a URDF file. q is (base position
+/// [m], base quaternion (x, y, z, w), joints [rad]) and v (base linear and angular velocity in
+/// base axes, joint rates), as in the Rust library.
+#[pyclass(name = "Robot", module = "iktc", frozen)]
+pub struct PyRobot {
+    pub(crate) robot: Arc<Robot>,
+}
+
+#[pymethods]
+impl PyRobot {
+    #[new]
+    #[pyo3(signature = (spec, *, floating=None, lock=None, accel=None))]
+    fn new(
+        spec: &str,
+        floating: Option<bool>,
+        lock: Option<Vec<(String, f64)>>,
+        accel: Option<Vec<(String, f64)>>,
+    ) -> PyResult<Self> {
+        let robot = if spec.ends_with(".urdf") || spec.ends_with(".xml") {
+            let options = ModelOptions {
+                base: if floating.unwrap_or(true) {
+                    BaseKind::Floating
+                } else {
+                    BaseKind::Fixed
+                },
+                locked: lock.unwrap_or_default(),
+                acceleration_limits: accel.unwrap_or_default(),
+                ..ModelOptions::default()
+            };
+            Robot::from_urdf_file(std::path::Path::new(spec), &options).map_err(to_py)?
+        } else {
+            if floating.is_some() || lock.is_some() || accel.is_some() {
+                return Err(crate::IktcError::new_err(format!(
+                    "`{spec}` is a built-in robot: floating, lock and accel apply to URDF files only"
+                )));
+            }
+            builtin_robot(spec).map_err(to_py)?
+        };
+        Ok(Self {
+            robot: Arc::new(robot),
+        })
+    }
+
+    /// The robot's name.
+    #[getter]
+    fn name(&self) -> &str {
+        self.robot.name()
+    }
+
+    /// Size of q.
+    #[getter]
+    fn nq(&self) -> usize {
+        self.robot.nq()
+    }
+
+    /// Size of v (and of q̈).
+    #[getter]
+    fn nv(&self) -> usize {
+        self.robot.nv()
+    }
+
+    /// Whether the base floats (q starts with 7 base entries, v with 6).
+    #[getter]
+    fn floating(&self) -> bool {
+        self.robot.base() == BaseKind::Floating
+    }
+
+    /// Active joint names, in q order.
+    #[getter]
+    fn joint_names(&self) -> Vec<String> {
+        self.robot.active_joints().map(|j| j.name.clone()).collect()
+    }
+
+    /// Every frame name (links first).
+    #[getter]
+    fn frame_names(&self) -> Vec<String> {
+        self.robot.frames().iter().map(|f| f.name.clone()).collect()
+    }
+
+    /// Total mass [kg].
+    #[getter]
+    fn total_mass(&self) -> f64 {
+        self.robot.total_mass()
+    }
+
+    /// Index of a joint in q.
+    fn q_index(&self, joint: &str) -> PyResult<usize> {
+        self.robot.joint_q_index(joint).map_err(to_py)
+    }
+
+    /// Index of a joint in v.
+    fn v_index(&self, joint: &str) -> PyResult<usize> {
+        self.robot.joint_v_index(joint).map_err(to_py)
+    }
+
+    /// Per velocity dof (base entries unbounded): (lower [rad], upper [rad], velocity [rad/s],
+    /// acceleration [rad/s²]) as four numpy arrays of length nv.
+    fn limits<'py>(&self, py: Python<'py>) -> [Bound<'py, PyArray1<f64>>; 4] {
+        let l = self.robot.dof_limits();
+        let pick = |f: fn(&iktc::model::JointLimit) -> f64| l.iter().map(f).collect::<Vec<_>>();
+        [
+            array(py, &pick(|x| x.lower)),
+            array(py, &pick(|x| x.upper)),
+            array(py, &pick(|x| x.velocity)),
+            array(py, &pick(|x| x.acceleration)),
+        ]
+    }
+
+    /// The neutral configuration: (q, v) as numpy arrays (base at the origin, joints at 0).
+    fn neutral<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>) {
+        let s = State::neutral(&self.robot);
+        (array(py, s.q.as_slice()), array(py, s.qd.as_slice()))
+    }
+
+    /// Pose of a frame at configuration q, as a 4 × 4 homogeneous matrix (world axes, [m]).
+    fn frame_pose<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        frame: &str,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let kin = self.kinematics(q)?;
+        let f = self.robot.frame_id(frame).map_err(to_py)?;
+        let p = kin.frame_pose(&self.robot, f).map_err(to_py)?;
+        Ok(pose_matrix(py, &p))
+    }
+
+    /// Frame Jacobian at q: 6 × nv, rows (vx, vy, vz, ωx, ωy, ωz) in world axes.
+    fn frame_jacobian<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        frame: &str,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let kin = self.kinematics(q)?;
+        let f = self.robot.frame_id(frame).map_err(to_py)?;
+        let mut j = nalgebra::DMatrix::zeros(6, self.robot.nv());
+        kin.frame_jacobian(&self.robot, f, &mut j).map_err(to_py)?;
+        Ok(matrix(py, &j))
+    }
+
+    /// Centre of mass at q [m], world axes.
+    fn com<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let kin = self.kinematics(q)?;
+        Ok(array(py, kin.com().as_slice()))
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Robot(name={:?}, nq={}, nv={}, mass={:.3} kg)",
+            self.robot.name(),
+            self.robot.nq(),
+            self.robot.nv(),
+            self.robot.total_mass()
+        )
+    }
+}
+
+impl PyRobot {
+    /// A state at configuration `q` (v = 0).
+    pub(crate) fn state(
+        &self,
+        q: &Bound<'_, PyAny>,
+        v: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<State> {
+        let mut s = State::neutral(&self.robot);
+        let qv = vector(q, self.robot.nq(), "q")?;
+        s.q.as_mut_slice().copy_from_slice(&qv);
+        if let Some(v) = v {
+            if !v.is_none() {
+                let vv = vector(v, self.robot.nv(), "v")?;
+                s.qd.as_mut_slice().copy_from_slice(&vv);
+            }
+        }
+        s.validate(&self.robot).map_err(to_py)?;
+        Ok(s)
+    }
+
+    fn kinematics(&self, q: &Bound<'_, PyAny>) -> PyResult<Kinematics> {
+        let s = self.state(q, None)?;
+        Kinematics::new(&self.robot, &s).map_err(to_py)
+    }
+}

@@ -1,0 +1,241 @@
+//! "The peer problem" of issue 17, as one self-contained closed loop shared by the
+//! `peer_problem` bench and the solver tests that replay it.
+//!
+//! - JVRC-1 built in (32 joints, fingers locked, floating base: n = 38), Δt = 5 ms, viable
+//!   bounds, a_max = 10·v_max (the model's default acceleration per velocity), no damping.
+//! - Initial pose: base at the origin, hip pitch −0.4, knee 0.8, ankle pitch −0.4 rad on both
+//!   legs, shoulder roll ∓0.3 rad (right −, left +), elbow pitch −0.5 rad, everything else 0,
+//!   at rest.
+//! - Tasks in priority order, k_p = 400 s⁻², k_v = 40 s⁻¹ on every task: (1) both ankle frames
+//!   6D held at their initial pose; (2) COM x, y held; (3) pelvis orientation held; (4) pelvis
+//!   height held; (5) the 20 upper-body joints following
+//!   q_ref,j(t) = q0,j + A·s(t)·sin(2π f t + φ_j), A = 0.8 rad, f = 1 Hz, s(t) the quintic
+//!   smoothstep 10τ³ − 15τ⁴ + 6τ⁵, τ = min(t / 1 s, 1), with the reference's velocity and
+//!   acceleration fed forward.
+//! - φ_j: uniform in [0, 2π) from `rand_chacha::ChaCha8Rng::seed_from_u64(PHASE_SEED)`
+//!   (rand 0.9, `random_range(0.0..TAU)`), drawn in the order of [`UPPER_BODY`].
+//! - One step = kinematics update, task linearisation, acceleration box, solve, integration
+//!   ([`PeerProblem::step`]); it allocates nothing.
+#![allow(dead_code)]
+
+use std::f64::consts::{PI, TAU};
+
+use iktc::limits::{compute_box, AccelerationBox, BoundMethod, JointLimits};
+use iktc::model::{jvrc1, Kinematics, ModelOptions, Robot, State};
+use iktc::solver::{Method, SolveReport, Solver, SolverSettings};
+use iktc::task::{
+    Axes, ComReference, ComTask, FrameReference, FrameTask, Gains, JointTask, Task, TaskEquation,
+    TaskStack,
+};
+use nalgebra::DVector;
+use rand::{Rng, SeedableRng};
+
+/// Control period Δt \[s\].
+pub const DT: f64 = 0.005;
+/// Steps run before the timed ones.
+pub const WARMUP: usize = 50;
+/// Timed steps.
+pub const TIMED: usize = 2000;
+/// Seed of the ChaCha8 generator that draws the phases φ_j.
+pub const PHASE_SEED: u64 = 17;
+/// Amplitude A of the upper-body sinusoids \[rad\].
+pub const AMPLITUDE: f64 = 0.8;
+/// Frequency f of the upper-body sinusoids \[Hz\].
+pub const FREQUENCY: f64 = 1.0;
+/// Duration of the quintic smoothstep that fades the sinusoids in \[s\].
+pub const RAMP: f64 = 1.0;
+/// Task gains: k_p \[1/s²\], k_v \[1/s\].
+pub const GAINS: Gains = Gains {
+    kp: 400.0,
+    kv: 40.0,
+};
+
+/// The 20 upper-body joints of level 5 (waist 3, neck 3, arms 2 × 7), in row order.
+pub const UPPER_BODY: [&str; 20] = [
+    "WAIST_Y",
+    "WAIST_P",
+    "WAIST_R",
+    "NECK_Y",
+    "NECK_R",
+    "NECK_P",
+    "R_SHOULDER_P",
+    "R_SHOULDER_R",
+    "R_SHOULDER_Y",
+    "R_ELBOW_P",
+    "R_ELBOW_Y",
+    "R_WRIST_R",
+    "R_WRIST_Y",
+    "L_SHOULDER_P",
+    "L_SHOULDER_R",
+    "L_SHOULDER_Y",
+    "L_ELBOW_P",
+    "L_ELBOW_Y",
+    "L_WRIST_R",
+    "L_WRIST_Y",
+];
+
+/// The initial joint angles that are not zero \[rad\].
+pub const INITIAL_POSE: [(&str, f64); 10] = [
+    ("R_HIP_P", -0.4),
+    ("R_KNEE", 0.8),
+    ("R_ANKLE_P", -0.4),
+    ("L_HIP_P", -0.4),
+    ("L_KNEE", 0.8),
+    ("L_ANKLE_P", -0.4),
+    ("R_SHOULDER_R", -0.3),
+    ("L_SHOULDER_R", 0.3),
+    ("R_ELBOW_P", -0.5),
+    ("L_ELBOW_P", -0.5),
+];
+
+/// The quintic smoothstep s(t) and its first two time derivatives \[1, 1/s, 1/s²\].
+pub fn smoothstep(t: f64) -> (f64, f64, f64) {
+    if t >= RAMP {
+        return (1.0, 0.0, 0.0);
+    }
+    let tau = (t / RAMP).max(0.0);
+    let (t2, t3) = (tau * tau, tau * tau * tau);
+    (
+        10.0 * t3 - 15.0 * t3 * tau + 6.0 * t3 * t2,
+        (30.0 * t2 - 60.0 * t3 + 30.0 * t2 * t2) / RAMP,
+        (60.0 * tau - 180.0 * t2 + 120.0 * t3) / (RAMP * RAMP),
+    )
+}
+
+/// The closed loop of the peer problem.
+#[derive(Debug, Clone)]
+pub struct PeerProblem {
+    pub robot: Robot,
+    pub state: State,
+    pub kin: Kinematics,
+    pub stack: TaskStack,
+    pub eqs: Vec<TaskEquation>,
+    pub limits: JointLimits,
+    pub bounds: BoundMethod,
+    pub bx: AccelerationBox,
+    pub solver: Solver,
+    pub method: Method,
+    pub qdd: DVector<f64>,
+    pos: Vec<f64>,
+    /// q0,j and φ_j of the upper-body joints \[rad\].
+    q0: Vec<f64>,
+    pub phases: Vec<f64>,
+    qr: [Vec<f64>; 3],
+    /// The next step's index k (time k Δt).
+    pub k: usize,
+}
+
+impl PeerProblem {
+    /// The problem at t = 0, solved by `method` with `settings`.
+    pub fn new(method: Method, settings: SolverSettings) -> iktc::Result<Self> {
+        let robot = jvrc1(&ModelOptions::default())?;
+        let mut state = State::neutral(&robot);
+        for (name, v) in INITIAL_POSE {
+            state.set_joint(&robot, name, v)?;
+        }
+        let kin = Kinematics::new(&robot, &state)?;
+        let mut feet = Vec::new();
+        for f in ["r_ankle", "l_ankle"] {
+            let mut t = FrameTask::new(&robot, f, Axes::ALL, GAINS)?;
+            t.set_reference(FrameReference::hold(kin.frame_pose(&robot, t.frame())?))?;
+            feet.push(Task::Frame(t));
+        }
+        let mut com = ComTask::new(&robot, [true, true, false], GAINS)?;
+        com.set_reference(ComReference {
+            position: kin.com(),
+            velocity: Default::default(),
+            acceleration: Default::default(),
+        })?;
+        let mut attitude = FrameTask::new(&robot, "PELVIS_S", Axes::ORIENTATION, GAINS)?;
+        let pelvis = kin.frame_pose(&robot, attitude.frame())?;
+        attitude.set_reference(FrameReference::hold(pelvis))?;
+        let mut height = FrameTask::new(&robot, "PELVIS_S", Axes::Z, GAINS)?;
+        height.set_reference(FrameReference::hold(pelvis))?;
+        let upper = JointTask::new(&robot, &UPPER_BODY, GAINS)?;
+        let q0 = UPPER_BODY
+            .iter()
+            .map(|j| state.joint(&robot, j))
+            .collect::<iktc::Result<Vec<_>>>()?;
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(PHASE_SEED);
+        let phases = (0..UPPER_BODY.len())
+            .map(|_| rng.random_range(0.0..TAU))
+            .collect();
+        let mut stack = TaskStack::default();
+        stack
+            .push("feet", feet)
+            .push("com_xy", vec![Task::Com(com)])
+            .push("pelvis_attitude", vec![Task::Frame(attitude)])
+            .push("pelvis_height", vec![Task::Frame(height)])
+            .push("upper_body", vec![Task::Joint(upper)]);
+        let eqs = stack.equations(&robot);
+        let dims: Vec<usize> = eqs.iter().map(|e| e.dim()).collect();
+        let nv = robot.nv();
+        Ok(Self {
+            limits: JointLimits::from_robot(&robot)?,
+            bounds: BoundMethod::viable(),
+            bx: AccelerationBox::new(nv),
+            solver: Solver::new(nv, &dims, settings)?,
+            method,
+            qdd: DVector::zeros(nv),
+            pos: vec![0.0; nv],
+            q0,
+            phases,
+            qr: std::array::from_fn(|_| vec![0.0; UPPER_BODY.len()]),
+            k: 0,
+            robot,
+            state,
+            kin,
+            stack,
+            eqs,
+        })
+    }
+
+    /// The upper-body reference at time t \[s\]: positions \[rad\], rates \[rad/s\] and
+    /// accelerations \[rad/s²\] into `self.qr`.
+    fn reference(&mut self, t: f64) {
+        let (s, sd, sdd) = smoothstep(t);
+        let w = 2.0 * PI * FREQUENCY;
+        for j in 0..self.q0.len() {
+            let (sn, cs) = (w * t + self.phases[j]).sin_cos();
+            self.qr[0][j] = self.q0[j] + AMPLITUDE * s * sn;
+            self.qr[1][j] = AMPLITUDE * (sd * sn + s * w * cs);
+            self.qr[2][j] = AMPLITUDE * (sdd * sn + 2.0 * sd * w * cs - s * w * w * sn);
+        }
+    }
+
+    /// Kinematics, references and task linearisation, and the box of step k, without solving.
+    pub fn prepare(&mut self) -> iktc::Result<()> {
+        self.kin.update(&self.robot, &self.state)?;
+        self.reference(self.k as f64 * DT);
+        if let Some(Task::Joint(j)) = self.stack.levels[4].tasks.first_mut() {
+            j.set_reference(&self.qr[0], &self.qr[1], &self.qr[2])?;
+        }
+        self.stack
+            .linearize(&self.robot, &self.kin, &self.state, &mut self.eqs)?;
+        self.state.dof_positions(&self.robot, &mut self.pos)?;
+        compute_box(
+            &self.limits,
+            &self.bounds,
+            &self.pos,
+            self.state.qd.as_slice(),
+            DT,
+            &mut self.bx,
+        )
+    }
+
+    /// Integrates the q̈ of the last solve over Δt and advances k.
+    pub fn finish(&mut self) -> iktc::Result<()> {
+        self.state.integrate(&self.robot, &self.qdd, DT)?;
+        self.k += 1;
+        Ok(())
+    }
+
+    /// One step: kinematics, linearisation, box, solve, integration. Allocates nothing.
+    pub fn step(&mut self) -> iktc::Result<&SolveReport> {
+        self.prepare()?;
+        self.solver
+            .solve(self.method, &self.eqs, &self.bx, &mut self.qdd)?;
+        self.finish()?;
+        Ok(self.solver.report())
+    }
+}

@@ -1,0 +1,181 @@
+//! A first pass over a URDF's raw XML, before `urdf-rs` builds its tree.
+//!
+//! It streams the document once (no recursion, no tree) and checks what the typed parse
+//! cannot see or would not survive:
+//!
+//! * the nesting depth, against [`ReadLimits::max_xml_depth`] (the tree parser recurses once per
+//!   level: 20 000 nested elements overflow the stack);
+//! * the elements inside each `<joint>` and `<inertial>` of the robot (a misspelled `<limit>`
+//!   would otherwise leave a revolute joint with the range \[0, 0\]; a misspelled `<mass>` a
+//!   massless link), and the attributes of `<limit>`;
+//! * which `<limit>` attributes are written at all, so that a missing value and an explicit 0
+//!   can be told apart (the typed parse gives 0 for both).
+
+use std::collections::HashMap;
+
+use quick_xml::events::{BytesStart, Event};
+
+use crate::error::{Error, Result};
+use crate::resources::ReadLimits;
+
+/// Elements URDF allows inside `<joint>`.
+pub(crate) const JOINT_CHILDREN: [&str; 9] = [
+    "origin",
+    "parent",
+    "child",
+    "axis",
+    "calibration",
+    "dynamics",
+    "limit",
+    "mimic",
+    "safety_controller",
+];
+
+/// Elements URDF allows inside `<inertial>`.
+const INERTIAL_CHILDREN: [&str; 3] = ["origin", "mass", "inertia"];
+
+/// Attributes URDF (up to 1.2) allows on `<limit>`.
+const LIMIT_ATTRIBUTES: [&str; 7] = [
+    "lower",
+    "upper",
+    "effort",
+    "velocity",
+    "acceleration",
+    "deceleration",
+    "jerk",
+];
+
+/// What the raw pass saw of one `<joint>` of the robot.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub(crate) struct RawJoint {
+    /// Its `<limit>` attributes as written (name, text), or `None` without a `<limit>`.
+    pub limit: Option<Vec<(String, String)>>,
+}
+
+impl RawJoint {
+    /// The text of `<limit attr="…">`, if written.
+    pub fn limit_attr(&self, name: &str) -> Option<&str> {
+        self.limit
+            .as_ref()?
+            .iter()
+            .find(|(n, _)| n == name)
+            .map(|(_, v)| v.as_str())
+    }
+}
+
+fn error(message: String) -> Error {
+    Error::Urdf { message }
+}
+
+fn name_of(e: &BytesStart<'_>) -> String {
+    String::from_utf8_lossy(e.name().as_ref()).into_owned()
+}
+
+fn attributes(e: &BytesStart<'_>) -> Result<Vec<(String, String)>> {
+    let tag = name_of(e);
+    e.attributes()
+        .map(|a| {
+            let a = a.map_err(|err| error(format!("cannot parse the URDF: <{tag}>: {err}")))?;
+            let key = String::from_utf8_lossy(a.key.as_ref()).into_owned();
+            let value = a
+                .unescape_value()
+                .map_err(|err| error(format!("cannot parse the URDF: <{tag} {key}>: {err}")))?
+                .into_owned();
+            Ok((key, value))
+        })
+        .collect()
+}
+
+/// One open element: its tag and, for a joint or link of the robot, its name.
+struct Open {
+    tag: String,
+    name: String,
+}
+
+/// Streams `text` once; returns the robot's joints by name. Errors: a nesting deeper than
+/// `limits.max_xml_depth`, an element URDF does not know inside a robot's `<joint>` or
+/// `<inertial>`, an unknown `<limit>` attribute, malformed XML.
+pub(crate) fn check_raw(text: &str, limits: &ReadLimits) -> Result<HashMap<String, RawJoint>> {
+    limits.validate()?;
+    let mut reader = quick_xml::Reader::from_str(text);
+    let mut stack: Vec<Open> = Vec::new();
+    let mut joints: HashMap<String, RawJoint> = HashMap::new();
+    loop {
+        let event = reader.read_event().map_err(|e| {
+            error(format!(
+                "cannot parse the URDF at byte {}: {e}",
+                reader.error_position()
+            ))
+        })?;
+        let (start, empty) = match &event {
+            Event::Start(e) => (e, false),
+            Event::Empty(e) => (e, true),
+            Event::End(_) => {
+                stack.pop();
+                continue;
+            }
+            Event::Eof => break,
+            _ => continue,
+        };
+        let tag = name_of(start);
+        let depth = stack.len() + 1;
+        if depth > limits.max_xml_depth {
+            return Err(Error::ResourceLimit {
+                what: format!("XML nesting depth of the URDF (at <{tag}>)"),
+                value: depth.to_string(),
+                limit: limits.max_xml_depth.to_string(),
+                option: "ReadLimits::max_xml_depth (Robot::from_urdf_str_with)".into(),
+            });
+        }
+        let attrs = attributes(start)?;
+        let name = attrs
+            .iter()
+            .find(|(k, _)| k == "name")
+            .map(|(_, v)| v.clone())
+            .unwrap_or_default();
+        // Parent and grandparent tags: a robot's joint is `robot › joint`, its children
+        // `robot › joint › *`, an inertial's children `robot › link › inertial › *`.
+        let parent = stack.last();
+        let grandparent = stack.len().checked_sub(2).and_then(|i| stack.get(i));
+        let in_robot_joint = parent.is_some_and(|p| p.tag == "joint")
+            && grandparent.is_some_and(|g| g.tag == "robot")
+            && stack.len() == 2;
+        if in_robot_joint {
+            let joint = parent.map_or("", |p| p.name.as_str());
+            if !JOINT_CHILDREN.contains(&tag.as_str()) {
+                return Err(error(format!(
+                    "joint `{joint}` contains <{tag}>, which URDF does not define inside <joint>; expected one of {}",
+                    JOINT_CHILDREN.map(|t| format!("<{t}>")).join(", ")
+                )));
+            }
+            if tag == "limit" {
+                if let Some((bad, _)) = attrs
+                    .iter()
+                    .find(|(k, _)| !LIMIT_ATTRIBUTES.contains(&k.as_str()))
+                {
+                    return Err(error(format!(
+                        "joint `{joint}`: <limit> has the attribute `{bad}`, which URDF does not define; expected {}",
+                        LIMIT_ATTRIBUTES.join(", ")
+                    )));
+                }
+                joints.entry(joint.to_string()).or_default().limit = Some(attrs.clone());
+            }
+        }
+        let in_inertial = stack.len() == 3
+            && parent.is_some_and(|p| p.tag == "inertial")
+            && grandparent.is_some_and(|g| g.tag == "link");
+        if in_inertial && !INERTIAL_CHILDREN.contains(&tag.as_str()) {
+            let link = grandparent.map_or("", |g| g.name.as_str());
+            return Err(error(format!(
+                "link `{link}`: <inertial> contains <{tag}>, which URDF does not define there; expected <origin>, <mass> or <inertia>"
+            )));
+        }
+        if tag == "joint" && stack.len() == 1 {
+            joints.entry(name.clone()).or_default();
+        }
+        if !empty {
+            stack.push(Open { tag, name });
+        }
+    }
+    Ok(joints)
+}

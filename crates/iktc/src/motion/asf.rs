@@ -1,0 +1,453 @@
+//! Acclaim skeleton files (ASF), as used by the CMU motion-capture database.
+//!
+//! Supported: `:units` (`length`, `angle deg|rad`; `mass` ignored), `:root` (`order`, `axis`,
+//! `position`, `orientation`), `:bonedata` (`begin … end` blocks with `id`, `name`,
+//! `direction`, `length`, `axis x y z ORDER`, `dof` of `rx ry rz tx ty tz`, `limits` ignored),
+//! `:hierarchy` (`begin`, lines `parent child…`, `end`); `:version`, `:name` and
+//! `:documentation` are skipped. Not supported: the `l` (length) degree of freedom.
+//!
+//! Conventions (Acclaim, as in CMU's viewer): a list of rotations about axes `a_1 … a_n`
+//! (an `axis` order or the `dof` order) is applied in the listed order about fixed axes,
+//! `R = Rot(a_n) ··· Rot(a_1)`. Bone `b` has the rest frame `C_b` (its `axis`) and the motion
+//! rotation `M_b` (its AMC values); in a frame parallel to the world at rest its local rotation
+//! is `Q_b = C_b M_b C_bᵀ`. Bone `b` starts at the end of its parent, whose rest vector is
+//! `direction · length` (the root's children start at the root).
+
+use nalgebra::{Unit, UnitQuaternion, Vector3};
+
+use super::{Clip, JointKind, Pose, Skeleton, SkeletonJoint, UpAxis};
+use crate::error::{Error, Result};
+
+/// A degree of freedom of a bone or the root.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum AsfDof {
+    /// Rotation about x, y or z (0, 1, 2).
+    Rotation(usize),
+    /// Translation along x, y or z (0, 1, 2).
+    Translation(usize),
+}
+
+/// One bone of an ASF skeleton.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AsfBone {
+    /// The bone's name.
+    pub name: String,
+    /// Rest vector from its start to its end \[file units\]: `direction · length`.
+    pub vector: Vector3<f64>,
+    /// Rest frame `C_b` of its degrees of freedom.
+    pub axis: UnitQuaternion<f64>,
+    /// Degrees of freedom, in AMC value order.
+    pub dofs: Vec<AsfDof>,
+    /// Parent bone index, `None` for a child of the root.
+    pub parent: Option<usize>,
+}
+
+/// An ASF skeleton.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Asf {
+    /// The file name (for messages).
+    pub source: String,
+    /// Whether angles (axis, AMC values) are in degrees (`:units angle deg`, the default).
+    pub degrees: bool,
+    /// The root's AMC value order.
+    pub root_order: Vec<AsfDof>,
+    /// The root's rest frame `C_root`.
+    pub root_axis: UnitQuaternion<f64>,
+    /// The root's rest position \[file units\].
+    pub root_position: Vector3<f64>,
+    /// Bones, parents before children.
+    pub bones: Vec<AsfBone>,
+}
+
+/// `Rot(a_n) ··· Rot(a_1)` for axes listed `a_1 … a_n` with angles \[rad\].
+pub(crate) fn fixed_axes_rotation(axes: &[usize], angles: &[f64]) -> UnitQuaternion<f64> {
+    let mut q = UnitQuaternion::identity();
+    for (a, v) in axes.iter().zip(angles) {
+        let axis = Unit::new_unchecked(Vector3::ith(*a, 1.0));
+        q = UnitQuaternion::from_axis_angle(&axis, *v) * q;
+    }
+    q
+}
+
+fn axis_index(c: char) -> Option<usize> {
+    match c.to_ascii_lowercase() {
+        'x' => Some(0),
+        'y' => Some(1),
+        'z' => Some(2),
+        _ => None,
+    }
+}
+
+/// The lines of an ASF or AMC file that are not blank or `#` comments: (1-based line, trimmed).
+pub(crate) fn acclaim_lines(text: &str) -> impl Iterator<Item = (usize, &str)> {
+    text.lines()
+        .enumerate()
+        .map(|(i, l)| (i + 1, l.trim()))
+        .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'))
+}
+
+struct Parser<'a> {
+    source: &'a str,
+}
+
+impl Parser<'_> {
+    fn error(&self, line: usize, message: impl Into<String>) -> Error {
+        Error::Parse {
+            source_name: self.source.to_string(),
+            line,
+            message: message.into(),
+        }
+    }
+
+    fn numbers<const N: usize>(
+        &self,
+        line: usize,
+        what: &str,
+        tokens: &[&str],
+    ) -> Result<[f64; N]> {
+        let mut out = [0.0; N];
+        if tokens.len() < N {
+            return Err(self.error(
+                line,
+                format!("`{what}` needs {N} numbers, found {}", tokens.len()),
+            ));
+        }
+        for (o, t) in out.iter_mut().zip(tokens) {
+            *o = t
+                .parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| {
+                    self.error(line, format!("`{what}`: `{t}` is not a finite number"))
+                })?;
+        }
+        Ok(out)
+    }
+
+    fn dof(&self, line: usize, token: &str) -> Result<AsfDof> {
+        let lower = token.to_ascii_lowercase();
+        let mut chars = lower.chars();
+        let kind = chars.next();
+        let axis = chars.next().and_then(axis_index);
+        match (kind, axis, chars.next()) {
+            (Some('r'), Some(a), None) => Ok(AsfDof::Rotation(a)),
+            (Some('t'), Some(a), None) => Ok(AsfDof::Translation(a)),
+            _ => Err(self.error(
+                line,
+                format!("unsupported degree of freedom `{token}`; expected rx ry rz tx ty tz"),
+            )),
+        }
+    }
+
+    fn axis_order(&self, line: usize, token: &str) -> Result<Vec<usize>> {
+        let order: Option<Vec<usize>> = token.chars().map(axis_index).collect();
+        match order {
+            Some(o) if o.len() == 3 => Ok(o),
+            _ => Err(self.error(line, format!("axis order `{token}`; expected e.g. XYZ"))),
+        }
+    }
+}
+
+#[derive(Default)]
+struct RawBone {
+    name: String,
+    line: usize,
+    direction: Vector3<f64>,
+    length: f64,
+    axis: [f64; 3],
+    order: Vec<usize>,
+    dofs: Vec<AsfDof>,
+}
+
+/// Reads an ASF file; `source` names it in errors ([`Error::Parse`] with the line): an unknown
+/// section, a malformed number, a bone without name, a missing `:hierarchy`, a hierarchy naming
+/// an unknown bone or leaving a bone out.
+pub fn read_asf(text: &str, source: &str) -> Result<Asf> {
+    let p = Parser { source };
+    let mut degrees = true;
+    let mut root_order: Vec<AsfDof> = Vec::new();
+    let mut root_axis_order = vec![0, 1, 2];
+    let mut root_orientation = [0.0; 3];
+    let mut root_position = Vector3::zeros();
+    let mut bones: Vec<RawBone> = Vec::new();
+    let mut links: Vec<(usize, String, String)> = Vec::new();
+    let mut section = String::new();
+    let mut current: Option<RawBone> = None;
+    let mut hierarchy_seen = false;
+    let mut in_limits = false;
+    let last_line = text.lines().count();
+    for (line, l) in acclaim_lines(text) {
+        let tokens: Vec<&str> = l.split_whitespace().collect();
+        let key = tokens[0].to_ascii_lowercase();
+        if key.starts_with(':') {
+            section = key.clone();
+            in_limits = false;
+            match key.as_str() {
+                ":version" | ":name" | ":units" | ":documentation" | ":root" | ":bonedata" => {}
+                ":hierarchy" => hierarchy_seen = true,
+                other => return Err(p.error(line, format!("unknown section `{other}`"))),
+            }
+            continue;
+        }
+        let args = &tokens[1..];
+        match section.as_str() {
+            ":units" if key == "angle" => {
+                degrees = match args.first().map(|a| a.to_ascii_lowercase()) {
+                    Some(a) if a.starts_with("deg") => true,
+                    Some(a) if a.starts_with("rad") => false,
+                    _ => return Err(p.error(line, "`angle` must be deg or rad")),
+                };
+            }
+            ":root" => match key.as_str() {
+                "order" => {
+                    root_order = args
+                        .iter()
+                        .map(|t| p.dof(line, t))
+                        .collect::<Result<Vec<_>>>()?
+                }
+                "axis" => {
+                    root_axis_order = p.axis_order(line, args.first().copied().unwrap_or(""))?
+                }
+                "position" => {
+                    root_position = Vector3::from(p.numbers::<3>(line, "position", args)?)
+                }
+                "orientation" => root_orientation = p.numbers::<3>(line, "orientation", args)?,
+                _ => return Err(p.error(line, format!("unknown root field `{key}`"))),
+            },
+            ":bonedata" => {
+                if in_limits && key.starts_with('(') {
+                    continue;
+                }
+                in_limits = false;
+                match (key.as_str(), current.as_mut()) {
+                    ("begin", None) => {
+                        current = Some(RawBone {
+                            line,
+                            order: vec![0, 1, 2],
+                            ..RawBone::default()
+                        })
+                    }
+                    ("end", Some(_)) => {
+                        if let Some(b) = current.take() {
+                            if b.name.is_empty() {
+                                return Err(p.error(b.line, "a bone without `name`"));
+                            }
+                            bones.push(b);
+                        }
+                    }
+                    ("id", Some(_)) => {}
+                    ("name", Some(b)) => {
+                        b.name = args.first().map(|s| s.to_string()).unwrap_or_default()
+                    }
+                    ("direction", Some(b)) => {
+                        b.direction = Vector3::from(p.numbers::<3>(line, "direction", args)?)
+                    }
+                    ("length", Some(b)) => b.length = p.numbers::<1>(line, "length", args)?[0],
+                    ("axis", Some(b)) => {
+                        b.axis = p.numbers::<3>(line, "axis", args)?;
+                        b.order = p.axis_order(line, args.get(3).copied().unwrap_or("XYZ"))?;
+                    }
+                    ("dof", Some(b)) => {
+                        b.dofs = args
+                            .iter()
+                            .map(|t| p.dof(line, t))
+                            .collect::<Result<Vec<_>>>()?
+                    }
+                    ("limits", Some(_)) => in_limits = true,
+                    (k, Some(_)) if k.starts_with("bodymass") || k.starts_with("cofmass") => {}
+                    (other, _) => {
+                        return Err(p.error(line, format!("unexpected `{other}` in :bonedata")))
+                    }
+                }
+            }
+            ":hierarchy" => match key.as_str() {
+                "begin" | "end" => {}
+                _ => {
+                    for child in args {
+                        links.push((line, tokens[0].to_string(), child.to_string()));
+                    }
+                }
+            },
+            _ => {}
+        }
+    }
+    if let Some(b) = current {
+        return Err(p.error(b.line, "bone block without `end` (truncated file)"));
+    }
+    if !hierarchy_seen || links.is_empty() {
+        return Err(p.error(
+            last_line,
+            "no `:hierarchy` section (or an empty one): the bones' parents are unknown",
+        ));
+    }
+    let angle = |v: f64| if degrees { v.to_radians() } else { v };
+    // Order bones parents first, following the hierarchy from the root.
+    let mut order: Vec<(usize, Option<usize>)> = Vec::new(); // (raw bone index, parent in `order`)
+    let mut frontier: Vec<(String, Option<usize>)> = vec![("root".to_string(), None)];
+    while let Some((parent_name, parent_slot)) = frontier.pop() {
+        for (line, parent, child) in links.iter().filter(|(_, p, _)| *p == parent_name) {
+            let b = bones.iter().position(|b| &b.name == child).ok_or_else(|| {
+                p.error(
+                    *line,
+                    format!("`:hierarchy` names unknown bone `{child}` (child of `{parent}`)"),
+                )
+            })?;
+            if order.iter().any(|(o, _)| *o == b) {
+                return Err(p.error(*line, format!("bone `{child}` has two parents")));
+            }
+            order.push((b, parent_slot));
+            frontier.push((child.clone(), Some(order.len() - 1)));
+        }
+    }
+    if let Some(b) = bones
+        .iter()
+        .find(|b| !order.iter().any(|(o, _)| bones[*o].name == b.name))
+    {
+        return Err(p.error(
+            b.line,
+            format!(
+                "bone `{}` is not reachable from `root` in `:hierarchy`",
+                b.name
+            ),
+        ));
+    }
+    let axis_rotation = |values: [f64; 3], axes: &[usize]| {
+        let angles: Vec<f64> = axes.iter().map(|a| angle(values[*a])).collect();
+        fixed_axes_rotation(axes, &angles)
+    };
+    let out_bones = order
+        .iter()
+        .map(|(b, parent)| {
+            let raw = &bones[*b];
+            AsfBone {
+                name: raw.name.clone(),
+                vector: raw.direction * raw.length,
+                axis: axis_rotation(raw.axis, &raw.order),
+                dofs: raw.dofs.clone(),
+                parent: *parent,
+            }
+        })
+        .collect();
+    Ok(Asf {
+        source: source.to_string(),
+        degrees,
+        root_order,
+        root_axis: axis_rotation(root_orientation, &root_axis_order),
+        root_position,
+        bones: out_bones,
+    })
+}
+
+impl Asf {
+    /// The motion skeleton: joint 0 `root`, then one joint per bone at the bone's start, then an
+    /// end site `<bone>_end` at the end of every bone without children. A bone with 2–3 rotation
+    /// dofs is spherical, with 1 a hinge about `C_b e_axis`, with none fixed.
+    pub fn skeleton(&self) -> Result<Skeleton> {
+        let mut joints = vec![SkeletonJoint {
+            name: "root".to_string(),
+            parent: None,
+            offset: self.root_position,
+            kind: JointKind::Root,
+        }];
+        for b in &self.bones {
+            let rotations: Vec<usize> = b
+                .dofs
+                .iter()
+                .filter_map(|d| match d {
+                    AsfDof::Rotation(a) => Some(*a),
+                    AsfDof::Translation(_) => None,
+                })
+                .collect();
+            let kind = match rotations.as_slice() {
+                [] => JointKind::Fixed,
+                [a] => JointKind::Hinge {
+                    axis: Unit::new_normalize(b.axis * Vector3::ith(*a, 1.0)),
+                },
+                _ => JointKind::Spherical,
+            };
+            let (parent, offset) = match b.parent {
+                None => (0, Vector3::zeros()),
+                Some(p) => (p + 1, self.bones[p].vector),
+            };
+            joints.push(SkeletonJoint {
+                name: b.name.clone(),
+                parent: Some(parent),
+                offset,
+                kind,
+            });
+        }
+        for (i, b) in self.bones.iter().enumerate() {
+            if !self.bones.iter().any(|c| c.parent == Some(i)) {
+                joints.push(SkeletonJoint {
+                    name: format!("{}_end", b.name),
+                    parent: Some(i + 1),
+                    offset: b.vector,
+                    kind: JointKind::Fixed,
+                });
+            }
+        }
+        Skeleton::new(joints)
+    }
+
+    /// The rest pose as a one-frame clip (Y up, the Acclaim convention).
+    pub fn rest_clip(&self) -> Result<Clip> {
+        let skeleton = self.skeleton()?;
+        let pose = skeleton.rest_pose();
+        Clip::new(&self.source, skeleton, vec![0.0], vec![pose], UpAxis::Y)
+    }
+
+    /// The pose of the skeleton (see [`Asf::skeleton`]) for one frame's values: `root` holds the
+    /// root's values in `root_order`, `bone_values[b]` bone `b`'s in its dof order (angles in
+    /// degrees or radians as `degrees` says). Root: position `(TX, TY, TZ)` in the world, orientation
+    /// `C_root M_root C_rootᵀ`; a bone's translation dofs `t` move it by `C_b t`.
+    pub(crate) fn pose(
+        &self,
+        root: &[f64],
+        bone_values: &[Vec<f64>],
+        joints: usize,
+        degrees: bool,
+    ) -> Pose {
+        let angle = |v: f64| if degrees { v.to_radians() } else { v };
+        let (q_root, t_root) = self.dof_motion(&self.root_order, root, &self.root_axis, angle);
+        let mut pose = Pose {
+            root_position: t_root,
+            root_orientation: q_root,
+            rotations: vec![UnitQuaternion::identity(); joints],
+            translations: vec![Vector3::zeros(); joints],
+        };
+        for (i, (b, values)) in self.bones.iter().zip(bone_values).enumerate() {
+            let (q, t) = self.dof_motion(&b.dofs, values, &b.axis, angle);
+            if let Some(r) = pose.rotations.get_mut(i + 1) {
+                *r = q;
+            }
+            if let Some(tr) = pose.translations.get_mut(i + 1) {
+                *tr = b.axis * t;
+            }
+        }
+        pose
+    }
+
+    /// `(C M Cᵀ, t)` for the given dofs and values (`t` in the dofs' own axes).
+    fn dof_motion(
+        &self,
+        dofs: &[AsfDof],
+        values: &[f64],
+        c: &UnitQuaternion<f64>,
+        angle: impl Fn(f64) -> f64,
+    ) -> (UnitQuaternion<f64>, Vector3<f64>) {
+        let mut axes = Vec::with_capacity(3);
+        let mut angles = Vec::with_capacity(3);
+        let mut t = Vector3::zeros();
+        for (d, v) in dofs.iter().zip(values) {
+            match d {
+                AsfDof::Rotation(a) => {
+                    axes.push(*a);
+                    angles.push(angle(*v));
+                }
+                AsfDof::Translation(a) => t[*a] = *v,
+            }
+        }
+        let m = fixed_axes_rotation(&axes, &angles);
+        (c * m * c.inverse(), t)
+    }
+}

@@ -1,0 +1,295 @@
+//! A minimal reader of C3D files: the 3D point (marker) trajectories.
+//!
+//! Supported: the header block (number of points, analog values per frame, first and last
+//! frame, scale factor, data start block, frame rate), the parameter section (groups and
+//! parameters of any type; `POINT:LABELS` names the points, `POINT:RATE` overrides the
+//! header's rate when present), and the data section with integer (scale factor > 0: every
+//! coordinate is `value · scale`) or floating-point (scale factor < 0) samples, for Intel
+//! (processor type 84, little-endian) and MIPS/SGI (86, big-endian) files. A point whose
+//! residual word is negative is missing in that frame (a gap). Analog samples are skipped.
+//!
+//! Not supported (an error): DEC files (processor type 85); more than 255 labels
+//! (`POINT:LABELS2`) name the extra points `P256`, `P257`, ….
+//!
+//! Layout (C3D.org, "The C3D File Format User Guide"): 512-byte blocks; header words are 16-bit;
+//! a parameter entry is `[name length (i8, < 0 if locked), group id (i8, < 0 for a group),
+//! name, offset to the next entry (i16), …]`, a parameter continuing with
+//! `[type (i8: −1 char, 1 byte, 2 int16, 4 float), dimension count, dimensions, data,
+//! description length, description]`.
+
+use nalgebra::Vector3;
+
+use super::markers::MarkerSet;
+use crate::error::{Error, Result};
+
+const BLOCK: usize = 512;
+
+#[derive(Clone, Copy)]
+enum Endian {
+    Little,
+    Big,
+}
+
+struct Reader<'a> {
+    bytes: &'a [u8],
+    endian: Endian,
+    source: &'a str,
+}
+
+impl Reader<'_> {
+    fn error(&self, offset: usize, message: impl Into<String>) -> Error {
+        Error::Parse {
+            source_name: self.source.to_string(),
+            line: 0,
+            message: format!("byte {offset}: {}", message.into()),
+        }
+    }
+
+    fn get<const N: usize>(&self, at: usize) -> Result<[u8; N]> {
+        self.bytes
+            .get(at..at + N)
+            .and_then(|s| <[u8; N]>::try_from(s).ok())
+            .ok_or_else(|| {
+                self.error(
+                    at,
+                    format!("the file ends (it has {} bytes)", self.bytes.len()),
+                )
+            })
+    }
+
+    fn u16(&self, at: usize) -> Result<u16> {
+        let b = self.get::<2>(at)?;
+        Ok(match self.endian {
+            Endian::Little => u16::from_le_bytes(b),
+            Endian::Big => u16::from_be_bytes(b),
+        })
+    }
+
+    fn i16(&self, at: usize) -> Result<i16> {
+        let b = self.get::<2>(at)?;
+        Ok(match self.endian {
+            Endian::Little => i16::from_le_bytes(b),
+            Endian::Big => i16::from_be_bytes(b),
+        })
+    }
+
+    fn f32(&self, at: usize) -> Result<f32> {
+        let b = self.get::<4>(at)?;
+        Ok(match self.endian {
+            Endian::Little => f32::from_le_bytes(b),
+            Endian::Big => f32::from_be_bytes(b),
+        })
+    }
+}
+
+/// One parameter: group name, name, type, dimensions, raw data.
+struct Parameter {
+    group: String,
+    name: String,
+    kind: i8,
+    dims: Vec<usize>,
+    data_at: usize,
+}
+
+/// Reads a C3D file's points (see the module documentation); `source` names it in errors
+/// ([`Error::Parse`] with the byte offset).
+pub fn read_c3d(bytes: &[u8], source: &str) -> Result<MarkerSet> {
+    let mut r = Reader {
+        bytes,
+        endian: Endian::Little,
+        source,
+    };
+    if bytes.len() < BLOCK || bytes[1] != 0x50 {
+        return Err(r.error(
+            1,
+            format!(
+                "not a C3D file: it needs a 512-byte header whose second byte is 0x50 (found {} bytes, second byte {:#04x})",
+                bytes.len(),
+                bytes.get(1).copied().unwrap_or(0)
+            ),
+        ));
+    }
+    let param_block = bytes[0] as usize;
+    if param_block < 2 {
+        return Err(r.error(0, format!("parameter block {param_block}; expected ≥ 2")));
+    }
+    let param_at = (param_block - 1) * BLOCK;
+    let processor = r.get::<4>(param_at)?[3];
+    r.endian =
+        match processor {
+            84 => Endian::Little,
+            86 => Endian::Big,
+            85 => return Err(r.error(
+                param_at + 3,
+                "DEC (VAX) C3D files are not supported; convert the file to the PC (Intel) format",
+            )),
+            other => {
+                return Err(r.error(
+                    param_at + 3,
+                    format!("processor type {other}; expected 84 (Intel), 86 (MIPS) or 85 (DEC)"),
+                ))
+            }
+        };
+    let points = r.u16(2)? as usize;
+    let analog_per_frame = r.u16(4)? as usize;
+    let first = r.u16(6)? as usize;
+    let last = r.u16(8)? as usize;
+    let scale = r.f32(12)? as f64;
+    let data_block = r.u16(16)? as usize;
+    let header_rate = r.f32(20)? as f64;
+    if last < first || first == 0 {
+        return Err(r.error(
+            6,
+            format!("frames {first}–{last}; expected 1 ≤ first ≤ last"),
+        ));
+    }
+    if !scale.is_finite() || scale == 0.0 {
+        return Err(r.error(
+            12,
+            format!("scale factor {scale}; expected a finite non-zero number"),
+        ));
+    }
+    if data_block < 2 {
+        return Err(r.error(16, format!("data start block {data_block}; expected ≥ 2")));
+    }
+    let params = parameters(&r, param_at)?;
+    let find = |g: &str, n: &str| {
+        params
+            .iter()
+            .find(|p| p.group.eq_ignore_ascii_case(g) && p.name.eq_ignore_ascii_case(n))
+    };
+    let mut names: Vec<String> = match find("POINT", "LABELS") {
+        Some(p) if p.kind == -1 && p.dims.len() == 2 => {
+            let (len, count) = (p.dims[0], p.dims[1]);
+            (0..count)
+                .map(|k| {
+                    let at = p.data_at + k * len;
+                    let raw = bytes.get(at..at + len).unwrap_or(&[]);
+                    String::from_utf8_lossy(raw).trim().to_string()
+                })
+                .collect()
+        }
+        _ => Vec::new(),
+    };
+    names.truncate(points);
+    for k in names.len()..points {
+        names.push(format!("P{}", k + 1));
+    }
+    for (k, n) in names.iter_mut().enumerate() {
+        if n.is_empty() {
+            *n = format!("P{}", k + 1);
+        }
+    }
+    let rate = match find("POINT", "RATE") {
+        Some(p) if p.kind == 4 => r.f32(p.data_at)? as f64,
+        _ => header_rate,
+    };
+    if !(rate.is_finite() && rate > 0.0) {
+        return Err(r.error(20, format!("frame rate {rate} Hz; expected > 0")));
+    }
+    let float = scale < 0.0;
+    let word = if float { 4 } else { 2 };
+    let frame_bytes = (points * 4 + analog_per_frame) * word;
+    let frames = last - first + 1;
+    let data_at = (data_block - 1) * BLOCK;
+    let needed = data_at + frames * frame_bytes;
+    if bytes.len() < needed {
+        return Err(r.error(
+            bytes.len(),
+            format!(
+                "truncated data: {frames} frames of {points} points need {needed} bytes, the file has {}",
+                bytes.len()
+            ),
+        ));
+    }
+    let mut positions = Vec::with_capacity(frames * points);
+    for f in 0..frames {
+        for (k, name) in names.iter().enumerate() {
+            let at = data_at + f * frame_bytes + k * 4 * word;
+            let value = |i: usize| -> Result<f64> {
+                Ok(if float {
+                    r.f32(at + i * 4)? as f64
+                } else {
+                    r.i16(at + i * 2)? as f64 * scale
+                })
+            };
+            let residual = value(3)?;
+            let p = Vector3::new(value(0)?, value(1)?, value(2)?);
+            if residual < 0.0 {
+                positions.push(None);
+            } else if p.iter().all(|v| v.is_finite()) {
+                positions.push(Some(p));
+            } else {
+                return Err(r.error(
+                    at,
+                    format!(
+                        "frame {}, point `{name}`: a non-finite coordinate",
+                        first + f
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(MarkerSet {
+        source: source.to_string(),
+        names,
+        times: (0..frames).map(|f| f as f64 / rate).collect(),
+        positions,
+    })
+}
+
+fn parameters(r: &Reader, start: usize) -> Result<Vec<Parameter>> {
+    let mut groups: Vec<(u8, String)> = Vec::new();
+    let mut raw: Vec<(u8, Parameter)> = Vec::new();
+    let mut at = start + 4;
+    loop {
+        let [len, id] = r.get::<2>(at)?;
+        let name_len = (len as i8).unsigned_abs() as usize;
+        let id = id as i8;
+        if name_len == 0 || id == 0 {
+            break;
+        }
+        let name_bytes = r
+            .bytes
+            .get(at + 2..at + 2 + name_len)
+            .ok_or_else(|| r.error(at, "a parameter name runs past the end of the file"))?;
+        let name = String::from_utf8_lossy(name_bytes).to_string();
+        let offset_at = at + 2 + name_len;
+        let next = r.i16(offset_at)?;
+        let body = offset_at + 2;
+        if id < 0 {
+            groups.push((id.unsigned_abs(), name));
+        } else {
+            let kind = r.get::<1>(body)?[0] as i8;
+            let ndims = r.get::<1>(body + 1)?[0] as usize;
+            let dims: Vec<usize> = (0..ndims)
+                .map(|d| r.get::<1>(body + 2 + d).map(|b| b[0] as usize))
+                .collect::<Result<Vec<_>>>()?;
+            raw.push((
+                id.unsigned_abs(),
+                Parameter {
+                    group: String::new(),
+                    name,
+                    kind,
+                    dims,
+                    data_at: body + 2 + ndims,
+                },
+            ));
+        }
+        if next <= 0 {
+            break;
+        }
+        at = offset_at + next as usize;
+    }
+    Ok(raw
+        .into_iter()
+        .map(|(id, mut p)| {
+            p.group = groups
+                .iter()
+                .find(|(g, _)| *g == id)
+                .map(|(_, n)| n.clone())
+                .unwrap_or_default();
+            p
+        })
+        .collect())
+}

@@ -1,0 +1,469 @@
+//! One entry point for every motion source: [`load_motion`] detects the format, reads the file,
+//! finds the body points (or takes a map), decides units and up axis, and gives keypoints (and,
+//! for skeletons, a clip in metres).
+//!
+//! Format detection: by content first — BVH starts with `HIERARCHY`; ASF has `:version`,
+//! `:units`, `:root` or `:bonedata` keywords; AMC has `:FULLY-SPECIFIED`, `:DEGREES` or
+//! `:RADIANS` before its first frame; DeepMimic is JSON with `"Frames"`; C3D has `0x50` as its
+//! second byte; a points CSV has a header whose columns end in `_x`, `_y`, `_z` — then by the
+//! extension (`.bvh`, `.asf`, `.amc`, `.txt`/`.json`, `.c3d`, `.csv`). A file read by its
+//! extension alone that fails says so and lists the signatures its content did not match.
+
+use std::path::{Path, PathBuf};
+
+use nalgebra::{Isometry3, Vector3};
+
+use super::amc::AMC_DEFAULT_RATE;
+use super::body_map::{BodyMap, PointSource};
+use super::keypoints::{clip_keypoints, marker_keypoints, Keypoints};
+use super::markers::{MarkerSet, DEFAULT_MAX_GAP};
+use super::recognise::{recognise_markers, recognise_skeleton};
+use super::units::{
+    decide_units, decide_up, extent_along, Units, UnitsDecision, UpChoice, UpDecision,
+};
+use super::{BodyPoint, BvhReadOptions, Clip, LengthUnit, Pose, Skeleton, SkeletonJoint, UpAxis};
+use crate::error::{Error, Result};
+
+/// The formats [`load_motion`] reads.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MotionFormat {
+    /// Biovision hierarchy.
+    Bvh,
+    /// Acclaim skeleton alone (its rest pose, one frame).
+    Asf,
+    /// Acclaim motion, with its ASF skeleton.
+    Amc,
+    /// DeepMimic motion (JSON) on the DeepMimic character.
+    DeepMimic,
+    /// C3D marker trajectories.
+    C3d,
+    /// A CSV of named 3D points.
+    PointsCsv,
+}
+
+impl MotionFormat {
+    /// A short name.
+    pub fn name(self) -> &'static str {
+        match self {
+            MotionFormat::Bvh => "BVH",
+            MotionFormat::Asf => "ASF",
+            MotionFormat::Amc => "AMC",
+            MotionFormat::DeepMimic => "DeepMimic JSON",
+            MotionFormat::C3d => "C3D",
+            MotionFormat::PointsCsv => "points CSV",
+        }
+    }
+}
+
+/// Options of [`load_motion`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct MotionOptions {
+    /// Length unit (default `Auto`).
+    pub units: Units,
+    /// Up axis (default `Auto`).
+    pub up: UpChoice,
+    /// The ASF skeleton of an AMC file (default: found beside it).
+    pub skeleton: Option<PathBuf>,
+    /// Force a format instead of detecting it.
+    pub format: Option<MotionFormat>,
+    /// Use this body map instead of recognising the body points.
+    pub body_map: Option<BodyMap>,
+    /// Longest marker gap filled \[s\] (default [`DEFAULT_MAX_GAP`]).
+    pub max_gap: f64,
+    /// Frame rate of AMC files, which do not carry one \[Hz\] (default [`AMC_DEFAULT_RATE`]).
+    pub amc_frame_rate: f64,
+    /// Most frames and longest duration accepted from a BVH or DeepMimic file.
+    pub limits: crate::resources::ReadLimits,
+}
+
+impl Default for MotionOptions {
+    fn default() -> Self {
+        Self {
+            units: Units::Auto,
+            up: UpChoice::Auto,
+            skeleton: None,
+            format: None,
+            body_map: None,
+            max_gap: DEFAULT_MAX_GAP,
+            amc_frame_rate: AMC_DEFAULT_RATE,
+            limits: crate::resources::ReadLimits::default(),
+        }
+    }
+}
+
+/// What a file holds, in its own units and axes.
+#[derive(Debug, Clone, PartialEq)]
+pub enum MotionContent {
+    /// A skeleton and its poses.
+    Skeleton(Clip),
+    /// Marker or point trajectories.
+    Markers(MarkerSet),
+}
+
+/// A loaded motion: what the file holds, its body map, and the units and up axis used.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Motion {
+    /// The file.
+    pub source: String,
+    /// Its format.
+    pub format: MotionFormat,
+    /// Its content in file units and axes.
+    pub content: MotionContent,
+    /// The body map given or recognised; the recognition error if neither.
+    pub body_map: Result<BodyMap>,
+    /// The unit.
+    pub units: UnitsDecision,
+    /// The up axis.
+    pub up: UpDecision,
+}
+
+impl Motion {
+    /// The body keypoints (errors if no body map could be found).
+    pub fn keypoints(&self, max_gap: f64) -> Result<Keypoints> {
+        let map = self.body_map.as_ref().map_err(Clone::clone)?;
+        match &self.content {
+            MotionContent::Skeleton(clip) => clip_keypoints(clip, map, self.units, self.up),
+            MotionContent::Markers(m) => marker_keypoints(m, map, self.units, self.up, max_gap),
+        }
+    }
+
+    /// The skeleton clip in metres with its decided up axis (`None` for marker data).
+    pub fn clip(&self) -> Option<Result<Clip>> {
+        match &self.content {
+            MotionContent::Skeleton(clip) => Some(scale_clip(
+                clip,
+                self.units.unit.metres_per_unit(),
+                self.up.up,
+            )),
+            MotionContent::Markers(_) => None,
+        }
+    }
+
+    /// A few lines: source, format, units, up, body map status.
+    pub fn summary(&self) -> String {
+        let map = match &self.body_map {
+            Ok(m) => format!("{} body points mapped", m.points.len()),
+            Err(e) => format!("body points not recognised: {e}"),
+        };
+        format!(
+            "{} ({}): units {}; up {}; {map}",
+            self.source,
+            self.format.name(),
+            self.units,
+            self.up
+        )
+    }
+}
+
+/// A clip with every length scaled by `s` \[m/unit\] and the given up axis.
+pub fn scale_clip(clip: &Clip, s: f64, up: UpAxis) -> Result<Clip> {
+    let joints: Vec<SkeletonJoint> = clip
+        .skeleton()
+        .joints()
+        .iter()
+        .map(|j| SkeletonJoint {
+            offset: j.offset * s,
+            ..j.clone()
+        })
+        .collect();
+    let frames: Vec<Pose> = clip
+        .frames()
+        .iter()
+        .map(|p| Pose {
+            root_position: p.root_position * s,
+            root_orientation: p.root_orientation,
+            rotations: p.rotations.clone(),
+            translations: p.translations.iter().map(|t| t * s).collect(),
+        })
+        .collect();
+    Clip::new(
+        clip.name(),
+        Skeleton::new(joints)?,
+        clip.times().to_vec(),
+        frames,
+        up,
+    )
+}
+
+fn io_error(path: &Path, e: std::io::Error) -> Error {
+    Error::Parse {
+        source_name: path.display().to_string(),
+        line: 0,
+        message: format!("cannot read the file: {e}"),
+    }
+}
+
+/// The format a file's content shows, if any.
+pub fn detect_format(bytes: &[u8]) -> Option<MotionFormat> {
+    if bytes.len() >= 512 && bytes.get(1) == Some(&0x50) && bytes[0] < 0x20 {
+        return Some(MotionFormat::C3d);
+    }
+    let head = String::from_utf8_lossy(&bytes[..bytes.len().min(4096)]);
+    let mut lines = head
+        .lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty() && !l.starts_with('#'));
+    let first = lines.next()?;
+    if first.starts_with("HIERARCHY") {
+        return Some(MotionFormat::Bvh);
+    }
+    let keyword = |l: &str, k: &[&str]| k.iter().any(|k| l.to_ascii_lowercase().starts_with(k));
+    if keyword(
+        first,
+        &[
+            ":version",
+            ":name",
+            ":units",
+            ":root",
+            ":bonedata",
+            ":documentation",
+        ],
+    ) {
+        return Some(MotionFormat::Asf);
+    }
+    if keyword(first, &[":fully-specified", ":degrees", ":radians"]) {
+        return Some(MotionFormat::Amc);
+    }
+    if first.starts_with('{') && head.contains("\"Frames\"") {
+        return Some(MotionFormat::DeepMimic);
+    }
+    let cols: Vec<&str> = first.split(',').map(str::trim).collect();
+    if cols.len() >= 3
+        && cols
+            .iter()
+            .any(|c| c.ends_with("_x") || c.ends_with("_X") || c.ends_with(".x"))
+    {
+        return Some(MotionFormat::PointsCsv);
+    }
+    None
+}
+
+fn format_from_extension(path: &Path) -> Option<MotionFormat> {
+    let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+    Some(match ext.as_str() {
+        "bvh" => MotionFormat::Bvh,
+        "asf" => MotionFormat::Asf,
+        "amc" => MotionFormat::Amc,
+        "txt" | "json" => MotionFormat::DeepMimic,
+        "c3d" => MotionFormat::C3d,
+        "csv" => MotionFormat::PointsCsv,
+        _ => return None,
+    })
+}
+
+const SIGNATURES: &str = "BVH `HIERARCHY`, ASF `:version`/`:units`/`:root`/`:bonedata`, AMC \
+    `:FULLY-SPECIFIED`/`:DEGREES`, DeepMimic JSON with \"Frames\", C3D (second byte 0x50), CSV \
+    header with `_x/_y/_z` columns";
+
+/// The ASF beside an AMC file: same stem, else the only `.asf` in its folder.
+pub fn find_asf(amc: &Path) -> Result<PathBuf> {
+    let dir = amc
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let is_asf = |p: &Path| {
+        p.extension()
+            .and_then(|e| e.to_str())
+            .is_some_and(|e| e.eq_ignore_ascii_case("asf"))
+    };
+    let entries: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map_err(|e| io_error(dir, e))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| is_asf(p))
+        .collect();
+    let stem = amc.file_stem();
+    if let Some(p) = entries.iter().find(|p| p.file_stem() == stem) {
+        return Ok(p.clone());
+    }
+    match entries.as_slice() {
+        [only] => Ok(only.clone()),
+        _ => Err(Error::InsufficientData {
+            what: format!("skeleton of `{}`", amc.display()),
+            message: format!(
+                "no `{}.asf` beside it and {} other .asf files in `{}`; give the skeleton (--skeleton FILE.asf)",
+                stem.map(|s| s.to_string_lossy()).unwrap_or_default(),
+                entries.len(),
+                dir.display()
+            ),
+        }),
+    }
+}
+
+/// Reads a motion file of any supported format (see the module documentation).
+pub fn load_motion(path: &Path, options: &MotionOptions) -> Result<Motion> {
+    let bytes = std::fs::read(path).map_err(|e| io_error(path, e))?;
+    let source = path.display().to_string();
+    let by_content = detect_format(&bytes);
+    let by_extension = format_from_extension(path);
+    let format = options
+        .format
+        .or(by_content)
+        .or(by_extension)
+        .ok_or_else(|| Error::Parse {
+            source_name: source.clone(),
+            line: 0,
+            message: format!(
+                "unknown motion format: the extension is not one of .bvh .asf .amc .txt .json \
+                 .c3d .csv and the content matched none of: {SIGNATURES}"
+            ),
+        })?;
+    let content = read_content(path, &bytes, format, options).map_err(|e| {
+        if options.format.is_none() && by_content.is_none() {
+            Error::Parse {
+                source_name: source.clone(),
+                line: 0,
+                message: format!(
+                    "read as {} because of the extension (its content matched none of: \
+                     {SIGNATURES}): {e}",
+                    format.name()
+                ),
+            }
+        } else {
+            e
+        }
+    })?;
+    motion_from_content(source, format, content, options)
+}
+
+fn read_content(
+    path: &Path,
+    bytes: &[u8],
+    format: MotionFormat,
+    options: &MotionOptions,
+) -> Result<MotionContent> {
+    let source = path.display().to_string();
+    let text = || {
+        std::str::from_utf8(bytes).map_err(|e| Error::Parse {
+            source_name: source.clone(),
+            line: 1 + bytes
+                .get(..e.valid_up_to())
+                .map_or(0, |b| b.iter().filter(|c| **c == b'\n').count()),
+            message: format!("{} files are text; this one is not UTF-8", format.name()),
+        })
+    };
+    Ok(match format {
+        MotionFormat::Bvh => MotionContent::Skeleton(
+            super::read_bvh(
+                text()?,
+                &source,
+                &BvhReadOptions {
+                    length_unit: LengthUnit::Metres,
+                    up_axis: UpAxis::Y,
+                    limits: options.limits,
+                },
+            )?
+            .to_clip()?,
+        ),
+        MotionFormat::DeepMimic => {
+            MotionContent::Skeleton(super::read_deepmimic_with(
+                text()?,
+                &source,
+                &super::DeepMimicSettings {
+                    limits: options.limits,
+                    ..Default::default()
+                },
+            )?)
+        }
+        MotionFormat::Asf => {
+            let asf = super::asf::read_asf(text()?, &source)?;
+            MotionContent::Skeleton(asf.rest_clip()?)
+        }
+        MotionFormat::Amc => {
+            let asf_path = match &options.skeleton {
+                Some(p) => p.clone(),
+                None => find_asf(path)?,
+            };
+            let asf_text =
+                std::fs::read_to_string(&asf_path).map_err(|e| io_error(&asf_path, e))?;
+            let asf = super::asf::read_asf(&asf_text, &asf_path.display().to_string())?;
+            MotionContent::Skeleton(super::amc::read_amc(
+                text()?,
+                &source,
+                &asf,
+                options.amc_frame_rate,
+            )?)
+        }
+        MotionFormat::C3d => MotionContent::Markers(super::c3d::read_c3d(bytes, &source)?),
+        MotionFormat::PointsCsv => {
+            MotionContent::Markers(super::points_csv::read_points_csv(text()?, &source)?)
+        }
+    })
+}
+
+/// `head − (left ankle + right ankle)/2` from a point lookup, if all three are found.
+fn ankles_to_head(at: impl Fn(BodyPoint) -> Option<Vector3<f64>>) -> Option<Vector3<f64>> {
+    Some(at(BodyPoint::Head)? - (at(BodyPoint::LeftAnkle)? + at(BodyPoint::RightAnkle)?) / 2.0)
+}
+
+/// The ankles-to-head vector (if the body map gives them) and all rest points.
+type RestMeasure = (Option<Vector3<f64>>, Vec<Vector3<f64>>);
+
+/// Rest measurements for the automatic decisions: the ankles-to-head vector and all rest
+/// points \[file units\].
+fn rest_measure(content: &MotionContent, map: Option<&BodyMap>) -> Result<RestMeasure> {
+    match content {
+        MotionContent::Skeleton(clip) => {
+            let skeleton = clip.skeleton();
+            let mut world = vec![Isometry3::identity(); skeleton.len()];
+            skeleton.world_transforms(&skeleton.rest_pose(), &mut world)?;
+            let all: Vec<Vector3<f64>> = world.iter().map(|t| t.translation.vector).collect();
+            let at = |p: BodyPoint| match map.and_then(|m| m.get(p)) {
+                Some(PointSource::Joint(name)) => skeleton.index_of(name).ok().map(|j| all[j]),
+                _ => None,
+            };
+            Ok((ankles_to_head(at), all))
+        }
+        MotionContent::Markers(m) => {
+            let f = m.most_complete_frame();
+            let n = m.names.len();
+            let frame: Vec<Option<Vector3<f64>>> = (0..n)
+                .map(|k| m.positions.get(f * n + k).copied().flatten())
+                .collect();
+            let all: Vec<Vector3<f64>> = frame.iter().flatten().copied().collect();
+            let at = |p: BodyPoint| -> Option<Vector3<f64>> {
+                let names: Vec<&String> = match map?.get(p)? {
+                    PointSource::Markers(g) => g.iter().collect(),
+                    PointSource::Joint(j) => vec![j],
+                };
+                let pts: Vec<Vector3<f64>> = names
+                    .iter()
+                    .filter_map(|name| m.names.iter().position(|x| x == *name))
+                    .filter_map(|k| frame.get(k).copied().flatten())
+                    .collect();
+                (!pts.is_empty()).then(|| pts.iter().sum::<Vector3<f64>>() / pts.len() as f64)
+            };
+            Ok((ankles_to_head(at), all))
+        }
+    }
+}
+
+/// Finds the body map and decides units and up axis for content already read.
+pub fn motion_from_content(
+    source: String,
+    format: MotionFormat,
+    content: MotionContent,
+    options: &MotionOptions,
+) -> Result<Motion> {
+    let body_map = match &options.body_map {
+        Some(m) => Ok(m.clone()),
+        None => match &content {
+            MotionContent::Skeleton(clip) => recognise_skeleton(clip.skeleton(), &source),
+            MotionContent::Markers(m) => recognise_markers(&m.names, &source),
+        },
+    };
+    let (ankles_to_head, rest) = rest_measure(&content, body_map.as_ref().ok())?;
+    if options.up == UpChoice::Auto && ankles_to_head.is_none() {
+        // The recognition error says what is missing and how to write a map.
+        body_map.clone()?;
+    }
+    let up = decide_up(options.up, ankles_to_head, &source)?;
+    let units = decide_units(options.units, extent_along(&rest, up.up), &source)?;
+    Ok(Motion {
+        source,
+        format,
+        content,
+        body_map,
+        units,
+        up,
+    })
+}

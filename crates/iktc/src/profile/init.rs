@@ -1,0 +1,279 @@
+//! A starting profile guessed from a URDF's tree (`iktc profile init`).
+//!
+//! Guesses, each marked `# guessed` in the written TOML:
+//! * feet: per side, the deepest link whose name contains `foot`, `ankle`, `sole` or `toe`
+//!   (the side from a `left`/`l_`/`_l` or `right`/`r_`/`_r` in its name); their sole rectangle
+//!   and ankle height from the link's collision boxes and spheres (the bounding rectangle of
+//!   their footprints, the ankle height from the lowest point), else a placeholder;
+//! * pelvis: the first link (from the root) whose name contains `pelvis`, else the root link;
+//! * torso (`torso`, `chest`, `trunk`) and head (`head`, `neck`): the matching link nearest the
+//!   root; hands (`hand`, `palm`, `wrist`): the deepest matching link per side;
+//! * base: floating when both feet were found, else fixed;
+//! * locks: movable joints whose names contain `finger`, `thumb`, `index`, `middle`, `ring`,
+//!   `little` or `pinky`, as one glob pattern each.
+
+use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
+
+use crate::error::{Error, Result};
+
+/// A link of the parsed tree: name, parent link index, depth from the root.
+struct TreeLink {
+    name: String,
+    lower: String,
+    depth: usize,
+}
+
+#[derive(Clone, Copy, PartialEq)]
+enum Side {
+    Left,
+    Right,
+}
+
+fn side_of(lower: &str) -> Option<Side> {
+    let has = |tags: &[&str]| {
+        tags.iter()
+            .any(|t| lower.starts_with(t) || lower.ends_with(&t.chars().rev().collect::<String>()))
+    };
+    if lower.contains("left") || has(&["l_", "l-"]) || lower.contains("_l_") {
+        Some(Side::Left)
+    } else if lower.contains("right") || has(&["r_", "r-"]) || lower.contains("_r_") {
+        Some(Side::Right)
+    } else {
+        None
+    }
+}
+
+/// The deepest (or, with `shallow`, the shallowest) link, then the first, whose lowercase name
+/// contains one of `words`, on `side`.
+fn pick<'a>(
+    links: &'a [TreeLink],
+    words: &[&str],
+    side: Option<Side>,
+    shallow: bool,
+) -> Option<&'a TreeLink> {
+    links
+        .iter()
+        .filter(|l| words.iter().any(|w| l.lower.contains(w)))
+        .filter(|l| side.is_none() || side_of(&l.lower) == side)
+        .fold(None, |best: Option<&TreeLink>, l| match best {
+            Some(b) if (b.depth >= l.depth) != shallow || b.depth == l.depth => Some(b),
+            _ => Some(l),
+        })
+}
+
+fn deepest<'a>(links: &'a [TreeLink], words: &[&str], side: Option<Side>) -> Option<&'a TreeLink> {
+    pick(links, words, side, false)
+}
+
+/// A guessed sole: `(length, width, offset_x, ankle_height)` \[m\] from the collision boxes and
+/// spheres of `link` (their footprints in the link frame, ignoring their rotation about z).
+fn sole_from_collisions(link: &urdf_rs::Link) -> Option<(f64, f64, f64, f64)> {
+    let (mut xmin, mut xmax, mut ymin, mut ymax, mut zmin) = (
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+    );
+    for c in &link.collision {
+        let o = Isometry3::from_parts(
+            Translation3::new(c.origin.xyz[0], c.origin.xyz[1], c.origin.xyz[2]),
+            UnitQuaternion::from_euler_angles(c.origin.rpy[0], c.origin.rpy[1], c.origin.rpy[2]),
+        );
+        let corners: Vec<Vector3<f64>> = match &c.geometry {
+            urdf_rs::Geometry::Sphere { radius } => {
+                let p = o.translation.vector;
+                // The footprint is the contact point; the sphere reaches `radius` lower.
+                vec![p - Vector3::z() * *radius]
+            }
+            urdf_rs::Geometry::Box { size } => {
+                let h = Vector3::new(size[0], size[1], size[2]) * 0.5;
+                let mut v = Vec::new();
+                for sx in [-1.0, 1.0] {
+                    for sy in [-1.0, 1.0] {
+                        for sz in [-1.0, 1.0] {
+                            v.push(
+                                o * nalgebra::Point3::from(
+                                    h.component_mul(&Vector3::new(sx, sy, sz)),
+                                ),
+                            );
+                        }
+                    }
+                }
+                v.into_iter().map(|p| p.coords).collect()
+            }
+            _ => continue,
+        };
+        for p in corners {
+            xmin = xmin.min(p.x);
+            xmax = xmax.max(p.x);
+            ymin = ymin.min(p.y);
+            ymax = ymax.max(p.y);
+            zmin = zmin.min(p.z);
+        }
+    }
+    let (l, w) = (xmax - xmin, ymax - ymin);
+    (l > 0.0 && w > 0.0 && zmin < 0.0).then(|| (l, w, 0.5 * (xmin + xmax), -zmin))
+}
+
+fn quote(s: &str) -> String {
+    // TOML basic string: escape backslashes and quotes.
+    format!("\"{}\"", s.replace('\\', "\\\\").replace('"', "\\\""))
+}
+
+/// Writes a starting profile for the URDF `text`, whose path relative to where the profile
+/// will be written is `urdf_path`. Every guessed value is marked `# guessed`; the result parses
+/// as a [`RobotProfile`](super::RobotProfile) (keys it could not guess are left out or
+/// commented).
+///
+/// Errors: a URDF that does not parse or has no single root link.
+pub fn init_profile_toml(text: &str, urdf_path: &str) -> Result<String> {
+    let u = urdf_rs::read_from_string(text.trim_end_matches('\0')).map_err(|e| Error::Urdf {
+        message: format!("cannot parse the URDF: {e}"),
+    })?;
+    let is_child = |name: &str| u.joints.iter().any(|j| j.child.link == name);
+    let roots: Vec<&urdf_rs::Link> = u.links.iter().filter(|l| !is_child(&l.name)).collect();
+    let [root] = roots.as_slice() else {
+        return Err(Error::Urdf {
+            message: format!(
+                "expected one root link (a link that is no joint's child), found {}: {}",
+                roots.len(),
+                roots
+                    .iter()
+                    .map(|l| l.name.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        });
+    };
+    // Breadth-first from the root: depth of every link, parents before children.
+    let mut links: Vec<TreeLink> = vec![TreeLink {
+        name: root.name.clone(),
+        lower: root.name.to_lowercase(),
+        depth: 0,
+    }];
+    let mut i = 0;
+    while i < links.len() {
+        let (parent, depth) = (links[i].name.clone(), links[i].depth);
+        for j in u.joints.iter().filter(|j| j.parent.link == parent) {
+            if links.iter().all(|l| l.name != j.child.link) {
+                links.push(TreeLink {
+                    name: j.child.link.clone(),
+                    lower: j.child.link.to_lowercase(),
+                    depth: depth + 1,
+                });
+            }
+        }
+        i += 1;
+    }
+    let foot_words = ["foot", "ankle", "sole", "toe"];
+    let left = deepest(&links, &foot_words, Some(Side::Left));
+    let right = deepest(&links, &foot_words, Some(Side::Right));
+    let pelvis = links
+        .iter()
+        .find(|l| l.lower.contains("pelvis"))
+        .unwrap_or(&links[0]);
+    // The body's own link comes before the sensors and frames attached to it.
+    let torso = pick(&links, &["torso", "chest", "trunk"], None, true);
+    let head = pick(&links, &["head", "neck"], None, true);
+    let hand_words = ["hand", "palm", "wrist"];
+    let left_hand = deepest(&links, &hand_words, Some(Side::Left));
+    let right_hand = deepest(&links, &hand_words, Some(Side::Right));
+
+    let mut out = String::new();
+    let name = if u.name.is_empty() { "robot" } else { &u.name };
+    out.push_str(&format!(
+        "# Robot profile of `{name}`, written by `iktc profile init`: check every value marked\n\
+         # `# guessed` (and the comments) before use.\nname = {}\nurdf = {}\n",
+        quote(name),
+        quote(urdf_path)
+    ));
+    let feet = left.zip(right);
+    out.push_str(&format!(
+        "base = \"{}\" # guessed: {}\n",
+        if feet.is_some() { "floating" } else { "fixed" },
+        if feet.is_some() {
+            "two feet were found"
+        } else {
+            "no pair of feet was found"
+        }
+    ));
+    let fingers = [
+        "finger", "thumb", "index", "middle", "ring", "little", "pinky",
+    ];
+    for j in u.joints.iter().filter(|j| {
+        !matches!(j.joint_type, urdf_rs::JointType::Fixed)
+            && fingers.iter().any(|w| j.name.to_lowercase().contains(w))
+    }) {
+        out.push_str(&format!(
+            "[[lock]] # guessed: a finger joint\njoints = {}\nvalue = 0.0\n",
+            quote(&j.name)
+        ));
+    }
+    out.push('\n');
+    match feet {
+        Some((l, r)) => {
+            for (side, link) in [("left", l), ("right", r)] {
+                let sole = u
+                    .links
+                    .iter()
+                    .find(|x| x.name == link.name)
+                    .and_then(sole_from_collisions);
+                out.push_str(&format!(
+                    "[feet.{side}]\nframe = {} # guessed: deepest link named like a foot on the {side}\n",
+                    quote(&link.name)
+                ));
+                let (len, wid, off, ankle, why) = match sole {
+                    Some((a, b, c, d)) => (a, b, c, d, "from the link's collision boxes/spheres"),
+                    None => (
+                        0.2,
+                        0.1,
+                        0.0,
+                        0.1,
+                        "PLACEHOLDER, no collision box or sphere: measure the robot",
+                    ),
+                };
+                out.push_str(&format!(
+                    "ankle_height = {ankle:?} # guessed: {why}\n\
+                     sole = {{ length = {len:?}, width = {wid:?}, offset_x = {off:?} }} # guessed: {why}\n\n"
+                ));
+            }
+        }
+        None => out.push_str(
+            "# No pair of feet found (links named foot/ankle/sole/toe with a left/right tag):\n\
+             # add [feet.left] and [feet.right] (frame, ankle_height, sole) for a standing robot.\n\n",
+        ),
+    }
+    out.push_str("[frames]\n");
+    out.push_str(&format!(
+        "pelvis = {} # guessed: {}\n",
+        quote(&pelvis.name),
+        if pelvis.lower.contains("pelvis") {
+            "named like a pelvis"
+        } else {
+            "the root link"
+        }
+    ));
+    for (key, found) in [
+        ("torso", torso),
+        ("head", head),
+        ("left_hand", left_hand),
+        ("right_hand", right_hand),
+    ] {
+        match found {
+            Some(l) => out.push_str(&format!(
+                "{key} = {} # guessed: a link named like it\n",
+                quote(&l.name)
+            )),
+            None => out.push_str(&format!("# {key} = \"...\" # not found\n")),
+        }
+    }
+    out.push_str(
+        "\n# Initial joint angles [rad] (joint = angle), e.g. bent knees for a humanoid.\n[posture]\n\n\
+         # Default narrowed ranges [rad] (joint = [lower, upper]).\n[narrow]\n\n\
+         [acceleration]\nper_velocity = 10.0 # guessed: the paper's ratio (180°/s, 1800°/s²)\n\n\
+         # Retargeting maps per motion format (built-in name or TOML file relative to this file).\n\
+         [imitate.maps]\n# deepmimic = \"my_deepmimic_map.toml\"\n",
+    );
+    Ok(out)
+}

@@ -1,0 +1,222 @@
+//! The robot profile as plain data: the keys of the TOML file.
+
+use std::collections::BTreeMap;
+
+use serde::{Deserialize, Serialize};
+
+use crate::model::BaseKind;
+
+/// Everything iktc needs about a robot beyond its URDF (one TOML file per robot; see the
+/// [module documentation](super) for an example).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RobotProfile {
+    /// The robot's name (key `name`).
+    pub name: String,
+    /// The URDF file, relative to the profile file's directory (key `urdf`).
+    pub urdf: String,
+    /// Floating or fixed base (key `base`: `"floating"` or `"fixed"`).
+    pub base: BaseKind,
+    /// Joints held at a value, by glob pattern (key `lock`, an array of tables).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub lock: Vec<LockRule>,
+    /// The two feet (key `feet`); absent for a robot that does not stand.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub feet: Option<Feet>,
+    /// Named body frames (key `frames`).
+    #[serde(default)]
+    pub frames: BodyFrames,
+    /// Initial joint angles \[rad\] (key `posture`, joint name → angle); joints not named start
+    /// at 0.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub posture: BTreeMap<String, f64>,
+    /// Default narrowed joint ranges \[rad\] (key `narrow`, joint name → `[lower, upper]`),
+    /// inside the joints' own ranges; in the order the TOML reader gives (sorted by name).
+    #[serde(default, skip_serializing_if = "Vec::is_empty", with = "ordered_map")]
+    pub narrow: Vec<(String, [f64; 2])>,
+    /// Acceleration limits (key `acceleration`).
+    #[serde(default)]
+    pub acceleration: AccelerationProfile,
+    /// Imitation settings (key `imitate`).
+    #[serde(default)]
+    pub imitate: ImitateProfile,
+    /// Where the profile was read from (not a key): relative paths are resolved against it.
+    #[serde(skip)]
+    pub origin: ProfileOrigin,
+}
+
+/// Where a profile was read from; relative paths in it (`urdf`, `imitate.maps.*`) are resolved
+/// against it. Two profiles that differ only in their origin are equal.
+#[derive(Debug, Clone, Default)]
+pub enum ProfileOrigin {
+    /// A built-in profile: paths name files embedded in the library (its `data/profiles/`).
+    #[default]
+    Builtin,
+    /// A profile file in this directory (or profile fields given in code, with paths relative
+    /// to this directory).
+    Directory(std::path::PathBuf),
+}
+
+impl PartialEq for ProfileOrigin {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
+}
+
+/// Joints whose names match a glob pattern, held at one value (key `lock[i]`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LockRule {
+    /// Glob pattern over joint names: `*` matches any run of characters, `?` one character
+    /// (key `lock[i].joints`, e.g. `"*_FINGER_*"`). It must match at least one movable joint.
+    pub joints: String,
+    /// The value the matched joints are held at \[rad\] or \[m\] (key `lock[i].value`,
+    /// default 0).
+    #[serde(default)]
+    pub value: f64,
+}
+
+/// The feet of a standing robot (key `feet`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Feet {
+    /// The left foot (key `feet.left`).
+    pub left: Foot,
+    /// The right foot (key `feet.right`).
+    pub right: Foot,
+}
+
+/// One foot: its frame, sole and ankle height (key `feet.left` or `feet.right`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Sole {
+    /// Length along the foot frame's x axis \[m\], `> 0` (key `…sole.length`).
+    pub length: f64,
+    /// Width along the foot frame's y axis \[m\], `> 0` (key `…sole.width`).
+    pub width: f64,
+    /// Forward offset of the sole's centre from the foot frame's origin along its x axis
+    /// \[m\] (key `…sole.offset_x`, default 0).
+    #[serde(default)]
+    pub offset_x: f64,
+}
+
+/// One foot (key `feet.left` / `feet.right`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Foot {
+    /// The foot frame (a link or frame of the URDF; key `…frame`), its z axis up when the
+    /// sole is flat.
+    pub frame: String,
+    /// Height of the foot frame above the sole \[m\], `≥ 0` (key `…ankle_height`).
+    pub ankle_height: f64,
+    /// The sole rectangle in the foot frame (key `…sole`).
+    pub sole: Sole,
+}
+
+/// Named body frames (key `frames`); each a link or frame of the URDF.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BodyFrames {
+    /// The pelvis (key `frames.pelvis`): attitude and height tasks of the imitation.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pelvis: Option<String>,
+    /// The torso (key `frames.torso`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub torso: Option<String>,
+    /// The head (key `frames.head`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub head: Option<String>,
+    /// The left hand (key `frames.left_hand`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub left_hand: Option<String>,
+    /// The right hand (key `frames.right_hand`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub right_hand: Option<String>,
+}
+
+/// The default acceleration limit as a multiple of the velocity limit \[1/s\] (the ratio of the
+/// paper's 3R arm, 180°/s and 1800°/s²), as in [`crate::model::ModelOptions`].
+pub const DEFAULT_ACCELERATION_PER_VELOCITY: f64 = 10.0;
+
+fn default_per_velocity() -> f64 {
+    DEFAULT_ACCELERATION_PER_VELOCITY
+}
+
+/// Acceleration limits (URDF has none; key `acceleration`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AccelerationProfile {
+    /// Acceleration limit of joints not listed in `limits`, as a multiple of their velocity
+    /// limit \[1/s\], `> 0` (key `acceleration.per_velocity`, default 10).
+    #[serde(default = "default_per_velocity")]
+    pub per_velocity: f64,
+    /// Acceleration limits by joint name \[rad/s²\] or \[m/s²\] (key `acceleration.limits`).
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub limits: BTreeMap<String, f64>,
+}
+
+impl Default for AccelerationProfile {
+    fn default() -> Self {
+        Self {
+            per_velocity: DEFAULT_ACCELERATION_PER_VELOCITY,
+            limits: BTreeMap::new(),
+        }
+    }
+}
+
+/// Imitation settings (key `imitate`).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ImitateProfile {
+    /// The retargeting map per motion format (key `imitate.maps`, format → map): `deepmimic`
+    /// and `bvh`; a map is a built-in map name or a TOML file relative to the profile.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub maps: BTreeMap<String, String>,
+}
+
+/// A TOML table read and written as `(key, value)` pairs in the order the reader gives them
+/// (the TOML reader sorts keys), rejecting a key given twice.
+mod ordered_map {
+    use std::marker::PhantomData;
+
+    use serde::de::{Deserialize, Deserializer, MapAccess, Visitor};
+    use serde::ser::{Serialize, SerializeMap, Serializer};
+
+    pub fn serialize<S: Serializer, V: Serialize>(
+        entries: &[(String, V)],
+        s: S,
+    ) -> Result<S::Ok, S::Error> {
+        let mut m = s.serialize_map(Some(entries.len()))?;
+        for (k, v) in entries {
+            m.serialize_entry(k, v)?;
+        }
+        m.end()
+    }
+
+    struct Entries<V>(PhantomData<V>);
+
+    impl<'de, V: Deserialize<'de>> Visitor<'de> for Entries<V> {
+        type Value = Vec<(String, V)>;
+
+        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+            f.write_str("a table of joint names")
+        }
+
+        fn visit_map<A: MapAccess<'de>>(self, mut a: A) -> Result<Self::Value, A::Error> {
+            let mut out: Vec<(String, V)> = Vec::new();
+            while let Some((k, v)) = a.next_entry::<String, V>()? {
+                if out.iter().any(|(n, _)| *n == k) {
+                    return Err(serde::de::Error::custom(format!("joint `{k}` given twice")));
+                }
+                out.push((k, v));
+            }
+            Ok(out)
+        }
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>, V: Deserialize<'de>>(
+        d: D,
+    ) -> Result<Vec<(String, V)>, D::Error> {
+        d.deserialize_map(Entries(PhantomData))
+    }
+}

@@ -1,0 +1,360 @@
+//! Robot profiles: glob locks, one error per profile key (each naming the key), the TOML round
+//! trip, the starting profile guessed from a URDF.
+
+use iktc::model::{jvrc1, JointRole, ModelOptions};
+use iktc::profile::{
+    builtin_profile_text, init_profile_toml, ProfileOrigin, RobotProfile, BUILTIN_PROFILES,
+};
+use iktc::sim::ImitateConfig;
+use iktc::Error;
+
+/// A JVRC-1 profile text with `extra` appended (built-in origin: the embedded URDF).
+fn jvrc1_with(head: &str, extra: &str) -> String {
+    format!(
+        "name = \"t\"\nurdf = \"../robots/jvrc1/jvrc1.urdf\"\nbase = \"floating\"\n{head}\n\
+         [feet.left]\nframe = \"l_ankle\"\nankle_height = 0.1\nsole = {{ length = 0.2, width = 0.1 }}\n\
+         [feet.right]\nframe = \"r_ankle\"\nankle_height = 0.1\nsole = {{ length = 0.2, width = 0.1 }}\n\
+         {extra}\n"
+    )
+}
+
+fn parse(text: &str) -> iktc::Result<RobotProfile> {
+    RobotProfile::from_toml_str(text, "test profile", ProfileOrigin::Builtin)
+}
+
+/// Parses and builds; returns the error.
+fn build_error(text: &str) -> Error {
+    match parse(text).and_then(|p| {
+        let robot = p.robot()?;
+        p.imitate_config(ImitateConfig::default())?;
+        Ok(robot)
+    }) {
+        Ok(_) => panic!("expected an error for\n{text}"),
+        Err(e) => e,
+    }
+}
+
+fn assert_key(e: &Error, want_key: &str, want_value: &str, message_has: &str) {
+    match e {
+        Error::Profile {
+            key,
+            value,
+            message,
+        } => {
+            assert_eq!(key, want_key, "{e}");
+            assert_eq!(value, want_value, "{e}");
+            assert!(message.contains(message_has), "`{message_has}` not in: {e}");
+            assert!(e
+                .to_string()
+                .starts_with(&format!("profile key `{want_key}`")));
+        }
+        other => panic!("expected a profile error on `{want_key}`, got {other}"),
+    }
+}
+
+#[test]
+fn glob_locks_match_several_joints_and_equal_the_listed_locks() {
+    let text = jvrc1_with(
+        "[[lock]]\njoints = \"?_?THUMB\"\n[[lock]]\njoints = \"*INDEX\"\nvalue = 0.0\n[[lock]]\njoints = \"*LITTLE\"",
+        "",
+    );
+    let robot = parse(&text).unwrap().robot().unwrap();
+    let reference = jvrc1(&ModelOptions::default()).unwrap();
+    assert_eq!(robot.nv(), 6 + 32);
+    assert_eq!(robot.dof_names(), reference.dof_names());
+    // Each pattern matched four joints: the two phalanges of a finger on both hands.
+    for finger in ["THUMB", "INDEX", "LITTLE"] {
+        let locked: Vec<&str> = robot
+            .joints()
+            .iter()
+            .filter(|j| j.name.ends_with(finger) && matches!(j.role, JointRole::Locked { .. }))
+            .map(|j| j.name.as_str())
+            .collect();
+        assert_eq!(locked.len(), 4, "{finger}: {locked:?}");
+    }
+}
+
+#[test]
+fn a_lock_value_is_applied_to_every_matched_joint() {
+    let text = jvrc1_with("[[lock]]\njoints = \"?_ELBOW_?\"\nvalue = -0.5", "");
+    let robot = parse(&text).unwrap().robot().unwrap();
+    let locked: Vec<(String, f64)> = robot
+        .joints()
+        .iter()
+        .filter_map(|j| match j.role {
+            JointRole::Locked { value } => Some((j.name.clone(), value)),
+            _ => None,
+        })
+        .collect();
+    let mut names: Vec<&str> = locked.iter().map(|(n, _)| n.as_str()).collect();
+    names.sort();
+    assert_eq!(names, ["L_ELBOW_P", "L_ELBOW_Y", "R_ELBOW_P", "R_ELBOW_Y"]);
+    assert!(locked.iter().all(|(_, v)| *v == -0.5));
+}
+
+#[test]
+fn a_lock_pattern_matching_nothing_is_named() {
+    let e = build_error(&jvrc1_with(
+        "[[lock]]\njoints = \"*THUMB\"\n[[lock]]\njoints = \"*F??\"",
+        "",
+    ));
+    assert_key(&e, "lock[1].joints", "*F??", "matches no movable joint");
+    assert!(e.to_string().contains("R_HIP_P"), "lists the joints: {e}");
+}
+
+#[test]
+fn every_frame_key_names_itself_and_the_valid_frames() {
+    for (key, toml) in [
+        ("feet.left.frame", None),
+        ("feet.right.frame", None),
+        ("frames.pelvis", Some("[frames]\npelvis = \"NOPE\"")),
+        ("frames.torso", Some("[frames]\ntorso = \"NOPE\"")),
+        ("frames.head", Some("[frames]\nhead = \"NOPE\"")),
+        ("frames.left_hand", Some("[frames]\nleft_hand = \"NOPE\"")),
+        ("frames.right_hand", Some("[frames]\nright_hand = \"NOPE\"")),
+    ] {
+        let text = match toml {
+            Some(extra) => jvrc1_with("", extra),
+            None => {
+                let foot = if key.contains("left") {
+                    "l_ankle"
+                } else {
+                    "r_ankle"
+                };
+                jvrc1_with("", "").replace(&format!("\"{foot}\""), "\"NOPE\"")
+            }
+        };
+        let e = build_error(&text);
+        assert_key(&e, key, "NOPE", "no such frame; frames are");
+        assert!(e.to_string().contains("PELVIS_S"), "lists the frames: {e}");
+    }
+}
+
+#[test]
+fn every_joint_key_names_itself() {
+    for (toml, key, value, says) in [
+        (
+            "[posture]\nR_KNEES = 0.3",
+            "posture.R_KNEES",
+            "R_KNEES",
+            "no such active joint",
+        ),
+        // A locked joint is not active.
+        (
+            "[posture]\nR_UTHUMB = 0.3",
+            "posture.R_UTHUMB",
+            "R_UTHUMB",
+            "no such active joint",
+        ),
+        (
+            "[narrow]\nL_KNEES = [0.1, 0.2]",
+            "narrow.L_KNEES",
+            "L_KNEES",
+            "no such active joint",
+        ),
+        (
+            "[narrow]\nL_KNEE = [-5.0, 0.2]",
+            "narrow.L_KNEE",
+            "[-5, 0.2]",
+            "inside the joint's own",
+        ),
+        (
+            "[acceleration]\nlimits = { L_KNEES = 10.0 }",
+            "acceleration.limits.L_KNEES",
+            "L_KNEES",
+            "no such movable joint",
+        ),
+    ] {
+        let head = "[[lock]]\njoints = \"*THUMB\"";
+        let e = build_error(&jvrc1_with(head, toml));
+        assert_key(&e, key, value, says);
+    }
+}
+
+#[test]
+fn every_number_key_names_itself() {
+    let base = jvrc1_with("", "");
+    for (from, to, key) in [
+        (
+            "ankle_height = 0.1\nsole = { length = 0.2, width = 0.1 }\n[feet.right]",
+            "ankle_height = -0.1\nsole = { length = 0.2, width = 0.1 }\n[feet.right]",
+            "feet.left.ankle_height",
+        ),
+        (
+            "sole = { length = 0.2, width = 0.1 }\n[feet.right]",
+            "sole = { length = 0.0, width = 0.1 }\n[feet.right]",
+            "feet.left.sole.length",
+        ),
+        (
+            "sole = { length = 0.2, width = 0.1 }\n\n",
+            "sole = { length = 0.2, width = -1.0 }\n\n",
+            "feet.right.sole.width",
+        ),
+    ] {
+        assert!(base.contains(from), "{from}");
+        let e = build_error(&base.replacen(from, to, 1));
+        assert_key(&e, key, &e_value(&e), "expected");
+    }
+    for (extra, key) in [
+        (
+            "[acceleration]\nper_velocity = 0.0",
+            "acceleration.per_velocity",
+        ),
+        ("[narrow]\nL_KNEE = [0.9, 0.5]", "narrow.L_KNEE"),
+        ("[posture]\nL_KNEE = nan", "posture.L_KNEE"),
+    ] {
+        let e = build_error(&jvrc1_with("", extra));
+        assert_key(&e, key, &e_value(&e), "expected");
+    }
+}
+
+fn e_value(e: &Error) -> String {
+    match e {
+        Error::Profile { value, .. } => value.clone(),
+        _ => String::new(),
+    }
+}
+
+#[test]
+fn missing_keys_the_imitation_needs_are_named() {
+    let no_feet = "name = \"t\"\nurdf = \"../robots/jvrc1/jvrc1.urdf\"\nbase = \"floating\"\n[frames]\npelvis = \"PELVIS_S\"\n";
+    assert_key(&build_error(no_feet), "feet", "(missing)", "feet.left");
+    let no_pelvis = jvrc1_with("", "");
+    assert_key(
+        &build_error(&no_pelvis),
+        "frames.pelvis",
+        "(missing)",
+        "pelvis",
+    );
+    let right = "frame = \"r_ankle\"\nankle_height = 0.1\nsole = { length = 0.2, width = 0.1 }";
+    let different = jvrc1_with("", "[frames]\npelvis = \"PELVIS_S\"")
+        .replace(right, &right.replace("width = 0.1", "width = 0.12"));
+    let e = build_error(&different);
+    assert_key(&e, "feet.right.sole", &e_value(&e), "one sole");
+    let g1 = RobotProfile::builtin("g1").unwrap();
+    let robot = g1.robot().unwrap();
+    let e = g1.retarget_map("bvh", &robot).unwrap_err();
+    assert_key(&e, "imitate.maps.bvh", "(missing)", "deepmimic");
+}
+
+#[test]
+fn the_urdf_key_and_unknown_keys_are_named() {
+    let e = build_error(&jvrc1_with("", "").replace("jvrc1/jvrc1.urdf", "jvrc1/none.urdf"));
+    assert_key(&e, "urdf", "../robots/jvrc1/none.urdf", "embedded files");
+    let file = std::env::temp_dir().join(format!("iktc_profile_{}.toml", std::process::id()));
+    std::fs::write(
+        &file,
+        jvrc1_with("", "").replace("jvrc1/jvrc1.urdf", "x/missing.urdf"),
+    )
+    .unwrap();
+    let e = RobotProfile::load(&file).unwrap().robot().unwrap_err();
+    std::fs::remove_file(&file).ok();
+    assert_key(&e, "urdf", "../robots/x/missing.urdf", "cannot read");
+    match parse(&jvrc1_with("", "[frames]\npelvs = \"PELVIS_S\"")) {
+        Err(Error::Parse { line, message, .. }) => {
+            assert!(message.contains("pelvs"), "{message}");
+            assert_eq!(line, 14, "{message}");
+        }
+        other => panic!("expected a parse error, got {other:?}"),
+    }
+}
+
+#[test]
+fn map_entries_with_unknown_joints_are_named() {
+    // The JVRC-1 map applied to the G1: the first unknown joint, its entry and the valid ones.
+    let g1 = RobotProfile::builtin("g1").unwrap();
+    let robot = g1.robot().unwrap();
+    let map = iktc::motion::builtin_map("deepmimic_jvrc1").unwrap();
+    let e = iktc::profile::check_map_joints(&robot, &map).unwrap_err();
+    let text = e.to_string();
+    for part in [
+        "deepmimic_jvrc1",
+        "entry `chest`",
+        "WAIST_Y",
+        "waist_yaw_joint",
+    ] {
+        assert!(text.contains(part), "`{part}` not in {text}");
+    }
+}
+
+#[test]
+fn printed_profiles_parse_back_to_the_same_profile() {
+    for name in BUILTIN_PROFILES {
+        let p = RobotProfile::builtin(name).unwrap();
+        let printed = p.to_toml_string().unwrap();
+        let back = parse(&printed).unwrap();
+        assert_eq!(back, p, "{name}:\n{printed}");
+        // The commented text `iktc profile show` prints is the same profile too.
+        let shown = parse(builtin_profile_text(name).unwrap()).unwrap();
+        assert_eq!(shown, p);
+        // And both build the robot.
+        back.robot().unwrap();
+    }
+    assert!(matches!(
+        RobotProfile::builtin("atlas"),
+        Err(Error::UnknownName { .. })
+    ));
+}
+
+#[test]
+fn the_jvrc1_profile_gives_the_paper_settings() {
+    let p = RobotProfile::builtin("jvrc1").unwrap();
+    let cfg = p.imitate_config(ImitateConfig::default()).unwrap();
+    let paper = ImitateConfig::jvrc1();
+    assert_eq!(cfg.feet, paper.feet);
+    assert_eq!(cfg.pelvis, paper.pelvis);
+    assert_eq!(cfg.support, paper.support);
+    let sorted = |mut v: Vec<(String, f64)>| {
+        v.sort_by(|a, b| a.0.cmp(&b.0));
+        v
+    };
+    assert_eq!(sorted(cfg.initial_posture), sorted(paper.initial_posture));
+    // TOML tables carry no order: the profile's narrowed joints come sorted by name.
+    let mut narrow = paper.narrow.clone();
+    narrow.sort_by(|a, b| a.joint.cmp(&b.joint));
+    assert_eq!(cfg.narrow, narrow);
+}
+
+#[test]
+fn init_guesses_the_g1_feet_pelvis_and_hands_and_marks_them() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/data/robots/g1");
+    let text = std::fs::read_to_string(format!("{dir}/g1_29dof_rev_1_0.urdf")).unwrap();
+    let toml = init_profile_toml(&text, "g1_29dof_rev_1_0.urdf").unwrap();
+    assert!(toml.matches("# guessed").count() >= 8, "{toml}");
+    let p =
+        RobotProfile::from_toml_str(&toml, "init", ProfileOrigin::Directory(dir.into())).unwrap();
+    let feet = p.feet.clone().unwrap();
+    assert_eq!(feet.left.frame, "left_ankle_roll_link");
+    assert_eq!(feet.right.frame, "right_ankle_roll_link");
+    // The four contact spheres (radius 5 mm) at x = -0.05, 0.12 m, y = ±0.025, ±0.03 m,
+    // z = -0.03 m: contact points 0.035 m below the ankle.
+    let s = feet.left.sole;
+    assert!(
+        (s.length - 0.17).abs() < 1e-12 && (s.width - 0.06).abs() < 1e-12,
+        "{s:?}"
+    );
+    assert!((s.offset_x - 0.035).abs() < 1e-12 && (feet.left.ankle_height - 0.035).abs() < 1e-12);
+    assert_eq!(p.frames.pelvis.as_deref(), Some("pelvis"));
+    assert_eq!(p.frames.torso.as_deref(), Some("torso_link"));
+    assert_eq!(p.frames.head.as_deref(), Some("head_link"));
+    assert_eq!(p.frames.left_hand.as_deref(), Some("left_rubber_hand"));
+    assert_eq!(p.frames.right_hand.as_deref(), Some("right_rubber_hand"));
+    assert_eq!(p.robot().unwrap().nv(), 6 + 29);
+}
+
+#[test]
+fn init_on_jvrc1_finds_its_ankles_and_fingers() {
+    let toml = init_profile_toml(iktc::model::JVRC1_URDF, "../robots/jvrc1/jvrc1.urdf").unwrap();
+    let p = parse(&toml).unwrap();
+    let feet = p.feet.clone().unwrap();
+    assert_eq!(
+        (feet.left.frame.as_str(), feet.right.frame.as_str()),
+        ("l_ankle", "r_ankle")
+    );
+    assert!(
+        toml.contains("PLACEHOLDER"),
+        "no collision geometry on the ankles: {toml}"
+    );
+    assert_eq!(p.lock.len(), 12, "{toml}");
+    assert_eq!(p.robot().unwrap().nv(), 6 + 32);
+}
