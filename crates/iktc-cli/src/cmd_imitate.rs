@@ -9,8 +9,8 @@ use iktc::motion::{
     builtin_clip, builtin_map, Clip, MotionFormat, RetargetMap, BUILTIN_CLIP_NAMES,
     BUILTIN_MAP_NAMES,
 };
-use iktc::resources::RunLimits;
 use iktc::profile::check_map_joints;
+use iktc::resources::RunLimits;
 use iktc::sim::imitate::LEVEL_NAMES;
 use iktc::sim::{imitation_references, run_imitate, ImitateConfig, ImitateRun};
 use iktc::solver::Method;
@@ -213,7 +213,9 @@ fn print_summary(r: &ImitateRun) -> std::io::Result<()> {
     )?;
     crate::outln!(
         "empty boxes {} ticks, fallbacks {} ticks, joints recovering into their range {} ticks",
-        s.empty_box_steps, s.fallback_steps, s.recovering_steps
+        s.empty_box_steps,
+        s.fallback_steps,
+        s.recovering_steps
     )?;
     crate::outln!(
         "the corrected level changed {} times between consecutive ticks, {} of them undone at the next tick",

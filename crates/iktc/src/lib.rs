@@ -56,10 +56,10 @@ pub mod error;
 pub mod limits;
 pub mod model;
 pub mod motion;
-pub mod resources;
 pub mod prelude;
 #[cfg(all(feature = "urdf", feature = "toml"))]
 pub mod profile;
+pub mod resources;
 pub mod sim;
 pub mod solver;
 pub mod task;

@@ -24,6 +24,7 @@ fn from_text(text: &str, name: &str, options: &MotionOptions) -> iktc::Result<Mo
         &BvhReadOptions {
             length_unit: LengthUnit::Metres,
             up_axis: UpAxis::Y,
+            ..Default::default()
         },
     )?
     .to_clip()?;
@@ -389,6 +390,7 @@ fn the_cmu_clip_rescaled_to_metres_gives_the_same_keypoints_within_a_millimetre(
                 metres_per_unit: CMU_METRES_PER_UNIT,
             },
             up_axis: UpAxis::Y,
+            ..Default::default()
         },
     )
     .unwrap();

@@ -19,6 +19,7 @@ fn clip(text: &str) -> Clip {
         &BvhReadOptions {
             length_unit: LengthUnit::Centimetres,
             up_axis: UpAxis::Y,
+            ..Default::default()
         },
     )
     .unwrap()

@@ -354,16 +354,14 @@ fn read_content(
             )?
             .to_clip()?,
         ),
-        MotionFormat::DeepMimic => {
-            MotionContent::Skeleton(super::read_deepmimic_with(
-                text()?,
-                &source,
-                &super::DeepMimicSettings {
-                    limits: options.limits,
-                    ..Default::default()
-                },
-            )?)
-        }
+        MotionFormat::DeepMimic => MotionContent::Skeleton(super::read_deepmimic_with(
+            text()?,
+            &source,
+            &super::DeepMimicSettings {
+                limits: options.limits,
+                ..Default::default()
+            },
+        )?),
         MotionFormat::Asf => {
             let asf = super::asf::read_asf(text()?, &source)?;
             MotionContent::Skeleton(asf.rest_clip()?)
