@@ -51,7 +51,7 @@ pub struct Args {
     #[arg(long, value_enum, default_value = "quiet")]
     pub bounds: BoundsArg,
     /// Start even if a joint is outside its (narrowed) range, and bring it back at the
-    /// acceleration limit (viable bounds only); without it such a start is an error.
+    /// acceleration limit (viable or quiet bounds); without it such a start is an error.
     #[arg(long)]
     pub recover: bool,
     /// Control period [s].
@@ -170,8 +170,10 @@ pub fn run(a: &Args) -> Result<()> {
     cfg.run_limits.check_dt("--dt", a.dt)?;
     if a.recover {
         match &mut cfg.bounds {
-            BoundMethod::Viable(settings) => settings.outside = OutsideLimits::Recover,
-            BoundMethod::Paper => anyhow::bail!("--recover needs --bounds viable"),
+            BoundMethod::Viable(settings) | BoundMethod::Quiet(settings) => {
+                settings.outside = OutsideLimits::Recover
+            }
+            BoundMethod::Paper => anyhow::bail!("--recover needs --bounds viable or quiet"),
         }
     }
     cfg.health.keep_going = a.keep_going;

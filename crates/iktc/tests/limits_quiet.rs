@@ -56,6 +56,7 @@ impl Case {
     fn method(&self) -> BoundMethod {
         BoundMethod::Quiet(ViableSettings {
             braking_fraction: self.fraction,
+            ..ViableSettings::default()
         })
     }
 
