@@ -71,7 +71,7 @@ pub struct Args {
     #[arg(long, value_enum, default_value = "iktc")]
     pub solver: SolverArg,
     /// Joint bounds.
-    #[arg(long, value_enum, default_value = "quiet")]
+    #[arg(long, value_enum, default_value = "viable")]
     pub bounds: BoundsArg,
     /// Control period \[s\].
     #[arg(long, default_value_t = 0.005)]

@@ -9,10 +9,8 @@ use crate::solver::{Method, SolverSettings};
 pub struct ControllerSettings {
     /// The solver: IKTC (default), the GF cascade, clamping or the plain prioritized solution.
     pub method: Method,
-    /// How joint limits become the acceleration box (default: [`BoundMethod::default`], the
-    /// quiet bounds, safe in discrete time and at rest on a limit with `q̈ = 0`;
-    /// [`BoundMethod::viable`] brakes on the continuous curve; [`BoundMethod::Paper`] is eq. 14
-    /// as printed).
+    /// How joint limits become the acceleration box (default: the viable bounds, safe in
+    /// discrete time; [`BoundMethod::Paper`] is eq. 14 as printed).
     pub bounds: BoundMethod,
     /// Damping, rank threshold, box tolerance and QP settings of the solver.
     pub solver: SolverSettings,
@@ -22,7 +20,7 @@ impl Default for ControllerSettings {
     fn default() -> Self {
         Self {
             method: Method::Iktc,
-            bounds: BoundMethod::default(),
+            bounds: BoundMethod::viable(),
             solver: SolverSettings::default(),
         }
     }

@@ -57,7 +57,7 @@ pub struct NarrowedJoint {
 pub struct ImitateConfig {
     /// Solver (IKTC by default).
     pub method: Method,
-    /// Joint bounds (quiet by default).
+    /// Joint bounds (viable by default).
     pub bounds: BoundMethod,
     /// Control period Δt \[s\]; must equal the references' period.
     pub dt: f64,
@@ -103,9 +103,7 @@ pub struct ImitateConfig {
 }
 
 impl ImitateConfig {
-    /// The defaults for JVRC-1: IKTC with a level hold of 3 ticks
-    /// ([`SolverSettings::level_hold`]: no corrected level alternates tick by tick), quiet bounds
-    /// ([`BoundMethod::Quiet`]), Δt = 5 ms, feet `r_ankle` and `l_ankle`,
+    /// The defaults for JVRC-1: IKTC, viable bounds, Δt = 5 ms, feet `r_ankle` and `l_ankle`,
     /// pelvis `PELVIS_S`, hip pitch −0.4, knee 0.8, ankle pitch −0.4 rad, L_KNEE narrowed to
     /// \[0.55, 0.95\] rad and L_HIP_R to \[−0.05, 0.05\] rad (so that the pelvis height and
     /// attitude tasks get corrected, as in Fig. 20), reference margin 0.05 rad.
@@ -118,7 +116,7 @@ impl ImitateConfig {
         }
         Self {
             method: Method::Iktc,
-            bounds: BoundMethod::quiet(),
+            bounds: BoundMethod::viable(),
             dt: 0.005,
             run_limits: RunLimits::default(),
             gains: Gains {
@@ -146,10 +144,7 @@ impl ImitateConfig {
             support: SupportSettings::default(),
             on_limit_position: 2e-3,
             on_limit_fraction: 0.01,
-            solver: SolverSettings {
-                level_hold: 3,
-                ..SolverSettings::default()
-            },
+            solver: SolverSettings::default(),
             health: HealthSettings::default(),
         }
     }

@@ -85,16 +85,12 @@ pub struct WalkImitateConfig {
 }
 
 impl WalkImitateConfig {
-    /// The default run on JVRC-1: the imitation defaults with a level hold of 4 ticks
-    /// ([`SolverSettings::level_hold`](crate::solver::SolverSettings::level_hold); at 3 the
-    /// damping ratio after the push measures 0.488 instead of 0.494), 4 steps of 0.1 m (0.6 s single
+    /// The default run on JVRC-1: the imitation defaults, 4 steps of 0.1 m (0.6 s single
     /// support, 0.1 s double support, 0.8 s initial and final double support, 4 cm swing), the
     /// damping controller on, a forward push of 5 N·s at 2.15 s (single support), 1 mm noise.
     pub fn jvrc1() -> Result<Self> {
-        let mut imitate = ImitateConfig::jvrc1();
-        imitate.solver.level_hold = 4;
         Ok(Self {
-            imitate,
+            imitate: ImitateConfig::jvrc1(),
             steps: 4,
             step_length: 0.1,
             walk: WalkSettings {
