@@ -51,7 +51,7 @@ pub struct Args {
     #[arg(long, value_enum, default_value = "viable")]
     pub bounds: BoundsArg,
     /// Start even if a joint is outside its (narrowed) range, and bring it back at the
-    /// acceleration limit (viable bounds only); without it such a start is an error.
+    /// acceleration limit (viable or quiet bounds); without it such a start is an error.
     #[arg(long)]
     pub recover: bool,
     /// Control period [s].
@@ -170,8 +170,10 @@ pub fn run(a: &Args) -> Result<()> {
     cfg.run_limits.check_dt("--dt", a.dt)?;
     if a.recover {
         match &mut cfg.bounds {
-            BoundMethod::Viable(settings) => settings.outside = OutsideLimits::Recover,
-            BoundMethod::Paper => anyhow::bail!("--recover needs --bounds viable"),
+            BoundMethod::Viable(settings) | BoundMethod::Quiet(settings) => {
+                settings.outside = OutsideLimits::Recover
+            }
+            BoundMethod::Paper => anyhow::bail!("--recover needs --bounds viable or quiet"),
         }
     }
     cfg.health.keep_going = a.keep_going;
@@ -627,6 +629,19 @@ fn summary_row(name: &str, r: &ImitateRun) -> Vec<String> {
             s.pelvis_corrected_steps, s.pelvis_corrected_while_narrowed_at_limit
         ),
         format!("{} ({})", s.level_switches.switches, s.level_switches.flips),
+        s.narrowed_smoothness
+            .iter()
+            .map(|j| {
+                format!(
+                    "{} {:.0} / {:.0} ({:.0} %)",
+                    j.joint,
+                    j.smoothness.rms_jerk,
+                    j.smoothness.max_jerk,
+                    100.0 * j.smoothness.reversal_share
+                )
+            })
+            .collect::<Vec<_>>()
+            .join("; "),
         format!("{:.2} / {}", s.qp_per_step_mean, s.qp_per_step_max),
         format!("{:.0} / {:.0}", s.tick_median_us, s.tick_p99_us),
     ]
@@ -658,6 +673,8 @@ pub fn imitate_section(out: &Path) -> Result<Section> {
          L_KNEE is narrowed to [0.55, 0.95] rad and L_HIP_R to [−0.05, 0.05] rad, as the paper narrows LKN and LHR, so that the pelvis tasks get corrected. \
          Feet: soles 0.2 × 0.1 m under the ankles (nominal), the support polygon is their convex hull; the COM reference moves to its centre in 0.5 s. \
          Margins are signed (positive = a limit exceeded, in-step peaks included). Tick times are wall-clock times of this run. The third run uses the paper's bound, eq. (14), which lets joints pass their limits (errata 3.1). \
+         IKTC and GF run with the default viable bounds and Algorithm 2's level as printed; the fourth run uses the quiet bounds and a hold of 3 ticks \
+         on the corrected level, for the smoothness figures of both (jerk = (q̈<sub>k</sub> − q̈<sub>k−1</sub>)/Δt). \
          The clip's arms pass near the shoulders' pitch–roll–yaw singularity (roll ±90°): the retargeted shoulder pitch and yaw then spin far faster \
          than their limits and leave their ranges (they are clamped), so the upper-body level, the lowest, is corrected most of the time.</p>",
     );
@@ -672,6 +689,7 @@ pub fn imitate_section(out: &Path) -> Result<Section> {
             "RMS error per level (feet / COM / att. / height / upper)",
             "pelvis corrected ticks (with narrowed joint on limit)",
             "corrected-level changes (undone at the next tick)",
+            "narrowed joints: RMS / max jerk [rad/s³] (ticks where q̈'s change reverses)",
             "QPs per tick mean / max",
             "tick median / p99 [µs]",
         ]
@@ -679,16 +697,26 @@ pub fn imitate_section(out: &Path) -> Result<Section> {
         .to_vec(),
     );
     let mut runs = Vec::new();
-    for (name, method, bounds) in [
-        ("iktc", Method::Iktc, BoundMethod::viable()),
-        ("gf", Method::Cascade, BoundMethod::viable()),
-        ("iktc_paper_bounds", Method::Iktc, BoundMethod::Paper),
+    // The last run uses the quiet bounds and a level hold of 3 ticks, to show the smoothness
+    // figures beside the defaults'.
+    let defaults = ImitateConfig::jvrc1();
+    for (name, method, bounds, hold) in [
+        (
+            "iktc",
+            Method::Iktc,
+            defaults.bounds,
+            defaults.solver.level_hold,
+        ),
+        ("gf", Method::Cascade, defaults.bounds, 1),
+        ("iktc_paper_bounds", Method::Iktc, BoundMethod::Paper, 1),
+        ("iktc_quiet_hold3", Method::Iktc, BoundMethod::quiet(), 3),
     ] {
-        let cfg = ImitateConfig {
+        let mut cfg = ImitateConfig {
             method,
             bounds,
             ..ImitateConfig::jvrc1()
         };
+        cfg.solver.level_hold = hold;
         let r = run_experiment(&e, &cfg)?;
         let figs = write_imitate(&r, &e, &base.join(name))?;
         table = table.row(summary_row(name, &r));

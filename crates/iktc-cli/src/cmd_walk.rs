@@ -583,6 +583,7 @@ pub fn walk_section(out: &Path) -> Result<Section> {
             "ZMP outside after the push [m]",
             "health",
             "corrected ticks; level changes (undone next tick)",
+            "worst joint: RMS jerk [rad/s³] (share of ticks where q̈'s change reverses)",
             "median / p99 tick [µs]",
         ]
         .map(String::from)
@@ -617,6 +618,11 @@ pub fn walk_section(out: &Path) -> Result<Section> {
             format!(
                 "{}; {} ({})",
                 s.corrected_ticks, s.level_switches.switches, s.level_switches.flips
+            ),
+            format!(
+                "{:.0} ({:.0} %)",
+                s.smoothness_worst.rms_jerk,
+                100.0 * s.smoothness_worst.reversal_share
             ),
             format!("{:.0} / {:.0}", s.tick_median_us, s.tick_p99_us),
         ]);

@@ -38,7 +38,8 @@ fn bench_compute_box(c: &mut Criterion) {
     let mut group = c.benchmark_group("compute_box_nv38");
     for (name, method) in [
         ("paper", BoundMethod::Paper),
-        ("viable", BoundMethod::default()),
+        ("viable", BoundMethod::viable()),
+        ("quiet", BoundMethod::quiet()),
     ] {
         group.bench_function(name, |b| {
             b.iter(|| {

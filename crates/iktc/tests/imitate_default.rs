@@ -247,3 +247,63 @@ fn bad_settings_are_errors() {
         .to_string()
         .contains("NOPE"));
 }
+
+/// Issue 13, the smooth settings (quiet bounds, level hold 3) against the defaults (viable
+/// bounds, Algorithm 2's level as printed), one run each: on the narrowed joints the RMS jerk of
+/// q̈ is at least 1.5× lower and q̈'s change reverses its sign on at most 30 % of the ticks (from
+/// about 40 %; the issue's goal, 3× and 10 %, is not reached: what remains comes from the
+/// correction of the levels above as other joints' bounds come and go, not from resting on a
+/// limit); at most 5 level changes are undone at the next tick (from 73); no limit exceeded;
+/// the pelvis is still corrected while a narrowed joint sits on its limit.
+#[test]
+fn default_run_is_smooth_at_the_limits() {
+    use iktc::limits::BoundMethod;
+    use iktc::solver::SolverSettings;
+    let (robot, refs) = setup();
+    let old = ImitateConfig::default();
+    let new = ImitateConfig {
+        bounds: BoundMethod::quiet(),
+        solver: SolverSettings {
+            level_hold: 3,
+            ..old.solver
+        },
+        ..ImitateConfig::default()
+    };
+    assert_eq!(old.bounds, BoundMethod::viable());
+    assert_eq!(old.solver.level_hold, 1);
+    let before = run_imitate(&robot, &refs, &old).unwrap();
+    let after = run_imitate(&robot, &refs, &new).unwrap();
+    let (b, a) = (&before.summary, &after.summary);
+    for (jb, ja) in b.narrowed_smoothness.iter().zip(&a.narrowed_smoothness) {
+        let (sb, sa) = (jb.smoothness, ja.smoothness);
+        println!(
+            "{}: RMS jerk {:.0} → {:.0} rad/s³, max {:.0} → {:.0}, reversals {:.1} % → {:.1} %",
+            ja.joint,
+            sb.rms_jerk,
+            sa.rms_jerk,
+            sb.max_jerk,
+            sa.max_jerk,
+            100.0 * sb.reversal_share,
+            100.0 * sa.reversal_share
+        );
+        assert!(sa.rms_jerk * 1.5 <= sb.rms_jerk, "{}", ja.joint);
+        assert!(sa.reversal_share <= 0.30, "{}", ja.joint);
+        assert!(sa.reversal_share < sb.reversal_share, "{}", ja.joint);
+    }
+    println!(
+        "level changes {} ({} undone) → {} ({} undone); pelvis corrected with a narrowed joint on its limit {} → {}",
+        b.level_switches.switches,
+        b.level_switches.flips,
+        a.level_switches.switches,
+        a.level_switches.flips,
+        b.pelvis_corrected_while_narrowed_at_limit,
+        a.pelvis_corrected_while_narrowed_at_limit
+    );
+    assert!(a.level_switches.flips <= 5, "{:?}", a.level_switches);
+    assert!(a.pelvis_corrected_while_narrowed_at_limit > 50);
+    assert!(a.worst_position_margin <= LIMIT_ROUNDING);
+    assert!(a.worst_velocity_margin <= LIMIT_ROUNDING);
+    assert!(a.worst_acceleration_margin <= LIMIT_ROUNDING);
+    check_limits_independently(&robot, &new, &after);
+    assert_eq!(a.empty_box_steps, 0);
+}

@@ -291,7 +291,7 @@ fn multi_dof_box_under_a_pushing_policy() {
         })
         .collect();
     let limits = JointLimits::new(dofs.clone()).unwrap();
-    let method = BoundMethod::default();
+    let method = BoundMethod::viable();
     for dt in [1e-3, 0.005, 0.1] {
         let mut q: Vec<f64> = dofs
             .iter()

@@ -373,3 +373,153 @@ fn the_infeasibility_screen_never_changes_the_answer() {
     assert!(screened > 50, "the screen must fire ({screened})");
     assert!(iters_on < iters_off);
 }
+
+#[test]
+fn level_hold_keeps_the_box_and_the_levels_above_exact() {
+    // Sequences of ticks whose box swings between two states, as a joint limit does when a
+    // correction of a higher level makes room: with the hold, the corrected level is never below
+    // Algorithm 2's, never alternates tick by tick, the box is met and every level above the
+    // corrected one is solved exactly; with a hold of 1 it is Algorithm 2 exactly.
+    let mut r = rng(1313);
+    let dims = [4, 4, 4, 4];
+    let n = 14;
+    let hold = 6;
+    let held = SolverSettings {
+        level_hold: hold,
+        ..Default::default()
+    };
+    let mut sh = Solver::new(n, &dims, held).unwrap();
+    let mut sa = Solver::new(n, &dims, SolverSettings::default()).unwrap();
+    let (mut held_ticks, mut a2_switches, mut held_flips) = (0, 0, 0);
+    for case in 0..60 {
+        let levels = random_levels(&mut r, n, &dims);
+        let mut q0 = DVector::zeros(n);
+        sa.solve(Method::Prioritized, &levels, &wide_box(n), &mut q0)
+            .unwrap();
+        let tight = box_violated_by(&mut r, &q0, 1.0, 3 + case % 4, 1.0);
+        let loose = box_violated_by(&mut r, &q0, 1.0, 1, 0.2);
+        let mut chosen = Vec::new();
+        let mut prev_a2 = None;
+        for tick in 0..24 {
+            let bx = if tick % 2 == 0 { &tight } else { &loose };
+            let (mut qh, mut qa) = (DVector::zeros(n), DVector::zeros(n));
+            let ra = sa
+                .solve(Method::Iktc, &levels, bx, &mut qa)
+                .unwrap()
+                .clone();
+            let rh = sh
+                .solve(Method::Iktc, &levels, bx, &mut qh)
+                .unwrap()
+                .clone();
+            assert_eq!(ra.corrected_from, ra.feasible_from);
+            assert_eq!(
+                rh.feasible_from, ra.corrected_from,
+                "case {case} tick {tick}"
+            );
+            if let (Some(c), Some(f)) = (rh.corrected_from, rh.feasible_from) {
+                assert!(c <= f);
+                if c < f {
+                    held_ticks += 1;
+                }
+                assert!(bx.max_violation(qh.as_slice()).unwrap() <= 1e-8);
+                for (i, e) in rh.task_error_norms.iter().enumerate().take(c) {
+                    assert!(*e <= 1e-8 * (1.0 + levels[i].rhs.norm()), "level {i}: {e}");
+                }
+            }
+            if prev_a2.is_some() && ra.corrected_from.is_some() && prev_a2 != ra.corrected_from {
+                a2_switches += 1;
+            }
+            prev_a2 = ra.corrected_from;
+            chosen.push(rh.corrected_from);
+        }
+        held_flips += chosen
+            .windows(3)
+            .filter(|w| w[0].is_some() && w[1].is_some() && w[0] == w[2] && w[0] != w[1])
+            .count();
+    }
+    println!("Algorithm 2 switched level {a2_switches} times; held ticks {held_ticks}, flips with the hold {held_flips}");
+    assert!(
+        a2_switches > 100,
+        "the test must make Algorithm 2 alternate"
+    );
+    assert!(held_ticks > 100);
+    assert_eq!(held_flips, 0);
+}
+
+#[test]
+fn rebase_converges_on_the_achievable_demand_and_leaves_uncorrected_levels_alone() {
+    // The same problem tick after tick, the box cutting the lowest levels: with the re-base the
+    // q̈ stays in the box, and the levels above every corrected one are exact
+    // with respect to their own (unchanged) demands. Once the box lets the level go, it recovers
+    // its demand geometrically.
+    let mut r = rng(3303);
+    let dims = [3, 3, 3];
+    let n = 8;
+    let release = 0.2;
+    let settings = SolverSettings {
+        rebase_release: release,
+        ..Default::default()
+    };
+    let mut checked = 0;
+    let mut ratios = Vec::new();
+    for _ in 0..40 {
+        let levels = random_levels(&mut r, n, &dims);
+        let mut s = Solver::new(n, &dims, settings).unwrap();
+        let mut q0 = DVector::zeros(n);
+        s.solve(Method::Prioritized, &levels, &wide_box(n), &mut q0)
+            .unwrap();
+        let bx = box_violated_by(&mut r, &q0, 1.0, 2, 0.5);
+        let mut q = DVector::zeros(n);
+        let mut first = None;
+        let mut last = DVector::zeros(n);
+        let mut highest = dims.len();
+        for _ in 0..200 {
+            let rep = s.solve(Method::Iktc, &levels, &bx, &mut q).unwrap().clone();
+            assert!(bx.max_violation(q.as_slice()).unwrap() <= 1e-8);
+            if let Some(c) = rep.corrected_from {
+                // Levels never corrected carry no offset.
+                highest = highest.min(c);
+                for (e, l) in rep.task_error_norms.iter().zip(&levels).take(highest) {
+                    assert!(*e <= 1e-8 * (1.0 + l.rhs.norm()));
+                }
+                let dh: f64 = rep
+                    .corrections
+                    .iter()
+                    .map(|c| c.norm_squared())
+                    .sum::<f64>();
+                first.get_or_insert(dh.sqrt());
+            }
+            last.copy_from(&q);
+        }
+        let Some(first) = first else { continue };
+        // The last correction against the first (printed: with a QP whose active set changes as
+        // the demand moves, the scalar steady state r/(1 − r) w is not a bound).
+        let rep = s.report().clone();
+        let dh: f64 = rep
+            .corrections
+            .iter()
+            .map(|c| c.norm_squared())
+            .sum::<f64>()
+            .sqrt();
+        ratios.push(dh / first);
+        // Released: a wide box, the re-based demand decays back to the CLIK demand.
+        let mut free = DVector::zeros(n);
+        for _ in 0..120 {
+            s.solve(Method::Iktc, &levels, &wide_box(n), &mut free)
+                .unwrap();
+        }
+        assert!(
+            (&free - &q0).norm() <= 1e-6 * (1.0 + q0.norm()),
+            "{}",
+            (&free - &q0).norm()
+        );
+        checked += 1;
+    }
+    ratios.sort_by(f64::total_cmp);
+    println!("last/first correction: {ratios:.3?}");
+    assert!(checked > 20, "{checked}");
+    // Where the active set settles, the refused part shrinks to r of the first one (scalar
+    // steady state: Δh = r/(1 − r) w = r Δh₀); most cases are such.
+    let settled = ratios.iter().filter(|&&x| x <= release + 1e-6).count();
+    assert!(4 * settled >= 3 * ratios.len(), "{ratios:?}");
+}

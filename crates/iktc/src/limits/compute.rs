@@ -7,6 +7,7 @@ use super::intersect::{intersect, DofBounds};
 use super::joint_limits::{DofLimits, JointLimits};
 use super::method::{BoundMethod, OutsideLimits};
 use super::paper::paper_sources;
+use super::quiet::quiet_sources;
 use super::source::{BoundSource, DofBoundSources, DroppedSources};
 use super::viable::{recovery_acceleration, viable_sources};
 
@@ -58,7 +59,7 @@ pub fn compute_box(
 
 /// The interval of one dof: the intersection of its sources; the recovery acceleration when
 /// the method asks for recovery and the dof is outside its range; for
-/// [`BoundMethod::Viable`] and a zero-width range, the single acceleration `−q̇/Δt` that
+/// [`BoundMethod::Viable`] or [`BoundMethod::Quiet`] and a zero-width range, the single acceleration `−q̇/Δt` that
 /// stops the joint within the step (its only viable state is at rest on the range, where
 /// this is 0; off it by a solver tolerance, stopping keeps the deviation from growing, which
 /// the bounds of a widened range would not).
@@ -70,7 +71,7 @@ fn resolve(
     qd: f64,
     dt: f64,
 ) -> DofBounds {
-    if let BoundMethod::Viable(settings) = method {
+    if let BoundMethod::Viable(settings) | BoundMethod::Quiet(settings) = method {
         if settings.outside == OutsideLimits::Recover {
             if let Some(x) = recovery_acceleration(dof, settings, q, qd, dt) {
                 return DofBounds {
@@ -129,6 +130,7 @@ fn sources_unchecked(
     match method {
         BoundMethod::Paper => paper_sources(dof, q, qd, dt),
         BoundMethod::Viable(settings) => viable_sources(dof, settings, q, qd, dt),
+        BoundMethod::Quiet(settings) => quiet_sources(dof, settings, q, qd, dt),
     }
 }
 

@@ -28,7 +28,7 @@ impl DofBounds {
 /// Intersects the sources of one dof: `b_u = min` and `b_l = max` over the sources.
 ///
 /// * [`BoundMethod::Paper`]: eq. (14) as printed; an empty interval stays empty.
-/// * [`BoundMethod::Viable`]: if `b_l > b_u`, the acceleration limit is dropped and the
+/// * [`BoundMethod::Viable`] and [`BoundMethod::Quiet`]: if `b_l > b_u`, the acceleration limit is dropped and the
 ///   intersection `[L, U]` of the other sources is redone; the interval is then the part of
 ///   `[L, U]` closest to `[−a_max, a_max]`: `[max(L, min(−a_max, U)), min(U, max(a_max, L))]`,
 ///   a single point (`U` or `L`) when the two do not overlap, so the acceleration limit is
@@ -43,11 +43,11 @@ impl DofBounds {
 pub fn intersect(sources: &DofBoundSources, method: &BoundMethod) -> DofBounds {
     let position_source = match method {
         BoundMethod::Paper => BoundSource::PaperPosition,
-        BoundMethod::Viable(_) => BoundSource::Position,
+        BoundMethod::Viable(_) | BoundMethod::Quiet(_) => BoundSource::Position,
     };
     let mut dropped = DroppedSources::default();
     let mut bounds = intersect_kept(sources, position_source, dropped);
-    if let BoundMethod::Viable(_) = method {
+    if let BoundMethod::Viable(_) | BoundMethod::Quiet(_) = method {
         if bounds.is_empty() {
             dropped.acceleration = true;
             bounds = intersect_kept(sources, position_source, dropped);

@@ -16,10 +16,17 @@ pub enum BoundMethod {
     /// discrete-time acceleration/torque control of robot manipulators*, IEEE RA-L 3(1), 2018,
     /// as given in errata §3.1 (see [`viable`](super::viable)), with conflict resolution.
     Viable(ViableSettings),
+    /// The sources of `Viable` with the continuous braking curve replaced by a discrete braking
+    /// profile that ends at rest at a tick (see [`quiet`](super::quiet)): a joint pushed into a
+    /// limit comes to rest on it and stays with `q̈ = 0`, where `Viable` chatters. Same settings
+    /// (`a_stop = braking_fraction · a_max`) and conflict resolution as `Viable`.
+    Quiet(ViableSettings),
 }
 
 impl Default for BoundMethod {
-    /// [`BoundMethod::Viable`] with default settings: the safe one.
+    /// [`BoundMethod::Viable`] with default settings: safe in discrete time. The quiet bounds
+    /// ([`BoundMethod::quiet`]) are selectable; they are not the default because the imitation
+    /// tests at coarse `Δt` and with a huge knee acceleration limit lose the feet task with them.
     fn default() -> Self {
         Self::Viable(ViableSettings::default())
     }
@@ -28,7 +35,21 @@ impl Default for BoundMethod {
 impl BoundMethod {
     /// [`BoundMethod::Viable`] with default settings.
     pub fn viable() -> Self {
-        Self::default()
+        Self::Viable(ViableSettings::default())
+    }
+
+    /// [`BoundMethod::Quiet`] with default settings.
+    pub fn quiet() -> Self {
+        Self::Quiet(ViableSettings::default())
+    }
+
+    /// Lower-case name for reports: "paper", "viable", "quiet".
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::Paper => "paper",
+            Self::Viable(_) => "viable",
+            Self::Quiet(_) => "quiet",
+        }
     }
 
     /// Checks the settings of the method.
@@ -38,7 +59,7 @@ impl BoundMethod {
     pub fn validate(&self) -> Result<()> {
         match self {
             Self::Paper => Ok(()),
-            Self::Viable(settings) => settings.validate(),
+            Self::Viable(settings) | Self::Quiet(settings) => settings.validate(),
         }
     }
 
@@ -48,7 +69,7 @@ impl BoundMethod {
     pub fn outside_limits(&self) -> OutsideLimits {
         match self {
             Self::Paper => OutsideLimits::Error,
-            Self::Viable(settings) => settings.outside,
+            Self::Viable(settings) | Self::Quiet(settings) => settings.outside,
         }
     }
 }
@@ -69,7 +90,7 @@ pub enum OutsideLimits {
     Recover,
 }
 
-/// Settings of [`BoundMethod::Viable`].
+/// Settings of [`BoundMethod::Viable`] and [`BoundMethod::Quiet`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ViableSettings {
     /// The braking acceleration assumed by the viability bound, as a fraction of the joint's

@@ -1,12 +1,13 @@
 //! Joint position, velocity and acceleration limits turned into one box on the joint
 //! accelerations, `b_l ≤ q̈ ≤ b_u` (paper eqs. 13–14), for a control period `Δt`.
 //!
-//! Two methods, side by side ([`BoundMethod`]):
+//! Three methods, side by side ([`BoundMethod`]):
 //!
 //! | method | formula | discrete-time safe |
 //! |---|---|---|
 //! | [`BoundMethod::Paper`] | Proposition 3.1, eq. (14), as printed ([`paper`]) | no: the box can empty and the joint overshoot (errata §3.1) |
 //! | [`BoundMethod::Viable`] | position with in-step peak, exact velocity, viability (discrete stopping distance) at the next state, `±a_max`; after Del Prete, IEEE RA-L 2018 ([`viable`]) | yes, from a viable state, for every `Δt` and ratio of the limits (proof in [`viable`]) |
+//! | [`BoundMethod::Quiet`] | as `Viable`, with a discrete braking profile that ends at rest at a tick ([`quiet`]) | yes, from a quietly viable state; the box never empties and a joint pushed into a limit rests on it with `q̈ = 0` |
 //!
 //! Each source of bound (acceleration, velocity, position, viability) is computed separately,
 //! as in TSID, then intersected ([`intersect`]). From a viable state the sources of `Viable`
@@ -48,6 +49,7 @@ mod intersect;
 mod joint_limits;
 mod method;
 pub mod paper;
+pub mod quiet;
 mod source;
 mod velocity;
 pub mod viable;
@@ -59,6 +61,7 @@ pub use intersect::{intersect, DofBounds};
 pub use joint_limits::{DofLimits, JointLimits};
 pub use method::{BoundMethod, OutsideLimits, ViableSettings};
 pub use paper::paper_sources;
+pub use quiet::quiet_sources;
 pub use source::{BoundSource, DofBoundSources, DroppedSources, SourceBounds};
 pub use velocity::{velocity_lower, velocity_upper};
 pub use viable::viable_sources;

@@ -27,7 +27,7 @@ pub enum BoundSource {
 
 /// Which sources conflict resolution removed for one dof (both sides).
 ///
-/// Only [`BoundMethod::Viable`](super::BoundMethod) drops sources: first the acceleration
+/// Only [`BoundMethod::Viable`](super::BoundMethod) and `Quiet` drop sources: first the acceleration
 /// limit, then the viability bound; position and velocity bounds are never dropped.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub struct DroppedSources {

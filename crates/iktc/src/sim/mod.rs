@@ -4,6 +4,7 @@ pub mod health;
 pub mod imitate;
 pub mod margins;
 pub mod planar3r;
+pub mod smoothness;
 pub mod sweep;
 pub mod switches;
 pub mod walk_imitate;
@@ -17,6 +18,7 @@ pub use margins::{dof_margins, median, percentile, DofMargins};
 pub use planar3r::{
     run_planar3r, ArmTask, Planar3rConfig, Planar3rRun, Planar3rStep, Planar3rSummary,
 };
+pub use smoothness::{DofSmoothness, JointSmoothness};
 pub use switches::LevelSwitches;
 pub use walk_imitate::{
     run_walk_imitate, Push, PushAxisMetrics, WalkImitateConfig, WalkPushSummary, WalkRun, WalkStep,

@@ -12,6 +12,7 @@ use nalgebra::{DVector, Isometry3, Translation3, UnitQuaternion, Vector3, Vector
 use serde::Serialize;
 
 use super::margins::{dof_margins, median, DofMargins};
+use super::smoothness::{joints_smoothness, JointSmoothness};
 use crate::controller::{ControllerBuilder, ControllerSettings};
 use crate::error::{Error, Result};
 use crate::limits::{BoundMethod, JointLimits, OutsideLimits};
@@ -159,7 +160,15 @@ pub struct Planar3rSummary {
     pub climbed_steps: usize,
     /// Median tick time \[µs\].
     pub tick_median_us: f64,
+    /// Smoothness of the commanded q̈ of q1, q2, q3 over the whole run.
+    pub smoothness: Vec<JointSmoothness>,
+    /// The same from [`SETTLED_FROM`] on, once q1 rests on its limit.
+    pub smoothness_settled: Vec<JointSmoothness>,
 }
+
+/// Start of the window of [`Planar3rSummary::smoothness_settled`] \[s\]: q1 reaches its 60°
+/// limit at about 0.5 s (P_x ≈ 1.48 m); from 0.7 s on it should rest there.
+pub const SETTLED_FROM: f64 = 0.7;
 
 /// A whole run.
 #[derive(Debug, Clone, Serialize)]
@@ -302,12 +311,19 @@ fn summarize(
     }
     let ticks: Vec<f64> = steps.iter().map(|s| s.tick_us).collect();
     let nt = cfg.priority.len();
+    let settled = steps.partition_point(|s| s.t < SETTLED_FROM - 0.5 * cfg.dt);
+    let smoothness_over = |window: std::ops::Range<usize>| {
+        joints_smoothness(
+            0..3,
+            window,
+            cfg.dt,
+            |k, d| steps[k].qdd[d],
+            |d| format!("q{}", d + 1),
+        )
+    };
     Planar3rSummary {
         solver: cfg.method.name().into(),
-        bounds: match cfg.bounds {
-            BoundMethod::Paper => "paper".into(),
-            BoundMethod::Viable(_) => "viable".into(),
-        },
+        bounds: cfg.bounds.name().into(),
         dt: cfg.dt,
         priority: cfg.priority.iter().map(|t| t.name().to_string()).collect(),
         worst_position_margin: margins
@@ -336,5 +352,7 @@ fn summarize(
             .filter(|s| s.corrected_from > 0 && s.corrected_from < nt)
             .count(),
         tick_median_us: median(&ticks),
+        smoothness: smoothness_over(0..steps.len()),
+        smoothness_settled: smoothness_over(settled..steps.len()),
     }
 }

@@ -200,6 +200,10 @@ pub struct WalkSummary {
     pub corrected_ticks: usize,
     /// How often the corrected level changed between consecutive corrected ticks.
     pub level_switches: crate::sim::LevelSwitches,
+    /// Smoothness of the commanded q̈ of every joint (jerk, sign reversals of its change).
+    pub smoothness: Vec<crate::sim::JointSmoothness>,
+    /// The worst of `smoothness` over the joints.
+    pub smoothness_worst: crate::sim::DofSmoothness,
     /// Median tick time \[µs\].
     pub tick_median_us: f64,
     /// 99th percentile tick time \[µs\].
@@ -824,6 +828,13 @@ fn summarize(
     };
     let ticks: Vec<f64> = steps.iter().map(|s| s.tick_us).collect();
     let nt = ctl.level_dims().len();
+    let smoothness = crate::sim::smoothness::joints_smoothness(
+        robot.base_nv()..robot.nv(),
+        0..steps.len(),
+        dt,
+        |k, d| steps[k].qdd[d],
+        |d| names.get(d).cloned().unwrap_or_default(),
+    );
     Ok(WalkSummary {
         damping: cfg.damping,
         steps: cfg.steps,
@@ -844,6 +855,8 @@ fn summarize(
         level_switches: crate::sim::LevelSwitches::count(
             &steps.iter().map(|s| s.corrected_from).collect::<Vec<_>>(),
         ),
+        smoothness_worst: crate::sim::smoothness::worst(&smoothness),
+        smoothness,
         tick_median_us: median(&ticks),
         tick_p99_us: percentile(&ticks, 0.99),
     })

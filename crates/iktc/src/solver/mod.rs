@@ -6,8 +6,10 @@ pub use qp::{
     ActiveConstraint, Hessian, QpConstraint, QpProblem, QpReport, QpSettings, QpStatus, QpWorkspace,
 };
 
+mod continuity;
 mod hierarchy;
 mod kernels;
+mod rebase;
 mod reflectors;
 mod report;
 mod screen;

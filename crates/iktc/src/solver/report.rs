@@ -51,6 +51,10 @@ pub struct SolveReport {
     /// IKTC: the highest-priority level (0-based) whose correction was needed; `None` when the
     /// prioritized solution was inside the box (or another method ran).
     pub corrected_from: Option<usize>,
+    /// IKTC: Algorithm 2's level, the lowest-priority one whose correction alone brings q̈ into
+    /// the box (0-based). `corrected_from` is a higher level only while
+    /// [`SolverSettings::level_hold`](super::SolverSettings::level_hold) holds an earlier choice.
+    pub feasible_from: Option<usize>,
     /// IKTC's correction Δh_i of each level \[task unit/s²\] (zero where uncorrected).
     pub corrections: Vec<DVector<f64>>,
     /// J_i q̈ − h_i of each level at the returned q̈ \[task unit/s²\]: what the level lost.
@@ -93,6 +97,7 @@ impl SolveReport {
         Self {
             method: Method::Iktc,
             corrected_from: None,
+            feasible_from: None,
             corrections: dims.iter().map(|&m| DVector::zeros(m)).collect(),
             task_errors: dims.iter().map(|&m| DVector::zeros(m)).collect(),
             task_error_norms: vec![0.0; dims.len()],
@@ -112,6 +117,7 @@ impl SolveReport {
     pub(crate) fn reset(&mut self, method: Method) {
         self.method = method;
         self.corrected_from = None;
+        self.feasible_from = None;
         for c in &mut self.corrections {
             c.fill(0.0);
         }

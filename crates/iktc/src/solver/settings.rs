@@ -66,6 +66,20 @@ pub struct SolverSettings {
     pub screen: bool,
     /// Where IKTC's climb starts. Default [`Climb::FromLast`].
     pub climb: Climb,
+    /// Hold on IKTC's corrected level \[ticks\]: a level that had to be corrected stays the
+    /// level corrected from until a lower-priority level has sufficed for this many ticks in a
+    /// row (the `continuity` module notes in the solver: the equations). Removes the tick-by-tick
+    /// alternation of Algorithm 2's choice between two levels near the boundary of feasibility;
+    /// the box and the levels above the corrected one stay exact. Longer holds correct the held
+    /// levels longer than needed; 0 or 1 is Algorithm 2 exactly. Default 1.
+    pub level_hold: usize,
+    /// Release rate `r` of the re-based demands of IKTC's corrected levels \[–\], in (0, 1]
+    /// (errata 3.3; the `rebase` module notes in the solver: `w ← (1 − r)(w + Δh)`). Below 1 a
+    /// sacrificed level's demand converges on what the limits let it achieve, so it stops pushing
+    /// into them tick after tick, and recovers its CLIK demand with a time constant of about
+    /// `Δt/r` once they let it. Smaller values push more gently and recover more slowly; 1 is
+    /// IKTC as printed. GF and clamp are not affected. Default 1.
+    pub rebase_release: f64,
     /// Before each IKTC correction QP, try the rows active at that level's last optimum: the
     /// least-norm correction on them is the QP's optimum when its multipliers have the right
     /// signs and it satisfies every row (see the `warm` module notes in the solver); otherwise
@@ -85,6 +99,8 @@ impl Default for SolverSettings {
             cascade_regularization: 1e-8,
             screen: true,
             climb: Climb::FromLast,
+            level_hold: 1,
+            rebase_release: 1.0,
             warm_start: true,
             qp: QpSettings::default(),
         }
@@ -121,6 +137,13 @@ impl SolverSettings {
         positive("rank_threshold", self.rank_threshold, false)?;
         positive("box_tolerance", self.box_tolerance, true)?;
         positive("cascade_regularization", self.cascade_regularization, false)?;
+        if !(self.rebase_release > 0.0 && self.rebase_release <= 1.0) {
+            return Err(Error::InvalidSetting {
+                name: "rebase_release".into(),
+                value: self.rebase_release.to_string(),
+                expected: "a release rate in (0, 1] [–] (1: no re-base)".into(),
+            });
+        }
         self.qp.validate()
     }
 }

@@ -2,8 +2,10 @@
 
 use nalgebra::{DMatrix, DVector};
 
+use super::continuity::LevelHold;
 use super::hierarchy::Hierarchy;
 use super::qp::{Hessian, QpProblem, QpStatus, QpWorkspace};
+use super::rebase::Rebase;
 use super::report::{Fallback, Method, SolveReport};
 use super::screen::Screen;
 use super::settings::{Climb, SolverSettings};
@@ -38,6 +40,10 @@ pub struct Solver {
     last_from: Option<usize>,
     /// The infeasibility certificate tried before each correction QP.
     screen: Screen,
+    /// The hold on the corrected level ([`SolverSettings::level_hold`]).
+    hold: LevelHold,
+    /// The re-based demands ([`SolverSettings::rebase_release`]).
+    rebase: Rebase,
     /// The active sets of the last optima, tried before each correction QP.
     warm: WarmStart,
     // Cascade buffers.
@@ -73,6 +79,8 @@ impl Solver {
             },
             last_from: None,
             screen: Screen::new(dims.len(), total),
+            hold: LevelHold::default(),
+            rebase: Rebase::new(nv, dims),
             warm: WarmStart::new(dims.len(), total, nv),
             h: DMatrix::zeros(nv, nv),
             c: vec![0.0; nv],
@@ -110,6 +118,55 @@ impl Solver {
             l.validate()?;
         }
         self.report.reset(method);
+        // Errata 3.3: IKTC solves the levels re-based on what was achieved (`rebase` module).
+        let rebase = method == Method::Iktc && self.settings.rebase_release < 1.0;
+        let mut rebased = Vec::new();
+        if rebase {
+            self.rebase.apply(levels);
+            rebased = std::mem::take(&mut self.rebase.levels);
+        }
+        let solved = self.solve_levels(method, if rebase { &rebased } else { levels }, bounds, qdd);
+        if rebase {
+            self.rebase.levels = rebased;
+            if solved.is_ok() {
+                self.rebase
+                    .update(&self.report.corrections, self.settings.rebase_release);
+            }
+        }
+        solved?;
+        self.report.violation = self.violation(qdd);
+        for (i, l) in levels.iter().enumerate() {
+            // e = J q̈ − h, by columns of J (contiguous).
+            let e = &mut self.report.task_errors[i];
+            let m = l.dim();
+            let es = e.as_mut_slice();
+            for (x, h) in es.iter_mut().zip(l.rhs.iter()) {
+                *x = -h;
+            }
+            let js = l.jacobian.as_slice();
+            for c in 0..n {
+                let qc = qdd[c];
+                if qc != 0.0 {
+                    for (x, j) in es.iter_mut().zip(&js[c * m..(c + 1) * m]) {
+                        *x += j * qc;
+                    }
+                }
+            }
+            self.report.task_error_norms[i] = e.norm();
+        }
+        Ok(&self.report)
+    }
+
+    /// The prioritized solution of `levels`, the box, and the method's q̈ (the body of
+    /// [`Solver::solve`] between the checks and the task errors).
+    fn solve_levels(
+        &mut self,
+        method: Method,
+        levels: &[TaskEquation],
+        bounds: &AccelerationBox,
+        qdd: &mut DVector<f64>,
+    ) -> Result<()> {
+        let n = self.hierarchy.n();
         self.hierarchy.solve(levels, &self.settings, &mut self.q0)?;
         self.report.ranks.copy_from_slice(self.hierarchy.ranks());
         // The box, with empty dofs relaxed to their midpoint (the least possible violation).
@@ -143,27 +200,7 @@ impl Solver {
             Method::Iktc => self.iktc(levels, qdd)?,
             Method::Cascade => self.cascade(levels, qdd)?,
         }
-        self.report.violation = self.violation(qdd);
-        for (i, l) in levels.iter().enumerate() {
-            // e = J q̈ − h, by columns of J (contiguous).
-            let e = &mut self.report.task_errors[i];
-            let m = l.dim();
-            let es = e.as_mut_slice();
-            for (x, h) in es.iter_mut().zip(l.rhs.iter()) {
-                *x = -h;
-            }
-            let js = l.jacobian.as_slice();
-            for c in 0..n {
-                let qc = qdd[c];
-                if qc != 0.0 {
-                    for (x, j) in es.iter_mut().zip(&js[c * m..(c + 1) * m]) {
-                        *x += j * qc;
-                    }
-                }
-            }
-            self.report.task_error_norms[i] = e.norm();
-        }
-        Ok(&self.report)
+        Ok(())
     }
 
     fn violation(&self, q: &DVector<f64>) -> f64 {
@@ -188,6 +225,7 @@ impl Solver {
     fn iktc(&mut self, levels: &[TaskEquation], qdd: &mut DVector<f64>) -> Result<()> {
         qdd.copy_from(&self.q0);
         if self.report.violation_before <= self.settings.box_tolerance {
+            self.hold.idle(self.settings.level_hold);
             return Ok(());
         }
         let n = self.hierarchy.n();
@@ -228,11 +266,14 @@ impl Solver {
             }
         }
         let Some(i) = found else {
+            self.hold.idle(self.settings.level_hold);
             self.last_from = Some(0);
             self.report.fallback = Some(Fallback::ClampedToBox);
             self.clamp(qdd);
             return Ok(());
         };
+        self.report.feasible_from = Some(i);
+        let i = self.held_level(i)?;
         self.last_from = Some(i);
         self.report.corrected_from = Some(i);
         let off = self.hierarchy.offset(i);
@@ -255,6 +296,25 @@ impl Solver {
             }
         }
         Ok(())
+    }
+
+    /// The level to correct from, given Algorithm 2's `found` (see the `continuity` module):
+    /// the held level when the hold keeps it, its QP solved into `xs` if the climb did not;
+    /// `found` if that QP fails (it cannot, feasibility being monotone, but for rounding).
+    fn held_level(&mut self, found: usize) -> Result<usize> {
+        let chosen = self.hold.choose(found, self.settings.level_hold);
+        if chosen == found {
+            return Ok(found);
+        }
+        let solved = match self.settings.climb {
+            // The climb started at the last level (= the held one) and went down from it.
+            Climb::FromLast if self.last_from == Some(chosen) => true,
+            _ => {
+                self.hierarchy.build_g_levels(chosen, found);
+                self.level_feasible(chosen)?
+            }
+        };
+        Ok(if solved { chosen } else { found })
     }
 
     /// Solves the correction QP of levels i..n_T into `xs[i]` (G blocks of those levels built);

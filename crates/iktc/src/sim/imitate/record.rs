@@ -153,6 +153,10 @@ pub struct ImitateSummary {
     pub pelvis_corrected_steps: usize,
     /// How often the corrected level changed between consecutive corrected ticks.
     pub level_switches: crate::sim::LevelSwitches,
+    /// Smoothness of the commanded q̈ of every joint (jerk, sign reversals of its change).
+    pub smoothness: Vec<crate::sim::JointSmoothness>,
+    /// The same for the narrowed joints only, in the order of [`ImitateConfig::narrow`].
+    pub narrowed_smoothness: Vec<crate::sim::JointSmoothness>,
     /// Ticks where a pelvis level was corrected while a narrowed joint sat on its limit.
     pub pelvis_corrected_while_narrowed_at_limit: usize,
     /// Largest feet error ‖x_d − x‖ while a lower level was corrected.
@@ -483,12 +487,20 @@ pub(crate) fn summarize(
         .iter()
         .map(|s| s.com_margin)
         .fold(f64::INFINITY, f64::min);
+    let smoothness_of = |dofs: Vec<usize>| {
+        crate::sim::smoothness::joints_smoothness(
+            dofs,
+            0..steps.len(),
+            cfg.dt,
+            |k, d| steps[k].qdd[d],
+            |d| names.get(d).cloned().unwrap_or_default(),
+        )
+    };
+    let smoothness = smoothness_of((nb..robot.nv()).collect());
+    let narrowed_smoothness = smoothness_of(narrowed_dofs.clone());
     ImitateSummary {
         solver: cfg.method.name().into(),
-        bounds: match cfg.bounds {
-            crate::limits::BoundMethod::Paper => "paper".into(),
-            crate::limits::BoundMethod::Viable(_) => "viable".into(),
-        },
+        bounds: cfg.bounds.name().into(),
         dt: cfg.dt,
         duration: steps.len() as f64 * cfg.dt,
         steps: steps.len(),
@@ -507,6 +519,8 @@ pub(crate) fn summarize(
         level_switches: crate::sim::LevelSwitches::count(
             &steps.iter().map(|s| s.corrected_from).collect::<Vec<_>>(),
         ),
+        smoothness,
+        narrowed_smoothness,
         pelvis_corrected_while_narrowed_at_limit: steps
             .iter()
             .filter(|s| pelvis_corrected(s) && narrowed_at(s))
