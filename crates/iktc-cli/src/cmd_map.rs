@@ -44,13 +44,13 @@ pub fn load(path: &Path, args: &MotionArgs, body_map: Option<BodyMap>) -> Result
     };
     let m = load_motion(path, &options)
         .with_context(|| format!("reading the motion `{}`", path.display()))?;
-    println!(
+    crate::outln!(
         "motion {} ({}): units {}; up {}",
         m.source,
         m.format.name(),
         m.units,
         m.up
-    );
+    )?;
     Ok(m)
 }
 
@@ -92,9 +92,12 @@ pub fn run(a: &Args) -> Result<()> {
     match &a.command {
         MapCommand::Show { name } => {
             if BUILTIN_MAP_NAMES.contains(&name.as_str()) {
-                print!("{}", builtin_map_text(name)?);
+                crate::out::write_out(format_args!("{}", builtin_map_text(name)?))?;
             } else if BUILTIN_BODY_MAP_NAMES.contains(&name.as_str()) {
-                print!("{}", builtin_body_map(name)?.to_toml_string());
+                crate::out::write_out(format_args!(
+                    "{}",
+                    builtin_body_map(name)?.to_toml_string()
+                ))?;
             } else {
                 anyhow::bail!(
                     "no built-in map `{name}`; retargeting maps: {}; body maps: {}",
@@ -124,9 +127,9 @@ pub fn run(a: &Args) -> Result<()> {
                 body_map.name = stem.to_string_lossy().to_string();
             }
             let keypoints = m.keypoints(iktc::motion::DEFAULT_MAX_GAP)?;
-            println!("{}", keypoints.summary());
+            crate::outln!("{}", keypoints.summary())?;
             let text = body_map.to_toml_string();
-            print!("{text}");
+            crate::out::write_out(format_args!("{text}"))?;
             let out = out.clone().unwrap_or_else(|| {
                 let stem = motion
                     .file_stem()
@@ -135,7 +138,7 @@ pub fn run(a: &Args) -> Result<()> {
                 PathBuf::from(format!("{stem}.map.toml"))
             });
             std::fs::write(&out, text).with_context(|| format!("writing `{}`", out.display()))?;
-            println!("wrote {}", out.display());
+            crate::outln!("wrote {}", out.display())?;
             Ok(())
         }
     }

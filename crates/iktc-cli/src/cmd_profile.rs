@@ -58,7 +58,7 @@ fn urdf_key(urdf: &Path, out: Option<&Path>) -> Result<String> {
 pub fn run(a: &Args) -> Result<()> {
     match &a.command {
         ProfileCommand::Show { name } => {
-            print!("{}", builtin_profile_text(name)?);
+            crate::out::write_out(format_args!("{}", builtin_profile_text(name)?))?;
             Ok(())
         }
         ProfileCommand::Init { urdf, out } => {
@@ -69,9 +69,9 @@ pub fn run(a: &Args) -> Result<()> {
                 Some(path) => {
                     std::fs::write(path, toml)
                         .with_context(|| format!("writing {}", path.display()))?;
-                    println!("wrote {}", path.display());
+                    crate::outln!("wrote {}", path.display())?;
                 }
-                None => print!("{toml}"),
+                None => crate::out::write_out(format_args!("{toml}"))?,
             }
             Ok(())
         }
