@@ -228,3 +228,273 @@ impl Screen {
         false
     }
 }
+
+#[cfg(test)]
+mod tests {
+    //! The screen against an independent evaluation of the same certificate (nalgebra's LU
+    //! instead of the in-place one, the interval summed directly), on seeded random problems,
+    //! plus the cases where the screen must decline.
+    use super::{Screen, PIVOT_TOLERANCE, ROUNDING_MARGIN};
+    use crate::solver::qp::{ActiveConstraint, QpConstraint};
+    use nalgebra::DMatrix;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    /// Cases within this relative distance of the decision threshold, or with G_S this close
+    /// to singular (ratio of smallest to largest singular value), are left out of the
+    /// comparison: there the two evaluations may round differently [–].
+    const AMBIGUOUS: f64 = 1e-6;
+
+    fn active(rows: &[usize], upper: bool) -> Vec<ActiveConstraint> {
+        rows.iter()
+            .map(|&row| ActiveConstraint {
+                constraint: if upper {
+                    QpConstraint::Upper { row }
+                } else {
+                    QpConstraint::Lower { row }
+                },
+                multiplier: 1.0,
+            })
+            .collect()
+    }
+
+    /// The certificate evaluated independently: `Some(verdict)`, or `None` when ambiguous.
+    fn oracle(
+        g: &DMatrix<f64>,
+        rows: &[usize],
+        failed: Option<usize>,
+        lower: &[f64],
+        upper: &[f64],
+        tol: f64,
+    ) -> Option<bool> {
+        let mc = g.ncols();
+        let gs = DMatrix::from_fn(mc, mc, |r, c| g[(rows[r], c)]);
+        let sv = gs.clone().singular_values();
+        if sv.min() <= AMBIGUOUS * sv.max() {
+            return Some(false).filter(|_| sv.min() <= PIVOT_TOLERANCE * 1e-3 * sv.max());
+        }
+        let lu = gs.transpose().lu();
+        let mut proven = false;
+        for j in 0..g.nrows() {
+            let violated = lower[j] > tol || upper[j] < -tol;
+            if !(violated || Some(j) == failed) || rows.contains(&j) {
+                continue;
+            }
+            let c = lu.solve(&g.row(j).transpose())?;
+            let (mut lo, mut hi, mut mag) = (0.0, 0.0, 0.0);
+            let mut bounded = true;
+            for (k, &ck) in c.iter().enumerate() {
+                let (l, u) = (lower[rows[k]] - tol, upper[rows[k]] + tol);
+                if ck == 0.0 {
+                    continue;
+                }
+                if !(l.is_finite() && u.is_finite()) {
+                    bounded = false;
+                }
+                lo += (ck * l).min(ck * u);
+                hi += (ck * l).max(ck * u);
+                mag += (ck * l).abs() + (ck * u).abs();
+            }
+            if !bounded {
+                continue;
+            }
+            let fin = |x: f64| if x.is_finite() { x.abs() } else { 0.0 };
+            let slack = ROUNDING_MARGIN * (mag + fin(lower[j]) + fin(upper[j]));
+            let miss = (lower[j] - tol - slack - hi).max(lo - upper[j] - tol - slack);
+            let scale = mag + fin(lower[j]) + fin(upper[j]) + 1.0;
+            if miss.abs() <= AMBIGUOUS * scale {
+                return None;
+            }
+            proven |= miss > 0.0;
+        }
+        Some(proven)
+    }
+
+    /// Random problems: G with entries of a random scale, the rows S tight around G_S x0, the
+    /// other rows random intervals (some one-sided), a random failed row.
+    #[test]
+    fn the_screen_agrees_with_an_independent_evaluation() {
+        let mut rng = ChaCha8Rng::seed_from_u64(2024);
+        let (mut proven, mut declined, mut compared) = (0, 0, 0);
+        let mut screen = Screen::new(2, 8);
+        for case in 0..4000 {
+            let mc = rng.random_range(1..=6);
+            let n = mc + rng.random_range(1..=8);
+            let scale = [1.0, 1e3, 1e-3][case % 3];
+            let g = DMatrix::from_fn(n, mc, |_, _| scale * rng.random_range(-1.0..1.0));
+            let x0: Vec<f64> = (0..mc).map(|_| rng.random_range(-1.0..1.0)).collect();
+            let mut rows: Vec<usize> = (0..n).collect();
+            for i in 0..mc {
+                let k = rng.random_range(i..n);
+                rows.swap(i, k);
+            }
+            rows.truncate(mc);
+            let tol = [0.0, 1e-9, 1e-3][case % 3];
+            let (mut lower, mut upper) = (vec![0.0; n], vec![0.0; n]);
+            for j in 0..n {
+                let gx: f64 = (0..mc).map(|k| g[(j, k)] * x0[k]).sum();
+                if rows.contains(&j) {
+                    let w = scale * rng.random_range(0.0..0.05);
+                    (lower[j], upper[j]) = (gx - w, gx + w);
+                } else {
+                    let a = scale * rng.random_range(-2.0..2.0);
+                    let b = scale * rng.random_range(0.0..1.0);
+                    (lower[j], upper[j]) = match rng.random_range(0..4) {
+                        0 => (f64::NEG_INFINITY, a),
+                        1 => (a, f64::INFINITY),
+                        _ => (a, a + b),
+                    };
+                }
+            }
+            let failed = rng.random_bool(0.5).then(|| rng.random_range(0..n));
+            let level = case % 2;
+            let fail_row = failed.map(|row| QpConstraint::Upper { row });
+            screen.remember(level, &active(&rows, case % 4 == 0), fail_row);
+            let got = screen.proves_infeasible(level, &g.as_view(), &lower, &upper, tol);
+            let Some(want) = oracle(&g, &rows, failed, &lower, &upper, tol) else {
+                continue;
+            };
+            assert_eq!(got, want, "case {case}: mc {mc}, n {n}, rows {rows:?}");
+            compared += 1;
+            if got {
+                proven += 1;
+            } else {
+                declined += 1;
+            }
+        }
+        // Both verdicts must be exercised for the comparison to mean anything.
+        assert!(
+            compared > 3000 && proven > 500 && declined > 500,
+            "{proven} / {declined}"
+        );
+    }
+
+    /// Two rows fix x to 0 within `tol` and a third asks for x ≥ 1: proven; the same third row
+    /// asking for x ≥ 0 (feasible) is not.
+    #[test]
+    fn a_plain_contradiction_is_proven_and_a_feasible_set_is_not() {
+        let g = DMatrix::from_row_slice(3, 2, &[1.0, 0.0, 0.0, 1.0, 1.0, 1.0]);
+        let mut screen = Screen::new(1, 2);
+        screen.remember(0, &active(&[0, 1], false), None);
+        let tol = 1e-9;
+        let lo = [0.0, 0.0, 1.0];
+        let hi = [0.0, 0.0, 2.0];
+        assert!(screen.proves_infeasible(0, &g.as_view(), &lo, &hi, tol));
+        // x1 + x2 = 0 is reachable: not violated at 0, so never a candidate.
+        assert!(!screen.proves_infeasible(0, &g.as_view(), &[0.0, 0.0, 0.0], &hi, tol));
+        // The contradiction is smaller than the tolerance: the QP would accept it.
+        // (Upper end 1e-6: the rounding margin, 1e-9 of the magnitudes, stays far below tol.)
+        let small = [0.0, 0.0, 1e-6];
+        let near = [0.0, 0.0, 1.5 * tol];
+        assert!(!screen.proves_infeasible(0, &g.as_view(), &near, &small, tol));
+        // ... and larger than twice the tolerance (each S row may move by tol): proven.
+        let beyond = [0.0, 0.0, 3.5 * tol];
+        assert!(screen.proves_infeasible(0, &g.as_view(), &beyond, &small, tol));
+        // Row j violated from above.
+        let below = [-2.0, -2.0, -2.0];
+        let cap = [0.0, 0.0, -1.0];
+        let mut tight = [0.0, 0.0, 0.0];
+        tight[..2].copy_from_slice(&[0.0, 0.0]);
+        assert!(screen.proves_infeasible(0, &g.as_view(), &tight, &cap, tol));
+        assert!(!screen.proves_infeasible(0, &g.as_view(), &below, &cap, tol));
+    }
+
+    /// The margin of the test: a miss smaller than `ROUNDING_MARGIN` times the magnitudes summed
+    /// is not a proof.
+    #[test]
+    fn a_miss_within_the_rounding_margin_is_not_a_proof() {
+        let g = DMatrix::from_row_slice(2, 1, &[1.0, 1.0]);
+        let mut screen = Screen::new(1, 1);
+        screen.remember(0, &active(&[0], true), None);
+        // Row 0 pins x to 1e3; row 1 asks x ≥ 1e3 + d.
+        let x = 1e3;
+        let mag = 2.0 * x;
+        for (d, want) in [(0.5, false), (2.0, true)] {
+            let lo = [x, x + d * ROUNDING_MARGIN * (mag + x + 1e4)];
+            let hi = [x, 1e4];
+            let got = screen.proves_infeasible(0, &g.as_view(), &lo, &hi, 0.0);
+            assert_eq!(got, want, "miss {d} × margin");
+        }
+    }
+
+    /// G_S singular or nearly so (a pivot below `PIVOT_TOLERANCE` of the largest entry): the
+    /// screen declines even where the set is in fact empty.
+    #[test]
+    fn a_near_singular_certificate_is_declined() {
+        let s = 1e3;
+        let eps = 0.1 * PIVOT_TOLERANCE * s;
+        let g = DMatrix::from_row_slice(3, 2, &[s, 0.0, s, eps, 0.0, 1.0]);
+        let mut screen = Screen::new(1, 2);
+        screen.remember(0, &active(&[0, 1], false), None);
+        let (lo, hi) = ([0.0, 0.0, 1.0], [0.0, 0.0, 2.0]);
+        assert!(!screen.proves_infeasible(0, &g.as_view(), &lo, &hi, 1e-9));
+        // Well conditioned (eps 100× above the threshold): the same contradiction is proven.
+        let eps = 100.0 * PIVOT_TOLERANCE * s;
+        let g = DMatrix::from_row_slice(3, 2, &[s, 0.0, s, eps, 0.0, 1.0]);
+        assert!(screen.proves_infeasible(0, &g.as_view(), &lo, &hi, 1e-12));
+    }
+
+    /// Nothing remembered, a different count of rows than variables, more active rows than
+    /// room, equality rows only, an unbounded S row: no proof.
+    #[test]
+    fn the_screen_declines_without_a_usable_certificate() {
+        let g = DMatrix::from_row_slice(3, 2, &[1.0, 0.0, 0.0, 1.0, 1.0, 1.0]);
+        let (lo, hi) = ([0.0, 0.0, 1.0], [0.0, 0.0, 2.0]);
+        let mut screen = Screen::new(1, 2);
+        assert!(!screen.proves_infeasible(0, &g.as_view(), &lo, &hi, 0.0));
+        screen.remember(0, &active(&[0], false), None);
+        assert!(!screen.proves_infeasible(0, &g.as_view(), &lo, &hi, 0.0));
+        // Three active rows into room for two: the list is dropped.
+        screen.remember(0, &active(&[0, 1, 2], false), None);
+        assert!(!screen.proves_infeasible(0, &g.as_view(), &lo, &hi, 0.0));
+        let eq: Vec<ActiveConstraint> = (0..2)
+            .map(|row| ActiveConstraint {
+                constraint: QpConstraint::Equality { row },
+                multiplier: 1.0,
+            })
+            .collect();
+        screen.remember(0, &eq, None);
+        assert!(!screen.proves_infeasible(0, &g.as_view(), &lo, &hi, 0.0));
+        // Row 1 of S unbounded above: x2 may grow, x1 + x2 ≥ 1 is reachable.
+        screen.remember(0, &active(&[0, 1], false), None);
+        let hi_open = [0.0, f64::INFINITY, 2.0];
+        assert!(!screen.proves_infeasible(0, &g.as_view(), &lo, &hi_open, 0.0));
+        assert!(screen.proves_infeasible(0, &g.as_view(), &lo, &hi, 0.0));
+        // A zero G: no scale, no proof; a non-finite entry: no proof.
+        let zero = DMatrix::zeros(3, 2);
+        assert!(!screen.proves_infeasible(0, &zero.as_view(), &lo, &hi, 0.0));
+        let mut bad = g.clone();
+        bad[(0, 0)] = f64::NAN;
+        assert!(!screen.proves_infeasible(0, &bad.as_view(), &lo, &hi, 0.0));
+    }
+
+    /// The failed row is tried even when it is not violated at Δh = 0 (a row the QP failed on
+    /// can be satisfiable alone), and a failed row out of range is ignored.
+    #[test]
+    fn the_failed_row_is_a_candidate_even_when_not_violated_at_zero() {
+        // S: x1 = 1, x2 = −1; row 2: x1 − x2 ∈ [−1, 1] — satisfied at 0, not on S (x1 − x2 = 2).
+        let g = DMatrix::from_row_slice(3, 2, &[1.0, 0.0, 0.0, 1.0, 1.0, -1.0]);
+        let (lo, hi) = ([1.0, -1.0, -1.0], [1.0, -1.0, 1.0]);
+        let mut screen = Screen::new(1, 2);
+        screen.remember(0, &active(&[0, 1], false), None);
+        assert!(!screen.proves_infeasible(0, &g.as_view(), &lo, &hi, 0.0));
+        screen.remember(
+            0,
+            &active(&[0, 1], false),
+            Some(QpConstraint::Lower { row: 2 }),
+        );
+        assert!(screen.proves_infeasible(0, &g.as_view(), &lo, &hi, 0.0));
+        screen.remember(
+            0,
+            &active(&[0, 1], false),
+            Some(QpConstraint::Lower { row: 9 }),
+        );
+        assert!(!screen.proves_infeasible(0, &g.as_view(), &lo, &hi, 0.0));
+        screen.remember(
+            0,
+            &active(&[0, 1], false),
+            Some(QpConstraint::Equality { row: 2 }),
+        );
+        assert!(!screen.proves_infeasible(0, &g.as_view(), &lo, &hi, 0.0));
+    }
+}
