@@ -129,7 +129,7 @@ pub fn run(args: BalanceArgs) -> anyhow::Result<()> {
                 "ZMP outside the support polygon by at most {:.4} m without the controller, {:.4} m with it; {}",
                 r.zmp_excursion_open,
                 r.zmp_excursion_closed,
-                crate::cmd_imitate::health_text(&r.health)
+                crate::scenario::health_text(&r.health)
             )?;
             crate::outln!(
                 "-> {}",

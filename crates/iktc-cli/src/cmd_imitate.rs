@@ -3,196 +3,38 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
-use iktc::limits::{BoundMethod, OutsideLimits};
-use iktc::model::Robot;
-use iktc::motion::{
-    builtin_clip, builtin_map, Clip, MotionFormat, RetargetMap, BUILTIN_CLIP_NAMES,
-    BUILTIN_MAP_NAMES,
-};
-use iktc::profile::check_map_joints;
-use iktc::resources::RunLimits;
+use iktc::limits::BoundMethod;
 use iktc::sim::imitate::LEVEL_NAMES;
-use iktc::sim::{imitation_references, run_imitate, ImitateConfig, ImitateRun};
+use iktc::sim::viewer::imitation_viewer;
+use iktc::sim::{Experiment, ImitateConfig, ImitateRun};
 use iktc::solver::Method;
 use iktc_report::{write_csv, write_figure, Figure, Panel, Section, Series, Table};
 
-use crate::cmd_run::{BoundsArg, SolverArg};
-use crate::robot_arg::{resolve_robot, ProfileFlags, ResolvedRobot, RobotOptions};
-use crate::viewer::{write_viewer, Figure3d, ViewerData};
+use crate::scenario::{health_text, prepare, ScenarioArgs};
+use crate::viewer::write_viewer;
 
 /// Arguments of `iktc imitate`.
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// Robot: a built-in profile (jvrc1, g1), a robot profile (.toml) or a URDF file (.urdf,
-    /// floating base; its feet, pelvis and posture from --feet, --sole, --ankle-height,
-    /// --pelvis, --posture).
-    #[arg(long, default_value = "jvrc1")]
-    pub robot: String,
     #[command(flatten)]
-    pub robot_options: RobotOptions,
-    #[command(flatten)]
-    pub profile: ProfileFlags,
-    /// Motion: a built-in DeepMimic clip (humanoid3d_dance_a, humanoid3d_dance_b,
-    /// humanoid3d_punch, humanoid3d_walk) or a skeleton motion file (.bvh, .amc, DeepMimic),
-    /// its format detected from its content and extension.
-    #[arg(long, default_value = "humanoid3d_dance_b")]
-    pub motion: String,
-    #[command(flatten)]
-    pub motion_options: crate::cmd_map::MotionArgs,
-    /// Retargeting map: a built-in name (deepmimic_jvrc1, bvh_jvrc1, deepmimic_g1) or a TOML
-    /// file; default: the robot profile's map for the motion's format (profile key
-    /// `imitate.maps.deepmimic` or `imitate.maps.bvh`).
-    #[arg(long)]
-    pub map: Option<String>,
-    /// Solver.
-    #[arg(long, value_enum, default_value = "iktc")]
-    pub solver: SolverArg,
-    /// Joint bounds.
-    #[arg(long, value_enum, default_value = "viable")]
-    pub bounds: BoundsArg,
-    /// Start even if a joint is outside its (narrowed) range, and bring it back at the
-    /// acceleration limit (viable or quiet bounds); without it such a start is an error.
-    #[arg(long)]
-    pub recover: bool,
-    /// Control period [s].
-    #[arg(long, default_value_t = 0.005)]
-    pub dt: f64,
-    /// Keep running when a run check fails (a foot drifts past its tolerance, the ZMP leaves
-    /// the support polygon) and mark it in the summary, instead of stopping with an error.
-    #[arg(long)]
-    pub keep_going: bool,
+    pub scenario: ScenarioArgs,
     /// Output directory.
     #[arg(long, default_value = "out/imitate")]
     pub out: PathBuf,
-    /// Most control ticks of one run (the clip's duration over --dt, or the walk's).
-    #[arg(long, default_value_t = RunLimits::default().max_ticks)]
-    pub max_ticks: usize,
-    #[command(flatten)]
-    pub walk: crate::cmd_walk::WalkArgs,
-}
-
-/// Loads a clip: a built-in name or a skeleton motion file (in metres, units and up axis given
-/// or decided). Returns the clip and whether it is not DeepMimic (BVH, ASF/AMC).
-fn load_clip(spec: &str, options: &crate::cmd_map::MotionArgs) -> Result<(Clip, bool)> {
-    if BUILTIN_CLIP_NAMES.contains(&spec) {
-        return Ok((builtin_clip(spec)?, false));
-    }
-    if !Path::new(spec).is_file() {
-        anyhow::bail!(
-            "`{spec}` is neither a built-in clip ({}) nor a file",
-            BUILTIN_CLIP_NAMES.join(", ")
-        );
-    }
-    let motion = crate::cmd_map::load(Path::new(spec), options, None)?;
-    let clip = motion.clip().with_context(|| {
-        format!(
-            "`{spec}` holds marker trajectories ({}); the joint-angle imitation needs a skeleton",
-            motion.format.name()
-        )
-    })??;
-    Ok((clip, motion.format != MotionFormat::DeepMimic))
-}
-
-/// The retargeting map: `--map` if given, else the robot profile's map for the motion's format;
-/// checked against the robot (an unknown joint names the map entry and its source).
-fn load_map(spec: Option<&str>, is_bvh: bool, r: &ResolvedRobot) -> Result<RetargetMap> {
-    let format = if is_bvh { "bvh" } else { "deepmimic" };
-    let Some(spec) = spec else {
-        let profile = r
-            .profile
-            .as_ref()
-            .context("`planar3r` has no profile and cannot imitate a motion")?;
-        return profile
-            .retarget_map(format, &r.robot)
-            .map_err(|e| r.explain(e));
-    };
-    let map = if BUILTIN_MAP_NAMES.contains(&spec) {
-        builtin_map(spec)?
-    } else {
-        let text = std::fs::read_to_string(spec).with_context(|| {
-            format!(
-                "--map `{spec}` is neither a built-in map ({}) nor a readable TOML file",
-                BUILTIN_MAP_NAMES.join(", ")
-            )
-        })?;
-        RetargetMap::from_toml_str(&text, spec)?
-    };
-    check_map_joints(&r.robot, &map).with_context(|| format!("--map `{spec}`"))?;
-    Ok(map)
-}
-
-/// Everything one run needs besides its settings.
-pub struct Experiment {
-    /// The robot.
-    pub robot: Robot,
-    /// The clip.
-    pub clip: Clip,
-    /// The map.
-    pub map: RetargetMap,
-}
-
-/// Retargets and runs.
-pub fn run_experiment(e: &Experiment, cfg: &ImitateConfig) -> Result<ImitateRun> {
-    let refs = imitation_references(&e.robot, &e.clip, &e.map, cfg)?;
-    Ok(run_imitate(&e.robot, &refs, cfg)?)
+    /// Walking moved to its own command, `iktc walk` (kept only to say so).
+    #[arg(long, hide = true)]
+    pub walk: bool,
 }
 
 /// Runs `iktc imitate`.
 pub fn run(a: &Args) -> Result<()> {
-    let mut ro = a.robot_options.clone();
-    let path = std::path::Path::new(&a.robot);
-    if path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("urdf"))
-    {
-        // The imitation moves a free-floating humanoid.
-        ro.floating = true;
+    if a.walk {
+        anyhow::bail!(
+            "`iktc imitate --walk` is now `iktc walk` (same options, plus --steps, --step-length, --push, --no-damping)"
+        );
     }
-    let resolved = resolve_robot(&a.robot, &ro, Some(&a.profile))?;
-    let (clip, is_bvh) = load_clip(&a.motion, &a.motion_options)?;
-    let map = load_map(a.map.as_deref(), is_bvh, &resolved)?;
-    let profile = resolved
-        .profile
-        .as_ref()
-        .context("`planar3r` has no profile and cannot imitate a motion")?;
-    let mut cfg = profile
-        .imitate_config(ImitateConfig {
-            method: a.solver.method(),
-            bounds: a.bounds.method(),
-            dt: a.dt,
-            run_limits: RunLimits {
-                max_ticks: a.max_ticks,
-                ..RunLimits::default()
-            },
-            ..ImitateConfig::default()
-        })
-        .map_err(|e| resolved.explain(e))?;
-    cfg.run_limits.check_dt("--dt", a.dt)?;
-    if a.recover {
-        match &mut cfg.bounds {
-            BoundMethod::Viable(settings) | BoundMethod::Quiet(settings) => {
-                settings.outside = OutsideLimits::Recover
-            }
-            BoundMethod::Paper => anyhow::bail!("--recover needs --bounds viable or quiet"),
-        }
-    }
-    cfg.health.keep_going = a.keep_going;
-    let e = Experiment {
-        robot: resolved.robot,
-        clip,
-        map,
-    };
-    if a.walk.walk {
-        let (figs, with, without) = crate::cmd_walk::run_walk(&e, &cfg, &a.walk, &a.out)?;
-        crate::cmd_walk::print_walk(&with, &without)?;
-        crate::outln!(
-            "wrote {} figures, walk.csv, walk_summary.json and walk_viewer.html to {}",
-            figs.len(),
-            a.out.display()
-        )?;
-        return Ok(());
-    }
-    let r = run_experiment(&e, &cfg)?;
+    let (e, cfg) = prepare(&a.scenario)?;
+    let r = e.imitate(&cfg)?;
     let files = write_imitate(&r, &e, &a.out)?;
     print_summary(&r)?;
     crate::outln!(
@@ -229,30 +71,6 @@ fn print_summary(r: &ImitateRun) -> std::io::Result<()> {
     )?;
     crate::outln!("{}", health_text(&s.health))?;
     Ok(())
-}
-
-/// The health of a run in words: "healthy", or every failed check with its first and worst
-/// value (runs continued with `--keep-going`).
-pub fn health_text(h: &iktc::sim::HealthReport) -> String {
-    if h.healthy {
-        return "run checks: healthy".into();
-    }
-    let mut s = format!(
-        "run checks: FAILED on {} ticks{} (continued with --keep-going)",
-        h.failed_ticks,
-        if h.completed {
-            ""
-        } else {
-            ", stopped early on a non-finite state"
-        }
-    );
-    for i in &h.issues {
-        s.push_str(&format!(
-            "; {i} (worst {:.4e} at t = {:.4} s, {} ticks)",
-            i.worst_value, i.worst_time, i.ticks
-        ));
-    }
-    s
 }
 
 /// Writes trajectory.csv, summary.json, the figures and viewer.html; returns the figures
@@ -502,107 +320,8 @@ pub fn write_imitate(r: &ImitateRun, e: &Experiment, dir: &Path) -> Result<Vec<(
         "corrections.svg".into(),
         format!("Which level was corrected, when, and by how much ({tag})"),
     ));
-    write_viewer(&dir.join("viewer.html"), &viewer_data(r, e)?)?;
+    write_viewer(&dir.join("viewer.html"), &imitation_viewer(r, e)?)?;
     Ok(figs)
-}
-
-/// Where the captured skeleton stands in the viewer: this far along +y (the robot's left) [m].
-const SKELETON_OFFSET: f64 = 1.2;
-
-/// The viewer's data: robot links, the skeleton beside it, COM, support polygon, joints on a limit.
-fn viewer_data(r: &ImitateRun, e: &Experiment) -> Result<ViewerData> {
-    let robot = &e.robot;
-    let stride = ((0.02 / r.summary.dt).round() as usize).max(1);
-    let segments: Vec<[usize; 2]> = robot.joints().iter().map(|j| [j.parent, j.child]).collect();
-    let joint_of_dof: Vec<Option<usize>> = (0..robot.nv())
-        .map(|d| {
-            let name = r.dof_names.get(d)?;
-            robot.joints().iter().position(|j| &j.name == name)
-        })
-        .collect();
-    let mut robot_frames = Vec::new();
-    let mut com = Vec::new();
-    let mut on_limit = Vec::new();
-    let mut on_limit_names = Vec::new();
-    let mut skel_frames = Vec::new();
-    let sk = e.clip.skeleton();
-    let b = e.map.basis;
-    let t0 = e.clip.times().first().copied().unwrap_or(0.0);
-    for st in r.steps.iter().step_by(stride) {
-        robot_frames.push(
-            st.links
-                .iter()
-                .map(|p| [p[0] as f32, p[1] as f32, p[2] as f32])
-                .collect(),
-        );
-        com.push([st.com[0] as f32, st.com[1] as f32, st.com[2] as f32]);
-        on_limit.push(
-            st.on_limit
-                .iter()
-                .filter_map(|d| joint_of_dof.get(*d).copied().flatten())
-                .collect(),
-        );
-        on_limit_names.push(
-            st.on_limit
-                .iter()
-                .filter_map(|d| r.dof_names.get(*d).cloned())
-                .collect(),
-        );
-        let pose = e.clip.sample(t0 + st.t)?;
-        let pts = sk.world_positions(&pose)?;
-        // The skeleton is pinned beside the robot: its root's horizontal motion (the stepping,
-        // which the robot does not imitate) is removed.
-        let root = b * pose.root_position;
-        skel_frames.push(
-            pts.iter()
-                .map(|p| {
-                    let q = b * p;
-                    [
-                        (q.x - root.x) as f32,
-                        (q.y - root.y + SKELETON_OFFSET) as f32,
-                        q.z as f32,
-                    ]
-                })
-                .collect(),
-        );
-    }
-    let skel_segments: Vec<[usize; 2]> = sk
-        .joints()
-        .iter()
-        .enumerate()
-        .filter_map(|(i, j)| j.parent.map(|p| [p, i]))
-        .collect();
-    Ok(ViewerData {
-        title: format!(
-            "{} imitating {} ({} / {} bounds)",
-            robot.name(),
-            e.clip.name(),
-            r.summary.solver.to_uppercase(),
-            r.summary.bounds
-        ),
-        dt: r.summary.dt * stride as f64,
-        robot: Figure3d {
-            name: robot.name().into(),
-            segments,
-            frames: robot_frames,
-        },
-        skeleton: Figure3d {
-            name: e.clip.name().into(),
-            segments: skel_segments,
-            frames: skel_frames,
-        },
-        com,
-        support: r
-            .support
-            .iter()
-            .map(|p| [p[0] as f32, p[1] as f32, p[2] as f32])
-            .collect(),
-        on_limit,
-        on_limit_names,
-        support_frames: Vec::new(),
-        footsteps: Vec::new(),
-        phases: Vec::new(),
-    })
 }
 
 fn summary_row(name: &str, r: &ImitateRun) -> Vec<String> {
@@ -647,25 +366,11 @@ fn summary_row(name: &str, r: &ImitateRun) -> Vec<String> {
     ]
 }
 
-/// Runs the default imitation (JVRC-1, humanoid3d_dance_b) with IKTC, and GF for comparison,
-/// under `out/imitate`, and returns the report section.
-/// The default experiment: JVRC-1, `humanoid3d_dance_b`, the built-in map, the default
-/// configuration.
-pub fn default_experiment() -> Result<(Experiment, ImitateConfig)> {
-    let robot = iktc::model::jvrc1(&iktc::model::ModelOptions::default())?;
-    Ok((
-        Experiment {
-            robot,
-            clip: builtin_clip("humanoid3d_dance_b")?,
-            map: builtin_map("deepmimic_jvrc1")?,
-        },
-        ImitateConfig::jvrc1(),
-    ))
-}
-
+/// Runs the default imitation (JVRC-1, humanoid3d_dance_b) with IKTC, GF, the paper's bound
+/// and the quiet bounds under `out/imitate`, and returns the report section.
 pub fn imitate_section(out: &Path) -> Result<Section> {
     let base = out.join("imitate");
-    let (e, _) = default_experiment()?;
+    let (e, _) = Experiment::jvrc1()?;
     let mut sec = Section::new("Imitating a captured motion with JVRC-1 (Section 5.3)").intro(
         "<p>The DeepMimic clip <code>humanoid3d_dance_b</code> is retargeted onto JVRC-1 (built-in map <code>deepmimic_jvrc1</code>: \
          chest → waist, neck → neck, shoulders and elbows → arms, root → pelvis height and attitude; natural cubic splines to 200 Hz). \
@@ -720,7 +425,7 @@ pub fn imitate_section(out: &Path) -> Result<Section> {
         // A report compares the methods: a run whose feet drift past their tolerance (the
         // paper's bound, 58 ticks of the default clip) is shown with its health report.
         cfg.health.keep_going = true;
-        let r = run_experiment(&e, &cfg)?;
+        let r = e.imitate(&cfg)?;
         let figs = write_imitate(&r, &e, &base.join(name))?;
         table = table.row(summary_row(name, &r));
         if name == "iktc" {

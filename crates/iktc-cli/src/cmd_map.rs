@@ -28,19 +28,28 @@ pub struct MotionArgs {
     pub max_clip_duration: f64,
 }
 
+impl MotionArgs {
+    /// The library's options these arguments give (no body map).
+    pub fn options(&self) -> Result<MotionOptions> {
+        Ok(MotionOptions {
+            units: self.units.parse()?,
+            up: self.up.parse()?,
+            skeleton: self.skeleton.clone(),
+            limits: iktc::resources::ReadLimits {
+                max_clip_duration: self.max_clip_duration,
+                ..iktc::resources::ReadLimits::default()
+            },
+            ..MotionOptions::default()
+        })
+    }
+}
+
 /// Reads a motion file with these options (and a body map, if given) and prints what was
 /// decided.
 pub fn load(path: &Path, args: &MotionArgs, body_map: Option<BodyMap>) -> Result<Motion> {
     let options = MotionOptions {
-        units: args.units.parse()?,
-        up: args.up.parse()?,
-        skeleton: args.skeleton.clone(),
         body_map,
-        limits: iktc::resources::ReadLimits {
-            max_clip_duration: args.max_clip_duration,
-            ..iktc::resources::ReadLimits::default()
-        },
-        ..MotionOptions::default()
+        ..args.options()?
     };
     let m = load_motion(path, &options)
         .with_context(|| format!("reading the motion `{}`", path.display()))?;

@@ -1,33 +1,43 @@
-//! `iktc imitate --walk`: the humanoid walks while it imitates, with the damping controller in
-//! the loop (Sections 4 and 5.3): ZMP over time, footsteps from above, the phase timeline, the
-//! narrowed joints, a viewer.
+//! `iktc walk`: the humanoid walks while it imitates, with the damping controller in the loop
+//! (Sections 4 and 5.3): ZMP over time, footsteps from above, the phase timeline, the narrowed
+//! joints, a viewer.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
-use iktc::motion::retarget;
+use iktc::sim::viewer::{supporting_feet, walking_viewer};
 use iktc::sim::{
-    run_walk_imitate, ImitateConfig, Push, PushAxisMetrics, WalkImitateConfig, WalkRun, WalkStep,
+    Experiment, ImitateConfig, Push, PushAxisMetrics, WalkImitateConfig, WalkRun, WalkStep,
     WalkSummary,
 };
 use iktc_report::{write_csv, write_figure, Figure, Panel, Section, Series, Table};
 
-use crate::cmd_imitate::Experiment;
-use crate::viewer::{write_viewer, Figure3d, ViewerData};
+use crate::scenario::{health_text, prepare, ScenarioArgs};
+use crate::viewer::write_viewer;
 
-/// Walking options of `iktc imitate --walk`.
+/// Arguments of `iktc walk`.
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    #[command(flatten)]
+    pub scenario: ScenarioArgs,
+    #[command(flatten)]
+    pub walk: WalkArgs,
+    /// Output directory.
+    #[arg(long, default_value = "out/walk")]
+    pub out: PathBuf,
+}
+
+/// The walking options.
 #[derive(clap::Args, Debug, Clone)]
 pub struct WalkArgs {
-    /// Walk while imitating (the legs follow a walking pattern; the damping controller acts).
-    #[arg(long)]
-    pub walk: bool,
     /// Number of footsteps.
     #[arg(long, default_value_t = 4)]
     pub steps: usize,
     /// Step length [m]; 0 steps in place.
     #[arg(long, default_value_t = 0.1)]
     pub step_length: f64,
-    /// Leave the damping controller out of the loop.
+    /// Leave the damping controller out of the loop (the run without it is still made, for
+    /// the comparison).
     #[arg(long)]
     pub no_damping: bool,
     /// Push on the COM: TIME,IMPULSE_X,IMPULSE_Y [s, N·s, N·s], or `none`.
@@ -55,12 +65,12 @@ fn parse_push(s: &str) -> Result<Option<Push>> {
     }))
 }
 
-fn config(imitate: &ImitateConfig, w: &WalkArgs, damping: bool) -> Result<WalkImitateConfig> {
+fn config(imitate: &ImitateConfig, w: &WalkArgs) -> Result<WalkImitateConfig> {
     Ok(WalkImitateConfig {
         imitate: imitate.clone(),
         steps: w.steps,
         step_length: w.step_length,
-        damping,
+        damping: !w.no_damping,
         push: parse_push(&w.push)?,
         ..WalkImitateConfig::jvrc1()?
     })
@@ -72,23 +82,28 @@ pub type Figures = Vec<(String, String)>;
 /// Runs the walking imitation with and without the damping controller (for the comparison),
 /// writes everything to `dir` and returns the figures (path relative to `dir`, caption) and the
 /// two runs (with, without).
-pub fn run_walk(
+fn run_walk(
     e: &Experiment,
     imitate: &ImitateConfig,
     w: &WalkArgs,
     dir: &Path,
 ) -> Result<(Figures, WalkRun, WalkRun)> {
-    let refs =
-        retarget(&e.clip, &e.robot, &e.map)?.resample_with(imitate.dt, &imitate.run_limits)?;
-    let main = run_walk_imitate(&e.robot, &refs, &config(imitate, w, !w.no_damping)?)?;
-    let other = run_walk_imitate(&e.robot, &refs, &config(imitate, w, w.no_damping)?)?;
-    let (with, without) = if w.no_damping {
-        (other, main)
-    } else {
-        (main, other)
-    };
+    let (with, without) = e.walk_with_and_without_damping(&config(imitate, w)?)?;
     let figs = write_walk(&with, &without, e, imitate, dir)?;
     Ok((figs, with, without))
+}
+
+/// Runs `iktc walk`.
+pub fn run(a: &Args) -> Result<()> {
+    let (e, cfg) = prepare(&a.scenario)?;
+    let (figs, with, without) = run_walk(&e, &cfg, &a.walk, &a.out)?;
+    print_walk(&with, &without)?;
+    crate::outln!(
+        "wrote {} figures, walk.csv, walk_summary.json and walk_viewer.html to {}",
+        figs.len(),
+        a.out.display()
+    )?;
+    Ok(())
 }
 
 /// Prints the two summaries.
@@ -112,7 +127,7 @@ pub fn print_walk(with: &WalkRun, without: &WalkRun) -> std::io::Result<()> {
             "  tick median {:.1} µs, p99 {:.1} µs; {}",
             s.tick_median_us,
             s.tick_p99_us,
-            crate::cmd_imitate::health_text(&s.health)
+            health_text(&s.health)
         )?;
         crate::outln!(
             "  corrected {} ticks; the corrected level changed {} times between consecutive ticks, {} of them undone at the next tick",
@@ -246,7 +261,7 @@ pub fn write_walk(
             .steps
             .iter()
             .map(|s| {
-                let feet: Vec<f64> = active_feet(s).iter().map(|f| f[i]).collect();
+                let feet: Vec<f64> = supporting_feet(s).iter().map(|f| f[i]).collect();
                 feet.iter().copied().fold(f64::INFINITY, f64::min) - half
             })
             .collect();
@@ -254,7 +269,7 @@ pub fn write_walk(
             .steps
             .iter()
             .map(|s| {
-                let feet: Vec<f64> = active_feet(s).iter().map(|f| f[i]).collect();
+                let feet: Vec<f64> = supporting_feet(s).iter().map(|f| f[i]).collect();
                 feet.iter().copied().fold(f64::NEG_INFINITY, f64::max) + half
             })
             .collect();
@@ -424,134 +439,20 @@ pub fn write_walk(
     ));
     write_viewer(
         &dir.join("walk_viewer.html"),
-        &viewer_data(with, e, imitate)?,
+        &walking_viewer(
+            with,
+            e,
+            imitate.dt,
+            [imitate.support.sole_length, imitate.support.sole_width],
+        )?,
     )?;
     Ok(figs)
 }
 
-/// Ankles of the feet in support at a step (both in double support).
-fn active_feet(s: &WalkStep) -> Vec<[f64; 3]> {
-    match s.phase {
-        1 => vec![s.feet_reference[0]],
-        2 => vec![s.feet_reference[1]],
-        _ => vec![s.feet_reference[0], s.feet_reference[1]],
-    }
-}
-
-fn viewer_data(r: &WalkRun, e: &Experiment, imitate: &ImitateConfig) -> Result<ViewerData> {
-    let robot = &e.robot;
-    let dt = imitate.dt;
-    let stride = ((0.02 / dt).round() as usize).max(1);
-    let segments: Vec<[usize; 2]> = robot.joints().iter().map(|j| [j.parent, j.child]).collect();
-    let sk = e.clip.skeleton();
-    let b = e.map.basis;
-    let first = e
-        .clip
-        .frame(0)
-        .map(|p| b * p.root_position)
-        .unwrap_or_default();
-    let t0 = e.clip.times().first().copied().unwrap_or(0.0);
-    let (l, w) = (
-        0.5 * imitate.support.sole_length,
-        0.5 * imitate.support.sole_width,
-    );
-    let sole = |p: &[f64; 3], yaw: f64| -> Vec<[f32; 3]> {
-        let (c, s) = (yaw.cos(), yaw.sin());
-        [(l, w), (-l, w), (-l, -w), (l, -w)]
-            .iter()
-            .map(|(a, bb)| {
-                [
-                    (p[0] + c * a - s * bb) as f32,
-                    (p[1] + s * a + c * bb) as f32,
-                    0.0,
-                ]
-            })
-            .collect()
-    };
-    let mut out = ViewerData {
-        title: format!(
-            "{} walking while imitating {} (damping controller on)",
-            robot.name(),
-            e.clip.name()
-        ),
-        dt: dt * stride as f64,
-        robot: Figure3d {
-            name: robot.name().into(),
-            segments,
-            frames: Vec::new(),
-        },
-        skeleton: Figure3d {
-            name: e.clip.name().into(),
-            segments: sk
-                .joints()
-                .iter()
-                .enumerate()
-                .filter_map(|(i, j)| j.parent.map(|p| [p, i]))
-                .collect(),
-            frames: Vec::new(),
-        },
-        com: Vec::new(),
-        support: Vec::new(),
-        on_limit: Vec::new(),
-        on_limit_names: Vec::new(),
-        support_frames: Vec::new(),
-        footsteps: r.footsteps.iter().map(|(_, p)| sole(p, p[2])).collect(),
-        phases: Vec::new(),
-    };
-    let clip_end = e.clip.times().last().copied().unwrap_or(0.0);
-    for st in r.steps.iter().step_by(stride) {
-        out.robot.frames.push(
-            st.links
-                .iter()
-                .map(|p| [p[0] as f32, p[1] as f32, p[2] as f32])
-                .collect(),
-        );
-        out.com
-            .push([st.com[0] as f32, st.com[1] as f32, st.com[2] as f32]);
-        out.on_limit.push(Vec::new());
-        out.on_limit_names.push(Vec::new());
-        let pose = e.clip.sample((t0 + st.t).min(clip_end))?;
-        let pts = sk.world_positions(&pose)?;
-        out.skeleton.frames.push(
-            pts.iter()
-                .map(|p| {
-                    let q = b * p;
-                    [
-                        (q.x - first.x) as f32,
-                        (q.y - first.y + 1.0) as f32,
-                        q.z as f32,
-                    ]
-                })
-                .collect(),
-        );
-        let feet = active_feet(st);
-        let poly: Vec<[f32; 3]> = if feet.len() == 1 {
-            sole(&feet[0], 0.0)
-        } else {
-            // Double support: the hull of both soles (axis-aligned feet: the outer corners).
-            let (a, bb) = (sole(&feet[0], 0.0), sole(&feet[1], 0.0));
-            let (left, right) = if feet[0][1] > feet[1][1] {
-                (a, bb)
-            } else {
-                (bb, a)
-            };
-            vec![left[0], left[1], right[2], right[3]]
-        };
-        out.support_frames.push(poly);
-        out.phases.push(match st.phase {
-            1 => "single (left foot)".into(),
-            2 => "single (right foot)".into(),
-            _ => "double".into(),
-        });
-    }
-    Ok(out)
-}
-
 /// Runs the default walking imitation into `out/walk` and returns its report section.
 pub fn walk_section(out: &Path) -> Result<Section> {
-    let (e, imitate) = crate::cmd_imitate::default_experiment()?;
+    let (e, imitate) = Experiment::jvrc1()?;
     let w = WalkArgs {
-        walk: true,
         steps: 4,
         step_length: 0.1,
         no_damping: false,
@@ -614,7 +515,7 @@ pub fn walk_section(out: &Path) -> Result<Section> {
             }),
             s.push
                 .map_or("–".into(), |p| format!("{:.4}", p.zmp_excursion)),
-            crate::cmd_imitate::health_text(&s.health),
+            health_text(&s.health),
             format!(
                 "{}; {} ({})",
                 s.corrected_ticks, s.level_switches.switches, s.level_switches.flips

@@ -13,7 +13,9 @@ mod cmd_run;
 mod cmd_walk;
 mod finite;
 mod out;
+mod pairs;
 mod robot_arg;
+mod scenario;
 mod viewer;
 
 #[derive(Parser)]
@@ -39,6 +41,9 @@ enum Command {
     Balance(cmd_balance::BalanceArgs),
     /// Imitate a captured motion with a humanoid (Section 5.3): figures, summary, 3D viewer.
     Imitate(Box<cmd_imitate::Args>),
+    /// Walk while imitating a captured motion, with the ZMP damping controller in the loop
+    /// (Sections 4 and 5.3): ZMP, footsteps, phases, summary, 3D viewer.
+    Walk(Box<cmd_walk::Args>),
     /// Robot profiles: print a built-in one, or write a starting one for a URDF.
     Profile(cmd_profile::Args),
     /// Print a built-in map, or find the body points of a motion file and write a body map.
@@ -72,6 +77,7 @@ fn main() -> std::process::ExitCode {
         Command::Reproduce(a) => cmd_reproduce::run(&a),
         Command::Balance(a) => cmd_balance::run(a),
         Command::Imitate(a) => cmd_imitate::run(&a),
+        Command::Walk(a) => cmd_walk::run(&a),
         Command::Profile(a) => cmd_profile::run(&a),
         Command::Map(a) => cmd_map::run(&a),
     };

@@ -10,6 +10,8 @@ use iktc::profile::{
     Feet, Foot, LockRule, ProfileOrigin, RobotProfile, Sole, BUILTIN_PROFILES, MISSING,
 };
 
+use crate::pairs::{number, parse_assignments, range};
+
 /// Robot-level options of every command that loads a robot; they override the profile.
 #[derive(clap::Args, Debug, Clone, Default)]
 pub struct RobotOptions {
@@ -67,40 +69,6 @@ pub struct ResolvedRobot {
     pub source: String,
     /// Profile key prefixes set by flags, with the flag.
     pub flag_keys: Vec<(String, &'static str)>,
-}
-
-/// Parses `NAME=VALUE` items (`what` names the flag in errors).
-pub fn parse_pairs(what: &str, items: &[String]) -> Result<Vec<(String, f64)>> {
-    items
-        .iter()
-        .filter(|s| !s.trim().is_empty())
-        .map(|s| {
-            let (n, v) = s
-                .split_once('=')
-                .with_context(|| format!("{what} `{s}`: expected NAME=VALUE"))?;
-            let v: f64 = v
-                .trim()
-                .parse()
-                .with_context(|| format!("{what} `{s}`: `{v}` is not a number"))?;
-            Ok((n.trim().to_string(), v))
-        })
-        .collect()
-}
-
-fn parse_narrow(s: &str) -> Result<Vec<(String, [f64; 2])>> {
-    if s.trim() == "none" || s.trim().is_empty() {
-        return Ok(Vec::new());
-    }
-    s.split(',')
-        .map(|item| {
-            let bad = || format!("--narrow `{item}`: expected NAME=lo:hi with numbers [rad]");
-            let (name, range) = item.split_once('=').with_context(bad)?;
-            let (lo, hi) = range.split_once(':').with_context(bad)?;
-            let lower: f64 = lo.trim().parse().with_context(bad)?;
-            let upper: f64 = hi.trim().parse().with_context(bad)?;
-            Ok((name.trim().to_string(), [lower, upper]))
-        })
-        .collect()
 }
 
 fn parse_sole(s: &str) -> Result<Sole> {
@@ -180,7 +148,7 @@ fn apply_flags(
         keys.push(("base".into(), "--floating"));
     }
     let first_flag_lock = p.lock.len();
-    for (pattern, value) in parse_pairs("--lock", &o.lock)? {
+    for (pattern, value) in parse_assignments("--lock", &o.lock, "a number", number)? {
         p.lock.push(LockRule {
             joints: pattern,
             value,
@@ -189,7 +157,7 @@ fn apply_flags(
     for i in first_flag_lock..p.lock.len() {
         keys.push((format!("lock[{i}]"), "--lock"));
     }
-    for (n, v) in parse_pairs("--accel", &o.accel)? {
+    for (n, v) in parse_assignments("--accel", &o.accel, "a number [rad/s² or m/s²]", number)? {
         keys.push((format!("acceleration.limits.{n}"), "--accel"));
         p.acceleration.limits.insert(n, v);
     }
@@ -256,16 +224,23 @@ fn apply_flags(
         keys.push(("frames.pelvis".into(), "--pelvis"));
     }
     if let Some(s) = &f.posture {
-        let items: Vec<String> = if s.trim() == "none" {
-            Vec::new()
-        } else {
-            s.split(',').map(String::from).collect()
-        };
-        p.posture = parse_pairs("--posture", &items)?.into_iter().collect();
+        p.posture = parse_assignments(
+            "--posture",
+            std::slice::from_ref(s),
+            "a number [rad]",
+            number,
+        )?
+        .into_iter()
+        .collect();
         keys.push(("posture".into(), "--posture"));
     }
     if let Some(s) = &f.narrow {
-        p.narrow = parse_narrow(s)?;
+        p.narrow = parse_assignments(
+            "--narrow",
+            std::slice::from_ref(s),
+            "lo:hi with numbers [rad]",
+            range,
+        )?;
         keys.push(("narrow".into(), "--narrow"));
     }
     Ok(keys)

@@ -1,52 +1,11 @@
-//! The 3D viewer of `iktc imitate` (Fig. 21): one self-contained HTML file (inline script, plain
+//! The 3D viewer of `iktc imitate` and `iktc walk` (Fig. 21): one self-contained HTML file (inline script, plain
 //! 2D canvas, no network, no library) showing the captured skeleton and the robot side by side.
 //! Drag to orbit, wheel to zoom; `viewer.html#t=1.5` opens paused at 1.5 s.
 
 use std::path::Path;
 
 use anyhow::{Context, Result};
-use serde::Serialize;
-
-/// A stick figure: segments between points, and the points of every frame.
-#[derive(Debug, Clone, Serialize)]
-pub struct Figure3d {
-    /// Name shown in the legend.
-    pub name: String,
-    /// Pairs of point indices joined by a segment.
-    pub segments: Vec<[usize; 2]>,
-    /// Points of every frame [m], world axes (z up).
-    pub frames: Vec<Vec<[f32; 3]>>,
-}
-
-/// Everything the viewer plays.
-#[derive(Debug, Clone, Serialize)]
-pub struct ViewerData {
-    /// Page title.
-    pub title: String,
-    /// Time between frames [s].
-    pub dt: f64,
-    /// The robot.
-    pub robot: Figure3d,
-    /// The captured skeleton (drawn beside the robot).
-    pub skeleton: Figure3d,
-    /// COM of every frame [m].
-    pub com: Vec<[f32; 3]>,
-    /// Support polygon [m] (counter-clockwise, on the ground).
-    pub support: Vec<[f32; 3]>,
-    /// Per frame: indices of robot segments whose joint sits on a limit.
-    pub on_limit: Vec<Vec<usize>>,
-    /// Per frame: names of the joints on a limit.
-    pub on_limit_names: Vec<Vec<String>>,
-    /// Walking: the support polygon of every frame (replaces `support` when not empty).
-    #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub support_frames: Vec<Vec<[f32; 3]>>,
-    /// Walking: the footsteps' sole outlines \[m\].
-    #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub footsteps: Vec<Vec<[f32; 3]>>,
-    /// Walking: the support phase of every frame.
-    #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub phases: Vec<String>,
-}
+use iktc::sim::viewer::ViewerData;
 
 /// The page; `__DATA__` is replaced by the JSON of [`ViewerData`].
 const TEMPLATE: &str = r##"<!DOCTYPE html>

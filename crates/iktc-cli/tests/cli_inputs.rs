@@ -81,7 +81,7 @@ fn tick_bounds_name_their_option() {
     let out = out.to_str().unwrap();
     // Before: 10 GB and rising.
     assert_error(
-        &["imitate", "--walk", "--steps", "10000", "--out", out],
+        &["walk", "--steps", "10000", "--out", out],
         &[
             "ticks of the walk",
             "exceeds the limit 200000",

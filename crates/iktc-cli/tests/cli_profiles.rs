@@ -76,14 +76,7 @@ fn g1_walks_while_imitating_within_its_limits() {
     // health check reports it, so the run is asked to go on and the limits are checked.
     let out = tmp("g1walk");
     let o = iktc()
-        .args([
-            "imitate",
-            "--walk",
-            "--keep-going",
-            "--robot",
-            "g1",
-            "--out",
-        ])
+        .args(["walk", "--keep-going", "--robot", "g1", "--out"])
         .arg(&out)
         .output()
         .unwrap();

@@ -65,11 +65,11 @@ fn walking_viewer_loads_and_draws() {
     std::fs::create_dir_all(&dir).unwrap();
     let out = dir.join("run");
     let status = Command::new(env!("CARGO_BIN_EXE_iktc"))
-        .args(["imitate", "--walk", "--out"])
+        .args(["walk", "--out"])
         .arg(&out)
         .status()
         .unwrap();
-    assert!(status.success(), "iktc imitate --walk failed");
+    assert!(status.success(), "iktc walk failed");
     let page = out.join("walk_viewer.html");
     let html = std::fs::read_to_string(&page).unwrap();
     assert!(

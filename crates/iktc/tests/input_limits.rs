@@ -317,7 +317,7 @@ fn imitation_and_walking_bounds() {
     };
     let e = r.resample_with(0.005, &tight).unwrap_err();
     assert!(matches!(e, Error::ResourceLimit { .. }), "{e}");
-    // `--walk --steps 10000` (before: 10 GB and rising): refused before the plan is built.
+    // `iktc walk --steps 10000` (before: 10 GB and rising): refused before the plan is built.
     let refs = r.resample(0.005).unwrap();
     let mut wcfg = WalkImitateConfig::jvrc1().unwrap();
     wcfg.steps = 10_000;

@@ -1,5 +1,7 @@
 //! Scenarios: the paper's experiments as runnable, recorded simulations.
 
+#[cfg(all(feature = "urdf", feature = "json", feature = "toml"))]
+pub mod experiment;
 pub mod health;
 pub mod imitate;
 pub mod margins;
@@ -7,8 +9,12 @@ pub mod planar3r;
 pub mod smoothness;
 pub mod sweep;
 pub mod switches;
+#[cfg(all(feature = "urdf", feature = "json", feature = "toml"))]
+pub mod viewer;
 pub mod walk_imitate;
 
+#[cfg(all(feature = "urdf", feature = "json", feature = "toml"))]
+pub use experiment::{load_clip, load_map, Experiment, LoadedClip};
 pub use health::{HealthCheck, HealthIssue, HealthMonitor, HealthReport, HealthSettings, Verdict};
 pub use imitate::{
     imitation_references, run_imitate, ImitateConfig, ImitateRun, ImitateStep, ImitateSummary,

@@ -1,0 +1,156 @@
+//! The arguments `iktc imitate` and `iktc walk` share (robot, motion, map, solver, bounds,
+//! period, checks) and their translation into the library's [`Experiment`] and
+//! [`ImitateConfig`].
+
+use anyhow::{Context, Result};
+use iktc::limits::{BoundMethod, OutsideLimits};
+use iktc::motion::{MotionFormat, RetargetMap};
+use iktc::resources::RunLimits;
+use iktc::sim::{load_clip, load_map, Experiment, ImitateConfig};
+
+use crate::cmd_run::{BoundsArg, SolverArg};
+use crate::robot_arg::{resolve_robot, ProfileFlags, ResolvedRobot, RobotOptions};
+
+/// Robot, motion and solver options of `iktc imitate` and `iktc walk`.
+#[derive(clap::Args, Debug)]
+pub struct ScenarioArgs {
+    /// Robot: a built-in profile (jvrc1, g1), a robot profile (.toml) or a URDF file (.urdf,
+    /// floating base; its feet, pelvis and posture from --feet, --sole, --ankle-height,
+    /// --pelvis, --posture).
+    #[arg(long, default_value = "jvrc1")]
+    pub robot: String,
+    #[command(flatten)]
+    pub robot_options: RobotOptions,
+    #[command(flatten)]
+    pub profile: ProfileFlags,
+    /// Motion: a built-in DeepMimic clip (humanoid3d_dance_a, humanoid3d_dance_b,
+    /// humanoid3d_punch, humanoid3d_walk) or a skeleton motion file (.bvh, .amc, DeepMimic),
+    /// its format detected from its content and extension.
+    #[arg(long, default_value = iktc::sim::experiment::DEFAULT_CLIP)]
+    pub motion: String,
+    #[command(flatten)]
+    pub motion_options: crate::cmd_map::MotionArgs,
+    /// Retargeting map: a built-in name (deepmimic_jvrc1, bvh_jvrc1, deepmimic_g1) or a TOML
+    /// file; default: the robot profile's map for the motion's format (profile key
+    /// `imitate.maps.deepmimic` or `imitate.maps.bvh`).
+    #[arg(long)]
+    pub map: Option<String>,
+    /// Solver.
+    #[arg(long, value_enum, default_value = "iktc")]
+    pub solver: SolverArg,
+    /// Joint bounds.
+    #[arg(long, value_enum, default_value = "viable")]
+    pub bounds: BoundsArg,
+    /// Start even if a joint is outside its (narrowed) range, and bring it back at the
+    /// acceleration limit (viable or quiet bounds); without it such a start is an error.
+    #[arg(long)]
+    pub recover: bool,
+    /// Control period [s].
+    #[arg(long, default_value_t = 0.005)]
+    pub dt: f64,
+    /// Keep running when a run check fails (a foot drifts past its tolerance, the ZMP leaves
+    /// the support polygon) and mark it in the summary, instead of stopping with an error.
+    #[arg(long)]
+    pub keep_going: bool,
+    /// Most control ticks of one run.
+    #[arg(long, default_value_t = RunLimits::default().max_ticks)]
+    pub max_ticks: usize,
+}
+
+/// The retargeting map: `--map` if given, else the robot profile's map for the motion's format;
+/// checked against the robot (an unknown joint names the map entry and its source).
+fn choose_map(spec: Option<&str>, format: MotionFormat, r: &ResolvedRobot) -> Result<RetargetMap> {
+    let Some(spec) = spec else {
+        let format = if format == MotionFormat::DeepMimic {
+            "deepmimic"
+        } else {
+            "bvh"
+        };
+        let profile = r
+            .profile
+            .as_ref()
+            .context("`planar3r` has no profile and cannot imitate a motion")?;
+        return profile
+            .retarget_map(format, &r.robot)
+            .map_err(|e| r.explain(e));
+    };
+    load_map(spec, &r.robot).with_context(|| format!("--map `{spec}`"))
+}
+
+/// The experiment and its configuration the arguments describe.
+pub fn prepare(a: &ScenarioArgs) -> Result<(Experiment, ImitateConfig)> {
+    let mut ro = a.robot_options.clone();
+    let path = std::path::Path::new(&a.robot);
+    if path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("urdf"))
+    {
+        // The imitation moves a free-floating humanoid.
+        ro.floating = true;
+    }
+    let resolved = resolve_robot(&a.robot, &ro, Some(&a.profile))?;
+    let loaded = load_clip(&a.motion, &a.motion_options.options()?)
+        .with_context(|| format!("--motion `{}`", a.motion))?;
+    if let Some(decided) = &loaded.decided {
+        crate::outln!("{decided}")?;
+    }
+    let map = choose_map(a.map.as_deref(), loaded.format, &resolved)?;
+    let profile = resolved
+        .profile
+        .as_ref()
+        .context("`planar3r` has no profile and cannot imitate a motion")?;
+    let mut cfg = profile
+        .imitate_config(ImitateConfig {
+            method: a.solver.method(),
+            bounds: a.bounds.method(),
+            dt: a.dt,
+            run_limits: RunLimits {
+                max_ticks: a.max_ticks,
+                ..RunLimits::default()
+            },
+            ..ImitateConfig::default()
+        })
+        .map_err(|e| resolved.explain(e))?;
+    cfg.run_limits.check_dt("--dt", a.dt)?;
+    if a.recover {
+        match &mut cfg.bounds {
+            BoundMethod::Viable(settings) | BoundMethod::Quiet(settings) => {
+                settings.outside = OutsideLimits::Recover
+            }
+            BoundMethod::Paper => anyhow::bail!("--recover needs --bounds viable or quiet"),
+        }
+    }
+    cfg.health.keep_going = a.keep_going;
+    Ok((
+        Experiment {
+            robot: resolved.robot,
+            clip: loaded.clip,
+            map,
+        },
+        cfg,
+    ))
+}
+
+/// The health of a run in words: "healthy", or every failed check with its first and worst
+/// value (runs continued with `--keep-going`).
+pub fn health_text(h: &iktc::sim::HealthReport) -> String {
+    if h.healthy {
+        return "run checks: healthy".into();
+    }
+    let mut s = format!(
+        "run checks: FAILED on {} ticks{} (continued with --keep-going)",
+        h.failed_ticks,
+        if h.completed {
+            ""
+        } else {
+            ", stopped early on a non-finite state"
+        }
+    );
+    for i in &h.issues {
+        s.push_str(&format!(
+            "; {i} (worst {:.4e} at t = {:.4} s, {} ticks)",
+            i.worst_value, i.worst_time, i.ticks
+        ));
+    }
+    s
+}

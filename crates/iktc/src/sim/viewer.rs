@@ -1,0 +1,284 @@
+//! The data a 3D viewer plays for an imitation or walking run (Fig. 21): the robot's links, the
+//! captured skeleton beside it, the COM, the support polygon, the joints on a limit and, for a
+//! walk, the footsteps and support phases. Plain data (serialisable); the page that plays it
+//! is the CLI's.
+
+use serde::Serialize;
+
+use crate::error::Result;
+use crate::motion::Clip;
+use crate::sim::experiment::Experiment;
+use crate::sim::{ImitateRun, WalkRun, WalkStep};
+
+/// Where the captured skeleton stands in the viewer: this far along +y (the robot's left) of
+/// the robot [m].
+pub const SKELETON_OFFSET: f64 = 1.2;
+
+/// Time between two viewer frames [s] (the run's ticks are decimated to it).
+pub const FRAME_PERIOD: f64 = 0.02;
+
+/// A stick figure: segments between points, and the points of every frame.
+#[derive(Debug, Clone, Serialize)]
+pub struct Figure3d {
+    /// Name shown in the legend.
+    pub name: String,
+    /// Pairs of point indices joined by a segment.
+    pub segments: Vec<[usize; 2]>,
+    /// Points of every frame [m], world axes (z up).
+    pub frames: Vec<Vec<[f32; 3]>>,
+}
+
+/// Everything the viewer plays.
+#[derive(Debug, Clone, Serialize)]
+pub struct ViewerData {
+    /// Page title.
+    pub title: String,
+    /// Time between frames [s].
+    pub dt: f64,
+    /// The robot.
+    pub robot: Figure3d,
+    /// The captured skeleton (drawn beside the robot).
+    pub skeleton: Figure3d,
+    /// COM of every frame [m].
+    pub com: Vec<[f32; 3]>,
+    /// Support polygon [m] (counter-clockwise, on the ground).
+    pub support: Vec<[f32; 3]>,
+    /// Per frame: indices of robot segments whose joint sits on a limit.
+    pub on_limit: Vec<Vec<usize>>,
+    /// Per frame: names of the joints on a limit.
+    pub on_limit_names: Vec<Vec<String>>,
+    /// Walking: the support polygon of every frame (replaces `support` when not empty).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub support_frames: Vec<Vec<[f32; 3]>>,
+    /// Walking: the footsteps' sole outlines \[m\].
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub footsteps: Vec<Vec<[f32; 3]>>,
+    /// Walking: the support phase of every frame.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub phases: Vec<String>,
+}
+
+/// How the skeleton's root moves in the viewer.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum RootMotion {
+    /// Pinned beside the robot: the root's horizontal motion is removed at every frame (the
+    /// robot imitates standing and does not follow the clip's stepping).
+    Pinned,
+    /// The root moves as captured, from where it starts (the robot walks too).
+    Free,
+}
+
+fn point(p: &[f64; 3]) -> [f32; 3] {
+    [p[0] as f32, p[1] as f32, p[2] as f32]
+}
+
+/// Ticks between viewer frames for a control period `dt` [s].
+fn stride(dt: f64) -> usize {
+    ((FRAME_PERIOD / dt).round() as usize).max(1)
+}
+
+/// The robot's stick figure with no frames yet.
+fn robot_figure(e: &Experiment) -> Figure3d {
+    Figure3d {
+        name: e.robot.name().into(),
+        segments: e
+            .robot
+            .joints()
+            .iter()
+            .map(|j| [j.parent, j.child])
+            .collect(),
+        frames: Vec::new(),
+    }
+}
+
+/// The skeleton's stick figure at the run times `times` [s] (clamped to the clip's end), in the
+/// robot's world axes (the map's basis), [`SKELETON_OFFSET`] to the robot's left.
+fn skeleton_figure(e: &Experiment, times: &[f64], root: RootMotion) -> Result<Figure3d> {
+    let clip: &Clip = &e.clip;
+    let sk = clip.skeleton();
+    let b = e.map.basis;
+    let t0 = clip.times().first().copied().unwrap_or(0.0);
+    let end = clip.times().last().copied().unwrap_or(0.0);
+    let first = clip
+        .frame(0)
+        .map(|p| b * p.root_position)
+        .unwrap_or_default();
+    let mut frames = Vec::with_capacity(times.len());
+    for &t in times {
+        let pose = clip.sample((t0 + t).min(end))?;
+        let anchor = match root {
+            RootMotion::Pinned => b * pose.root_position,
+            RootMotion::Free => first,
+        };
+        let pts = sk.world_positions(&pose)?;
+        frames.push(
+            pts.iter()
+                .map(|p| {
+                    let q = b * p;
+                    [
+                        (q.x - anchor.x) as f32,
+                        (q.y - anchor.y + SKELETON_OFFSET) as f32,
+                        q.z as f32,
+                    ]
+                })
+                .collect(),
+        );
+    }
+    Ok(Figure3d {
+        name: clip.name().into(),
+        segments: sk
+            .joints()
+            .iter()
+            .enumerate()
+            .filter_map(|(i, j)| j.parent.map(|p| [p, i]))
+            .collect(),
+        frames,
+    })
+}
+
+/// The viewer data of a standing imitation: robot, skeleton pinned beside it, COM, the
+/// support polygon, and the joints on a limit at every frame.
+pub fn imitation_viewer(r: &ImitateRun, e: &Experiment) -> Result<ViewerData> {
+    let robot = &e.robot;
+    let stride = stride(r.summary.dt);
+    let joint_of_dof: Vec<Option<usize>> = (0..robot.nv())
+        .map(|d| {
+            let name = r.dof_names.get(d)?;
+            robot.joints().iter().position(|j| &j.name == name)
+        })
+        .collect();
+    let mut figure = robot_figure(e);
+    let (mut com, mut on_limit, mut on_limit_names, mut times) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    for st in r.steps.iter().step_by(stride) {
+        figure.frames.push(st.links.iter().map(point).collect());
+        com.push(point(&st.com));
+        on_limit.push(
+            st.on_limit
+                .iter()
+                .filter_map(|d| joint_of_dof.get(*d).copied().flatten())
+                .collect(),
+        );
+        on_limit_names.push(
+            st.on_limit
+                .iter()
+                .filter_map(|d| r.dof_names.get(*d).cloned())
+                .collect(),
+        );
+        times.push(st.t);
+    }
+    Ok(ViewerData {
+        title: format!(
+            "{} imitating {} ({} / {} bounds)",
+            robot.name(),
+            e.clip.name(),
+            r.summary.solver.to_uppercase(),
+            r.summary.bounds
+        ),
+        dt: r.summary.dt * stride as f64,
+        robot: figure,
+        skeleton: skeleton_figure(e, &times, RootMotion::Pinned)?,
+        com,
+        support: r.support.iter().map(point).collect(),
+        on_limit,
+        on_limit_names,
+        support_frames: Vec::new(),
+        footsteps: Vec::new(),
+        phases: Vec::new(),
+    })
+}
+
+/// The corners of a sole `length` × `width` [m] centred at `p` (x, y [m]) turned by `yaw`
+/// [rad], counter-clockwise, on the ground.
+fn sole(p: &[f64; 3], yaw: f64, length: f64, width: f64) -> Vec<[f32; 3]> {
+    let (l, w) = (0.5 * length, 0.5 * width);
+    let (c, s) = (yaw.cos(), yaw.sin());
+    [(l, w), (-l, w), (-l, -w), (l, -w)]
+        .iter()
+        .map(|(a, b)| {
+            [
+                (p[0] + c * a - s * b) as f32,
+                (p[1] + s * a + c * b) as f32,
+                0.0,
+            ]
+        })
+        .collect()
+}
+
+/// Ankles of the feet in support at a tick (both in double support).
+pub fn supporting_feet(s: &WalkStep) -> Vec<[f64; 3]> {
+    match s.phase {
+        1 => vec![s.feet_reference[0]],
+        2 => vec![s.feet_reference[1]],
+        _ => vec![s.feet_reference[0], s.feet_reference[1]],
+    }
+}
+
+/// The viewer data of a walk: robot, skeleton walking beside it, COM, the footsteps' soles,
+/// the support polygon and the support phase of every frame. `dt` is the control period [s],
+/// `sole` the sole's length and width [m].
+pub fn walking_viewer(
+    r: &WalkRun,
+    e: &Experiment,
+    dt: f64,
+    sole_size: [f64; 2],
+) -> Result<ViewerData> {
+    let stride = stride(dt);
+    let [length, width] = sole_size;
+    let mut figure = robot_figure(e);
+    let (mut com, mut support_frames, mut phases, mut times) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    for st in r.steps.iter().step_by(stride) {
+        figure.frames.push(st.links.iter().map(point).collect());
+        com.push(point(&st.com));
+        times.push(st.t);
+        let feet = supporting_feet(st);
+        let poly: Vec<[f32; 3]> = if let [foot] = feet[..] {
+            sole(&foot, 0.0, length, width)
+        } else {
+            // Double support: the hull of both soles (axis-aligned feet: the outer corners).
+            let (a, b) = (
+                sole(&feet[0], 0.0, length, width),
+                sole(&feet[1], 0.0, length, width),
+            );
+            let (left, right) = if feet[0][1] > feet[1][1] {
+                (a, b)
+            } else {
+                (b, a)
+            };
+            vec![left[0], left[1], right[2], right[3]]
+        };
+        support_frames.push(poly);
+        phases.push(
+            match st.phase {
+                1 => "single (left foot)",
+                2 => "single (right foot)",
+                _ => "double",
+            }
+            .to_string(),
+        );
+    }
+    let n = figure.frames.len();
+    Ok(ViewerData {
+        title: format!(
+            "{} walking while imitating {} (damping controller {})",
+            e.robot.name(),
+            e.clip.name(),
+            if r.summary.damping { "on" } else { "off" }
+        ),
+        dt: dt * stride as f64,
+        robot: figure,
+        skeleton: skeleton_figure(e, &times, RootMotion::Free)?,
+        com,
+        support: Vec::new(),
+        on_limit: vec![Vec::new(); n],
+        on_limit_names: vec![Vec::new(); n],
+        support_frames,
+        footsteps: r
+            .footsteps
+            .iter()
+            .map(|(_, p)| sole(p, p[2], length, width))
+            .collect(),
+        phases,
+    })
+}
