@@ -4,7 +4,7 @@
 //! controller's output) and the support-polygon margin of a measured ZMP is computed from the
 //! profile's soles.
 
-use iktc::motion::{RobotReferences, Track};
+use iktc::motion::{Clip, RobotReferences, Track};
 use iktc::sim::imitate::support_polygon;
 use iktc::sim::{imitation_references, ImitateConfig, ImitationController};
 use iktc::task::ComReference;
@@ -82,9 +82,11 @@ impl PyImitation {
     /// `robot` must have a profile (feet, pelvis, posture, narrowed ranges, soles); `motion` a
     /// skeleton. `map`: a built-in map or TOML file (default: the profile's); `dt` the control
     /// period [s]; `method` iktc, gf, clamp or prioritized; `bounds` viable or paper;
-    /// `duration` [s] keeps the first part of the clip (default: all of it).
+    /// `duration` [s] keeps the first part of the clip (default: all of it); `time_scale` [–]
+    /// plays the clip that many times slower (its frame times multiplied: rates divided by it,
+    /// accelerations by its square).
     #[new]
-    #[pyo3(signature = (robot, motion, *, map=None, dt=0.005, method="iktc", bounds="viable", duration=None))]
+    #[pyo3(signature = (robot, motion, *, map=None, dt=0.005, method="iktc", bounds="viable", duration=None, time_scale=1.0))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -95,7 +97,13 @@ impl PyImitation {
         method: &str,
         bounds: &str,
         duration: Option<f64>,
+        time_scale: f64,
     ) -> PyResult<Self> {
+        if !(time_scale.is_finite() && time_scale > 0.0) {
+            return Err(IktcError::new_err(format!(
+                "time_scale {time_scale}: expected a finite factor > 0"
+            )));
+        }
         let profile = robot.profile.as_ref().ok_or_else(|| {
             IktcError::new_err(format!(
                 "robot `{}` has no profile: the imitation needs its feet, pelvis and posture (load it by a built-in name or a profile file)",
@@ -111,6 +119,21 @@ impl PyImitation {
         let cfg = profile.imitate_config(base).map_err(to_py)?;
         let map = resolve_map(robot, motion, map)?;
         let clip = motion.clip()?;
+        let scaled;
+        let clip = if time_scale == 1.0 {
+            clip
+        } else {
+            let times: Vec<f64> = clip.times().iter().map(|t| t * time_scale).collect();
+            scaled = Clip::new(
+                clip.name(),
+                clip.skeleton().clone(),
+                times,
+                clip.frames().to_vec(),
+                clip.up_axis(),
+            )
+            .map_err(to_py)?;
+            &scaled
+        };
         let r = &robot.robot;
         let ctl = py
             .detach(|| -> iktc::Result<ImitationController> {

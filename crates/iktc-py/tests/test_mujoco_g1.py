@@ -1,0 +1,64 @@
+"""The MuJoCo closed loop of the G1 (crates/iktc-py/examples/g1_sim.py), run briefly, headless."""
+import pathlib
+import sys
+
+import mujoco
+import numpy as np
+import pytest
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "examples"))
+import g1_sim  # noqa: E402
+
+
+def test_the_plant_stands_and_its_ankle_sensors_carry_the_weight():
+    loop = g1_sim.Loop(duration=0.1)
+    p = loop.plant
+    q = loop.sim.q
+    for _ in range(200):  # 1 s holding the initial posture
+        p.command(q)
+        p.advance()
+    m = p.model
+    # Ground force on the feet = the weight of everything above the ankle sensors (the feet's own
+    # weight is below them), from the model's masses.
+    feet = sum(m.body_subtreemass[i] for i in p.feet)
+    above = (m.body_subtreemass[p.pelvis] - feet) * -m.opt.gravity[2]
+    fz = p.sensor_reading("left")[1][2] + p.sensor_reading("right")[1][2]
+    assert fz == pytest.approx(above, rel=0.02)
+    zmp, status = p.zmp()
+    assert status == "both"
+    assert loop.sim.support_margin(zmp, [p.foot_pose(i) for i in range(2)]) > 0.01
+    assert p.pelvis_height() > 0.74 and p.base_tilt() < 0.05
+
+
+def test_the_sensor_zmp_is_the_centre_of_pressure_of_the_contact_forces():
+    loop = g1_sim.Loop(duration=0.1)
+    loop.settle(0.5)
+    p, m, d = loop.plant, loop.plant.model, loop.plant.data
+    # Centre of pressure from MuJoCo's contact forces (an independent route to the ZMP).
+    total, moment = 0.0, np.zeros(2)
+    f6 = np.zeros(6)
+    for i in range(d.ncon):
+        c = d.contact[i]
+        mujoco.mj_contactForce(m, d, i, f6)
+        fz = (c.frame.reshape(3, 3).T @ f6[:3])[2]
+        total += fz
+        moment += fz * c.pos[:2]
+    cop = moment / total
+    zmp, _ = p.zmp()
+    # The sensors miss the feet's own weight and the spheres' 5 mm radius: within 5 mm.
+    assert np.abs(np.array(zmp) - cop).max() < 5e-3, (zmp, cop)
+
+
+def test_standing_imitation_of_the_default_clip_stays_up():
+    loop = g1_sim.run_standing()
+    s = loop.summary()
+    assert s["ticks"] == loop.sim.ticks == 507
+    assert s["stayed_up"], s
+    assert s["zmp_ticks_measured"] > 0.9 * s["ticks"]
+
+
+@pytest.mark.xfail(strict=True, reason="G1 on MuJoCo rocks and its feet slip 0.1 m or more "
+                   "while imitating humanoid3d_dance_b (see the example's README section)")
+def test_standing_imitation_of_the_default_clip_keeps_the_feet_within_5_mm():
+    s = g1_sim.run_standing().summary()
+    assert s["foot_slip_max_m"] <= 5e-3, s
