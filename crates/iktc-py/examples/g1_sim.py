@@ -217,9 +217,10 @@ class Loop:
 
     def __init__(self, clip: str = "humanoid3d_dance_b", duration: float | None = None,
                  kp: float = KP, kv: float = KV, physics_step: float = PHYSICS_STEP,
-                 rate_feedforward: bool = True, time_scale: float = 1.0):
+                 rate_feedforward: bool = True, time_scale: float = 1.0,
+                 robot: iktc.Robot | None = None):
         self.rate_feedforward = rate_feedforward
-        self.robot = iktc.Robot("g1")
+        self.robot = iktc.Robot("g1") if robot is None else robot
         self.sim = iktc.Imitation(self.robot, iktc.load_motion(clip), dt=CONTROL_PERIOD,
                                   duration=duration, time_scale=time_scale)
         self.plant = Plant(self.robot, kp=kp, kv=kv, physics_step=physics_step)
@@ -286,3 +287,50 @@ def run_standing(duration: float | None = None, settle: float = 0.5,
     for _ in range(loop.sim.ticks):
         loop.step()
     return loop
+
+
+def planned_zmp(plant: Plant, qs: list, dt: float = CONTROL_PERIOD) -> np.ndarray:
+    """The ZMP the kinematic plan asks for [m], one row per tick (NaN at the two ends).
+
+    The plan's configurations `qs` (iktc's q per tick) are put into MuJoCo's coordinates; rates
+    and accelerations by central differences (``mj_differentiatePos``); MuJoCo's inverse
+    dynamics (``mj_inverse``) then gives the wrench the ground must exert on the free base, force
+    F and torque τ at the base origin o (world axes), and the ZMP is the ground point where its
+    horizontal moment vanishes: p_x = o_x − (τ_y + o_z F_x)/F_z, p_y = o_y + (τ_x − o_z F_y)/F_z.
+    Constraints (the floor's contacts) are disabled for it: the free joint's force is then the
+    whole external wrench.
+    """
+    m = plant.model
+    d = mujoco.MjData(m)
+    flags = m.opt.disableflags
+    m.opt.disableflags = flags | mujoco.mjtDisableBit.mjDSBL_CONSTRAINT
+    try:
+        return _planned_zmp(plant, m, d, qs, dt)
+    finally:
+        m.opt.disableflags = flags
+
+
+def _planned_zmp(plant, m, d, qs, dt):
+    qpos = []
+    for q in qs:
+        x = np.zeros(m.nq)
+        x[:3] = q[:3]
+        x[3:7] = [q[6], q[3], q[4], q[5]]
+        x[plant.qadr] = q[7:]
+        qpos.append(x)
+    n = len(qpos)
+    out = np.full((n, 2), np.nan)
+    vel = np.zeros((n, m.nv))
+    for k in range(1, n - 1):
+        mujoco.mj_differentiatePos(m, vel[k], 2 * dt, qpos[k - 1], qpos[k + 1])
+    for k in range(2, n - 2):
+        d.qpos[:] = qpos[k]
+        d.qvel[:] = vel[k]
+        d.qacc[:] = (vel[k + 1] - vel[k - 1]) / (2 * dt)
+        mujoco.mj_inverse(m, d)
+        r = d.xmat[plant.pelvis].reshape(3, 3)
+        f = d.qfrc_inverse[:3]  # free joint: linear part in world axes
+        tau = r @ d.qfrc_inverse[3:6]  # angular part in the body's axes
+        o = d.qpos[:3]
+        out[k] = [o[0] - (tau[1] + o[2] * f[0]) / f[2], o[1] + (tau[0] - o[2] * f[1]) / f[2]]
+    return out

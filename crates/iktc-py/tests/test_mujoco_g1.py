@@ -62,3 +62,26 @@ def test_standing_imitation_of_the_default_clip_stays_up():
 def test_standing_imitation_of_the_default_clip_keeps_the_feet_within_5_mm():
     s = g1_sim.run_standing().summary()
     assert s["foot_slip_max_m"] <= 5e-3, s
+
+
+def test_the_planned_zmp_is_the_com_standing_and_shifts_by_z_a_over_g_when_accelerated():
+    loop = g1_sim.Loop(duration=0.1)
+    q0 = loop.sim.q
+    com = loop.robot.com(q0)
+    # Standing still: the ZMP is under the COM (iktc's COM, an independent computation).
+    z = g1_sim.planned_zmp(loop.plant, [q0] * 7)
+    assert np.allclose(z[2:5], com[:2], atol=1e-6)
+    # The whole robot translated with a constant horizontal acceleration a [m/s²]: the
+    # cart-table closed form x_zmp = x_com − z_com a / g holds exactly for a pure translation.
+    a = 0.8
+    qs = []
+    for k in range(7):
+        q = q0.copy()
+        q[0] += 0.5 * a * (k * g1_sim.CONTROL_PERIOD) ** 2
+        qs.append(q)
+    z = g1_sim.planned_zmp(loop.plant, qs)
+    g = -loop.plant.model.opt.gravity[2]
+    for k in range(2, 5):
+        expected = com[0] + 0.5 * a * (k * g1_sim.CONTROL_PERIOD) ** 2 - com[2] * a / g
+        assert z[k, 0] == pytest.approx(expected, abs=1e-6)
+        assert z[k, 1] == pytest.approx(com[1], abs=1e-6)
