@@ -85,3 +85,48 @@ def test_the_planned_zmp_is_the_com_standing_and_shifts_by_z_a_over_g_when_accel
         expected = com[0] + 0.5 * a * (k * g1_sim.CONTROL_PERIOD) ** 2 - com[2] * a / g
         assert z[k, 0] == pytest.approx(expected, abs=1e-6)
         assert z[k, 1] == pytest.approx(com[1], abs=1e-6)
+
+
+@pytest.mark.parametrize("zeta,wn", [(0.15, 4.8), (0.55, 4.5), (0.72, 5.0)])
+def test_the_damping_ratio_estimate_recovers_a_known_damped_sinusoid(zeta, wn):
+    t = np.arange(0.0, 2.0, g1_sim.CONTROL_PERIOD)
+    wd = wn * np.sqrt(1 - zeta ** 2)
+    y = 0.003 + 0.02 * np.exp(-zeta * wn * t) * np.cos(wd * t + 0.4)
+    z, w = g1_sim.damping_ratio(t, y)
+    assert z == pytest.approx(zeta, abs=0.01) and w == pytest.approx(wn, rel=0.01)
+
+
+@pytest.fixture(scope="module")
+def identified():
+    """The IPCJ model identified on MuJoCo by a short sweep (6 frequencies over the band)."""
+    return g1_sim.identify_on_plant(freqs=np.geomspace(*g1_sim.SWEEP_BAND, 6), settle=2.5,
+                                    cycles=3, min_time=1.5)
+
+
+def test_identification_on_mujoco_fits_the_measured_frequency_response(identified):
+    model, fit, (omega, mag, phase) = identified
+    # The model's own prediction at the measured frequencies (recomputed from the model, not
+    # the fitter's figure): within 10 % rms, 10° of phase everywhere.
+    assert fit["prediction_rms_relative_error"] < 0.10, fit
+    assert fit["prediction_max_phase_error_deg"] < 10.0, fit
+    # The pendulum length near the COM height (0.66 m) and a lightly damped mode.
+    wn, zeta = model.modal()
+    assert 0.5 < model.length < 0.8 and zeta < 0.3, (model, wn, zeta)
+
+
+def test_a_push_in_double_support_is_damped_more_with_the_damping_controller(identified):
+    model = identified[0]
+    ratios = {}
+    for name, m in (("open", None), ("damped", model)):
+        loop, t, y = g1_sim.push_test(model=m)
+        s = loop.summary()
+        assert s["stayed_up"] and s["foot_slip_max_m"] < 5e-3 and s["zmp_inside"], s
+        ratios[name] = g1_sim.damping_ratio(t, y)[0]
+    assert ratios["damped"] > ratios["open"] + 0.2, ratios
+
+
+@pytest.mark.xfail(strict=True, reason="the measured damping ratio with the controller is "
+                   "≈ 0.56 against the design 0.72 (see the example's README section)")
+def test_a_push_in_double_support_is_damped_to_the_design_ratio(identified):
+    loop, t, y = g1_sim.push_test(model=identified[0], damping=0.72)
+    assert abs(g1_sim.damping_ratio(t, y)[0] - 0.72) <= 0.15
