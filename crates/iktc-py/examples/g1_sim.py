@@ -479,3 +479,60 @@ def push_test(model=None, damping: float = 0.72, push_force: float = 60.0,
             ts.append((k - n_push) * CONTROL_PERIOD)
             ys.append(y)
     return loop, np.array(ts), np.array(ys)
+
+
+# --- (c) walking while imitating ----------------------------------------------------------
+
+#: A foot counts as standing when its ankle reference is within this of its initial height [m].
+ON_GROUND = 1e-3
+
+
+def run_walking(steps: int = 4, step_length: float = 0.1, clip: str = "humanoid3d_dance_b",
+                settle: float = 0.5, rate_feedforward: bool = True) -> dict:
+    """Walking `steps` footsteps while imitating the clip, on the MuJoCo G1, the damping
+    controller off. Returns the figures: stayed up, pelvis height, base tilt, the largest
+    horizontal error of a standing foot against its reference (slip), the ZMP from the ankle
+    sensors against the pattern's support polygon, servo tracking."""
+    robot = iktc.Robot("g1")
+    walk = iktc.Walking(robot, iktc.load_motion(clip), steps=steps, step_length=step_length)
+    plant = Plant(robot)
+    plant.set_state(walk.q)
+    z0 = [f[2, 3] for f in walk.feet0()]
+    for _ in range(int(round(settle / CONTROL_PERIOD))):
+        plant.command(walk.q)
+        plant.advance()
+    heights, tilts, slips, margins, errs, phases = [], [], [], [], [], []
+    for _ in range(walk.ticks):
+        report, phase = walk.tick()
+        if report.violation > 1e-9:
+            raise AssertionError(f"iktc left its acceleration box by {report.violation}")
+        q = walk.q
+        plant.command(q, walk.v if rate_feedforward else None)
+        plant.advance()
+        heights.append(plant.pelvis_height())
+        tilts.append(plant.base_tilt())
+        refs = walk.feet_references()
+        slip = 0.0
+        for i, r in enumerate(refs):
+            if abs(r[2, 3] - z0[i]) < ON_GROUND:
+                slip = max(slip, float(np.linalg.norm(plant.foot_pose(i)[:2, 3] - r[:2, 3])))
+        slips.append(slip)
+        zmp, _ = plant.zmp()
+        margins.append(None if zmp is None else walk.support_margin(zmp))
+        errs.append(float(np.abs(plant.joint_positions() - q[7:]).max()))
+        phases.append(phase)
+    h = np.array(heights)
+    m = np.array([x for x in margins if x is not None])
+    return {
+        "ticks": walk.ticks,
+        "stayed_up": bool(h.min() > 0.5),
+        "pelvis_height_min_m": float(h.min()),
+        "base_tilt_max_rad": float(np.max(tilts)),
+        "standing_foot_error_max_m": float(np.max(slips)),
+        "zmp_ticks_measured": int(m.size),
+        "zmp_margin_min_m": float(m.min()) if m.size else float("nan"),
+        "zmp_ticks_outside": int(np.sum(m < 0)),
+        "zmp_inside": bool(m.size == walk.ticks and m.min() > 0.0),
+        "joint_error_max_rad": float(np.max(errs)),
+        "forward_progress_m": float(plant.data.xpos[plant.pelvis][0] - walk.feet0()[0][0, 3]),
+    }

@@ -3,13 +3,16 @@
     python crates/iktc-py/examples/mujoco_g1.py standing [--clip humanoid3d_dance_b]
         [--time-scale 1] [--robot g1|profile.toml] [--json out.json]
     python crates/iktc-py/examples/mujoco_g1.py balance [--damping 0.72] [--json out.json]
+    python crates/iktc-py/examples/mujoco_g1.py walking [--steps 4] [--json out.json]
 
 `standing` prints the run's figures (stayed up, pelvis height, base tilt, foot slip, ZMP margin
 from the ankle force/torque sensors, tracking errors) and the ZMP that iktc's kinematic plan asks
 for (MuJoCo's inverse dynamics of the plan), which says whether any plant could follow it
 without tipping. `balance` identifies the IPCJ model of the sagittal plane on MuJoCo by the sine
 sweep of Section 4.2, places the poles, and pushes the standing robot at the pelvis with and
-without the damping controller, printing the fit and the damping ratios. See ``g1_sim.py``.
+without the damping controller, printing the fit and the damping ratios. `walking` walks
+while imitating the clip (damping controller off) and prints whether the robot stayed up, the
+standing feet's errors and the ZMP against the pattern's support polygon. See ``g1_sim.py``.
 """
 import argparse
 import json
@@ -46,7 +49,8 @@ def balance(a) -> dict:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("run", nargs="?", default="standing", choices=["standing", "balance"])
+    ap.add_argument("run", nargs="?", default="standing", choices=["standing", "balance", "walking"])
+    ap.add_argument("--steps", type=int, default=4, help="footsteps of the walking run")
     ap.add_argument("--damping", type=float, default=0.72, help="design damping ratio [–]")
     ap.add_argument("--clip", default="humanoid3d_dance_b")
     ap.add_argument("--time-scale", type=float, default=1.0, help="play the clip this many times slower")
@@ -54,7 +58,12 @@ def main() -> None:
     ap.add_argument("--settle", type=float, default=0.5, help="time holding the start posture [s]")
     ap.add_argument("--json", help="write the figures to this file")
     a = ap.parse_args()
-    s = balance(a) if a.run == "balance" else standing(a)
+    if a.run == "balance":
+        s = balance(a)
+    elif a.run == "walking":
+        s = g1_sim.run_walking(steps=a.steps, clip=a.clip)
+    else:
+        s = standing(a)
     print(json.dumps(s, indent=1))
     if a.json:
         with open(a.json, "w") as f:

@@ -15,6 +15,7 @@ mod convert;
 mod imitate;
 mod motion;
 mod robot;
+mod walk;
 
 pyo3::create_exception!(
     _iktc,
@@ -40,6 +41,7 @@ fn _iktc(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<controller::PyJointsHandle>()?;
     m.add_class::<controller::PySolveReport>()?;
     m.add_class::<imitate::PyImitation>()?;
+    m.add_class::<walk::PyWalking>()?;
     motion::register(m)?;
     balance::register(m)?;
     Ok(())

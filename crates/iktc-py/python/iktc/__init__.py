@@ -37,6 +37,7 @@ from ._iktc import (
     Retargeted,
     References,
     Imitation,
+    Walking,
     load_motion,
     retarget,
 )
@@ -59,6 +60,7 @@ __all__ = [
     "Retargeted",
     "References",
     "Imitation",
+    "Walking",
     "load_motion",
     "retarget",
 ]
