@@ -90,7 +90,7 @@ fn parse_axes(axes: &str) -> PyResult<Axes> {
     }
 }
 
-fn parse_method(method: &str) -> PyResult<Method> {
+pub(crate) fn parse_method(method: &str) -> PyResult<Method> {
     match method {
         "iktc" => Ok(Method::Iktc),
         "gf" | "cascade" => Ok(Method::Cascade),
@@ -102,7 +102,7 @@ fn parse_method(method: &str) -> PyResult<Method> {
     }
 }
 
-fn parse_bounds(bounds: &str) -> PyResult<BoundMethod> {
+pub(crate) fn parse_bounds(bounds: &str) -> PyResult<BoundMethod> {
     match bounds {
         "viable" => Ok(BoundMethod::viable()),
         "paper" => Ok(BoundMethod::Paper),

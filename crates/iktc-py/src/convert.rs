@@ -1,7 +1,8 @@
 //! numpy ↔ nalgebra conversions with the checks the Python side needs (sizes, finiteness).
 
 use nalgebra::{DMatrix, Isometry3, Quaternion, Translation3, UnitQuaternion, Vector3};
-use numpy::{PyArray1, PyArray2, PyArrayMethods, ToPyArray};
+use numpy::npyffi::NPY_ORDER;
+use numpy::{PyArray1, PyArray2, PyArray3, PyArrayMethods, ToPyArray};
 use pyo3::prelude::*;
 
 use crate::IktcError;
@@ -92,4 +93,22 @@ pub(crate) fn matrix<'py>(py: Python<'py>, m: &DMatrix<f64>) -> Bound<'py, PyArr
 /// A slice as a numpy vector (copied).
 pub(crate) fn array<'py>(py: Python<'py>, v: &[f64]) -> Bound<'py, PyArray1<f64>> {
     v.to_pyarray(py)
+}
+
+/// A row-major (rows, cols) numpy array from its flat data (moved, not copied again).
+pub(crate) fn table<'py>(
+    py: Python<'py>,
+    shape: [usize; 2],
+    flat: Vec<f64>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    PyArray1::from_vec(py, flat).reshape_with_order(shape, NPY_ORDER::NPY_CORDER)
+}
+
+/// A row-major 3-D numpy array from its flat data.
+pub(crate) fn table3<'py>(
+    py: Python<'py>,
+    shape: [usize; 3],
+    flat: Vec<f64>,
+) -> PyResult<Bound<'py, PyArray3<f64>>> {
+    PyArray1::from_vec(py, flat).reshape_with_order(shape, NPY_ORDER::NPY_CORDER)
 }

@@ -1,17 +1,21 @@
 //! Python bindings of iktc (module `iktc._iktc`, re-exported by the `iktc` package).
 //!
-//! The Python API follows the Rust one: a [`PyRobot`] (built-in name or URDF), a controller
+//! The Python API follows the Rust one: a [`PyRobot`] (built-in name, profile or URDF), a controller
 //! built level by level through a builder whose `frame`/`com`/`joints` return typed handles,
 //! and `Controller.step(q, v, dt)`, which advances the numpy arrays `q` and `v` in place and
 //! releases the GIL while Rust runs. Every `iktc::Error` becomes an `iktc.IktcError` (a
-//! `ValueError`) with the same message.
+//! `ValueError`) with the same message. Motions load with `load_motion` and retarget with
+//! `retarget` (numpy arrays out); `Imitation` steps the Section 5.3 imitation tick by tick.
 
 use pyo3::prelude::*;
 
 mod balance;
 mod controller;
 mod convert;
+mod imitate;
+mod motion;
 mod robot;
+mod walk;
 
 pyo3::create_exception!(
     _iktc,
@@ -36,6 +40,9 @@ fn _iktc(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<controller::PyComHandle>()?;
     m.add_class::<controller::PyJointsHandle>()?;
     m.add_class::<controller::PySolveReport>()?;
+    m.add_class::<imitate::PyImitation>()?;
+    m.add_class::<walk::PyWalking>()?;
+    motion::register(m)?;
     balance::register(m)?;
     Ok(())
 }

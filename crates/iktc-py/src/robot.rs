@@ -1,23 +1,31 @@
-//! `iktc.Robot`: an immutable robot model from a built-in name or a URDF file.
+//! `iktc.Robot`: an immutable robot model from a built-in name, a robot profile (TOML) or a
+//! URDF file.
 
+use std::path::Path;
 use std::sync::Arc;
 
 use iktc::model::{builtin_robot, BaseKind, Kinematics, ModelOptions, Robot, State};
+use iktc::profile::{RobotProfile, BUILTIN_PROFILES};
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
 
 use crate::convert::{array, matrix, pose_matrix, vector};
 use crate::to_py;
 
-/// A robot model (immutable).
+/// A robot model (immutable), with its robot profile when it has one.
 ///
-/// `Robot("jvrc1")` loads a built-in robot; `Robot("path/to/robot.urdf", floating=True,
-/// lock={"finger_joint": 0.0}, accel={"knee": 30.0})` reads a URDF file. q is (base position
-/// [m], base quaternion (x, y, z, w), joints [rad]) and v (base linear and angular velocity in
-/// base axes, joint rates), as in the Rust library.
+/// `Robot("jvrc1")` or `Robot("g1")` loads a built-in robot through its built-in profile (feet,
+/// pelvis, posture, locks, acceleration limits, retargeting maps), like the command line's
+/// `--robot g1`; `Robot("planar3r")` is the 3R arm (no profile); `Robot("my_robot.toml")` reads
+/// a profile file; `Robot("path/to/robot.urdf", floating=True, lock=[("finger", 0.0)],
+/// accel=[("knee", 30.0)])` reads a bare URDF file (no profile). q is (base position [m], base
+/// quaternion (x, y, z, w), joints [rad]) and v (base linear and angular velocity in base axes,
+/// joint rates), as in the Rust library.
 #[pyclass(name = "Robot", module = "iktc", frozen)]
 pub struct PyRobot {
     pub(crate) robot: Arc<Robot>,
+    /// The profile the robot was built from (built-in name or profile file), if any.
+    pub(crate) profile: Option<Arc<RobotProfile>>,
 }
 
 #[pymethods]
@@ -30,7 +38,27 @@ impl PyRobot {
         lock: Option<Vec<(String, f64)>>,
         accel: Option<Vec<(String, f64)>>,
     ) -> PyResult<Self> {
-        let robot = if spec.ends_with(".urdf") || spec.ends_with(".xml") {
+        let is_urdf = spec.ends_with(".urdf") || spec.ends_with(".xml");
+        if !is_urdf && (floating.is_some() || lock.is_some() || accel.is_some()) {
+            return Err(crate::IktcError::new_err(format!(
+                "`{spec}` is a built-in robot or a profile: floating, lock and accel apply to URDF files only (a profile sets them with its keys `base`, `lock` and `acceleration`)"
+            )));
+        }
+        let profile = if spec.ends_with(".toml") {
+            Some(RobotProfile::load(Path::new(spec)).map_err(to_py)?)
+        } else if BUILTIN_PROFILES.contains(&spec) {
+            Some(RobotProfile::builtin(spec).map_err(to_py)?)
+        } else {
+            None
+        };
+        if let Some(p) = profile {
+            let robot = p.robot().map_err(to_py)?;
+            return Ok(Self {
+                robot: Arc::new(robot),
+                profile: Some(Arc::new(p)),
+            });
+        }
+        let robot = if is_urdf {
             let options = ModelOptions {
                 base: if floating.unwrap_or(true) {
                     BaseKind::Floating
@@ -41,18 +69,20 @@ impl PyRobot {
                 acceleration_limits: accel.unwrap_or_default(),
                 ..ModelOptions::default()
             };
-            Robot::from_urdf_file(std::path::Path::new(spec), &options).map_err(to_py)?
+            Robot::from_urdf_file(Path::new(spec), &options).map_err(to_py)?
         } else {
-            if floating.is_some() || lock.is_some() || accel.is_some() {
-                return Err(crate::IktcError::new_err(format!(
-                    "`{spec}` is a built-in robot: floating, lock and accel apply to URDF files only"
-                )));
-            }
             builtin_robot(spec).map_err(to_py)?
         };
         Ok(Self {
             robot: Arc::new(robot),
+            profile: None,
         })
+    }
+
+    /// Whether the robot comes with a profile (feet, pelvis, posture, retargeting maps).
+    #[getter]
+    fn has_profile(&self) -> bool {
+        self.profile.is_some()
     }
 
     /// The robot's name.

@@ -12,6 +12,10 @@ Quick start::
     ctrl.set_com_reference(com, robot.com(q) + [0.02, 0.0, 0.0])
     report = ctrl.step(q, v, 0.005)     # q and v advanced in place
 
+Motions (``load_motion``: a built-in DeepMimic clip or a BVH, ASF/AMC, DeepMimic, C3D or
+points-CSV file) retarget to a robot with ``retarget`` (numpy arrays); ``Imitation`` steps the
+imitation of Section 5.3 tick by tick.
+
 Every error of the library is raised as ``iktc.IktcError`` (a ``ValueError``) with the
 library's message.
 """
@@ -29,6 +33,13 @@ from ._iktc import (
     DampingController,
     measure_zmp,
     identify,
+    Motion,
+    Retargeted,
+    References,
+    Imitation,
+    Walking,
+    load_motion,
+    retarget,
 )
 
 __all__ = [
@@ -45,4 +56,11 @@ __all__ = [
     "DampingController",
     "measure_zmp",
     "identify",
+    "Motion",
+    "Retargeted",
+    "References",
+    "Imitation",
+    "Walking",
+    "load_motion",
+    "retarget",
 ]

@@ -1,0 +1,329 @@
+//! `iktc.Imitation`: the humanoid imitation of Section 5.3 (Table 1 stack: feet, COM xy, pelvis
+//! attitude, pelvis height, upper-body joints) stepped tick by tick from Python, for a robot
+//! with a profile and a motion; the COM reference can be offset each tick (the damping
+//! controller's output) and the support-polygon margin of a measured ZMP is computed from the
+//! profile's soles.
+
+use iktc::motion::{Clip, RobotReferences, Track};
+use iktc::sim::imitate::support_polygon;
+use iktc::sim::{imitation_references, ImitateConfig, ImitationController};
+use iktc::task::ComReference;
+use nalgebra::{Isometry3, Matrix4, Rotation3, Translation3, UnitQuaternion, Vector3};
+use numpy::{PyArray1, PyArray2, PyReadonlyArray2};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::controller::{parse_bounds, parse_method, PySolveReport};
+use crate::convert::{array, pose_matrix};
+use crate::motion::{resolve_map, PyMotion};
+use crate::robot::PyRobot;
+use crate::{to_py, IktcError};
+
+/// The imitation closed loop of one robot and one motion (its own kinematic state, integrated
+/// with constant acceleration each tick).
+///
+/// ```python
+/// sim = iktc.Imitation(iktc.Robot("g1"), iktc.load_motion("humanoid3d_dance_b"), duration=2.0)
+/// for _ in range(sim.ticks):
+///     report = sim.tick()          # one control tick: solve, then integrate over dt
+///     q = sim.q                    # numpy, length nq
+/// ```
+#[pyclass(name = "Imitation", module = "iktc")]
+pub struct PyImitation {
+    ctl: ImitationController,
+    robot: std::sync::Arc<iktc::model::Robot>,
+    cfg: ImitateConfig,
+    k: usize,
+    com_offset: Option<[f64; 2]>,
+}
+
+/// The first `n` ticks of `refs`.
+fn first_ticks(r: &RobotReferences, n: usize) -> RobotReferences {
+    let cut = |t: &Track| Track {
+        position: t.position[..n].to_vec(),
+        velocity: t.velocity[..n].to_vec(),
+        acceleration: t.acceleration[..n].to_vec(),
+    };
+    RobotReferences {
+        dt: r.dt,
+        times: r.times[..n].to_vec(),
+        joint_names: r.joint_names.clone(),
+        joints: r.joints.iter().map(cut).collect(),
+        height: cut(&r.height),
+        angles: [cut(&r.angles[0]), cut(&r.angles[1]), cut(&r.angles[2])],
+        attitude: r.attitude[..n].to_vec(),
+        angular_velocity: r.angular_velocity[..n].to_vec(),
+        angular_acceleration: r.angular_acceleration[..n].to_vec(),
+    }
+}
+
+/// A pose from a 4 × 4 homogeneous matrix (its rotation block re-orthonormalised).
+fn pose_of(m: &PyReadonlyArray2<'_, f64>) -> PyResult<Isometry3<f64>> {
+    let a = m.as_array();
+    if a.shape() != [4, 4] {
+        return Err(IktcError::new_err(format!(
+            "foot pose: expected a 4 × 4 homogeneous matrix, got shape {:?}",
+            a.shape()
+        )));
+    }
+    let h = Matrix4::from_fn(|i, j| a[[i, j]]);
+    if h.iter().any(|x| !x.is_finite()) {
+        return Err(IktcError::new_err("foot pose: not finite"));
+    }
+    let r = Rotation3::from_matrix(&h.fixed_view::<3, 3>(0, 0).into_owned());
+    Ok(Isometry3::from_parts(
+        Translation3::new(h[(0, 3)], h[(1, 3)], h[(2, 3)]),
+        UnitQuaternion::from_rotation_matrix(&r),
+    ))
+}
+
+#[pymethods]
+impl PyImitation {
+    /// `robot` must have a profile (feet, pelvis, posture, narrowed ranges, soles); `motion` a
+    /// skeleton. `map`: a built-in map or TOML file (default: the profile's); `dt` the control
+    /// period [s]; `method` iktc, gf, clamp or prioritized; `bounds` viable or paper;
+    /// `duration` [s] keeps the first part of the clip (default: all of it); `time_scale` [–]
+    /// plays the clip that many times slower (its frame times multiplied: rates divided by it,
+    /// accelerations by its square).
+    #[new]
+    #[pyo3(signature = (robot, motion, *, map=None, dt=0.005, method="iktc", bounds="viable", duration=None, time_scale=1.0))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        py: Python<'_>,
+        robot: &PyRobot,
+        motion: &PyMotion,
+        map: Option<&str>,
+        dt: f64,
+        method: &str,
+        bounds: &str,
+        duration: Option<f64>,
+        time_scale: f64,
+    ) -> PyResult<Self> {
+        if !(time_scale.is_finite() && time_scale > 0.0) {
+            return Err(IktcError::new_err(format!(
+                "time_scale {time_scale}: expected a finite factor > 0"
+            )));
+        }
+        let profile = robot.profile.as_ref().ok_or_else(|| {
+            IktcError::new_err(format!(
+                "robot `{}` has no profile: the imitation needs its feet, pelvis and posture (load it by a built-in name or a profile file)",
+                robot.robot.name()
+            ))
+        })?;
+        let base = ImitateConfig {
+            method: parse_method(method)?,
+            bounds: parse_bounds(bounds)?,
+            dt,
+            ..ImitateConfig::default()
+        };
+        let cfg = profile.imitate_config(base).map_err(to_py)?;
+        let map = resolve_map(robot, motion, map)?;
+        let clip = motion.clip()?;
+        let scaled;
+        let clip = if time_scale == 1.0 {
+            clip
+        } else {
+            let times: Vec<f64> = clip.times().iter().map(|t| t * time_scale).collect();
+            scaled = Clip::new(
+                clip.name(),
+                clip.skeleton().clone(),
+                times,
+                clip.frames().to_vec(),
+                clip.up_axis(),
+            )
+            .map_err(to_py)?;
+            &scaled
+        };
+        let r = &robot.robot;
+        let ctl = py
+            .detach(|| -> iktc::Result<ImitationController> {
+                let mut refs = imitation_references(r, clip, &map, &cfg)?;
+                if let Some(d) = duration {
+                    if !(d.is_finite() && d > 0.0) {
+                        return Err(iktc::Error::InvalidSetting {
+                            name: "duration".into(),
+                            value: d.to_string(),
+                            expected: "a finite time > 0 [s]".into(),
+                        });
+                    }
+                    let n = ((d / dt).round() as usize).clamp(1, refs.len());
+                    refs = first_ticks(&refs, n);
+                }
+                ImitationController::new(r, &refs, &cfg)
+            })
+            .map_err(to_py)?;
+        Ok(Self {
+            ctl,
+            robot: robot.robot.clone(),
+            cfg,
+            k: 0,
+            com_offset: None,
+        })
+    }
+
+    /// Number of reference ticks.
+    #[getter]
+    fn ticks(&self) -> usize {
+        self.ctl.references().len()
+    }
+
+    /// Index of the next tick (ticks past the end hold the last reference).
+    #[getter]
+    fn k(&self) -> usize {
+        self.k
+    }
+
+    /// Control period [s].
+    #[getter]
+    fn dt(&self) -> f64 {
+        self.cfg.dt
+    }
+
+    /// One control tick: references of tick k, kinematics, task equations, acceleration box,
+    /// solve, then constant-acceleration integration over dt; k advances. The GIL is released.
+    fn tick(&mut self, py: Python<'_>) -> PyResult<PySolveReport> {
+        let t = self.k as f64 * self.cfg.dt;
+        let com = self.com_offset.map(|[dx, dy]| {
+            let c = self.ctl.com_reference_at(t);
+            ComReference {
+                position: c.position + Vector3::new(dx, dy, 0.0),
+                ..c
+            }
+        });
+        self.ctl.set_com_override(com);
+        let (ctl, robot, k) = (&mut self.ctl, &self.robot, self.k);
+        let report = py
+            .detach(|| -> iktc::Result<PySolveReport> {
+                let report = PySolveReport::from(ctl.tick(robot, k)?);
+                ctl.integrate(robot)?;
+                Ok(report)
+            })
+            .map_err(to_py)?;
+        self.k += 1;
+        Ok(report)
+    }
+
+    /// Offsets the COM reference of the next ticks by (dx, dy) [m] in the horizontal plane (the
+    /// damping controller's `com_offset`); `None` returns to the standing reference.
+    #[pyo3(signature = (offset=None))]
+    fn set_com_offset(&mut self, offset: Option<(f64, f64)>) -> PyResult<()> {
+        if let Some((dx, dy)) = offset {
+            if !(dx.is_finite() && dy.is_finite()) {
+                return Err(IktcError::new_err(format!(
+                    "COM offset ({dx}, {dy}) is not finite"
+                )));
+            }
+        }
+        self.com_offset = offset.map(|(dx, dy)| [dx, dy]);
+        Ok(())
+    }
+
+    /// The configuration q (numpy, length nq) at the start of the next tick.
+    #[getter]
+    fn q<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        array(py, self.ctl.state().q.as_slice())
+    }
+
+    /// The velocity v (numpy, length nv) at the start of the next tick.
+    #[getter]
+    fn v<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        array(py, self.ctl.state().qd.as_slice())
+    }
+
+    /// q̈ of the last tick (numpy, length nv).
+    #[getter]
+    fn qdd<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        array(py, self.ctl.qdd().as_slice())
+    }
+
+    /// The standing COM reference at tick k [m] (before any offset): the initial COM blended
+    /// to the centre of the support polygon.
+    fn com_reference<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        let c = self.ctl.com_reference_at(self.k as f64 * self.cfg.dt);
+        array(py, c.position.as_slice())
+    }
+
+    /// The COM of the state q [m] (world axes).
+    fn com<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let kin = iktc::model::Kinematics::new(&self.robot, self.ctl.state()).map_err(to_py)?;
+        Ok(array(py, kin.com().as_slice()))
+    }
+
+    /// The feet frames (right, then left) and their initial, held poses as 4 × 4 matrices.
+    fn feet<'py>(&self, py: Python<'py>) -> Vec<(String, Bound<'py, PyArray2<f64>>)> {
+        self.cfg
+            .feet
+            .iter()
+            .zip(self.ctl.feet0())
+            .map(|(n, p)| (n.clone(), pose_matrix(py, p)))
+            .collect()
+    }
+
+    /// The pelvis frame's name and its initial pose (4 × 4).
+    fn pelvis<'py>(&self, py: Python<'py>) -> (String, Bound<'py, PyArray2<f64>>) {
+        (self.cfg.pelvis.clone(), pose_matrix(py, self.ctl.pelvis0()))
+    }
+
+    /// The soles of the support polygon: sole_length, sole_width, sole_offset_x, ankle_height
+    /// [m].
+    fn sole<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let s = &self.cfg.support;
+        let d = PyDict::new(py);
+        d.set_item("sole_length", s.sole_length)?;
+        d.set_item("sole_width", s.sole_width)?;
+        d.set_item("sole_offset_x", s.sole_offset_x)?;
+        d.set_item("ankle_height", s.ankle_height)?;
+        Ok(d)
+    }
+
+    /// Signed distance [m] from the point (x, y) (a ZMP) to the edge of the support polygon of
+    /// the feet at the given ankle poses (4 × 4 each; default: the initial ones): the convex
+    /// hull of their soles; positive inside.
+    #[pyo3(signature = (point, feet=None))]
+    fn support_margin(
+        &self,
+        point: (f64, f64),
+        feet: Option<Vec<PyReadonlyArray2<'_, f64>>>,
+    ) -> PyResult<f64> {
+        let poses = match feet {
+            Some(f) => f.iter().map(pose_of).collect::<PyResult<Vec<_>>>()?,
+            None => self.ctl.feet0().to_vec(),
+        };
+        let p = support_polygon(&poses, &self.cfg.support).map_err(to_py)?;
+        Ok(p.margin(point))
+    }
+
+    /// Names of the upper-body joints the motion drives (level 5).
+    #[getter]
+    fn upper_body_joints(&self) -> Vec<String> {
+        self.ctl.references().joint_names.clone()
+    }
+
+    /// The upper-body joint references of tick `k` [rad] (default: the last tick solved).
+    #[pyo3(signature = (k=None))]
+    fn upper_body_reference<'py>(
+        &self,
+        py: Python<'py>,
+        k: Option<usize>,
+    ) -> Bound<'py, PyArray1<f64>> {
+        let r = self.ctl.references();
+        let k = k
+            .unwrap_or(self.k.saturating_sub(1))
+            .min(r.len().saturating_sub(1));
+        let v: Vec<f64> = r
+            .joints
+            .iter()
+            .map(|t| t.position.get(k).copied().unwrap_or(f64::NAN))
+            .collect();
+        array(py, &v)
+    }
+
+    /// Resets to the start (state, tick index, no COM offset).
+    fn reset(&mut self) -> PyResult<()> {
+        let refs = self.ctl.references().clone();
+        self.ctl = ImitationController::new(&self.robot, &refs, &self.cfg).map_err(to_py)?;
+        self.k = 0;
+        self.com_offset = None;
+        Ok(())
+    }
+}

@@ -1,0 +1,136 @@
+"""Robots from profiles, motion loading, retargeting and the imitation, from Python, against
+independently computed values and the Rust command line."""
+import csv
+import os
+import subprocess
+import tempfile
+
+import numpy as np
+import pytest
+
+import iktc
+from test_controller import REPO, iktc_binary
+
+DATA = REPO / "crates" / "iktc" / "data"
+BVH = REPO / "crates" / "iktc" / "tests" / "data" / "motions" / "cmu" / "131_01.bvh"
+DT = 0.005  # control period [s]
+
+
+def test_a_robot_from_a_builtin_name_a_profile_file_and_a_urdf_agree():
+    by_name = iktc.Robot("g1")
+    by_profile = iktc.Robot(str(DATA / "profiles" / "g1.toml"))
+    by_urdf = iktc.Robot(str(DATA / "robots" / "g1" / "g1_29dof_rev_1_0.urdf"), floating=True)
+    assert by_name.has_profile and by_profile.has_profile and not by_urdf.has_profile
+    for r in (by_profile, by_urdf):
+        assert r.joint_names == by_name.joint_names
+        assert (r.nq, r.nv) == (by_name.nq, by_name.nv) == (36, 35)
+        assert r.total_mass == pytest.approx(by_name.total_mass, rel=1e-12)
+    # The profile's acceleration limits (10 × the velocity limit) replace the URDF's none.
+    _, _, vel, acc = by_profile.limits()
+    assert np.allclose(acc[6:], 10.0 * vel[6:])
+    with pytest.raises(iktc.IktcError, match="apply to URDF files only"):
+        iktc.Robot("g1", floating=True)
+    with pytest.raises(iktc.IktcError, match="cannot read the profile"):
+        iktc.Robot("no_such_profile.toml")
+
+
+def test_a_builtin_clip_and_its_file_load_to_the_same_keypoints():
+    builtin = iktc.load_motion("humanoid3d_dance_b")
+    from_file = iktc.load_motion(str(DATA / "motions" / "deepmimic" / "humanoid3d_dance_b.txt"))
+    assert builtin.format == from_file.format == "DeepMimic JSON"
+    names, times, pos = builtin.keypoints()
+    names_f, times_f, pos_f = from_file.keypoints()
+    assert names == names_f and np.array_equal(times, times_f) and np.array_equal(pos, pos_f)
+    assert pos.dtype == np.float64 and pos.shape == (len(times), len(names), 3)
+    # Z up: the head is above the ankles in every frame.
+    head, la, ra = (names.index(n) for n in ("head", "left_ankle", "right_ankle"))
+    assert np.all(pos[:, head, 2] > pos[:, la, 2] + 1.0)
+    assert np.all(pos[:, head, 2] > pos[:, ra, 2] + 1.0)
+    with pytest.raises(iktc.IktcError):
+        iktc.load_motion(str(REPO / "no_such_motion.bvh"))
+
+
+def test_retargeting_returns_arrays_and_the_resampled_splines_pass_through_the_frames():
+    robot = iktc.Robot("g1")
+    rt = iktc.retarget(iktc.load_motion("humanoid3d_dance_b"), robot)
+    f, j = rt.joint_angles.shape
+    assert f == rt.times.shape[0] and j == len(rt.joint_names) and rt.pelvis_angles.shape == (f, 3)
+    assert all(n in robot.joint_names for n in rt.joint_names)
+    # Resampled at the clip's own (uniform) frame period, the ticks are the frames: the cubic
+    # splines interpolate their knots.
+    period = float(np.mean(np.diff(rt.times)))
+    assert np.allclose(np.diff(rt.times), period, atol=1e-9)
+    refs = rt.resample(period)
+    n = min(len(refs), f)
+    assert refs.position.shape == (len(refs), j)
+    assert np.allclose(refs.position[:n], rt.joint_angles[:n], atol=1e-9)
+    assert np.allclose(refs.pelvis_height[:n, 0], rt.pelvis_height[:n], atol=1e-9)
+    # Rates: a central difference of the spline at the control rate.
+    fine = rt.resample(DT)
+    fd = (fine.position[2:] - fine.position[:-2]) / (2 * DT)
+    assert np.allclose(fine.velocity[1:-1], fd, atol=0.05 * max(1.0, np.abs(fd).max()))
+
+
+def test_a_bvh_file_loads_with_its_body_points_in_metres_z_up():
+    motion = iktc.load_motion(str(BVH))
+    assert motion.format == "BVH" and motion.has_skeleton
+    names, times, pos = motion.keypoints()
+    assert pos.shape == (len(times), len(names), 3) and np.all(np.isfinite(pos))
+    # A standing adult: the head 1.2–2.1 m above the ankles (units decided from that height).
+    head, ankle = names.index("head"), names.index("left_ankle")
+    assert 1.2 < pos[0, head, 2] - pos[0, ankle, 2] < 2.1
+
+
+def test_a_map_is_needed_without_a_profile_and_the_profile_map_is_the_builtin_one():
+    motion = iktc.load_motion("humanoid3d_dance_b")
+    bare = iktc.Robot(str(DATA / "robots" / "jvrc1" / "jvrc1.urdf"), floating=True)
+    with pytest.raises(iktc.IktcError, match="has no profile: pass map="):
+        iktc.retarget(motion, bare)
+    by_profile = iktc.retarget(motion, iktc.Robot("jvrc1"))
+    by_name = iktc.retarget(motion, bare, map="deepmimic_jvrc1")
+    assert by_name.joint_names == by_profile.joint_names
+    assert np.array_equal(by_name.joint_angles, by_profile.joint_angles)
+
+
+def test_the_imitation_from_python_equals_the_rust_command_line():
+    out = tempfile.mkdtemp()
+    subprocess.run([iktc_binary(), "imitate", "--robot", "g1", "--out", out], check=True,
+                   stdout=subprocess.DEVNULL)
+    with open(os.path.join(out, "joints.csv")) as f:
+        rows = list(csv.DictReader(f))
+    robot = iktc.Robot("g1")
+    sim = iktc.Imitation(robot, iktc.load_motion("humanoid3d_dance_b"))
+    assert sim.ticks == len(rows)
+    names = robot.joint_names
+    worst = 0.0
+    for row in rows:
+        q = sim.q
+        worst = max(worst, max(abs(q[7 + i] - float(row[n])) for i, n in enumerate(names)))
+        report = sim.tick()
+        assert report.violation <= 1e-9
+    # Same code, same inputs: equal up to the CSV's printed digits.
+    assert worst < 1e-9, worst
+
+
+def test_the_imitation_holds_the_feet_and_moves_the_com_by_the_offset():
+    robot = iktc.Robot("g1")
+    sim = iktc.Imitation(robot, iktc.load_motion("humanoid3d_dance_b"), duration=1.0)
+    assert sim.ticks == 200
+    feet = sim.feet()
+    for _ in range(100):
+        sim.tick()
+    sim.set_com_offset((0.01, -0.005))
+    for _ in range(100):
+        sim.tick()
+    q = sim.q
+    for name, pose in feet:
+        assert np.abs(robot.frame_pose(q, name)[:3, 3] - pose[:3, 3]).max() < 1e-3
+    # COM xy: the standing reference plus the offset (k_p = 100 s⁻², 0.5 s: converged to ~mm).
+    target = sim.com_reference()[:2] + [0.01, -0.005]
+    assert np.abs(robot.com(q)[:2] - target).max() < 2e-3
+    # The support margin of the polygon's own centre is half the narrower extent, here the
+    # sole length (the feet stand side by side, 0.237 m apart, soles 0.17 m × 0.05 m).
+    centre = np.mean([p[:2, 3] for _, p in feet], axis=0) + [sim.sole()["sole_offset_x"], 0.0]
+    assert sim.support_margin(tuple(centre)) == pytest.approx(0.5 * sim.sole()["sole_length"])
+    with pytest.raises(iktc.IktcError, match="no profile"):
+        iktc.Imitation(iktc.Robot("planar3r"), iktc.load_motion("humanoid3d_dance_b"))

@@ -1,0 +1,156 @@
+"""The MuJoCo closed loop of the G1 (crates/iktc-py/examples/g1_sim.py), run briefly, headless."""
+import pathlib
+import sys
+
+import mujoco
+import numpy as np
+import pytest
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "examples"))
+import g1_sim  # noqa: E402
+import iktc  # noqa: E402
+
+
+def test_the_plant_stands_and_its_ankle_sensors_carry_the_weight():
+    loop = g1_sim.Loop(duration=0.1)
+    p = loop.plant
+    q = loop.sim.q
+    for _ in range(200):  # 1 s holding the initial posture
+        p.command(q)
+        p.advance()
+    m = p.model
+    # Ground force on the feet = the weight of everything above the ankle sensors (the feet's own
+    # weight is below them), from the model's masses.
+    feet = sum(m.body_subtreemass[i] for i in p.feet)
+    above = (m.body_subtreemass[p.pelvis] - feet) * -m.opt.gravity[2]
+    fz = p.sensor_reading("left")[1][2] + p.sensor_reading("right")[1][2]
+    assert fz == pytest.approx(above, rel=0.02)
+    zmp, status = p.zmp()
+    assert status == "both"
+    assert loop.sim.support_margin(zmp, [p.foot_pose(i) for i in range(2)]) > 0.01
+    assert p.pelvis_height() > 0.74 and p.base_tilt() < 0.05
+
+
+def test_the_sensor_zmp_is_the_centre_of_pressure_of_the_contact_forces():
+    loop = g1_sim.Loop(duration=0.1)
+    loop.settle(0.5)
+    p, m, d = loop.plant, loop.plant.model, loop.plant.data
+    # Centre of pressure from MuJoCo's contact forces (an independent route to the ZMP).
+    total, moment = 0.0, np.zeros(2)
+    f6 = np.zeros(6)
+    for i in range(d.ncon):
+        c = d.contact[i]
+        mujoco.mj_contactForce(m, d, i, f6)
+        fz = (c.frame.reshape(3, 3).T @ f6[:3])[2]
+        total += fz
+        moment += fz * c.pos[:2]
+    cop = moment / total
+    zmp, _ = p.zmp()
+    # The sensors miss the feet's own weight and the spheres' 5 mm radius: within 5 mm.
+    assert np.abs(np.array(zmp) - cop).max() < 5e-3, (zmp, cop)
+
+
+def test_standing_imitation_of_the_default_clip_stays_up():
+    loop = g1_sim.run_standing()
+    s = loop.summary()
+    assert s["ticks"] == loop.sim.ticks == 507
+    assert s["stayed_up"], s
+    assert s["zmp_ticks_measured"] > 0.9 * s["ticks"]
+
+
+@pytest.mark.xfail(strict=True, reason="G1 on MuJoCo rocks and its feet slip 0.1 m or more "
+                   "while imitating humanoid3d_dance_b (see the example's README section)")
+def test_standing_imitation_of_the_default_clip_keeps_the_feet_within_5_mm():
+    s = g1_sim.run_standing().summary()
+    assert s["foot_slip_max_m"] <= 5e-3, s
+
+
+def test_the_planned_zmp_is_the_com_standing_and_shifts_by_z_a_over_g_when_accelerated():
+    loop = g1_sim.Loop(duration=0.1)
+    q0 = loop.sim.q
+    com = loop.robot.com(q0)
+    # Standing still: the ZMP is under the COM (iktc's COM, an independent computation).
+    z = g1_sim.planned_zmp(loop.plant, [q0] * 7)
+    assert np.allclose(z[2:5], com[:2], atol=1e-6)
+    # The whole robot translated with a constant horizontal acceleration a [m/s²]: the
+    # cart-table closed form x_zmp = x_com − z_com a / g holds exactly for a pure translation.
+    a = 0.8
+    qs = []
+    for k in range(7):
+        q = q0.copy()
+        q[0] += 0.5 * a * (k * g1_sim.CONTROL_PERIOD) ** 2
+        qs.append(q)
+    z = g1_sim.planned_zmp(loop.plant, qs)
+    g = -loop.plant.model.opt.gravity[2]
+    for k in range(2, 5):
+        expected = com[0] + 0.5 * a * (k * g1_sim.CONTROL_PERIOD) ** 2 - com[2] * a / g
+        assert z[k, 0] == pytest.approx(expected, abs=1e-6)
+        assert z[k, 1] == pytest.approx(com[1], abs=1e-6)
+
+
+@pytest.mark.parametrize("zeta,wn", [(0.15, 4.8), (0.55, 4.5), (0.72, 5.0)])
+def test_the_damping_ratio_estimate_recovers_a_known_damped_sinusoid(zeta, wn):
+    t = np.arange(0.0, 2.0, g1_sim.CONTROL_PERIOD)
+    wd = wn * np.sqrt(1 - zeta ** 2)
+    y = 0.003 + 0.02 * np.exp(-zeta * wn * t) * np.cos(wd * t + 0.4)
+    z, w = g1_sim.damping_ratio(t, y)
+    assert z == pytest.approx(zeta, abs=0.01) and w == pytest.approx(wn, rel=0.01)
+
+
+@pytest.fixture(scope="module")
+def identified():
+    """The IPCJ model identified on MuJoCo by a short sweep (6 frequencies over the band)."""
+    return g1_sim.identify_on_plant(freqs=np.geomspace(*g1_sim.SWEEP_BAND, 6), settle=2.5,
+                                    cycles=3, min_time=1.5)
+
+
+def test_identification_on_mujoco_fits_the_measured_frequency_response(identified):
+    model, fit, (omega, mag, phase) = identified
+    # The model's own prediction at the measured frequencies (recomputed from the model, not
+    # the fitter's figure): within 10 % rms, 10° of phase everywhere.
+    assert fit["prediction_rms_relative_error"] < 0.10, fit
+    assert fit["prediction_max_phase_error_deg"] < 10.0, fit
+    # The pendulum length near the COM height (0.66 m) and a lightly damped mode.
+    wn, zeta = model.modal()
+    assert 0.5 < model.length < 0.8 and zeta < 0.3, (model, wn, zeta)
+
+
+def test_a_push_in_double_support_is_damped_more_with_the_damping_controller(identified):
+    model = identified[0]
+    ratios = {}
+    for name, m in (("open", None), ("damped", model)):
+        loop, t, y = g1_sim.push_test(model=m)
+        s = loop.summary()
+        assert s["stayed_up"] and s["foot_slip_max_m"] < 5e-3 and s["zmp_inside"], s
+        ratios[name] = g1_sim.damping_ratio(t, y)[0]
+    assert ratios["damped"] > ratios["open"] + 0.2, ratios
+
+
+@pytest.mark.xfail(strict=True, reason="the measured damping ratio with the controller is "
+                   "≈ 0.56 against the design 0.72 (see the example's README section)")
+def test_a_push_in_double_support_is_damped_to_the_design_ratio(identified):
+    loop, t, y = g1_sim.push_test(model=identified[0], damping=0.72)
+    assert abs(g1_sim.damping_ratio(t, y)[0] - 0.72) <= 0.15
+
+
+def test_the_walking_binding_moves_the_feet_as_the_pattern_says():
+    robot = iktc.Robot("g1")
+    walk = iktc.Walking(robot, iktc.load_motion("humanoid3d_dance_b"), steps=4, step_length=0.1)
+    start = [f[:3, 3] for f in walk.feet0()]
+    worst = 0.0
+    for _ in range(walk.ticks):
+        walk.tick()
+        for name, ref in zip(g1_sim.FEET, walk.feet_references()):
+            worst = max(worst, float(np.abs(robot.frame_pose(walk.q, name)[:3, 3] - ref[:3, 3]).max()))
+    end = [robot.frame_pose(walk.q, f)[:3, 3] for f in g1_sim.FEET]
+    # Four steps of 0.1 m, the last closing the feet side by side: both feet 0.3 m ahead.
+    for s, e in zip(start, end):
+        assert e[0] - s[0] == pytest.approx(0.3, abs=2e-3) and abs(e[1] - s[1]) < 2e-3
+    assert worst < 0.01, worst
+
+
+@pytest.mark.xfail(strict=True, reason="G1 in MuJoCo falls in the first single support of the "
+                   "walk while imitating (see the example's README section)")
+def test_walking_four_steps_in_mujoco_stays_up_with_the_zmp_inside():
+    s = g1_sim.run_walking()
+    assert s["stayed_up"] and s["zmp_inside"], s
