@@ -157,3 +157,43 @@ impl AccelerationBox {
         check_dim("AccelerationBox::sources", nv, self.sources.len())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::AccelerationBox;
+    use nalgebra::DVector;
+
+    fn boxed(lower: &[f64], upper: &[f64]) -> AccelerationBox {
+        let mut b = AccelerationBox::new(lower.len());
+        b.lower = DVector::from_column_slice(lower);
+        b.upper = DVector::from_column_slice(upper);
+        b
+    }
+
+    /// A zero-width interval (lower = upper, a joint held) is not empty; lower > upper is.
+    #[test]
+    fn only_crossed_intervals_are_empty() {
+        let b = boxed(&[0.0, 1.0, -2.0, 3.0], &[0.0, 2.0, -2.0, 2.5]);
+        assert_eq!(b.empty_dofs().collect::<Vec<_>>(), [3]);
+        assert!(b.is_empty());
+        let held = boxed(&[1.0, -1.0], &[1.0, -1.0]);
+        assert!(!held.is_empty());
+        assert_eq!(held.nv(), 2);
+    }
+
+    /// The violation is the largest distance outside the box, 0 inside, and `contains`
+    /// compares it with the tolerance inclusively.
+    #[test]
+    fn violation_is_the_largest_distance_outside() {
+        let b = boxed(&[-1.0, 0.0, 2.0], &[1.0, 0.5, 3.0]);
+        assert_eq!(b.max_violation(&[0.0, 0.25, 2.5]).ok(), Some(0.0));
+        assert_eq!(b.max_violation(&[-1.5, 0.75, 2.5]).ok(), Some(0.5));
+        assert_eq!(b.max_violation(&[0.0, 0.0, 5.0]).ok(), Some(2.0));
+        assert_eq!(b.contains(&[0.0, 0.0, 3.25], 0.25).ok(), Some(true));
+        assert_eq!(b.contains(&[0.0, 0.0, 3.5], 0.25).ok(), Some(false));
+        assert!(b.contains(&[0.0, 0.0], 0.0).is_err());
+        assert!(b.contains(&[0.0, f64::NAN, 0.0], 0.0).is_err());
+        assert!(b.contains(&[0.0, 0.0, 2.5], -1.0).is_err());
+        assert!(b.contains(&[0.0, 0.0, 2.5], f64::NAN).is_err());
+    }
+}
