@@ -421,3 +421,7 @@ pub fn recovery_acceleration(
         None
     }
 }
+
+#[cfg(test)]
+#[path = "viable_tests.rs"]
+mod tests;
