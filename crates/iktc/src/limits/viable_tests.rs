@@ -78,10 +78,17 @@ fn position_upper_is_exactly_the_in_step_peak_condition() {
     let mut rng = ChaCha8Rng::seed_from_u64(11);
     let mut turning = 0;
     for _ in 0..20_000 {
-        let Draw { q, qd, hi, dt, .. } = draw(&mut rng);
-        if hi - q <= 0.0 && qd > 0.0 {
-            continue; // at the limit moving out: not a viable state (fallback documented)
+        let Draw {
+            q, qd, lo, hi, dt, ..
+        } = draw(&mut rng);
+        if (hi - q <= 0.0 && qd > 0.0) || (q - lo <= 0.0 && qd < 0.0) {
+            continue; // at a limit moving out: not a viable state (fallback documented)
         }
+        // The lower side on its own limit: the lowest point of the step stays above q_min.
+        let bl = position_lower(q, qd, lo, dt);
+        let s = 1e-6 * (1.0 + bl.abs() + qd.abs() / dt);
+        assert!(-peak(-q, -qd, -(bl + s), dt) >= lo - 1e-12 * (1.0 + lo.abs()));
+        assert!(-peak(-q, -qd, -(bl - s), dt) < lo);
         let b = position_upper(q, qd, hi, dt);
         let scale = 1.0 + b.abs() + qd.abs() / dt;
         let inside = b - 1e-6 * scale;
