@@ -65,3 +65,6 @@ pub use quiet::quiet_sources;
 pub use source::{BoundSource, DofBoundSources, DroppedSources, SourceBounds};
 pub use velocity::{velocity_lower, velocity_upper};
 pub use viable::viable_sources;
+
+#[cfg(test)]
+mod tests;
