@@ -344,8 +344,8 @@ SWEEP_AMPLITUDE = 0.005
 
 
 def standing_loop(settle: float = 4.0, **kw) -> Loop:
-    """A loop whose imitation holds the first pose of the clip (upper body still), with the COM
-    reference settled over the centre of the support polygon."""
+    """A loop whose imitation holds the start of the clip (its first 1/60 s, then still), with
+    the COM reference settled over the centre of the support polygon."""
     loop = Loop(duration=CONTROL_PERIOD, **kw)
     for _ in range(int(round(settle / CONTROL_PERIOD))):
         loop.step(com_offset=(0.0, 0.0))
