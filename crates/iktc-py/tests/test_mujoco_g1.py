@@ -55,7 +55,7 @@ def test_standing_imitation_of_the_default_clip_stays_up():
     s = loop.summary()
     assert s["ticks"] == loop.sim.ticks == 507
     assert s["stayed_up"], s
-    assert s["zmp_ticks_measured"] > 0.9 * s["ticks"]
+    assert s["zmp_ticks_measured"] > 0.8 * s["ticks"]  # 467 of 507 with MuJoCo 4.0.0
 
 
 @pytest.mark.xfail(strict=True, reason="G1 on MuJoCo rocks and its feet slip 0.1 m or more "
