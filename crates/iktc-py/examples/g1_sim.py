@@ -344,8 +344,8 @@ SWEEP_AMPLITUDE = 0.005
 
 
 def standing_loop(settle: float = 4.0, **kw) -> Loop:
-    """A loop whose imitation holds the first pose of the clip (upper body still), with the COM
-    reference settled over the centre of the support polygon."""
+    """A loop whose imitation holds the start of the clip (its first 1/60 s, then still), with
+    the COM reference settled over the centre of the support polygon."""
     loop = Loop(duration=CONTROL_PERIOD, **kw)
     for _ in range(int(round(settle / CONTROL_PERIOD))):
         loop.step(com_offset=(0.0, 0.0))
@@ -536,3 +536,79 @@ def run_walking(steps: int = 4, step_length: float = 0.1, clip: str = "humanoid3
         "joint_error_max_rad": float(np.max(errs)),
         "forward_progress_m": float(plant.data.xpos[plant.pelvis][0] - walk.feet0()[0][0, 3]),
     }
+
+
+# --- replay -------------------------------------------------------------------------------
+
+_REPLAY_HTML = """<!doctype html>
+<html><head><meta charset="utf-8"><title>%(title)s</title>
+<style>body{font:14px sans-serif;margin:1em}svg{border:1px solid #ccc;background:#fafafa}</style>
+</head><body>
+<h3>%(title)s</h3>
+<p><span style="color:#1f77b4">&#9632;</span> MuJoCo (physics) &nbsp;
+<span style="color:#999">&#9632;</span> iktc's plan (kinematic) &nbsp; side view (x, z) and front
+view (y, z), metres; ground at z = 0.</p>
+<svg id="side" width="420" height="420" viewBox="-0.7 -1.4 1.4 1.4"></svg>
+<svg id="front" width="420" height="420" viewBox="-0.7 -1.4 1.4 1.4"></svg><br>
+<input id="k" type="range" min="0" max="%(last)d" value="0" style="width:840px">
+<button id="play">play</button> <span id="t"></span>
+<script>
+const D = %(data)s;
+const svgs = {side: document.getElementById('side'), front: document.getElementById('front')};
+function draw(k) {
+  for (const [name, svg] of Object.entries(svgs)) {
+    const a = name === 'side' ? 0 : 1;
+    let s = '<line x1="-0.7" y1="0" x2="0.7" y2="0" stroke="#333" stroke-width="0.004"/>';
+    for (const [key, colour] of [['plan', '#999'], ['physics', '#1f77b4']]) {
+      const p = D[key][k];
+      for (const [c, q] of D.edges) {
+        s += `<line x1="${p[q][a]}" y1="${-p[q][2]}" x2="${p[c][a]}" y2="${-p[c][2]}" ` +
+             `stroke="${colour}" stroke-width="0.012" stroke-linecap="round"/>`;
+      }
+    }
+    svg.innerHTML = s;
+  }
+  document.getElementById('t').textContent = `t = ${(k * D.dt).toFixed(3)} s`;
+}
+const slider = document.getElementById('k');
+slider.oninput = () => draw(+slider.value);
+let timer = null;
+document.getElementById('play').onclick = () => {
+  if (timer) { clearInterval(timer); timer = null; return; }
+  timer = setInterval(() => {
+    slider.value = (+slider.value + 1) %% (D.physics.length);
+    draw(+slider.value);
+  }, D.dt * 1000);
+};
+draw(0);
+</script></body></html>
+"""
+
+
+def write_replay(path, plant: Plant, qpos_physics: list, q_plan: list, title: str) -> None:
+    """An HTML replay (no dependency, stick figures of the body tree) of the physics run next to
+    iktc's plan: `qpos_physics` MuJoCo's qpos per tick, `q_plan` iktc's q per tick."""
+    import json
+    m = plant.model
+    d = mujoco.MjData(m)
+    bodies = list(range(1, m.nbody))
+    edges = [[b - 1, int(m.body_parentid[b]) - 1] for b in bodies if m.body_parentid[b] > 0]
+
+    def frames(rows, from_plan):
+        out = []
+        for r in rows:
+            if from_plan:
+                d.qpos[:3] = r[:3]
+                d.qpos[3:7] = [r[6], r[3], r[4], r[5]]
+                d.qpos[plant.qadr] = r[7:]
+            else:
+                d.qpos[:] = r
+            mujoco.mj_kinematics(m, d)
+            out.append([[round(float(v), 4) for v in d.xpos[b]] for b in bodies])
+        return out
+
+    data = {"dt": CONTROL_PERIOD, "edges": edges, "physics": frames(qpos_physics, False),
+            "plan": frames(q_plan, True)}
+    with open(path, "w") as f:
+        f.write(_REPLAY_HTML % {"title": title, "last": len(qpos_physics) - 1,
+                                "data": json.dumps(data, separators=(",", ":"))})

@@ -1,7 +1,7 @@
 """The Unitree G1 in MuJoCo driven by iktc tick by tick: standing imitation, identification, push.
 
     python crates/iktc-py/examples/mujoco_g1.py standing [--clip humanoid3d_dance_b]
-        [--time-scale 1] [--robot g1|profile.toml] [--json out.json]
+        [--time-scale 1] [--robot g1|profile.toml] [--json out.json] [--replay out.html]
     python crates/iktc-py/examples/mujoco_g1.py balance [--damping 0.72] [--json out.json]
     python crates/iktc-py/examples/mujoco_g1.py walking [--steps 4] [--json out.json]
 
@@ -57,6 +57,8 @@ def main() -> None:
     ap.add_argument("--robot", default="g1", help="the built-in g1 or a G1 profile file (.toml)")
     ap.add_argument("--settle", type=float, default=0.5, help="time holding the start posture [s]")
     ap.add_argument("--json", help="write the figures to this file")
+    ap.add_argument("--replay", help="standing: write an HTML replay of the physics run next to "
+                    "iktc's plan to this file")
     a = ap.parse_args()
     if a.run == "balance":
         s = balance(a)
@@ -80,6 +82,9 @@ def standing(a) -> dict:
     margins = [loop.sim.support_margin(tuple(p)) for p in plan if np.all(np.isfinite(p))]
     s["planned_zmp_margin_min_m"] = float(min(margins))
     s["planned_zmp_ticks_outside"] = int(sum(m < 0 for m in margins))
+    if a.replay:
+        g1_sim.write_replay(a.replay, loop.plant, loop.log.qpos, loop.log.q_cmd,
+                            f"G1 in MuJoCo imitating {a.clip} (time scale {a.time_scale})")
     s["plant"] = {"kp_Nm_per_rad": g1_sim.KP, "kv_Nms_per_rad": g1_sim.KV,
                   "physics_step_s": g1_sim.PHYSICS_STEP, "control_period_s": g1_sim.CONTROL_PERIOD,
                   "integrator": "implicitfast"}

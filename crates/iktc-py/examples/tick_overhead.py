@@ -8,6 +8,8 @@ L_HIP_R narrowed, Δt = 5 ms): the bench times `tick` + `integrate` in Rust, thi
 `Imitation.tick()` (the same two calls plus the Python call, the GIL release and the report
 turned into Python objects) with timeit, over passes of the whole clip.
 """
+import statistics
+import time
 import timeit
 
 import iktc
@@ -28,6 +30,16 @@ def main() -> None:
     reset = min(timeit.repeat(sim.reset, number=1, repeat=passes))
     print(f"Imitation.tick from Python: {(best - reset) / n * 1e6:.1f} µs per tick "
           f"(best of {passes} passes of {n} ticks, reset excluded)")
+    # Single ticks, as the bench prints them: median over 5 passes.
+    ticks = []
+    for _ in range(passes):
+        sim.reset()
+        for _ in range(n):
+            t0 = time.perf_counter()
+            sim.tick()
+            ticks.append(time.perf_counter() - t0)
+    print(f"Imitation.tick from Python: single ticks over {passes} passes of {n}: median "
+          f"{statistics.median(ticks) * 1e6:.1f} µs")
 
 
 if __name__ == "__main__":

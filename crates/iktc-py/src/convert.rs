@@ -1,8 +1,9 @@
 //! numpy ↔ nalgebra conversions with the checks the Python side needs (sizes, finiteness).
 
 use nalgebra::{DMatrix, Isometry3, Quaternion, Translation3, UnitQuaternion, Vector3};
+use numpy::ndarray::IntoDimension;
 use numpy::npyffi::NPY_ORDER;
-use numpy::{PyArray1, PyArray2, PyArray3, PyArrayMethods, ToPyArray};
+use numpy::{PyArray, PyArray1, PyArray2, PyArrayMethods, ToPyArray};
 use pyo3::prelude::*;
 
 use crate::IktcError;
@@ -95,20 +96,12 @@ pub(crate) fn array<'py>(py: Python<'py>, v: &[f64]) -> Bound<'py, PyArray1<f64>
     v.to_pyarray(py)
 }
 
-/// A row-major (rows, cols) numpy array from its flat data (moved, not copied again).
-pub(crate) fn table<'py>(
+/// A row-major numpy array of shape `shape` (e.g. `[rows, cols]`) from its flat data (moved,
+/// not copied again).
+pub(crate) fn table<'py, D: IntoDimension>(
     py: Python<'py>,
-    shape: [usize; 2],
+    shape: D,
     flat: Vec<f64>,
-) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    PyArray1::from_vec(py, flat).reshape_with_order(shape, NPY_ORDER::NPY_CORDER)
-}
-
-/// A row-major 3-D numpy array from its flat data.
-pub(crate) fn table3<'py>(
-    py: Python<'py>,
-    shape: [usize; 3],
-    flat: Vec<f64>,
-) -> PyResult<Bound<'py, PyArray3<f64>>> {
+) -> PyResult<Bound<'py, PyArray<f64, D::Dim>>> {
     PyArray1::from_vec(py, flat).reshape_with_order(shape, NPY_ORDER::NPY_CORDER)
 }

@@ -4,7 +4,7 @@
 //! controller's output) and the support-polygon margin of a measured ZMP is computed from the
 //! profile's soles.
 
-use iktc::motion::{Clip, RobotReferences, Track};
+use iktc::motion::Clip;
 use iktc::sim::imitate::support_polygon;
 use iktc::sim::{imitation_references, ImitateConfig, ImitationController};
 use iktc::task::ComReference;
@@ -37,24 +37,44 @@ pub struct PyImitation {
     com_offset: Option<[f64; 2]>,
 }
 
-/// The first `n` ticks of `refs`.
-fn first_ticks(r: &RobotReferences, n: usize) -> RobotReferences {
-    let cut = |t: &Track| Track {
-        position: t.position[..n].to_vec(),
-        velocity: t.velocity[..n].to_vec(),
-        acceleration: t.acceleration[..n].to_vec(),
-    };
-    RobotReferences {
-        dt: r.dt,
-        times: r.times[..n].to_vec(),
-        joint_names: r.joint_names.clone(),
-        joints: r.joints.iter().map(cut).collect(),
-        height: cut(&r.height),
-        angles: [cut(&r.angles[0]), cut(&r.angles[1]), cut(&r.angles[2])],
-        attitude: r.attitude[..n].to_vec(),
-        angular_velocity: r.angular_velocity[..n].to_vec(),
-        angular_acceleration: r.angular_acceleration[..n].to_vec(),
+/// `clip` played `time_scale` times slower (its frame times multiplied) and cut after the first
+/// frame at or past `duration` [s]; `None` when neither changes it.
+fn clip_part(clip: &Clip, time_scale: f64, duration: Option<f64>) -> iktc::Result<Option<Clip>> {
+    if !(time_scale.is_finite() && time_scale > 0.0) {
+        return Err(iktc::Error::InvalidSetting {
+            name: "time_scale".into(),
+            value: time_scale.to_string(),
+            expected: "a finite factor > 0".into(),
+        });
     }
+    if let Some(d) = duration {
+        if !(d.is_finite() && d > 0.0) {
+            return Err(iktc::Error::InvalidSetting {
+                name: "duration".into(),
+                value: d.to_string(),
+                expected: "a finite time > 0 [s]".into(),
+            });
+        }
+    }
+    if time_scale == 1.0 && duration.is_none() {
+        return Ok(None);
+    }
+    let times: Vec<f64> = clip.times().iter().map(|t| t * time_scale).collect();
+    let keep = match duration {
+        Some(d) => times
+            .iter()
+            .position(|t| *t >= d)
+            .map_or(times.len(), |i| i + 1),
+        None => times.len(),
+    };
+    Clip::new(
+        clip.name(),
+        clip.skeleton().clone(),
+        times[..keep].to_vec(),
+        clip.frames()[..keep].to_vec(),
+        clip.up_axis(),
+    )
+    .map(Some)
 }
 
 /// A pose from a 4 × 4 homogeneous matrix (its rotation block re-orthonormalised).
@@ -82,9 +102,9 @@ impl PyImitation {
     /// `robot` must have a profile (feet, pelvis, posture, narrowed ranges, soles); `motion` a
     /// skeleton. `map`: a built-in map or TOML file (default: the profile's); `dt` the control
     /// period [s]; `method` iktc, gf, clamp or prioritized; `bounds` viable or paper;
-    /// `duration` [s] keeps the first part of the clip (default: all of it); `time_scale` [–]
-    /// plays the clip that many times slower (its frame times multiplied: rates divided by it,
-    /// accelerations by its square).
+    /// `duration` [s] keeps the clip's frames up to the first at or past it (default: all);
+    /// `time_scale` [–] plays the clip that many times slower (its frame times multiplied:
+    /// rates divided by it, accelerations by its square), before the cut.
     #[new]
     #[pyo3(signature = (robot, motion, *, map=None, dt=0.005, method="iktc", bounds="viable", duration=None, time_scale=1.0))]
     #[allow(clippy::too_many_arguments)]
@@ -99,11 +119,6 @@ impl PyImitation {
         duration: Option<f64>,
         time_scale: f64,
     ) -> PyResult<Self> {
-        if !(time_scale.is_finite() && time_scale > 0.0) {
-            return Err(IktcError::new_err(format!(
-                "time_scale {time_scale}: expected a finite factor > 0"
-            )));
-        }
         let profile = robot.profile.as_ref().ok_or_else(|| {
             IktcError::new_err(format!(
                 "robot `{}` has no profile: the imitation needs its feet, pelvis and posture (load it by a built-in name or a profile file)",
@@ -119,36 +134,12 @@ impl PyImitation {
         let cfg = profile.imitate_config(base).map_err(to_py)?;
         let map = resolve_map(robot, motion, map)?;
         let clip = motion.clip()?;
-        let scaled;
-        let clip = if time_scale == 1.0 {
-            clip
-        } else {
-            let times: Vec<f64> = clip.times().iter().map(|t| t * time_scale).collect();
-            scaled = Clip::new(
-                clip.name(),
-                clip.skeleton().clone(),
-                times,
-                clip.frames().to_vec(),
-                clip.up_axis(),
-            )
-            .map_err(to_py)?;
-            &scaled
-        };
+        let part = clip_part(clip, time_scale, duration).map_err(to_py)?;
+        let clip = part.as_ref().unwrap_or(clip);
         let r = &robot.robot;
         let ctl = py
             .detach(|| -> iktc::Result<ImitationController> {
-                let mut refs = imitation_references(r, clip, &map, &cfg)?;
-                if let Some(d) = duration {
-                    if !(d.is_finite() && d > 0.0) {
-                        return Err(iktc::Error::InvalidSetting {
-                            name: "duration".into(),
-                            value: d.to_string(),
-                            expected: "a finite time > 0 [s]".into(),
-                        });
-                    }
-                    let n = ((d / dt).round() as usize).clamp(1, refs.len());
-                    refs = first_ticks(&refs, n);
-                }
+                let refs = imitation_references(r, clip, &map, &cfg)?;
                 ImitationController::new(r, &refs, &cfg)
             })
             .map_err(to_py)?;

@@ -12,7 +12,7 @@ use iktc::motion::{
 use numpy::{PyArray1, PyArray2, PyArray3};
 use pyo3::prelude::*;
 
-use crate::convert::{array, table, table3};
+use crate::convert::{array, table};
 use crate::robot::PyRobot;
 use crate::{to_py, IktcError};
 
@@ -103,7 +103,7 @@ impl PyMotion {
             .map_err(to_py)?;
         let names = kp.points.iter().map(|p| p.name().to_string()).collect();
         let flat: Vec<f64> = kp.positions.iter().flat_map(|p| [p.x, p.y, p.z]).collect();
-        let positions = table3(py, [kp.frame_count(), kp.points.len(), 3], flat)?;
+        let positions = table(py, [kp.frame_count(), kp.points.len(), 3], flat)?;
         Ok((names, array(py, &kp.times), positions))
     }
 
@@ -290,37 +290,19 @@ impl PyReferences {
     /// Joint positions [rad], shape (N, J).
     #[getter]
     fn position<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let t: Vec<&[f64]> = self
-            .inner
-            .joints
-            .iter()
-            .map(|t| t.position.as_slice())
-            .collect();
-        by_frame(py, &t, self.inner.len())
+        self.joint_table(py, |t| &t.position)
     }
 
     /// Joint rates [rad/s], shape (N, J).
     #[getter]
     fn velocity<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let t: Vec<&[f64]> = self
-            .inner
-            .joints
-            .iter()
-            .map(|t| t.velocity.as_slice())
-            .collect();
-        by_frame(py, &t, self.inner.len())
+        self.joint_table(py, |t| &t.velocity)
     }
 
     /// Joint accelerations [rad/s²], shape (N, J).
     #[getter]
     fn acceleration<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let t: Vec<&[f64]> = self
-            .inner
-            .joints
-            .iter()
-            .map(|t| t.acceleration.as_slice())
-            .collect();
-        by_frame(py, &t, self.inner.len())
+        self.joint_table(py, |t| &t.acceleration)
     }
 
     /// Pelvis height change [m], its rate [m/s] and acceleration [m/s²], shape (N, 3).
@@ -342,6 +324,23 @@ impl PyReferences {
 
     fn __len__(&self) -> usize {
         self.inner.len()
+    }
+}
+
+impl PyReferences {
+    /// One field of every joint track as a (ticks, joints) array.
+    fn joint_table<'py>(
+        &self,
+        py: Python<'py>,
+        field: fn(&Track) -> &Vec<f64>,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let t: Vec<&[f64]> = self
+            .inner
+            .joints
+            .iter()
+            .map(|t| field(t).as_slice())
+            .collect();
+        by_frame(py, &t, self.inner.len())
     }
 }
 

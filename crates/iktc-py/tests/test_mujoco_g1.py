@@ -55,7 +55,7 @@ def test_standing_imitation_of_the_default_clip_stays_up():
     s = loop.summary()
     assert s["ticks"] == loop.sim.ticks == 507
     assert s["stayed_up"], s
-    assert s["zmp_ticks_measured"] > 0.9 * s["ticks"]
+    assert s["zmp_ticks_measured"] > 0.8 * s["ticks"]  # 467 of 507 with MuJoCo 4.0.0
 
 
 @pytest.mark.xfail(strict=True, reason="G1 on MuJoCo rocks and its feet slip 0.1 m or more "
@@ -154,3 +154,22 @@ def test_the_walking_binding_moves_the_feet_as_the_pattern_says():
 def test_walking_four_steps_in_mujoco_stays_up_with_the_zmp_inside():
     s = g1_sim.run_walking()
     assert s["stayed_up"] and s["zmp_inside"], s
+
+
+def test_the_replay_holds_both_runs_tick_by_tick(tmp_path):
+    import json
+    loop = g1_sim.Loop(duration=0.1)
+    for _ in range(loop.sim.ticks):
+        loop.step()
+    path = tmp_path / "replay.html"
+    g1_sim.write_replay(path, loop.plant, loop.log.qpos, loop.log.q_cmd, "test")
+    text = path.read_text()
+    data = json.loads(text.split("const D = ", 1)[1].split(";\n", 1)[0])
+    n = loop.sim.ticks
+    assert len(data["physics"]) == len(data["plan"]) == n
+    # The plan's feet are where iktc puts them (MuJoCo's kinematics of the plan = iktc's).
+    m = loop.plant.model
+    for i, name in enumerate(g1_sim.FEET):
+        b = m.body(name).id - 1
+        assert np.allclose(data["plan"][-1][b], loop.robot.frame_pose(loop.log.q_cmd[-1], name)[:3, 3],
+                           atol=1e-4)
