@@ -10,6 +10,7 @@ use iktc::sim::{Experiment, ImitateConfig, ImitateRun};
 use iktc::solver::Method;
 use iktc_report::{write_csv, write_figure, Figure, Panel, Section, Series, Table};
 
+use crate::columns::level_number;
 use crate::scenario::{health_text, prepare, ScenarioArgs};
 use crate::viewer::write_viewer;
 
@@ -139,7 +140,7 @@ pub fn write_imitate(r: &ImitateRun, e: &Experiment, dir: &Path) -> Result<Vec<(
             v.extend(st.level_error);
             v.extend(st.correction);
             v.extend([
-                st.corrected_from as f64,
+                level_number(st.corrected_from),
                 st.com[0],
                 st.com[1],
                 st.com_margin,
@@ -296,7 +297,7 @@ pub fn write_imitate(r: &ImitateRun, e: &Experiment, dir: &Path) -> Result<Vec<(
     .with(Series::points(
         "corrected from",
         t.clone(),
-        col(&|st| st.corrected_from as f64),
+        col(&|st| level_number(st.corrected_from)),
     ));
     corr = corr
         .hline(3.0, "pelvis attitude")

@@ -180,7 +180,7 @@ pub fn write_run(r: &Planar3rRun, dir: &Path) -> Result<Vec<(String, String)>> {
                 v.extend(a);
             }
             v.extend([
-                s.corrected_from as f64,
+                crate::columns::level_number(s.corrected_from),
                 s.qp_solves as f64,
                 s.empty_dofs as f64,
                 s.tick_us,

@@ -5,13 +5,15 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
-use iktc::sim::viewer::{supporting_feet, walking_viewer};
+use iktc::sim::viewer::walking_viewer;
 use iktc::sim::{
     Experiment, ImitateConfig, Push, PushAxisMetrics, WalkImitateConfig, WalkRun, WalkStep,
     WalkSummary,
 };
+use iktc::walk::{sole_corners, Pose2};
 use iktc_report::{write_csv, write_figure, Figure, Panel, Section, Series, Table};
 
+use crate::columns::{level_number, phase_number};
 use crate::scenario::{health_text, prepare, ScenarioArgs};
 use crate::viewer::write_viewer;
 
@@ -220,7 +222,7 @@ pub fn write_walk(
         .steps
         .iter()
         .map(|s| {
-            let mut v = vec![s.t, s.phase as f64];
+            let mut v = vec![s.t, phase_number(s.phase)];
             v.extend(s.zmp_reference);
             v.extend(s.zmp_model);
             v.extend(s.zmp_measured);
@@ -234,7 +236,11 @@ pub fn write_walk(
             v.extend(s.feet_reference[1]);
             v.extend(s.feet[0]);
             v.extend(s.feet[1]);
-            v.extend([s.corrected_from as f64, s.qp_solves as f64, s.tick_us]);
+            v.extend([
+                level_number(s.corrected_from),
+                s.qp_solves as f64,
+                s.tick_us,
+            ]);
             v
         })
         .collect();
@@ -255,24 +261,12 @@ pub fn write_walk(
     let sole = (imitate.support.sole_length, imitate.support.sole_width);
     let mut fig = Figure::new("ZMP while walking and imitating, push at the dashed event");
     for (i, axis) in ["x", "y"].iter().enumerate() {
-        let half = if i == 0 { 0.5 * sole.0 } else { 0.5 * sole.1 };
-        // The extent of the support polygon along the axis: the feet's soles.
-        let lo: Vec<f64> = with
-            .steps
-            .iter()
-            .map(|s| {
-                let feet: Vec<f64> = supporting_feet(s).iter().map(|f| f[i]).collect();
-                feet.iter().copied().fold(f64::INFINITY, f64::min) - half
-            })
-            .collect();
-        let hi: Vec<f64> = with
-            .steps
-            .iter()
-            .map(|s| {
-                let feet: Vec<f64> = supporting_feet(s).iter().map(|f| f[i]).collect();
-                feet.iter().copied().fold(f64::NEG_INFINITY, f64::max) + half
-            })
-            .collect();
+        // The extent of the support polygon along the axis.
+        let extent = |fold: fn(f64, f64) -> f64, start: f64| {
+            col(with, &|s| s.support.iter().map(|v| v[i]).fold(start, fold))
+        };
+        let lo = extent(f64::min, f64::INFINITY);
+        let hi = extent(f64::max, f64::NEG_INFINITY);
         fig = fig.panel(
             Panel::new(
                 format!("ZMP {axis} (world)"),
@@ -327,11 +321,10 @@ pub fn write_walk(
     // Footsteps from above.
     let mut top = Panel::new("Footsteps from above", "x [m]", "y [m]").equal_aspect();
     for (k, (side, p)) in with.footsteps.iter().enumerate() {
-        let (c, s) = (p[2].cos(), p[2].sin());
-        let (l, w) = (0.5 * sole.0, 0.5 * sole.1);
-        let corners = [(l, w), (-l, w), (-l, -w), (l, -w), (l, w)];
-        let xs = corners.iter().map(|(a, b)| p[0] + c * a - s * b).collect();
-        let ys = corners.iter().map(|(a, b)| p[1] + s * a + c * b).collect();
+        let mut corners = sole_corners(&Pose2::new(p[0], p[1], p[2]), sole.0, sole.1).to_vec();
+        corners.push(corners[0]);
+        let xs = corners.iter().map(|c| c.0).collect();
+        let ys = corners.iter().map(|c| c.1).collect();
         let label = match (k, side) {
             (0, _) => "footsteps (soles)",
             _ => "",
@@ -376,7 +369,7 @@ pub fn write_walk(
             .with(Series::line(
                 "phase",
                 t.clone(),
-                col(with, &|s| s.phase as f64),
+                col(with, &|s| phase_number(s.phase)),
             )),
         )
         .panel(
@@ -428,7 +421,7 @@ pub fn write_walk(
             .with(Series::points(
                 "corrected from",
                 t.clone(),
-                col(with, &|s| s.corrected_from as f64),
+                col(with, &|s| level_number(s.corrected_from)),
             )),
         );
     write_figure(&fig, dir, "walk_phases")?;

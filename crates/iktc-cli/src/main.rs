@@ -11,6 +11,7 @@ mod cmd_profile;
 mod cmd_reproduce;
 mod cmd_run;
 mod cmd_walk;
+mod columns;
 mod finite;
 mod out;
 mod pairs;

@@ -69,14 +69,15 @@ fn g1_imitates_the_default_clip_within_its_limits() {
     );
 }
 
-#[test]
-fn g1_walks_while_imitating_within_its_limits() {
-    // The G1's ZMP leaves its support polygon after the default push (the walking pattern
-    // centres the sole under the ankle and ignores the profile's `sole.offset_x`): the run's
-    // health check reports it, so the run is asked to go on and the limits are checked.
-    let out = tmp("g1walk");
+/// Runs `iktc walk --robot g1` with `extra` arguments and returns its walk_summary.json and
+/// output directory, after checking that every joint limit held (with and without damping)
+/// and that the viewer was written.
+fn g1_walk(name: &str, extra: &[&str]) -> (serde_json::Value, PathBuf) {
+    let out = tmp(name);
     let o = iktc()
-        .args(["walk", "--keep-going", "--robot", "g1", "--out"])
+        .args(["walk", "--robot", "g1"])
+        .args(extra)
+        .arg("--out")
         .arg(&out)
         .output()
         .unwrap();
@@ -88,7 +89,38 @@ fn g1_walks_while_imitating_within_its_limits() {
             assert!(m.as_f64().unwrap() <= LIMIT_SLACK, "{}", r["worst_margins"]);
         }
     }
-    assert!(out.join("walk_viewer.html").exists());
+    let viewer = std::fs::read_to_string(out.join("walk_viewer.html")).unwrap();
+    assert!(
+        viewer.contains("\"g1_29dof_rev_1_0\""),
+        "the viewer shows the G1"
+    );
+    (s, out)
+}
+
+#[test]
+fn g1_walks_while_imitating_within_its_limits() {
+    // The default push (5 N·s, sized for the 62 kg JVRC-1) moves the 33 kg G1's ZMP about
+    // 3.6 cm past the front of its sole: the run's health check reports it, so the run is
+    // asked to go on and the limits are checked.
+    let (s, _) = g1_walk("g1walk", &["--keep-going"]);
+    assert_eq!(s["with_damping"]["health"]["healthy"], false);
+}
+
+#[test]
+fn g1_walks_healthily_under_a_push_scaled_to_its_mass() {
+    // The same change of COM velocity as the default push on JVRC-1 (5 N·s / 62.4 kg =
+    // 0.080 m/s → 2.67 N·s on 33.3 kg): every run check passes, no --keep-going, and the
+    // measured ZMP stays inside the support polygon of the soles (sole offset included).
+    let (s, _) = g1_walk("g1walkscaled", &["--push", "2.15,2.67,0"]);
+    for run in ["with_damping", "without_damping"] {
+        let r = &s[run];
+        assert_eq!(r["health"]["healthy"], true, "{run}: {}", r["health"]);
+        assert!(
+            r["zmp_inside"].as_bool().unwrap(),
+            "{run}: {}",
+            r["min_zmp_margin"]
+        );
+    }
 }
 
 #[test]

@@ -174,9 +174,9 @@ fn default_run_respects_limits_and_priorities() {
     );
     // The level switches of the summary, counted again tick by tick.
     let (mut switches, mut flips) = (0, 0);
-    let lv: Vec<usize> = run.steps.iter().map(|s| s.corrected_from).collect();
+    let lv: Vec<Option<usize>> = run.steps.iter().map(|s| s.corrected_from).collect();
     for k in 1..lv.len() {
-        if lv[k - 1] != 0 && lv[k] != 0 && lv[k - 1] != lv[k] {
+        if lv[k - 1].is_some() && lv[k].is_some() && lv[k - 1] != lv[k] {
             switches += 1;
             if k + 1 < lv.len() && lv[k + 1] == lv[k - 1] {
                 flips += 1;

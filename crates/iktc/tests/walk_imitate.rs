@@ -6,6 +6,7 @@
 use iktc::model::{jvrc1, ModelOptions, Robot};
 use iktc::motion::{builtin_clip, builtin_map, retarget, RobotReferences};
 use iktc::sim::{run_walk_imitate, WalkImitateConfig, WalkRun};
+use iktc::walk::{Phase, Side};
 
 /// Rounding allowed on a limit \[rad\], \[rad/s\], \[rad/s²\].
 const LIMIT_ROUNDING: f64 = 1e-9;
@@ -62,7 +63,10 @@ fn the_default_walk_keeps_every_constraint() {
     let last = r.steps.last().unwrap().com[0];
     assert!(last - first > 0.25, "the COM advanced {} m", last - first);
     // Both single-support phases occurred, and the swing foot left the ground.
-    assert!(r.steps.iter().any(|s| s.phase == 1) && r.steps.iter().any(|s| s.phase == 2));
+    for side in [Side::Left, Side::Right] {
+        let single = Phase::SingleSupport { stance: side };
+        assert!(r.steps.iter().any(|s| s.phase == single), "{side:?}");
+    }
     let lift = r
         .steps
         .iter()

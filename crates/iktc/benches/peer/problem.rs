@@ -88,20 +88,6 @@ pub const INITIAL_POSE: [(&str, f64); 10] = [
     ("L_ELBOW_P", -0.5),
 ];
 
-/// The quintic smoothstep s(t) and its first two time derivatives \[1, 1/s, 1/s²\].
-pub fn smoothstep(t: f64) -> (f64, f64, f64) {
-    if t >= RAMP {
-        return (1.0, 0.0, 0.0);
-    }
-    let tau = (t / RAMP).max(0.0);
-    let (t2, t3) = (tau * tau, tau * tau * tau);
-    (
-        10.0 * t3 - 15.0 * t3 * tau + 6.0 * t3 * t2,
-        (30.0 * t2 - 60.0 * t3 + 30.0 * t2 * t2) / RAMP,
-        (60.0 * tau - 180.0 * t2 + 120.0 * t3) / (RAMP * RAMP),
-    )
-}
-
 /// The closed loop of the peer problem.
 #[derive(Debug, Clone)]
 pub struct PeerProblem {
@@ -193,7 +179,7 @@ impl PeerProblem {
     /// The upper-body reference at time t \[s\]: positions \[rad\], rates \[rad/s\] and
     /// accelerations \[rad/s²\] into `self.qr`.
     fn reference(&mut self, t: f64) {
-        let (s, sd, sdd) = smoothstep(t);
+        let (s, sd, sdd) = iktc::walk::smoothstep(0.0, RAMP, t);
         let w = 2.0 * PI * FREQUENCY;
         for j in 0..self.q0.len() {
             let (sn, cs) = (w * t + self.phases[j]).sin_cos();

@@ -615,23 +615,18 @@ impl ImitationController {
     }
 
     /// The COM reference at time `t` \[s\]: `c(t) = c_0 + s(τ) (c_∞ − c_0)` with
-    /// `τ = t / T` clamped to \[0, 1\] and the quintic `s = 10τ³ − 15τ⁴ + 6τ⁵`.
+    /// `τ = t / T` clamped to \[0, 1\] and the quintic `s = 10τ³ − 15τ⁴ + 6τ⁵`
+    /// ([`crate::walk::smoothstep`]).
     pub fn com_reference_at(&self, t: f64) -> ComReference {
-        let big_t = self.com_settle_time;
         let d = self.com_ref - self.com_start;
-        if big_t <= 0.0 || t >= big_t {
-            return ComReference {
-                position: self.com_ref,
-                velocity: Vector3::zeros(),
-                acceleration: Vector3::zeros(),
-            };
-        }
-        let tau = (t / big_t).max(0.0);
-        let s = tau * tau * tau * (10.0 - 15.0 * tau + 6.0 * tau * tau);
-        let sd = 30.0 * tau * tau * (1.0 - tau) * (1.0 - tau) / big_t;
-        let sdd = 60.0 * tau * (1.0 - tau) * (1.0 - 2.0 * tau) / (big_t * big_t);
+        let (s, sd, sdd) = crate::walk::smoothstep(0.0, self.com_settle_time, t);
         ComReference {
-            position: self.com_start + d * s,
+            // Once settled, exactly the centre (not c_0 + (c_∞ − c_0), which may round).
+            position: if s >= 1.0 {
+                self.com_ref
+            } else {
+                self.com_start + d * s
+            },
             velocity: d * sd,
             acceleration: d * sdd,
         }

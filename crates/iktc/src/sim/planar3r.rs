@@ -113,8 +113,8 @@ pub struct Planar3rStep {
     pub error: [f64; 3],
     /// IKTC corrections Δh of (P_x, P_y, θ3) \[m/s², rad/s²\].
     pub correction: [f64; 3],
-    /// Level (1-based, priority order) the correction started from; 0 = none.
-    pub corrected_from: usize,
+    /// Level (0-based, priority order) the correction started from; `None` without correction.
+    pub corrected_from: Option<usize>,
     /// QPs solved this step.
     pub qp_solves: usize,
     /// Dofs with an empty box.
@@ -278,7 +278,7 @@ pub fn run_planar3r(cfg: &Planar3rConfig) -> Result<Planar3rRun> {
             value,
             error: [x[0] - value[0], x[1] - value[1], x[2] - value[2]],
             correction,
-            corrected_from: corrected_from.map_or(0, |l| l + 1),
+            corrected_from,
             qp_solves,
             empty_dofs,
             tick_us,
@@ -346,10 +346,10 @@ fn summarize(
         qp_per_step_mean: steps.iter().map(|s| s.qp_solves as f64).sum::<f64>()
             / steps.len().max(1) as f64,
         qp_per_step_max: steps.iter().map(|s| s.qp_solves).max().unwrap_or(0),
-        corrected_steps: steps.iter().filter(|s| s.corrected_from > 0).count(),
+        corrected_steps: steps.iter().filter(|s| s.corrected_from.is_some()).count(),
         climbed_steps: steps
             .iter()
-            .filter(|s| s.corrected_from > 0 && s.corrected_from < nt)
+            .filter(|s| matches!(s.corrected_from, Some(l) if l + 1 < nt))
             .count(),
         tick_median_us: median(&ticks),
         smoothness: smoothness_over(0..steps.len()),

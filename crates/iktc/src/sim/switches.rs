@@ -21,16 +21,16 @@ pub struct LevelSwitches {
 }
 
 impl LevelSwitches {
-    /// Counts over the corrected level of each tick, 1-based, 0 for a tick without correction
-    /// (the convention of [`ImitateStep::corrected_from`](super::ImitateStep::corrected_from)).
-    pub fn count(levels: &[usize]) -> Self {
+    /// Counts over the corrected level of each tick, `None` for a tick without correction
+    /// (as [`ImitateStep::corrected_from`](super::ImitateStep::corrected_from)).
+    pub fn count(levels: &[Option<usize>]) -> Self {
         let switches = levels
             .windows(2)
-            .filter(|w| w[0] > 0 && w[1] > 0 && w[0] != w[1])
+            .filter(|w| w[0].is_some() && w[1].is_some() && w[0] != w[1])
             .count();
         let flips = levels
             .windows(3)
-            .filter(|w| w.iter().all(|&l| l > 0) && w[0] == w[2] && w[0] != w[1])
+            .filter(|w| w.iter().all(Option::is_some) && w[0] == w[2] && w[0] != w[1])
             .count();
         Self { switches, flips }
     }
@@ -43,7 +43,7 @@ mod tests {
     #[test]
     fn counts_switches_and_flips_of_corrected_ticks_only() {
         // switches: 2→4, 4→2, 2→4, 3→5; flips: 2,4,2 and 4,2,4
-        let levels = [0, 2, 4, 2, 4, 4, 0, 3, 5, 0, 5, 0, 5];
+        let levels = [0, 2, 4, 2, 4, 4, 0, 3, 5, 0, 5, 0, 5].map(|l| (l > 0).then_some(l));
         assert_eq!(
             LevelSwitches::count(&levels),
             LevelSwitches {
@@ -52,6 +52,10 @@ mod tests {
             }
         );
         assert_eq!(LevelSwitches::count(&[]), LevelSwitches::default());
-        assert_eq!(LevelSwitches::count(&[3; 10]), LevelSwitches::default());
+        assert_eq!(
+            LevelSwitches::count(&[Some(3); 10]),
+            LevelSwitches::default()
+        );
+        assert_eq!(LevelSwitches::count(&[None; 10]), LevelSwitches::default());
     }
 }

@@ -8,7 +8,8 @@ use serde::Serialize;
 use crate::error::Result;
 use crate::motion::Clip;
 use crate::sim::experiment::Experiment;
-use crate::sim::{ImitateRun, WalkRun, WalkStep};
+use crate::sim::{ImitateRun, WalkRun};
+use crate::walk::{sole_corners, Phase, Pose2, Side};
 
 /// Where the captured skeleton stands in the viewer: this far along +y (the robot's left) of
 /// the robot [m].
@@ -188,35 +189,19 @@ pub fn imitation_viewer(r: &ImitateRun, e: &Experiment) -> Result<ViewerData> {
     })
 }
 
-/// The corners of a sole `length` × `width` [m] centred at `p` (x, y [m]) turned by `yaw`
-/// [rad], counter-clockwise, on the ground.
-fn sole(p: &[f64; 3], yaw: f64, length: f64, width: f64) -> Vec<[f32; 3]> {
-    let (l, w) = (0.5 * length, 0.5 * width);
-    let (c, s) = (yaw.cos(), yaw.sin());
-    [(l, w), (-l, w), (-l, -w), (l, -w)]
+/// The outline of a sole `length` × `width` \[m\] centred at the footstep `p` (x, y \[m\],
+/// yaw \[rad\]), counter-clockwise, on the ground ([`sole_corners`]).
+fn sole_outline(p: &[f64; 3], length: f64, width: f64) -> Vec<[f32; 3]> {
+    sole_corners(&Pose2::new(p[0], p[1], p[2]), length, width)
         .iter()
-        .map(|(a, b)| {
-            [
-                (p[0] + c * a - s * b) as f32,
-                (p[1] + s * a + c * b) as f32,
-                0.0,
-            ]
-        })
+        .map(|(x, y)| [*x as f32, *y as f32, 0.0])
         .collect()
 }
 
-/// Ankles of the feet in support at a tick (both in double support).
-pub fn supporting_feet(s: &WalkStep) -> Vec<[f64; 3]> {
-    match s.phase {
-        1 => vec![s.feet_reference[0]],
-        2 => vec![s.feet_reference[1]],
-        _ => vec![s.feet_reference[0], s.feet_reference[1]],
-    }
-}
-
 /// The viewer data of a walk: robot, skeleton walking beside it, COM, the footsteps' soles,
-/// the support polygon and the support phase of every frame. `dt` is the control period [s],
-/// `sole` the sole's length and width [m].
+/// the support polygon ([`WalkStep::support`](crate::sim::WalkStep::support)) and the support
+/// phase of every frame. `dt` is the control period \[s\], `sole_size` the sole's length and
+/// width \[m\].
 pub fn walking_viewer(
     r: &WalkRun,
     e: &Experiment,
@@ -232,28 +217,19 @@ pub fn walking_viewer(
         figure.frames.push(st.links.iter().map(point).collect());
         com.push(point(&st.com));
         times.push(st.t);
-        let feet = supporting_feet(st);
-        let poly: Vec<[f32; 3]> = if let [foot] = feet[..] {
-            sole(&foot, 0.0, length, width)
-        } else {
-            // Double support: the hull of both soles (axis-aligned feet: the outer corners).
-            let (a, b) = (
-                sole(&feet[0], 0.0, length, width),
-                sole(&feet[1], 0.0, length, width),
-            );
-            let (left, right) = if feet[0][1] > feet[1][1] {
-                (a, b)
-            } else {
-                (b, a)
-            };
-            vec![left[0], left[1], right[2], right[3]]
-        };
+        let poly: Vec<[f32; 3]> = st
+            .support
+            .iter()
+            .map(|p| [p[0] as f32, p[1] as f32, 0.0])
+            .collect();
         support_frames.push(poly);
         phases.push(
             match st.phase {
-                1 => "single (left foot)",
-                2 => "single (right foot)",
-                _ => "double",
+                Phase::SingleSupport { stance: Side::Left } => "single (left foot)",
+                Phase::SingleSupport {
+                    stance: Side::Right,
+                } => "single (right foot)",
+                Phase::DoubleSupport => "double",
             }
             .to_string(),
         );
@@ -277,7 +253,7 @@ pub fn walking_viewer(
         footsteps: r
             .footsteps
             .iter()
-            .map(|(_, p)| sole(p, p[2], length, width))
+            .map(|(_, p)| sole_outline(p, length, width))
             .collect(),
         phases,
     })

@@ -40,7 +40,7 @@ use crate::model::{Robot, State};
 use crate::motion::RobotReferences;
 use crate::task::{ComReference, FrameReference};
 use crate::walk::{
-    FootState, FootstepPlan, Phase, PreviewSettings, Side, SupportPolygon, WalkSample,
+    smoothstep, FootState, FootstepPlan, Phase, PreviewSettings, Side, SupportPolygon, WalkSample,
     WalkSettings, WalkingPattern,
 };
 
@@ -121,8 +121,8 @@ impl WalkImitateConfig {
 pub struct WalkStep {
     /// Time \[s\].
     pub t: f64,
-    /// 0 = double support, 1 = left foot in stance, 2 = right foot in stance.
-    pub phase: u8,
+    /// The support phase (with the stance foot in single support).
+    pub phase: Phase,
     /// ZMP reference of the pattern (world) \[m\].
     pub zmp_reference: [f64; 2],
     /// ZMP of the pattern's cart-table model (world) \[m\].
@@ -145,8 +145,12 @@ pub struct WalkStep {
     pub feet_reference: [[f64; 3]; 2],
     /// Left and right ankles achieved (world) \[m\].
     pub feet: [[f64; 3]; 2],
-    /// Level (1-based) IKTC corrected from; 0 = none.
-    pub corrected_from: usize,
+    /// The pattern's support polygon (world, counter-clockwise) \[m\]: the stance sole, or
+    /// the hull of both soles ([`WalkingPattern::support_polygon_into`]).
+    #[serde(skip)]
+    pub support: Vec<[f64; 2]>,
+    /// Level (0-based) IKTC corrected from; `None` without correction.
+    pub corrected_from: Option<usize>,
     /// QPs this tick.
     pub qp_solves: usize,
     /// Tick time: pattern sample, damping controller and IK \[µs\].
@@ -254,22 +258,12 @@ pub struct WalkPushSummary {
 pub struct WalkRun {
     /// Every tick.
     pub steps: Vec<WalkStep>,
-    /// The footsteps (world x, y, yaw; side 0 = left, 1 = right), initial feet first.
-    pub footsteps: Vec<(u8, [f64; 3])>,
-    /// The phase intervals (start, end \[s\], phase code as in [`WalkStep::phase`]).
-    pub phases: Vec<(f64, f64, u8)>,
+    /// The footsteps (foot, world x \[m\], y \[m\], yaw \[rad\]), initial feet first.
+    pub footsteps: Vec<(Side, [f64; 3])>,
+    /// The phase intervals (start, end \[s\], phase).
+    pub phases: Vec<(f64, f64, Phase)>,
     /// Summary.
     pub summary: WalkSummary,
-}
-
-fn phase_code(p: Phase) -> u8 {
-    match p {
-        Phase::DoubleSupport => 0,
-        Phase::SingleSupport { stance: Side::Left } => 1,
-        Phase::SingleSupport {
-            stance: Side::Right,
-        } => 2,
-    }
 }
 
 fn with_length(m: &FullModelParams, l: f64) -> FullModelParams {
@@ -316,8 +310,8 @@ pub struct WalkTick {
     pub com_reference: Vector2<f64>,
     /// The nominal COM (pattern and initial blend, without Δc), world \[m\].
     pub com_nominal: Vector2<f64>,
-    /// Level (1-based) IKTC corrected from; 0 = none.
-    pub corrected_from: usize,
+    /// Level (0-based) IKTC corrected from; `None` without correction.
+    pub corrected_from: Option<usize>,
     /// QPs this tick.
     pub qp_solves: usize,
 }
@@ -376,15 +370,24 @@ impl WalkingController {
         // The imitation lists the right foot first, then the left.
         let (r0, l0) = (ctl.feet0()[0], ctl.feet0()[1]);
         let feet = [ctl.tasks().feet[0], ctl.tasks().feet[1]];
-        let origin = Vector2::new(
-            0.5 * (r0.translation.x + l0.translation.x),
-            0.5 * (r0.translation.y + l0.translation.y),
-        );
-        let ankle_offset = Vector3::new(0.0, 0.0, r0.translation.z.min(l0.translation.z));
-        let com0 = ctl.kinematics().com();
         let support = cfg.imitate.support;
+        // The pattern plans the soles' centres: `sole_offset_x` ahead of each ankle along its
+        // foot's x axis (the sole of the imitation's support polygon).
+        let sole_centre = |ankle: &Isometry3<f64>| {
+            let r = ankle.rotation * Vector3::new(support.sole_offset_x, 0.0, 0.0);
+            Vector2::new(ankle.translation.x + r.x, ankle.translation.y + r.y)
+        };
+        let (rs, ls) = (sole_centre(&r0), sole_centre(&l0));
+        let origin = Vector2::new(0.5 * (rs.x + ls.x), 0.5 * (rs.y + ls.y));
+        // The ankle from the sole centre, foot axes.
+        let ankle_offset = Vector3::new(
+            -support.sole_offset_x,
+            0.0,
+            r0.translation.z.min(l0.translation.z),
+        );
+        let com0 = ctl.kinematics().com();
         let walk = WalkSettings {
-            foot_separation: (l0.translation.y - r0.translation.y).abs(),
+            foot_separation: (ls.y - rs.y).abs(),
             sole_length: support.sole_length,
             sole_width: support.sole_width,
             ..cfg.walk
@@ -451,7 +454,7 @@ impl WalkingController {
         &self.plan
     }
 
-    /// World position of the pattern's origin (between the initial ankles) \[m\].
+    /// World position of the pattern's origin (between the initial sole centres) \[m\].
     pub fn origin(&self) -> Vector2<f64> {
         self.origin
     }
@@ -502,17 +505,9 @@ impl WalkingController {
         };
         // COM reference: pattern + blend of the initial offset + Δc, with Δc's backward
         // differences fed forward so that the commanded COM follows it within a tick.
-        let tb = self.com_blend_time;
-        let (b, bd, bdd) = if tb > 0.0 && t < tb {
-            let x = t / tb;
-            (
-                1.0 - x * x * x * (10.0 - 15.0 * x + 6.0 * x * x),
-                -30.0 * x * x * (1.0 - x) * (1.0 - x) / tb,
-                -60.0 * x * (1.0 - x) * (1.0 - 2.0 * x) / (tb * tb),
-            )
-        } else {
-            (0.0, 0.0, 0.0)
-        };
+        // The blend is 1 − s(t) of the quintic smoothstep over the blend time.
+        let (s_blend, sd_blend, sdd_blend) = smoothstep(0.0, self.com_blend_time, t);
+        let (b, bd, bdd) = (1.0 - s_blend, -sd_blend, -sdd_blend);
         let (origin, blend0) = (self.origin, self.blend0);
         let cp = s.com.position;
         let nominal = Vector2::new(cp.x + origin.x, cp.y + origin.y) + blend0 * b;
@@ -547,7 +542,7 @@ impl WalkingController {
             com_offset: offset_world,
             com_reference: cref,
             com_nominal: nominal,
-            corrected_from: rep.corrected_from.map_or(0, |l| l + 1),
+            corrected_from: rep.corrected_from,
             qp_solves: rep.qp_solves,
         })
     }
@@ -681,7 +676,7 @@ pub fn run_walk_imitate(
             &polygon,
             (zm.0 - origin.x, zm.1 - origin.y),
             "measured ZMP",
-            "world axes, origin between the initial ankles",
+            "world axes, origin between the initial sole centres",
         )?;
         health.end_tick();
         let fr = |r: &FrameReference| {
@@ -690,7 +685,7 @@ pub fn run_walk_imitate(
         };
         steps.push(WalkStep {
             t,
-            phase: phase_code(s.phase),
+            phase: s.phase,
             zmp_reference: [s.zmp_reference.0 + origin.x, s.zmp_reference.1 + origin.y],
             zmp_model: [s.zmp_model.0 + origin.x, s.zmp_model.1 + origin.y],
             zmp_measured: [zm.0, zm.1],
@@ -702,6 +697,11 @@ pub fn run_walk_imitate(
             com_offset: [wt.com_offset.x, wt.com_offset.y],
             feet_reference: [fr(&frefs[0]), fr(&frefs[1])],
             feet,
+            support: polygon
+                .vertices()
+                .iter()
+                .map(|(x, y)| [x + origin.x, y + origin.y])
+                .collect(),
             corrected_from: wt.corrected_from,
             qp_solves: wt.qp_solves,
             tick_us,
@@ -722,7 +722,7 @@ pub fn run_walk_imitate(
     let footsteps = {
         let mut v = vec![
             (
-                0u8,
+                Side::Left,
                 [
                     plan.initial(Side::Left).x + origin.x,
                     plan.initial(Side::Left).y + origin.y,
@@ -730,7 +730,7 @@ pub fn run_walk_imitate(
                 ],
             ),
             (
-                1u8,
+                Side::Right,
                 [
                     plan.initial(Side::Right).x + origin.x,
                     plan.initial(Side::Right).y + origin.y,
@@ -739,8 +739,10 @@ pub fn run_walk_imitate(
             ),
         ];
         for f in plan.steps() {
-            let side = if f.side == Side::Left { 0 } else { 1 };
-            v.push((side, [f.pose.x + origin.x, f.pose.y + origin.y, f.pose.yaw]));
+            v.push((
+                f.side,
+                [f.pose.x + origin.x, f.pose.y + origin.y, f.pose.yaw],
+            ));
         }
         v
     };
@@ -748,7 +750,7 @@ pub fn run_walk_imitate(
         .timeline()
         .phases()
         .iter()
-        .map(|p| (p.start, p.end, phase_code(p.phase)))
+        .map(|p| (p.start, p.end, p.phase))
         .collect();
     let summary = summarize(robot, cfg, ctl, &steps, pattern.duration(), health.report())?;
     Ok(WalkRun {
@@ -796,11 +798,13 @@ fn summarize(
     // Stance feet: error against the reference, and drift within each stance interval.
     let mut max_err = 0.0f64;
     let mut max_slip = 0.0f64;
-    for foot in 0..2 {
-        let stance_code = if foot == 0 { 1 } else { 2 };
+    for (foot, side) in [Side::Left, Side::Right].into_iter().enumerate() {
         let mut anchor: Option<[f64; 3]> = None;
         for s in steps {
-            let in_stance = s.phase == 0 || s.phase == stance_code;
+            let in_stance = match s.phase {
+                Phase::DoubleSupport => true,
+                Phase::SingleSupport { stance } => stance == side,
+            };
             if in_stance {
                 let (p, r) = (s.feet[foot], s.feet_reference[foot]);
                 max_err = max_err.max(((p[0] - r[0]).powi(2) + (p[1] - r[1]).powi(2)).sqrt());
@@ -849,9 +853,9 @@ fn summarize(
         health,
         climbed_ticks: steps
             .iter()
-            .filter(|s| s.corrected_from > 0 && s.corrected_from < nt)
+            .filter(|s| matches!(s.corrected_from, Some(l) if l + 1 < nt))
             .count(),
-        corrected_ticks: steps.iter().filter(|s| s.corrected_from > 0).count(),
+        corrected_ticks: steps.iter().filter(|s| s.corrected_from.is_some()).count(),
         level_switches: crate::sim::LevelSwitches::count(
             &steps.iter().map(|s| s.corrected_from).collect::<Vec<_>>(),
         ),

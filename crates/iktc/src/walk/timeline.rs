@@ -103,9 +103,10 @@ pub fn smoothstep(t0: f64, t1: f64, t: f64) -> (f64, f64, f64) {
     } else if tau >= 1.0 {
         (1.0, 0.0, 0.0)
     } else {
-        let t2 = tau * tau;
-        let s = t2 * tau * (10.0 + tau * (-15.0 + 6.0 * tau));
-        let ds = 30.0 * t2 * (1.0 - tau) * (1.0 - tau) / d;
+        // Evaluated in this order by every user (the imitation's COM settle, the walking
+        // COM blend, swing feet): the closed loops are rounding-sensitive.
+        let s = tau * tau * tau * (10.0 - 15.0 * tau + 6.0 * tau * tau);
+        let ds = 30.0 * tau * tau * (1.0 - tau) * (1.0 - tau) / d;
         let dds = 60.0 * tau * (1.0 - tau) * (1.0 - 2.0 * tau) / (d * d);
         (s, ds, dds)
     }

@@ -36,10 +36,10 @@ pub struct ImitateStep {
     pub level_residual: [f64; 5],
     /// ‖Δh_i‖ of each level's correction \[task unit/s²\].
     pub correction: [f64; 5],
-    /// Highest-priority corrected level, 1-based; 0 = none. IKTC's own report; for GF and
-    /// clamp, the first level whose `‖J_i q̈ − h_i‖` exceeds
+    /// Highest-priority corrected level, 0-based; `None` without correction. IKTC's own
+    /// report; for GF and clamp, the first level whose `‖J_i q̈ − h_i‖` exceeds
     /// [`ImitateConfig::corrected_tolerance`].
-    pub corrected_from: usize,
+    pub corrected_from: Option<usize>,
     /// Largest foot position drift from the initial pose \[m\].
     pub foot_drift: f64,
     /// Largest foot orientation drift \[rad\].
@@ -358,11 +358,10 @@ pub fn run_imitate(
             level_residual,
             correction,
             corrected_from: match (rep.method, rep.corrected_from) {
-                (Method::Iktc, c) => c.map_or(0, |l| l + 1),
+                (Method::Iktc, c) => c,
                 _ => level_residual
                     .iter()
-                    .position(|r| *r > cfg.corrected_tolerance)
-                    .map_or(0, |l| l + 1),
+                    .position(|r| *r > cfg.corrected_tolerance),
             },
             foot_drift,
             foot_rotation_drift,
@@ -457,16 +456,20 @@ pub(crate) fn summarize(
             .iter()
             .any(|&d| s.q[d] <= limits[d].lower + pos_tol || s.q[d] >= limits[d].upper - pos_tol)
     };
-    let pelvis_corrected = |s: &ImitateStep| (1..=4).contains(&s.corrected_from);
-    let lower_corrected: Vec<&ImitateStep> =
-        steps.iter().filter(|s| s.corrected_from >= 3).collect();
+    // Corrected from a level at or above the pelvis height (index 3).
+    let pelvis_corrected = |s: &ImitateStep| matches!(s.corrected_from, Some(l) if l <= 3);
+    // Corrected from the pelvis attitude (index 2) or below.
+    let lower_corrected: Vec<&ImitateStep> = steps
+        .iter()
+        .filter(|s| matches!(s.corrected_from, Some(l) if l >= 2))
+        .collect();
     let ticks: Vec<f64> = steps.iter().map(|s| s.tick_us).collect();
     let levels = (0..level_dims.len().min(5))
         .map(|i| {
             let errs: Vec<f64> = steps.iter().map(|s| s.level_error[i]).collect();
             let corrected: Vec<f64> = steps
                 .iter()
-                .filter(|s| s.corrected_from > 0 && s.corrected_from <= i + 1)
+                .filter(|s| matches!(s.corrected_from, Some(l) if l <= i))
                 .map(|s| s.t)
                 .collect();
             LevelSummary {
