@@ -5,13 +5,19 @@
 //! the hips are the first links below the branching of the two feet's chains, the shoulders the
 //! first links below the branching of the two hands' chains; the knee (elbow) is the link of the
 //! chain's joint whose name contains `knee` (`elbow`), else the chain link whose origin is
-//! nearest the midpoint of hip and ankle (shoulder and hand) in the start posture.
+//! nearest the midpoint of hip and ankle (shoulder and hand) in the start posture. The head is
+//! the profile's head frame unless that sits at the pelvis ([`MIN_HEAD_HEIGHT`]).
 
 use nalgebra::Vector3;
 
 use crate::error::{Error, Result};
 use crate::model::{FrameId, Kinematics, Robot};
 use crate::motion::{BodyPoint, Side};
+
+/// A head frame closer than this to the pelvis frame \[m\] is not taken for the head (some
+/// URDFs put a head link's origin at the waist and its geometry higher up). A human head is
+/// 0.5–0.7 m above the pelvis; a robot's scaled head several decimetres.
+pub const MIN_HEAD_HEIGHT: f64 = 0.1;
 
 /// The frames of the robot that stand for body points (see the module documentation).
 #[derive(Debug, Clone, PartialEq)]
@@ -60,7 +66,12 @@ impl RobotBody {
         ];
         let mut points = vec![(BodyPoint::Pelvis, pelvis)];
         if let Some(h) = head {
-            points.push((BodyPoint::Head, h));
+            // A head frame at the pelvis (G1's `head_link`) does not mark the head.
+            let d = kin.frame_pose(robot, h)?.translation.vector
+                - kin.frame_pose(robot, pelvis)?.translation.vector;
+            if d.norm() > MIN_HEAD_HEIGHT {
+                points.push((BodyPoint::Head, h));
+            }
         }
         let leg_chains = [chain(robot, feet[0])?, chain(robot, feet[1])?];
         let arm_chains = [chain(robot, hands[0])?, chain(robot, hands[1])?];

@@ -34,7 +34,7 @@ mod quality;
 mod scale;
 mod tracker;
 
-pub use body::{BodyFrameNames, RobotBody};
+pub use body::{BodyFrameNames, RobotBody, MIN_HEAD_HEIGHT};
 pub use quality::{OrientationError, PointError, QualityRecorder, RetargetQuality};
 pub use scale::Scaling;
 pub use tracker::{KeypointController, KEYPOINT_LEVELS};
@@ -61,6 +61,17 @@ pub const DEFAULT_DAMPING: f64 = 0.05;
 
 /// Size of the singular region of the default damping \[unit of a singular value of J\].
 pub const DEFAULT_DAMPING_REGION: f64 = 0.1;
+
+/// Which support polygon the COM reference is kept over.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SupportArea {
+    /// The soles of the feet on the ground (the static support polygon: in single support
+    /// the one sole, which asks a walking robot to lean over its stance foot).
+    Stance,
+    /// The hull of both feet's soles at their references whenever a foot is on the ground
+    /// (the stride's polygon: the COM may pass between the feet as the captured person's does).
+    BothFeet,
+}
 
 /// Settings of a keypoint retargeting.
 #[derive(Debug, Clone, PartialEq)]
@@ -91,12 +102,19 @@ pub struct KeypointSettings {
     pub contact_speed: f64,
     /// Contact and flight phases shorter than this are removed \[s\] (default 0.08 s).
     pub min_phase: f64,
+    /// The polygon the COM reference is kept over (default [`SupportArea::BothFeet`]).
+    pub support_area: SupportArea,
     /// The COM reference keeps at least this distance inside the support polygon \[m\]
     /// (default 0.02 m). Larger values keep the COM more central, further from the pelvis'.
     pub com_margin: f64,
     /// Width of the COM reference's moving average \[s\] (applied twice; default 0.2 s).
     /// Wider is smoother but lags the support changes.
     pub com_smoothing: f64,
+    /// A leg is not asked to stretch beyond this fraction of its length (hip–knee plus
+    /// knee–ankle) \[–\]: the pelvis is lowered instead (default 0.95). Larger values keep the
+    /// pelvis height of the clip longer but bring the knees near their singularity, where the
+    /// feet's level loses rank.
+    pub max_leg_extension: f64,
     /// Posture references from the joint route are kept this far inside the joint ranges
     /// \[rad\] (default 0.05 rad).
     pub posture_margin: f64,
@@ -124,8 +142,10 @@ impl Default for KeypointSettings {
             contact_height: 0.05,
             contact_speed: 0.4,
             min_phase: 0.08,
+            support_area: SupportArea::BothFeet,
             com_margin: 0.02,
             com_smoothing: 0.2,
+            max_leg_extension: 0.85,
             posture_margin: 0.05,
         }
     }
@@ -143,6 +163,11 @@ impl KeypointSettings {
             ("com_margin", self.com_margin, "a distance >= 0 [m]"),
             ("com_smoothing", self.com_smoothing, "a time >= 0 [s]"),
             ("posture_margin", self.posture_margin, "an angle >= 0 [rad]"),
+            (
+                "max_leg_extension",
+                self.max_leg_extension,
+                "a fraction >= 0 [–]",
+            ),
         ] {
             if !(v.is_finite() && v >= 0.0) {
                 return Err(Error::InvalidSetting {

@@ -8,7 +8,12 @@
 //! the hip axis and the vertical, the torso frame from the shoulder axis and the hips-to-
 //! shoulders direction (`y` along the axis, `z` the other direction made orthogonal to it,
 //! `x = y × z`), each times the constant rotation that maps the same construction on the robot
-//! in its start posture onto the robot's frame. Rates and accelerations are central
+//! in its start posture onto the robot's frame. Where a leg would have to stretch beyond
+//! `max_leg_extension` of its length `L` (hip–knee plus knee–ankle) to reach its foot's
+//! reference, the pelvis and the points above it are lowered by
+//! `δz = −√((e L)² − |d_xy|²) − d_z` (`d` from the robot's hip, placed by the pelvis reference
+//! and heading, to the ankle's reference), the largest over both legs, spread over
+//! `com_smoothing` by a running maximum and the same moving averages. Rates and accelerations are central
 //! differences of the sampled references (`ẋ_k = (x_{k+1} − x_{k−1}) / 2Δt`, angular rates
 //! from `log(R_{k+1} R_{k−1}ᵀ) / 2Δt`).
 
@@ -17,7 +22,7 @@ use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, UnitQuaternion, Vect
 use super::body::RobotBody;
 use super::contacts::{detect, hold, remove_short};
 use super::scale::ScaledClip;
-use super::KeypointSettings;
+use super::{KeypointSettings, SupportArea};
 use crate::error::{Error, Result};
 use crate::model::{Kinematics, Robot};
 use crate::motion::{BodyPoint, CubicSpline, Keypoints};
@@ -369,8 +374,12 @@ pub(crate) fn plan(
     let mut com: Vec<Vector3<f64>> = Vec::with_capacity(ticks);
     let mut polygon = SupportPolygon::default();
     for k in 0..ticks {
+        let any = contact[0][k] || contact[1][k];
         let on: Vec<Isometry3<f64>> = (0..2)
-            .filter(|i| contact[*i][k])
+            .filter(|i| match s.support_area {
+                SupportArea::Stance => contact[*i][k],
+                SupportArea::BothFeet => any,
+            })
             .map(|i| {
                 Isometry3::from_parts(
                     Translation3::from(feet[i][k].position.position),
@@ -418,7 +427,47 @@ pub(crate) fn plan(
     let pelvis_rot: Vec<UnitQuaternion<f64>> = (0..ticks)
         .map(|k| pelvis_frame(lh[k], rh[k]) * c_pelvis)
         .collect();
-    let pelvis = pose_refs(pelvis_x.clone(), pelvis_rot, s.dt);
+    // Legs within reach: lower the pelvis (and the points above it) where needed.
+    let mut drop = vec![0.0; ticks];
+    for (i, (hip, knee, ankle)) in [
+        (
+            BodyPoint::LeftHip,
+            BodyPoint::LeftKnee,
+            BodyPoint::LeftAnkle,
+        ),
+        (
+            BodyPoint::RightHip,
+            BodyPoint::RightKnee,
+            BodyPoint::RightAnkle,
+        ),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let (h0, k0, a0) = (at0(hip)?, at0(knee)?, at0(ankle)?);
+        let reach = s.max_leg_extension * ((k0 - h0).norm() + (a0 - k0).norm());
+        let offset = h0 - kin.frame_pose(robot, body.pelvis)?.translation.vector;
+        for k in 0..ticks {
+            let turn = UnitQuaternion::from_euler_angles(0.0, 0.0, heading[k] - heading[0]);
+            let d = feet[i][k].position.position - (pelvis_x[k] + turn * offset);
+            let horizontal = d.xy().norm().min(reach);
+            let need = -(reach * reach - horizontal * horizontal).sqrt() - d.z;
+            drop[k] = f64::max(drop[k], need);
+        }
+    }
+    let half = (0.5 * s.com_smoothing / s.dt).round() as usize;
+    let peak: Vec<f64> = (0..ticks)
+        .map(|k| {
+            drop[k.saturating_sub(half)..(k + half + 1).min(ticks)]
+                .iter()
+                .fold(0.0, |a: f64, b| a.max(*b))
+        })
+        .collect();
+    let mut lowered: Vec<Vector3<f64>> = peak.iter().map(|d| Vector3::new(0.0, 0.0, *d)).collect();
+    moving_average(&mut lowered, half);
+    moving_average(&mut lowered, half);
+    let pelvis_x: Vec<Vector3<f64>> = pelvis_x.iter().zip(&lowered).map(|(p, d)| p - d).collect();
+    let pelvis = pose_refs(pelvis_x, pelvis_rot, s.dt);
     let (ls, rs) = (
         get(BodyPoint::LeftShoulder)?,
         get(BodyPoint::RightShoulder)?,
@@ -436,7 +485,8 @@ pub(crate) fn plan(
     for p in TRACKED {
         if body.frame_of(p).is_some() {
             if let Some(x) = track(p) {
-                points.push((p, point_refs(x.clone(), s.dt)));
+                let x = x.iter().zip(&lowered).map(|(p, d)| p - d).collect();
+                points.push((p, point_refs(x, s.dt)));
             }
         }
     }

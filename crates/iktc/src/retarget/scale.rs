@@ -7,8 +7,11 @@
 //! height of the clip \[m\].
 //!
 //! Scaling: the pelvis by the leg ratio `s_leg = L_robot / L_human` (hip–knee plus
-//! knee–ankle lengths), lifted by the robot's ankle height `h_a`:
-//! `p'_pelvis = s_leg a(p_pelvis) + (0, 0, h_a)`; every other point from its parent along the
+//! knee–ankle lengths), horizontally `p'_pelvis,xy = s_leg a(p_pelvis)_xy`, vertically from the
+//! middle of the hips (where the legs start, on both bodies):
+//! `p'_pelvis,z = h_a + s_leg a(p_hips)_z + (r_pelvis − r_hips)_z` with `h_a` the robot's ankle
+//! height above its sole and `r_hips` the middle of the robot's hips in its start posture; every
+//! other point from its parent along the
 //! segment tree (pelvis → hip → knee → ankle → toe, pelvis → shoulder → elbow → wrist,
 //! pelvis → head, chest, neck): `p'_c = p'_p + s_pc (a(p_c) − a(p_p))` with
 //! `s_pc = |r_c − r_p| / median_t |p_c(t) − p_p(t)|`, `r` the robot's points in its start
@@ -174,10 +177,19 @@ pub(crate) fn scale_clip(
         segments.push((pa, pb, r));
     }
     let mut scaled = vec![Vector3::zeros(); aligned.len()];
-    let lift = Vector3::new(0.0, 0.0, ankle_height);
+    let robot_hips = match (
+        robot_at(B::LeftHip)?,
+        robot_at(B::RightHip)?,
+        robot_at(B::Pelvis)?,
+    ) {
+        (Some(l), Some(r), Some(p)) => p.z - 0.5 * (l.z + r.z),
+        _ => 0.0,
+    };
     for f in 0..frames {
         let row = f * n;
-        scaled[row + pelvis] = leg * aligned[row + pelvis] + lift;
+        let hips = 0.5 * (aligned[row + lh] + aligned[row + rh]);
+        let p = leg * aligned[row + pelvis];
+        scaled[row + pelvis] = Vector3::new(p.x, p.y, ankle_height + leg * hips.z + robot_hips);
         for &(pa, pb, r) in &segments {
             if let (Some(a), Some(b)) = (index(kp, pa), index(kp, pb)) {
                 scaled[row + b] = scaled[row + a] + r * (aligned[row + b] - aligned[row + a]);

@@ -224,6 +224,20 @@ impl KeypointController {
         Ok(self.fallback.report())
     }
 
+    /// The position references of tick `k` \[m\]: the pelvis, the feet (ankles) and the
+    /// tracked points (hands, elbows).
+    pub fn position_references(&self, k: usize) -> Vec<(BodyPoint, nalgebra::Vector3<f64>)> {
+        let k = k.min(self.plan.ticks.saturating_sub(1));
+        let p = &self.plan;
+        let mut out = vec![
+            (BodyPoint::Pelvis, p.pelvis[k].position.position),
+            (BodyPoint::LeftAnkle, p.feet[0][k].position.position),
+            (BodyPoint::RightAnkle, p.feet[1][k].position.position),
+        ];
+        out.extend(p.points.iter().map(|(b, r)| (*b, r[k].position)));
+        out
+    }
+
     /// Whether the last tick was solved by GF (see [`KeypointController::tick`]).
     pub fn used_fallback(&self) -> bool {
         self.used_fallback
