@@ -39,6 +39,10 @@ pub struct Args {
     pub motion: String,
     #[command(flatten)]
     pub motion_options: crate::cmd_map::MotionArgs,
+    /// Retargeting: body keypoints tracked by a task stack (with the joint route's figures
+    /// beside them), or the paper's joint-angle route (figures, summary and 3D viewer).
+    #[arg(long, value_enum, default_value = "keypoints")]
+    pub retarget: crate::cmd_keypoints::RetargetArg,
     /// Retargeting map: a built-in name (deepmimic_jvrc1, bvh_jvrc1, deepmimic_g1) or a TOML
     /// file; default: the robot profile's map for the motion's format (profile key
     /// `imitate.maps.deepmimic` or `imitate.maps.bvh`).
@@ -149,8 +153,6 @@ pub fn run(a: &Args) -> Result<()> {
         ro.floating = true;
     }
     let resolved = resolve_robot(&a.robot, &ro, Some(&a.profile))?;
-    let (clip, is_bvh) = load_clip(&a.motion, &a.motion_options)?;
-    let map = load_map(a.map.as_deref(), is_bvh, &resolved)?;
     let profile = resolved
         .profile
         .as_ref()
@@ -177,6 +179,11 @@ pub fn run(a: &Args) -> Result<()> {
         }
     }
     cfg.health.keep_going = a.keep_going;
+    if a.retarget == crate::cmd_keypoints::RetargetArg::Keypoints && !a.walk.walk {
+        return crate::cmd_keypoints::run(profile, &a.motion, &a.motion_options, &cfg, &a.out);
+    }
+    let (clip, is_bvh) = load_clip(&a.motion, &a.motion_options)?;
+    let map = load_map(a.map.as_deref(), is_bvh, &resolved)?;
     let e = Experiment {
         robot: resolved.robot,
         clip,
