@@ -11,7 +11,7 @@ use iktc::solver::Method;
 use iktc_report::{write_csv, write_figure, Figure, Panel, Section, Series, Table};
 
 use crate::columns::level_number;
-use crate::scenario::{health_text, prepare, ScenarioArgs};
+use crate::scenario::{health_text, prepare, prepare_config, ScenarioArgs};
 use crate::viewer::write_viewer;
 
 /// Arguments of `iktc imitate`.
@@ -19,6 +19,10 @@ use crate::viewer::write_viewer;
 pub struct Args {
     #[command(flatten)]
     pub scenario: ScenarioArgs,
+    /// Retargeting: body keypoints tracked by a task stack (with the joint route's figures
+    /// beside them), or the paper's joint-angle route (figures, summary and 3D viewer).
+    #[arg(long, value_enum, default_value = "keypoints")]
+    pub retarget: crate::cmd_keypoints::RetargetArg,
     /// Output directory.
     #[arg(long, default_value = "out/imitate")]
     pub out: PathBuf,
@@ -33,6 +37,15 @@ pub fn run(a: &Args) -> Result<()> {
         anyhow::bail!(
             "`iktc imitate --walk` is now `iktc walk` (same options, plus --steps, --step-length, --push, --no-damping)"
         );
+    }
+    if a.retarget == crate::cmd_keypoints::RetargetArg::Keypoints {
+        let (resolved, cfg) = prepare_config(&a.scenario)?;
+        let profile = resolved
+            .profile
+            .as_ref()
+            .context("`planar3r` has no profile and cannot imitate a motion")?;
+        let sc = &a.scenario;
+        return crate::cmd_keypoints::run(profile, &sc.motion, &sc.motion_options, &cfg, &a.out);
     }
     let (e, cfg) = prepare(&a.scenario)?;
     let r = e.imitate(&cfg)?;

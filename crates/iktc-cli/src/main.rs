@@ -5,6 +5,7 @@ use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 
 mod cmd_balance;
 mod cmd_imitate;
+mod cmd_keypoints;
 mod cmd_map;
 mod cmd_model;
 mod cmd_profile;

@@ -77,8 +77,9 @@ fn choose_map(spec: Option<&str>, format: MotionFormat, r: &ResolvedRobot) -> Re
     load_map(spec, &r.robot).with_context(|| format!("--map `{spec}`"))
 }
 
-/// The experiment and its configuration the arguments describe.
-pub fn prepare(a: &ScenarioArgs) -> Result<(Experiment, ImitateConfig)> {
+/// The robot and the run configuration the arguments describe (robot flags, profile, solver,
+/// bounds, control period, recovery, run checks).
+pub fn prepare_config(a: &ScenarioArgs) -> Result<(ResolvedRobot, ImitateConfig)> {
     let mut ro = a.robot_options.clone();
     let path = std::path::Path::new(&a.robot);
     if path
@@ -89,12 +90,6 @@ pub fn prepare(a: &ScenarioArgs) -> Result<(Experiment, ImitateConfig)> {
         ro.floating = true;
     }
     let resolved = resolve_robot(&a.robot, &ro, Some(&a.profile))?;
-    let loaded = load_clip(&a.motion, &a.motion_options.options()?)
-        .with_context(|| format!("--motion `{}`", a.motion))?;
-    if let Some(decided) = &loaded.decided {
-        crate::outln!("{decided}")?;
-    }
-    let map = choose_map(a.map.as_deref(), loaded.format, &resolved)?;
     let profile = resolved
         .profile
         .as_ref()
@@ -121,6 +116,18 @@ pub fn prepare(a: &ScenarioArgs) -> Result<(Experiment, ImitateConfig)> {
         }
     }
     cfg.health.keep_going = a.keep_going;
+    Ok((resolved, cfg))
+}
+
+/// The experiment and its configuration the arguments describe.
+pub fn prepare(a: &ScenarioArgs) -> Result<(Experiment, ImitateConfig)> {
+    let (resolved, cfg) = prepare_config(a)?;
+    let loaded = load_clip(&a.motion, &a.motion_options.options()?)
+        .with_context(|| format!("--motion `{}`", a.motion))?;
+    if let Some(decided) = &loaded.decided {
+        crate::outln!("{decided}")?;
+    }
+    let map = choose_map(a.map.as_deref(), loaded.format, &resolved)?;
     Ok((
         Experiment {
             robot: resolved.robot,

@@ -46,7 +46,7 @@ fn bare_g1_urdf(dir: &Path) -> PathBuf {
 fn g1_imitates_the_default_clip_within_its_limits() {
     let out = tmp("g1");
     let o = iktc()
-        .args(["imitate", "--robot", "g1", "--out"])
+        .args(["imitate", "--retarget", "joints", "--robot", "g1", "--out"])
         .arg(&out)
         .output()
         .unwrap();
@@ -66,6 +66,33 @@ fn g1_imitates_the_default_clip_within_its_limits() {
     assert!(
         viewer.contains("\"g1_29dof_rev_1_0\""),
         "the viewer shows the G1"
+    );
+}
+
+#[test]
+fn g1_retargets_the_default_clip_by_keypoints_beside_the_joint_route() {
+    let out = tmp("g1kp");
+    let o = iktc()
+        .args(["imitate", "--robot", "g1", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let s = json(&out.join("keypoints_summary.json"));
+    for route in ["keypoints", "joints"] {
+        let q = &s[route];
+        for k in ["position_margin", "velocity_margin", "acceleration_margin"] {
+            let m = q[k].as_f64().unwrap();
+            assert!(m <= LIMIT_SLACK, "{route} {k} = {m} (> 0: exceeded)");
+        }
+        // One error per body point the G1 has (its head frame sits at the pelvis).
+        assert_eq!(q["points"].as_array().unwrap().len(), 13, "{route}");
+    }
+    let csv = std::fs::read_to_string(out.join("keypoints_trajectory.csv")).unwrap();
+    assert_eq!(csv.lines().next().unwrap().split(',').count(), 1 + 29);
+    assert!(
+        !out.join("viewer.html").exists(),
+        "the joint route's figures are not written"
     );
 }
 
@@ -149,6 +176,8 @@ fn a_bare_urdf_names_the_missing_flag_and_key() {
     // With feet and sole, no pelvis.
     let with_feet = [
         "imitate",
+        "--retarget",
+        "joints",
         "--robot",
         u,
         "--feet",
@@ -178,6 +207,8 @@ fn a_wrong_name_from_a_flag_names_the_flag_the_key_and_the_valid_names() {
     let u = urdf.to_str().unwrap();
     let common = [
         "imitate",
+        "--retarget",
+        "joints",
         "--robot",
         u,
         "--feet",

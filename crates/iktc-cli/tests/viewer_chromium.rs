@@ -48,7 +48,7 @@ fn viewer_loads_and_draws() {
     std::fs::create_dir_all(&dir).unwrap();
     let out = dir.join("run");
     let status = Command::new(env!("CARGO_BIN_EXE_iktc"))
-        .args(["imitate", "--out"])
+        .args(["imitate", "--retarget", "joints", "--out"])
         .arg(&out)
         .status()
         .unwrap();

@@ -60,6 +60,8 @@ pub mod prelude;
 #[cfg(all(feature = "urdf", feature = "toml"))]
 pub mod profile;
 pub mod resources;
+#[cfg(all(feature = "urdf", feature = "toml"))]
+pub mod retarget;
 pub mod sim;
 pub mod solver;
 pub mod task;

@@ -1,0 +1,211 @@
+//! `iktc imitate --retarget keypoints` (the default): the clip's body keypoints scaled to the
+//! robot and tracked by the keypoint stack ([`iktc::retarget`]), with the quality figures of the
+//! joint route on the same clip beside them.
+
+use std::path::Path;
+
+use anyhow::{Context, Result};
+use iktc::motion::{
+    builtin_clip, motion_from_content, Keypoints, MotionContent, MotionFormat, MotionOptions,
+    BUILTIN_CLIP_NAMES, DEFAULT_MAX_GAP,
+};
+use iktc::profile::RobotProfile;
+use iktc::retarget::{
+    joint_route_quality, retarget_keypoints, KeypointRun, KeypointSettings, RetargetQuality,
+};
+use iktc::sim::{imitation_references, ImitateConfig};
+
+/// Which retargeting `iktc imitate` runs.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RetargetArg {
+    /// Body keypoints scaled to the robot, tracked by a strict-priority stack.
+    Keypoints,
+    /// The paper's joint-angle route: captured rotations decomposed onto the robot's joints.
+    Joints,
+}
+
+/// The keypoints of `spec` (a built-in clip or a motion file) and, for a skeleton, its clip in
+/// metres, Z up, with its format.
+fn load(
+    spec: &str,
+    options: &crate::cmd_map::MotionArgs,
+) -> Result<(Keypoints, Option<(iktc::motion::Clip, MotionFormat)>)> {
+    let motion = if BUILTIN_CLIP_NAMES.contains(&spec) {
+        motion_from_content(
+            spec.to_string(),
+            MotionFormat::DeepMimic,
+            MotionContent::Skeleton(builtin_clip(spec)?),
+            &MotionOptions::default(),
+        )?
+    } else {
+        crate::cmd_map::load(Path::new(spec), options, None)?
+    };
+    let kp = motion
+        .keypoints(DEFAULT_MAX_GAP)
+        .with_context(|| format!("the body points of `{spec}`"))?;
+    let clip = motion.clip().transpose()?.map(|c| (c, motion.format));
+    Ok((kp, clip))
+}
+
+/// Runs the keypoint retargeting of `spec` on `profile` with the imitation's solver, bounds,
+/// period and tick limit from `cfg`, compares it with the joint route where the profile has a
+/// map for the clip's format, prints both and writes `keypoints_summary.json` and
+/// `keypoints_trajectory.csv` to `out`.
+pub fn run(
+    profile: &RobotProfile,
+    spec: &str,
+    options: &crate::cmd_map::MotionArgs,
+    cfg: &ImitateConfig,
+    out: &Path,
+) -> Result<()> {
+    let (kp, clip) = load(spec, options)?;
+    crate::outln!("{}", kp.summary())?;
+    let settings = KeypointSettings {
+        method: cfg.method,
+        bounds: cfg.bounds,
+        dt: cfg.dt,
+        run_limits: cfg.run_limits,
+        ..KeypointSettings::default()
+    };
+    let robot = profile.robot()?;
+    let refs = match &clip {
+        Some((clip, format)) => {
+            let key = if *format == MotionFormat::DeepMimic {
+                "deepmimic"
+            } else {
+                "bvh"
+            };
+            match profile.retarget_map(key, &robot) {
+                Ok(map) => {
+                    let joints_cfg = ImitateConfig {
+                        narrow: Vec::new(),
+                        ..cfg.clone()
+                    };
+                    Some(imitation_references(&robot, clip, &map, &joints_cfg)?)
+                }
+                Err(e) => {
+                    crate::outln!("joint route: not run ({e})")?;
+                    None
+                }
+            }
+        }
+        None => None,
+    };
+    let run = retarget_keypoints(profile, &kp, refs.as_ref(), &settings)?;
+    let joints = match &refs {
+        Some(r) => Some(joint_route_quality(profile, &kp, r, &settings)?),
+        None => None,
+    };
+    print(&run, joints.as_ref())?;
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    let summary = serde_json::json!({
+        "source": kp.source,
+        "leg_ratio": run.scaling.leg,
+        "gf_ticks": run.fallback_ticks,
+        "tick_median_us": run.tick_median_us,
+        "keypoints": run.quality,
+        "joints": joints,
+    });
+    let path = out.join("keypoints_summary.json");
+    std::fs::write(&path, serde_json::to_string_pretty(&summary)?)
+        .with_context(|| format!("writing {}", path.display()))?;
+    let mut csv = String::from("t");
+    for n in robot.dof_names().iter().skip(robot.base_nv()) {
+        csv.push(',');
+        csv.push_str(n);
+    }
+    csv.push('\n');
+    let nq = robot.nq() - robot.n_active();
+    for (t, q) in run.times.iter().zip(&run.trajectory) {
+        csv.push_str(&format!("{t:.4}"));
+        for v in &q[nq..] {
+            csv.push_str(&format!(",{v:.6}"));
+        }
+        csv.push('\n');
+    }
+    let path = out.join("keypoints_trajectory.csv");
+    std::fs::write(&path, csv).with_context(|| format!("writing {}", path.display()))?;
+    crate::outln!(
+        "wrote keypoints_summary.json and keypoints_trajectory.csv to {}",
+        out.display()
+    )?;
+    Ok(())
+}
+
+fn print(run: &KeypointRun, joints: Option<&RetargetQuality>) -> std::io::Result<()> {
+    let k = &run.quality;
+    crate::outln!(
+        "keypoint retargeting: {} ticks, leg ratio {:.3}, {} ticks solved by GF, tick median {:.1} µs",
+        k.ticks,
+        run.scaling.leg,
+        run.fallback_ticks,
+        run.tick_median_us
+    )?;
+    crate::outln!(
+        "{:<16} {:>22} {:>22}",
+        "",
+        "keypoints",
+        if joints.is_some() {
+            "joints"
+        } else {
+            "joints (not run)"
+        }
+    )?;
+    let row = |name: &str, a: String, b: Option<String>| {
+        crate::outln!("{name:<16} {a:>22} {:>22}", b.unwrap_or_default())
+    };
+    for (i, p) in k.points.iter().enumerate() {
+        let other = joints
+            .and_then(|j| j.points.get(i))
+            .map(|q| format!("{:.1} / {:.1} cm", q.mean_cm, q.max_cm));
+        row(
+            &p.point,
+            format!("{:.1} / {:.1} cm", p.mean_cm, p.max_cm),
+            other,
+        )?;
+    }
+    row(
+        "mean of points",
+        format!("{:.2} cm", k.mean_cm),
+        joints.map(|j| format!("{:.2} cm", j.mean_cm)),
+    )?;
+    for (i, o) in k.orientations.iter().enumerate() {
+        let other = joints
+            .and_then(|j| j.orientations.get(i))
+            .map(|q| format!("{:.1} / {:.1}°", q.mean_deg, q.max_deg));
+        row(
+            &format!("{} (orient.)", o.frame),
+            format!("{:.1} / {:.1}°", o.mean_deg, o.max_deg),
+            other,
+        )?;
+    }
+    row(
+        "stance slip",
+        format!("{:.2} mm", k.slip_mm),
+        joints.map(|j| format!("{:.2} mm", j.slip_mm)),
+    )?;
+    row(
+        "below ground",
+        format!("{:.2} mm", k.below_ground_mm),
+        joints.map(|j| format!("{:.2} mm", j.below_ground_mm)),
+    )?;
+    row(
+        "jerk RMS / max",
+        format!("{:.0} / {:.0}", k.jerk_rms, k.jerk_max),
+        joints.map(|j| format!("{:.0} / {:.0}", j.jerk_rms, j.jerk_max)),
+    )?;
+    row(
+        "worst margins",
+        format!(
+            "{:+.1e} {:+.1e} {:+.1e}",
+            k.position_margin, k.velocity_margin, k.acceleration_margin
+        ),
+        joints.map(|j| {
+            format!(
+                "{:+.1e} {:+.1e} {:+.1e}",
+                j.position_margin, j.velocity_margin, j.acceleration_margin
+            )
+        }),
+    )?;
+    crate::outln!("(mean / max; jerk in rad/s³; margins position [rad], velocity [rad/s], acceleration [rad/s²], positive = a limit exceeded)")
+}

@@ -1,0 +1,450 @@
+//! Keypoint retargeting: a captured motion's body points ([`Keypoints`]) scaled to a robot and
+//! tracked by a strict-priority stack on a [`Controller`](crate::Controller), under the
+//! robot's joint limits, with quality figures.
+//!
+//! 1. The robot's counterparts of the body points are found from its profile and its tree
+//!    ([`RobotBody`]).
+//! 2. The clip is aligned (facing +x, first pelvis over the origin, lowest ankle on the
+//!    ground) and scaled segment by segment ([`Scaling`], module `scale`).
+//! 3. Foot contacts are detected from the clip's foot heights and speeds; every task's
+//!    references are computed at the control rate, the stance feet held where they touched
+//!    down and the COM pulled over the support polygon (module `plan`).
+//! 4. The stack of [`KEYPOINT_LEVELS`] is tracked ([`KeypointController`]): after a settling
+//!    phase at rest on the first frame's references, one tick per control period; IKTC under
+//!    the viable box of the robot's own limits, nothing clipped after the solve.
+//! 5. The same quality figures ([`RetargetQuality`]) measure this run and, for comparison, the
+//!    joint-angle route ([`joint_route_quality`]).
+//!
+//! ```no_run
+//! use iktc::motion::{load_motion, MotionOptions};
+//! use iktc::profile::RobotProfile;
+//! use iktc::retarget::{retarget_keypoints, KeypointSettings};
+//!
+//! let motion = load_motion("walk.bvh".as_ref(), &MotionOptions::default())?;
+//! let kp = motion.keypoints(iktc::motion::DEFAULT_MAX_GAP)?;
+//! let run = retarget_keypoints(&RobotProfile::builtin("g1")?, &kp, None, &KeypointSettings::default())?;
+//! println!("mean keypoint error {:.1} cm", run.quality.mean_cm);
+//! # Ok::<(), iktc::Error>(())
+//! ```
+
+mod body;
+mod contacts;
+mod plan;
+mod quality;
+mod scale;
+mod tracker;
+
+pub use body::{BodyFrameNames, RobotBody, MIN_HEAD_HEIGHT};
+pub use quality::{OrientationError, PointError, QualityRecorder, RetargetQuality};
+pub use scale::Scaling;
+pub use tracker::{KeypointController, KEYPOINT_LEVELS};
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use crate::error::{Error, Result};
+use crate::limits::BoundMethod;
+use crate::model::{Kinematics, Robot, State};
+use crate::motion::{Keypoints, RobotReferences};
+use crate::profile::RobotProfile;
+use crate::resources::RunLimits;
+use crate::sim::imitate::SupportSettings;
+use crate::sim::{percentile, ImitateConfig, ImitationController};
+use crate::solver::{Damping, Method, SolverSettings};
+use crate::task::Gains;
+
+/// Damping λ_max reached at a singularity by default \[unit of a singular value of J\]: the
+/// keypoint stack uses every dof of the robot, its levels come close to singular (stretched
+/// legs and arms), and undamped inverses there ask for accelerations of 10⁶ rad/s² that IKTC
+/// must then correct away. Larger values track less exactly near singularities.
+pub const DEFAULT_DAMPING: f64 = 0.05;
+
+/// Size of the singular region of the default damping \[unit of a singular value of J\].
+pub const DEFAULT_DAMPING_REGION: f64 = 0.1;
+
+/// Which support polygon the COM reference is kept over.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SupportArea {
+    /// The soles of the feet on the ground (the static support polygon: in single support
+    /// the one sole, which asks a walking robot to lean over its stance foot).
+    Stance,
+    /// The hull of both feet's soles at their references whenever a foot is on the ground
+    /// (the stride's polygon: the COM may pass between the feet as the captured person's does).
+    BothFeet,
+}
+
+/// Settings of a keypoint retargeting.
+#[derive(Debug, Clone, PartialEq)]
+pub struct KeypointSettings {
+    /// Control period Δt \[s\].
+    pub dt: f64,
+    /// Range of Δt and largest tick count.
+    pub run_limits: RunLimits,
+    /// CLIK gains of every task (default k_p = 100 s⁻², k_v = 20 s⁻¹).
+    pub gains: Gains,
+    /// Solver (IKTC by default).
+    pub method: Method,
+    /// Joint bounds (viable by default).
+    pub bounds: BoundMethod,
+    /// Solver settings (default: adaptive damping, [`DEFAULT_DAMPING`] within
+    /// [`DEFAULT_DAMPING_REGION`] of a singularity).
+    pub solver: SolverSettings,
+    /// Time at rest on the first frame's references before the clip starts \[s\] (default
+    /// 1.5 s, about 15 time constants of the default gains): the robot moves from its standing
+    /// posture to the first frame. Not recorded. Shorter settling leaves a transient at the
+    /// start of the clip.
+    pub settle_time: f64,
+    /// A foot (ankle or toe) within this height of the clip's lowest ankle (toe) height is low
+    /// enough to be on the ground \[m\] (human scale, default 0.05 m). Larger values hold the
+    /// feet longer (more stance, less swing fidelity); smaller ones miss contacts.
+    pub contact_height: f64,
+    /// ... and slow enough below this speed \[m/s\] (default 0.4 m/s).
+    pub contact_speed: f64,
+    /// Contact and flight phases shorter than this are removed \[s\] (default 0.08 s).
+    pub min_phase: f64,
+    /// The polygon the COM reference is kept over (default [`SupportArea::BothFeet`]).
+    pub support_area: SupportArea,
+    /// The COM reference keeps at least this distance inside the support polygon \[m\]
+    /// (default 0.02 m). Larger values keep the COM more central, further from the pelvis'.
+    pub com_margin: f64,
+    /// Width of the COM reference's moving average \[s\] (applied twice; default 0.2 s).
+    /// Wider is smoother but lags the support changes.
+    pub com_smoothing: f64,
+    /// A leg is not asked to stretch beyond this fraction of its length (hip–knee plus
+    /// knee–ankle) \[–\]: the pelvis is lowered instead (default 0.95). Larger values keep the
+    /// pelvis height of the clip longer but bring the knees near their singularity, where the
+    /// feet's level loses rank.
+    pub max_leg_extension: f64,
+    /// Posture references from the joint route are kept this far inside the joint ranges
+    /// \[rad\] (default 0.05 rad).
+    pub posture_margin: f64,
+}
+
+impl Default for KeypointSettings {
+    fn default() -> Self {
+        Self {
+            dt: 0.005,
+            run_limits: RunLimits::default(),
+            gains: Gains {
+                kp: 100.0,
+                kv: 20.0,
+            },
+            method: Method::Iktc,
+            bounds: BoundMethod::viable(),
+            solver: SolverSettings {
+                damping: Damping::Adaptive {
+                    max: DEFAULT_DAMPING,
+                    threshold: DEFAULT_DAMPING_REGION,
+                },
+                ..SolverSettings::default()
+            },
+            settle_time: 1.5,
+            contact_height: 0.05,
+            contact_speed: 0.4,
+            min_phase: 0.08,
+            support_area: SupportArea::BothFeet,
+            com_margin: 0.02,
+            com_smoothing: 0.2,
+            max_leg_extension: 0.85,
+            posture_margin: 0.05,
+        }
+    }
+}
+
+impl KeypointSettings {
+    /// Checks the numbers.
+    pub fn validate(&self) -> Result<()> {
+        self.run_limits.check_dt("dt", self.dt)?;
+        for (name, v, what) in [
+            ("settle_time", self.settle_time, "a time >= 0 [s]"),
+            ("contact_height", self.contact_height, "a height >= 0 [m]"),
+            ("contact_speed", self.contact_speed, "a speed >= 0 [m/s]"),
+            ("min_phase", self.min_phase, "a time >= 0 [s]"),
+            ("com_margin", self.com_margin, "a distance >= 0 [m]"),
+            ("com_smoothing", self.com_smoothing, "a time >= 0 [s]"),
+            ("posture_margin", self.posture_margin, "an angle >= 0 [rad]"),
+            (
+                "max_leg_extension",
+                self.max_leg_extension,
+                "a fraction >= 0 [–]",
+            ),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(Error::InvalidSetting {
+                    name: name.into(),
+                    value: v.to_string(),
+                    expected: format!("a finite {what}"),
+                });
+            }
+        }
+        self.gains.validate()?;
+        self.bounds.validate()?;
+        self.solver.validate()
+    }
+}
+
+/// A keypoint retargeting run.
+#[derive(Debug, Clone)]
+pub struct KeypointRun {
+    /// How the clip was aligned and scaled.
+    pub scaling: Scaling,
+    /// Time of every recorded tick from the clip's start \[s\].
+    pub times: Vec<f64>,
+    /// The robot's configuration q at every recorded tick (base position \[m\] and quaternion,
+    /// then joints \[rad\]).
+    pub trajectory: Vec<Vec<f64>>,
+    /// Contacts per tick, left and right foot.
+    pub contacts: [Vec<bool>; 2],
+    /// Quality figures.
+    pub quality: RetargetQuality,
+    /// Ticks solved by GF because IKTC's answer left the box ([`KeypointController::tick`]).
+    pub fallback_ticks: usize,
+    /// Median time of one control tick (references, kinematics, box, solve, integration) \[µs\].
+    pub tick_median_us: f64,
+}
+
+/// Everything a keypoint run needs, built once.
+struct Setup {
+    robot: Arc<Robot>,
+    body: RobotBody,
+    support: SupportSettings,
+    controller: KeypointController,
+    scaling: Scaling,
+}
+
+/// The robot's start state: the profile's posture, the lowest sole on z = 0.
+fn start_state(robot: &Robot, cfg: &ImitateConfig, body: &RobotBody) -> Result<State> {
+    let mut state = State::neutral(robot);
+    for (name, value) in &cfg.initial_posture {
+        state.set_joint(robot, name, *value)?;
+    }
+    let kin = Kinematics::new(robot, &state)?;
+    let lowest = body
+        .feet
+        .iter()
+        .map(|f| kin.frame_pose(robot, *f).map(|p| p.translation.z))
+        .collect::<Result<Vec<_>>>()?
+        .into_iter()
+        .fold(f64::INFINITY, f64::min);
+    let mut base = state.base_pose(robot);
+    base.translation.vector.z += cfg.support.ankle_height - lowest;
+    state.set_base_pose(robot, &base)?;
+    Ok(state)
+}
+
+fn frame_names(profile: &RobotProfile, cfg: &ImitateConfig) -> Result<BodyFrameNames> {
+    let f = &profile.frames;
+    let missing = |key: &str| Error::Profile {
+        key: key.into(),
+        value: crate::profile::MISSING.into(),
+        message: "keypoint retargeting tracks the hands: set the hand frames".into(),
+    };
+    Ok(BodyFrameNames {
+        pelvis: cfg.pelvis.clone(),
+        torso: f.torso.clone(),
+        head: f.head.clone(),
+        // The imitation lists the feet right, left.
+        feet: [cfg.feet[1].clone(), cfg.feet[0].clone()],
+        hands: [
+            f.left_hand
+                .clone()
+                .ok_or_else(|| missing("frames.left_hand"))?,
+            f.right_hand
+                .clone()
+                .ok_or_else(|| missing("frames.right_hand"))?,
+        ],
+    })
+}
+
+fn setup(
+    profile: &RobotProfile,
+    kp: &Keypoints,
+    posture: Option<&RobotReferences>,
+    s: &KeypointSettings,
+) -> Result<Setup> {
+    s.validate()?;
+    let robot = Arc::new(profile.robot()?);
+    let cfg = profile.imitate_config(ImitateConfig::default())?;
+    let names = frame_names(profile, &cfg)?;
+    let state0 = State::neutral(&robot);
+    let mut kin = Kinematics::new(&robot, &state0)?;
+    let body = RobotBody::find(&robot, &kin, &names)?;
+    let state = start_state(&robot, &cfg, &body)?;
+    kin.update(&robot, &state)?;
+    let clip = scale::scale_clip(&robot, &kin, &body, kp, cfg.support.ankle_height)?;
+    let plan = plan::plan(&robot, &kin, &body, kp, &clip, &cfg.support, s)?;
+    let tracks = posture_tracks(&robot, &state, posture, s.posture_margin)?;
+    let controller = KeypointController::new(robot.clone(), state, &body, plan, tracks, s)?;
+    Ok(Setup {
+        robot,
+        body,
+        support: cfg.support,
+        controller,
+        scaling: clip.scaling,
+    })
+}
+
+/// Posture references of every active joint: the joint route's where given (kept
+/// `margin` inside the range), else the start posture.
+fn posture_tracks(
+    robot: &Robot,
+    state: &State,
+    refs: Option<&RobotReferences>,
+    margin: f64,
+) -> Result<tracker::PostureTracks> {
+    let mut names = Vec::new();
+    let mut tracks = Vec::new();
+    for j in robot.active_joints() {
+        let q0 = state.joint(robot, &j.name)?;
+        let given = refs.and_then(|r| {
+            r.joint_names
+                .iter()
+                .position(|n| *n == j.name)
+                .and_then(|i| r.joints.get(i))
+        });
+        let (lo, hi) = (j.limit.lower + margin, j.limit.upper - margin);
+        let track = match given {
+            Some(t) if lo <= hi => {
+                let mut p = t.position.clone();
+                let mut v = t.velocity.clone();
+                let mut a = t.acceleration.clone();
+                for k in 0..p.len() {
+                    if p[k] < lo || p[k] > hi {
+                        p[k] = p[k].clamp(lo, hi);
+                        v[k] = 0.0;
+                        a[k] = 0.0;
+                    }
+                }
+                [p, v, a]
+            }
+            _ => [vec![q0; 1], vec![0.0; 1], vec![0.0; 1]],
+        };
+        names.push(j.name.clone());
+        tracks.push(track);
+    }
+    Ok((names, tracks))
+}
+
+/// The keypoint controller of a clip on a profile's robot, set up and ready for its first
+/// (settling) tick: for benches and tests of the tick; [`retarget_keypoints`] runs it.
+pub fn keypoint_controller(
+    profile: &RobotProfile,
+    kp: &Keypoints,
+    posture: Option<&RobotReferences>,
+    s: &KeypointSettings,
+) -> Result<KeypointController> {
+    Ok(setup(profile, kp, posture, s)?.controller)
+}
+
+/// Retargets `kp` onto the robot of `profile` (see the module documentation); `posture`, the
+/// joint route's references at `s.dt` (e.g. [`crate::sim::imitation_references`]), is the
+/// posture level's reference where given, else the start posture is.
+///
+/// Errors: bad settings, a profile without feet, pelvis or hands, keypoints without the
+/// pelvis, hips, knees, ankles or shoulders, a clip longer than `s.run_limits` allows. An
+/// infeasible tick is not an error (the solver's fallback is taken and reported).
+pub fn retarget_keypoints(
+    profile: &RobotProfile,
+    kp: &Keypoints,
+    posture: Option<&RobotReferences>,
+    s: &KeypointSettings,
+) -> Result<KeypointRun> {
+    let Setup {
+        robot,
+        body,
+        support,
+        mut controller,
+        scaling,
+    } = setup(profile, kp, posture, s)?;
+    let settle = (s.settle_time / s.dt).round() as usize;
+    for _ in 0..settle {
+        controller.tick(0, true)?;
+        controller.integrate()?;
+    }
+    let ticks = controller.ticks();
+    let mut rec = QualityRecorder::new("keypoints", &body, s.dt);
+    let mut kin = Kinematics::new(&robot, controller.state())?;
+    let mut trajectory = Vec::with_capacity(ticks);
+    let mut times = Vec::with_capacity(ticks);
+    let mut tick_us = Vec::with_capacity(ticks);
+    let t0 = kp.times.first().copied().unwrap_or(0.0);
+    for k in 0..ticks {
+        let state = controller.state().clone();
+        let start = Instant::now();
+        controller.tick(k, false)?;
+        tick_us.push(start.elapsed().as_secs_f64() * 1e6);
+        let plan = controller.plan();
+        rec.record(
+            &robot,
+            &mut kin,
+            &body,
+            plan,
+            &support,
+            k,
+            &state,
+            controller.qdd().as_slice(),
+        )?;
+        let start = Instant::now();
+        controller.integrate()?;
+        if let Some(last) = tick_us.last_mut() {
+            *last += start.elapsed().as_secs_f64() * 1e6;
+        }
+        trajectory.push(state.q.as_slice().to_vec());
+        times.push(t0 + k as f64 * s.dt);
+    }
+    let contacts = controller.plan().contact.clone();
+    Ok(KeypointRun {
+        scaling,
+        times,
+        trajectory,
+        contacts,
+        quality: rec.finish(&robot),
+        fallback_ticks: controller.fallback_ticks(),
+        tick_median_us: percentile(&tick_us, 0.5),
+    })
+}
+
+/// The quality figures of the joint-angle route on the same clip: the imitation of Table 1
+/// ([`ImitationController`]) with the profile's feet, pelvis and posture, the robot's own
+/// joint ranges (no narrowed ones), IKTC with `s.method` and `s.bounds`, on the references
+/// `refs` (the clip retargeted by decomposition and resampled at `s.dt`), measured against the
+/// keypoints `kp` exactly as [`retarget_keypoints`] is.
+pub fn joint_route_quality(
+    profile: &RobotProfile,
+    kp: &Keypoints,
+    refs: &RobotReferences,
+    s: &KeypointSettings,
+) -> Result<RetargetQuality> {
+    let setup = setup(profile, kp, None, s)?;
+    let cfg = ImitateConfig {
+        method: s.method,
+        bounds: s.bounds,
+        dt: s.dt,
+        run_limits: s.run_limits,
+        gains: s.gains,
+        solver: s.solver,
+        narrow: Vec::new(),
+        ..profile.imitate_config(ImitateConfig::default())?
+    };
+    let robot = &setup.robot;
+    let mut ctl = ImitationController::new(robot, refs, &cfg)?;
+    let plan = setup.controller.plan();
+    let mut rec = QualityRecorder::new("joints", &setup.body, s.dt);
+    let mut kin = Kinematics::new(robot, ctl.state())?;
+    for k in 0..plan.ticks.min(refs.len()) {
+        let state = ctl.state().clone();
+        ctl.tick(robot, k)?;
+        rec.record(
+            robot,
+            &mut kin,
+            &setup.body,
+            plan,
+            &setup.support,
+            k,
+            &state,
+            ctl.qdd().as_slice(),
+        )?;
+        ctl.integrate(robot)?;
+    }
+    Ok(rec.finish(robot))
+}

@@ -1,0 +1,538 @@
+//! The references of every task at the control rate, computed once before the run.
+//!
+//! The scaled points ([`super::scale`]) are interpolated at the tick times by natural cubic
+//! splines ([`CubicSpline`]); the feet are held in stance ([`super::contacts`]); the COM
+//! reference is the scaled pelvis' ground projection pulled into the support polygon of the
+//! feet on the ground (shrunk by `com_margin`), then smoothed by two passes of a centred moving
+//! average of `com_smoothing` \[s\]; orientations come from the points: the pelvis frame from
+//! the hip axis and the vertical, the torso frame from the shoulder axis and the hips-to-
+//! shoulders direction (`y` along the axis, `z` the other direction made orthogonal to it,
+//! `x = y × z`), each times the constant rotation that maps the same construction on the robot
+//! in its start posture onto the robot's frame. Where a leg would have to stretch beyond
+//! `max_leg_extension` of its length `L` (hip–knee plus knee–ankle) to reach its foot's
+//! reference, the pelvis and the points above it are lowered by
+//! `δz = −√((e L)² − |d_xy|²) − d_z` (`d` from the robot's hip, placed by the pelvis reference
+//! and heading, to the ankle's reference), the largest over both legs, spread over
+//! `com_smoothing` by a running maximum and the same moving averages. Rates and accelerations are central
+//! differences of the sampled references (`ẋ_k = (x_{k+1} − x_{k−1}) / 2Δt`, angular rates
+//! from `log(R_{k+1} R_{k−1}ᵀ) / 2Δt`).
+
+use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, UnitQuaternion, Vector3, Vector6};
+
+use super::body::RobotBody;
+use super::contacts::{detect, hold, remove_short};
+use super::scale::ScaledClip;
+use super::{KeypointSettings, SupportArea};
+use crate::error::{Error, Result};
+use crate::model::{Kinematics, Robot};
+use crate::motion::{BodyPoint, CubicSpline, Keypoints};
+use crate::sim::imitate::{sole_pose, SupportSettings};
+use crate::task::{ComReference, FrameReference};
+use crate::walk::SupportPolygon;
+
+/// References of one tick.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct PointRef {
+    pub position: Vector3<f64>,
+    pub velocity: Vector3<f64>,
+    pub acceleration: Vector3<f64>,
+}
+
+impl PointRef {
+    pub fn frame(&self, hold: bool) -> FrameReference {
+        let z = Vector3::zeros();
+        let (v, a) = if hold {
+            (z, z)
+        } else {
+            (self.velocity, self.acceleration)
+        };
+        FrameReference {
+            pose: Isometry3::from_parts(
+                Translation3::from(self.position),
+                UnitQuaternion::identity(),
+            ),
+            velocity: Vector6::new(v.x, v.y, v.z, 0.0, 0.0, 0.0),
+            acceleration: Vector6::new(a.x, a.y, a.z, 0.0, 0.0, 0.0),
+        }
+    }
+}
+
+/// A pose reference of one tick.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct PoseRef {
+    pub position: PointRef,
+    pub rotation: UnitQuaternion<f64>,
+    pub angular_velocity: Vector3<f64>,
+    pub angular_acceleration: Vector3<f64>,
+}
+
+impl PoseRef {
+    pub fn frame(&self, hold: bool) -> FrameReference {
+        let mut r = self.position.frame(hold);
+        r.pose.rotation = self.rotation;
+        if !hold {
+            let (w, a) = (self.angular_velocity, self.angular_acceleration);
+            r.velocity.fixed_rows_mut::<3>(3).copy_from(&w);
+            r.acceleration.fixed_rows_mut::<3>(3).copy_from(&a);
+        }
+        r
+    }
+}
+
+/// Every task's references at every tick, the contacts, and the human points for the quality
+/// figures.
+#[derive(Debug, Clone)]
+pub(crate) struct Plan {
+    pub ticks: usize,
+    /// Feet (left, right) per tick.
+    pub feet: [Vec<PoseRef>; 2],
+    /// Feet on the ground per tick (left, right).
+    pub contact: [Vec<bool>; 2],
+    pub com: Vec<ComReference>,
+    pub pelvis: Vec<PoseRef>,
+    pub torso: Vec<PoseRef>,
+    /// The tracked points (hands, elbows, head) and their references per tick.
+    pub points: Vec<(BodyPoint, Vec<PointRef>)>,
+    /// Per tick, per point of the robot body: `s_leg (a(p) − a(p_pelvis))` \[m\], the neutral
+    /// target relative to the robot's pelvis.
+    pub neutral: Vec<Vec<(BodyPoint, Vector3<f64>)>>,
+}
+
+fn finite_differences(x: &[Vector3<f64>], dt: f64) -> (Vec<Vector3<f64>>, Vec<Vector3<f64>>) {
+    let n = x.len();
+    let diff = |x: &[Vector3<f64>]| -> Vec<Vector3<f64>> {
+        (0..n)
+            .map(|k| {
+                if n < 3 || k == 0 || k + 1 == n {
+                    Vector3::zeros()
+                } else {
+                    (x[k + 1] - x[k - 1]) / (2.0 * dt)
+                }
+            })
+            .collect()
+    };
+    let v = diff(x);
+    let a = diff(&v);
+    (v, a)
+}
+
+fn point_refs(x: Vec<Vector3<f64>>, dt: f64) -> Vec<PointRef> {
+    let (v, a) = finite_differences(&x, dt);
+    x.into_iter()
+        .zip(v.into_iter().zip(a))
+        .map(|(position, (velocity, acceleration))| PointRef {
+            position,
+            velocity,
+            acceleration,
+        })
+        .collect()
+}
+
+fn pose_refs(x: Vec<Vector3<f64>>, r: Vec<UnitQuaternion<f64>>, dt: f64) -> Vec<PoseRef> {
+    let n = r.len();
+    let w: Vec<Vector3<f64>> = (0..n)
+        .map(|k| {
+            if n < 3 || k == 0 || k + 1 == n {
+                Vector3::zeros()
+            } else {
+                (r[k + 1] * r[k - 1].inverse()).scaled_axis() / (2.0 * dt)
+            }
+        })
+        .collect();
+    let (_, wd) = finite_differences(&w, dt);
+    let wd: Vec<Vector3<f64>> = (0..n)
+        .map(|k| {
+            if n < 3 || k == 0 || k + 1 == n {
+                Vector3::zeros()
+            } else {
+                (w[k + 1] - w[k - 1]) / (2.0 * dt)
+            }
+        })
+        .zip(wd)
+        .map(|(a, _)| a)
+        .collect();
+    point_refs(x, dt)
+        .into_iter()
+        .zip(r.into_iter().zip(w.into_iter().zip(wd)))
+        .map(|(position, (rotation, (w, a)))| PoseRef {
+            position,
+            rotation,
+            angular_velocity: w,
+            angular_acceleration: a,
+        })
+        .collect()
+}
+
+/// The frame with `y` along `axis` and `z` along `up` made orthogonal to it.
+fn frame_from(axis: Vector3<f64>, up: Vector3<f64>) -> UnitQuaternion<f64> {
+    let y = axis.try_normalize(1e-12).unwrap_or_else(Vector3::y);
+    let z = (up - y * y.dot(&up))
+        .try_normalize(1e-12)
+        .unwrap_or_else(Vector3::z);
+    let x = y.cross(&z);
+    UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(Matrix3::from_columns(
+        &[x, y, z],
+    )))
+}
+
+fn pelvis_frame(lh: Vector3<f64>, rh: Vector3<f64>) -> UnitQuaternion<f64> {
+    frame_from(lh - rh, Vector3::z())
+}
+
+fn torso_frame(
+    ls: Vector3<f64>,
+    rs: Vector3<f64>,
+    lh: Vector3<f64>,
+    rh: Vector3<f64>,
+) -> UnitQuaternion<f64> {
+    frame_from(ls - rs, 0.5 * (ls + rs) - 0.5 * (lh + rh))
+}
+
+/// Pulls `p` into `polygon` until its margin is at least `margin` \[m\], along the segment to the
+/// polygon's vertex centroid (bisection).
+fn pull_inside(polygon: &SupportPolygon, p: (f64, f64), margin: f64) -> (f64, f64) {
+    if polygon.margin(p) >= margin {
+        return p;
+    }
+    let v = polygon.vertices();
+    let n = v.len().max(1) as f64;
+    let c = v
+        .iter()
+        .fold((0.0, 0.0), |a, q| (a.0 + q.0 / n, a.1 + q.1 / n));
+    if polygon.margin(c) < margin {
+        return c;
+    }
+    let (mut lo, mut hi) = (0.0, 1.0); // fraction of the way from c to p
+    for _ in 0..40 {
+        let mid = 0.5 * (lo + hi);
+        let q = (c.0 + mid * (p.0 - c.0), c.1 + mid * (p.1 - c.1));
+        if polygon.margin(q) >= margin {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    (c.0 + lo * (p.0 - c.0), c.1 + lo * (p.1 - c.1))
+}
+
+fn moving_average(x: &mut [Vector3<f64>], half: usize) {
+    if half == 0 || x.len() < 2 {
+        return;
+    }
+    let src = x.to_vec();
+    let n = src.len();
+    for (k, out) in x.iter_mut().enumerate() {
+        let (a, b) = (k.saturating_sub(half), (k + half).min(n - 1));
+        *out = src[a..=b].iter().sum::<Vector3<f64>>() / (b - a + 1) as f64;
+    }
+}
+
+/// The plan of a run (see the module documentation). `kin` is at the start posture.
+pub(crate) fn plan(
+    robot: &Robot,
+    kin: &Kinematics,
+    body: &RobotBody,
+    kp: &Keypoints,
+    clip: &ScaledClip,
+    support: &SupportSettings,
+    s: &KeypointSettings,
+) -> Result<Plan> {
+    let n = kp.points.len();
+    let frames = kp.frame_count();
+    let (t0, t1) = (kp.times[0], kp.times[frames - 1]);
+    let ticks = s
+        .run_limits
+        .ticks(&format!("`{}`", kp.source), t1 - t0, s.dt)?
+        + 1;
+    let times: Vec<f64> = (0..ticks).map(|k| (t0 + k as f64 * s.dt).min(t1)).collect();
+    let idx = |p: BodyPoint| kp.points.iter().position(|q| *q == p);
+    // Splines through the scaled and aligned points.
+    let sample = |data: &[Vector3<f64>], k: usize| -> Result<Vec<Vector3<f64>>> {
+        let mut out = vec![Vector3::zeros(); ticks];
+        if frames == 1 {
+            out.iter_mut().for_each(|o| *o = data[k]);
+            return Ok(out);
+        }
+        for axis in 0..3 {
+            let y: Vec<f64> = (0..frames).map(|f| data[f * n + k][axis]).collect();
+            let spline = CubicSpline::new(&kp.times, &y)?;
+            for (o, t) in out.iter_mut().zip(&times) {
+                o[axis] = spline.eval(*t)[0];
+            }
+        }
+        Ok(out)
+    };
+    let mut scaled: Vec<Option<Vec<Vector3<f64>>>> = vec![None; n];
+    let mut aligned: Vec<Option<Vec<Vector3<f64>>>> = vec![None; n];
+    for k in 0..n {
+        scaled[k] = Some(sample(&clip.scaled, k)?);
+        aligned[k] = Some(sample(&clip.aligned, k)?);
+    }
+    let track =
+        |p: BodyPoint| -> Option<&Vec<Vector3<f64>>> { idx(p).and_then(|k| scaled[k].as_ref()) };
+    let missing = |p: BodyPoint| Error::UnknownName {
+        kind: "body point (missing from the keypoints)",
+        name: format!("{p}` in `{}", kp.source),
+        valid: kp.points.iter().map(|q| q.name().to_string()).collect(),
+    };
+    let get = |p: BodyPoint| track(p).ok_or_else(|| missing(p));
+    // Contacts at the source rate, on the aligned clip, then per tick (nearest frame).
+    let frame_of_tick = |t: f64| -> usize {
+        let f = kp.times.partition_point(|x| *x < t);
+        if f == 0 {
+            0
+        } else if f >= frames {
+            frames - 1
+        } else if t - kp.times[f - 1] < kp.times[f] - t {
+            f - 1
+        } else {
+            f
+        }
+    };
+    let rate_dt = if frames > 1 {
+        (t1 - t0) / (frames - 1) as f64
+    } else {
+        s.dt
+    };
+    let min_len = (s.min_phase / rate_dt).round() as usize;
+    let sides = [
+        (BodyPoint::LeftAnkle, BodyPoint::LeftToe),
+        (BodyPoint::RightAnkle, BodyPoint::RightToe),
+    ];
+    let column =
+        |k: usize| -> Vec<Vector3<f64>> { (0..frames).map(|f| clip.aligned[f * n + k]).collect() };
+    let toe_ground = sides
+        .iter()
+        .filter_map(|(_, t)| idx(*t))
+        .flat_map(|k| (0..frames).map(move |f| (k, f)))
+        .map(|(k, f)| clip.aligned[f * n + k].z)
+        .fold(f64::INFINITY, f64::min);
+    let mut contact: [Vec<bool>; 2] = [Vec::new(), Vec::new()];
+    for (i, (a, t)) in sides.iter().enumerate() {
+        let ankle = column(idx(*a).ok_or_else(|| missing(*a))?);
+        let toe = idx(*t).map(column);
+        let mut c = detect(
+            &kp.times,
+            &ankle,
+            toe.as_deref(),
+            [0.0, toe_ground],
+            s.contact_height,
+            s.contact_speed,
+        );
+        remove_short(&mut c, false, min_len);
+        remove_short(&mut c, true, min_len);
+        contact[i] = times.iter().map(|t| c[frame_of_tick(*t)]).collect();
+    }
+    // Feet: x, y, yaw held in stance, z on the ground in stance.
+    let h_a = support.ankle_height;
+    let pelvis_x = get(BodyPoint::Pelvis)?;
+    let (lh, rh) = (get(BodyPoint::LeftHip)?, get(BodyPoint::RightHip)?);
+    let heading: Vec<f64> = unwrap(
+        (0..ticks)
+            .map(|k| {
+                let l = lh[k] - rh[k];
+                l.y.atan2(l.x) - std::f64::consts::FRAC_PI_2
+            })
+            .collect(),
+    );
+    let mut feet: [Vec<PoseRef>; 2] = [Vec::new(), Vec::new()];
+    for (i, (a, t)) in sides.iter().enumerate() {
+        let ankle = get(*a)?;
+        let foot0 = kin.frame_pose(robot, body.feet[i])?;
+        let yaw: Vec<f64> = match track(*t) {
+            Some(toe) => {
+                let raw = unwrap(
+                    (0..ticks)
+                        .map(|k| {
+                            let d = toe[k] - ankle[k];
+                            d.y.atan2(d.x)
+                        })
+                        .collect(),
+                );
+                raw.iter().map(|y| y - raw[0]).collect()
+            }
+            None => heading.iter().map(|y| y - heading[0]).collect(),
+        };
+        let mut x: Vec<f64> = ankle.iter().map(|p| p.x).collect();
+        let mut y: Vec<f64> = ankle.iter().map(|p| p.y).collect();
+        let mut z: Vec<f64> = ankle.iter().map(|p| p.z).collect();
+        let mut w = yaw;
+        hold(&mut x, &contact[i], None);
+        hold(&mut y, &contact[i], None);
+        hold(&mut z, &contact[i], Some(h_a));
+        hold(&mut w, &contact[i], None);
+        let pos: Vec<Vector3<f64>> = (0..ticks)
+            .map(|k| Vector3::new(x[k], y[k], z[k].max(h_a)))
+            .collect();
+        let rot: Vec<UnitQuaternion<f64>> = w
+            .iter()
+            .map(|yaw| UnitQuaternion::from_euler_angles(0.0, 0.0, *yaw) * foot0.rotation)
+            .collect();
+        feet[i] = pose_refs(pos, rot, s.dt);
+    }
+    // COM over the support polygon of the feet on the ground.
+    let mut com: Vec<Vector3<f64>> = Vec::with_capacity(ticks);
+    let mut polygon = SupportPolygon::default();
+    for k in 0..ticks {
+        let any = contact[0][k] || contact[1][k];
+        let on: Vec<Isometry3<f64>> = (0..2)
+            .filter(|i| match s.support_area {
+                SupportArea::Stance => contact[*i][k],
+                SupportArea::BothFeet => any,
+            })
+            .map(|i| {
+                Isometry3::from_parts(
+                    Translation3::from(feet[i][k].position.position),
+                    feet[i][k].rotation,
+                )
+            })
+            .collect();
+        let p = (pelvis_x[k].x, pelvis_x[k].y);
+        let (l, w) = (support.sole_length, support.sole_width);
+        let q = match on.as_slice() {
+            [a] => {
+                polygon.set_sole(&sole_pose(a, support), l, w);
+                pull_inside(&polygon, p, s.com_margin)
+            }
+            [a, b] => {
+                polygon.set_hull_of_soles(&sole_pose(a, support), &sole_pose(b, support), l, w);
+                pull_inside(&polygon, p, s.com_margin)
+            }
+            _ => p,
+        };
+        com.push(Vector3::new(q.0, q.1, 0.0));
+    }
+    let half = (0.5 * s.com_smoothing / s.dt).round() as usize;
+    moving_average(&mut com, half);
+    moving_average(&mut com, half);
+    let com = point_refs(com, s.dt)
+        .into_iter()
+        .map(|r| ComReference {
+            position: r.position,
+            velocity: r.velocity,
+            acceleration: r.acceleration,
+        })
+        .collect();
+    // Pelvis and torso orientations, from the same construction on the robot at its start.
+    let at0 = |p: BodyPoint| -> Result<Vector3<f64>> {
+        let f = body.frame_of(p).ok_or_else(|| missing(p))?;
+        Ok(kin.frame_pose(robot, f)?.translation.vector)
+    };
+    let (rlh, rrh) = (at0(BodyPoint::LeftHip)?, at0(BodyPoint::RightHip)?);
+    let (rls, rrs) = (
+        at0(BodyPoint::LeftShoulder)?,
+        at0(BodyPoint::RightShoulder)?,
+    );
+    let c_pelvis = pelvis_frame(rlh, rrh).inverse() * kin.frame_pose(robot, body.pelvis)?.rotation;
+    let pelvis_rot: Vec<UnitQuaternion<f64>> = (0..ticks)
+        .map(|k| pelvis_frame(lh[k], rh[k]) * c_pelvis)
+        .collect();
+    // Legs within reach: lower the pelvis (and the points above it) where needed.
+    let mut drop = vec![0.0; ticks];
+    for (i, (hip, knee, ankle)) in [
+        (
+            BodyPoint::LeftHip,
+            BodyPoint::LeftKnee,
+            BodyPoint::LeftAnkle,
+        ),
+        (
+            BodyPoint::RightHip,
+            BodyPoint::RightKnee,
+            BodyPoint::RightAnkle,
+        ),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let (h0, k0, a0) = (at0(hip)?, at0(knee)?, at0(ankle)?);
+        let reach = s.max_leg_extension * ((k0 - h0).norm() + (a0 - k0).norm());
+        let offset = h0 - kin.frame_pose(robot, body.pelvis)?.translation.vector;
+        for k in 0..ticks {
+            let turn = UnitQuaternion::from_euler_angles(0.0, 0.0, heading[k] - heading[0]);
+            let d = feet[i][k].position.position - (pelvis_x[k] + turn * offset);
+            let horizontal = d.xy().norm().min(reach);
+            let need = -(reach * reach - horizontal * horizontal).sqrt() - d.z;
+            drop[k] = f64::max(drop[k], need);
+        }
+    }
+    let half = (0.5 * s.com_smoothing / s.dt).round() as usize;
+    let peak: Vec<f64> = (0..ticks)
+        .map(|k| {
+            drop[k.saturating_sub(half)..(k + half + 1).min(ticks)]
+                .iter()
+                .fold(0.0, |a: f64, b| a.max(*b))
+        })
+        .collect();
+    let mut lowered: Vec<Vector3<f64>> = peak.iter().map(|d| Vector3::new(0.0, 0.0, *d)).collect();
+    moving_average(&mut lowered, half);
+    moving_average(&mut lowered, half);
+    let pelvis_x: Vec<Vector3<f64>> = pelvis_x.iter().zip(&lowered).map(|(p, d)| p - d).collect();
+    let pelvis = pose_refs(pelvis_x, pelvis_rot, s.dt);
+    let (ls, rs) = (
+        get(BodyPoint::LeftShoulder)?,
+        get(BodyPoint::RightShoulder)?,
+    );
+    let c_torso = match body.torso {
+        Some(f) => torso_frame(rls, rrs, rlh, rrh).inverse() * kin.frame_pose(robot, f)?.rotation,
+        None => UnitQuaternion::identity(),
+    };
+    let torso_rot: Vec<UnitQuaternion<f64>> = (0..ticks)
+        .map(|k| torso_frame(ls[k], rs[k], lh[k], rh[k]) * c_torso)
+        .collect();
+    let torso = pose_refs(vec![Vector3::zeros(); ticks], torso_rot, s.dt);
+    // Hands, elbows, head.
+    let mut points = Vec::new();
+    for p in TRACKED {
+        if body.frame_of(p).is_some() {
+            if let Some(x) = track(p) {
+                let x = x.iter().zip(&lowered).map(|(p, d)| p - d).collect();
+                points.push((p, point_refs(x, s.dt)));
+            }
+        }
+    }
+    // Neutral targets: the aligned human points scaled by the leg ratio, pelvis-aligned.
+    let pelvis_k = idx(BodyPoint::Pelvis).ok_or_else(|| missing(BodyPoint::Pelvis))?;
+    let leg = clip.scaling.leg;
+    let neutral = (0..ticks)
+        .map(|k| {
+            body.points
+                .iter()
+                .filter_map(|(p, _)| {
+                    let i = idx(*p)?;
+                    let a = aligned[i].as_ref()?[k];
+                    let o = aligned[pelvis_k].as_ref()?[k];
+                    Some((*p, leg * (a - o)))
+                })
+                .collect()
+        })
+        .collect();
+    Ok(Plan {
+        ticks,
+        feet,
+        contact,
+        com,
+        pelvis,
+        torso,
+        points,
+        neutral,
+    })
+}
+
+/// The points tracked below the pelvis: hands (level 4), then elbows (level 5, with the torso's
+/// orientation). The head is not tracked: on a robot whose head is fixed to the torso its
+/// position and the torso's orientation make a rank-deficient level, which IKTC's correction
+/// does not keep inside the box (seen on G1); its error is reported.
+pub(crate) const TRACKED: [BodyPoint; 4] = [
+    BodyPoint::LeftWrist,
+    BodyPoint::RightWrist,
+    BodyPoint::LeftElbow,
+    BodyPoint::RightElbow,
+];
+
+fn unwrap(mut a: Vec<f64>) -> Vec<f64> {
+    for k in 1..a.len() {
+        let d = crate::motion::wrap_to_pi(a[k] - a[k - 1]);
+        a[k] = a[k - 1] + d;
+    }
+    a
+}

@@ -1,0 +1,249 @@
+//! Quality figures of a retargeted motion, the same for the keypoint route and the joint route.
+//!
+//! Per tick `k` of the clip (after any settling), from the robot's state:
+//! * position error of each body point the robot has: `|x_k − (x_pelvis,k + s_leg (a(p_k) −
+//!   a(p_pelvis,k)))|` \[m\], the human point scaled by the leg ratio and placed at the robot's
+//!   pelvis (the aligned clip `a`, [`super::scale`]); mean and max per point, reported in cm;
+//! * orientation error of the pelvis and the torso frames against the references built from the
+//!   points ([`super::plan`]): the angle of `R_ref R_robotᵀ` \[rad\], mean and max, in degrees;
+//! * stance-foot slip: for each stance run of a foot (contacts of the clip), the largest
+//!   horizontal distance of the sole centre from where it was at the run's first tick \[m\], in mm;
+//! * foot below the ground: the largest depth below z = 0 of any sole corner \[m\], in mm;
+//! * joint jerk `(q̈_k − q̈_{k−1}) / Δt` of the active joints \[rad/s³\]: RMS over joints and
+//!   ticks, and max ([`DofSmoothness`]);
+//! * the worst limit margins ([`dof_margins`]): positive means a limit was exceeded.
+
+use nalgebra::{Point3, UnitQuaternion, Vector3};
+use serde::Serialize;
+
+use super::body::RobotBody;
+use super::plan::Plan;
+use crate::error::Result;
+use crate::model::{Kinematics, Robot, State};
+use crate::motion::BodyPoint;
+use crate::sim::imitate::SupportSettings;
+use crate::sim::{dof_margins, DofSmoothness};
+
+/// Position error of one body point \[cm\].
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PointError {
+    /// The body point.
+    pub point: String,
+    /// Mean over the ticks \[cm\].
+    pub mean_cm: f64,
+    /// Largest \[cm\].
+    pub max_cm: f64,
+}
+
+/// Orientation error of one frame \[deg\].
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct OrientationError {
+    /// `pelvis` or `torso`.
+    pub frame: String,
+    /// Mean over the ticks \[deg\].
+    pub mean_deg: f64,
+    /// Largest \[deg\].
+    pub max_deg: f64,
+}
+
+/// The quality figures of one run (see the module documentation).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RetargetQuality {
+    /// `keypoints` or `joints`.
+    pub route: String,
+    /// Ticks measured.
+    pub ticks: usize,
+    /// Per body point, in [`BodyPoint::ALL`] order.
+    pub points: Vec<PointError>,
+    /// Mean of the per-point means \[cm\].
+    pub mean_cm: f64,
+    /// Orientation errors.
+    pub orientations: Vec<OrientationError>,
+    /// Largest stance-foot slip \[mm\].
+    pub slip_mm: f64,
+    /// Deepest sole corner below the ground \[mm\] (0 if never below).
+    pub below_ground_mm: f64,
+    /// Ticks with at least one foot on the ground (per the clip's contacts).
+    pub stance_ticks: usize,
+    /// RMS joint jerk \[rad/s³\].
+    pub jerk_rms: f64,
+    /// Largest joint jerk \[rad/s³\].
+    pub jerk_max: f64,
+    /// Worst position margin \[rad\] (positive: a limit exceeded by that much).
+    pub position_margin: f64,
+    /// Worst velocity margin \[rad/s\].
+    pub velocity_margin: f64,
+    /// Worst acceleration margin \[rad/s²\].
+    pub acceleration_margin: f64,
+}
+
+/// Records the ticks of a run and gives its [`RetargetQuality`]. Allocates during `record`
+/// (it keeps the trajectory); not for the control loop's hot path.
+#[derive(Debug, Clone)]
+pub struct QualityRecorder {
+    route: String,
+    dt: f64,
+    sums: Vec<(BodyPoint, f64, f64)>,
+    orient: [(f64, f64); 2],
+    slip: f64,
+    below: f64,
+    stance_start: [Option<Vector3<f64>>; 2],
+    stance_ticks: usize,
+    ticks: usize,
+    q: Vec<Vec<f64>>,
+    qd: Vec<Vec<f64>>,
+    qdd: Vec<Vec<f64>>,
+    pos: Vec<f64>,
+}
+
+impl QualityRecorder {
+    pub(crate) fn new(route: &str, body: &RobotBody, dt: f64) -> Self {
+        Self {
+            route: route.into(),
+            dt,
+            sums: body.points.iter().map(|(p, _)| (*p, 0.0, 0.0)).collect(),
+            orient: [(0.0, 0.0); 2],
+            slip: 0.0,
+            below: 0.0,
+            stance_start: [None, None],
+            stance_ticks: 0,
+            ticks: 0,
+            q: Vec::new(),
+            qd: Vec::new(),
+            qdd: Vec::new(),
+            pos: Vec::new(),
+        }
+    }
+
+    /// Records tick `k` of `plan`: the state at its start and the q̈ applied over it.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn record(
+        &mut self,
+        robot: &Robot,
+        kin: &mut Kinematics,
+        body: &RobotBody,
+        plan: &Plan,
+        support: &SupportSettings,
+        k: usize,
+        state: &State,
+        qdd: &[f64],
+    ) -> Result<()> {
+        kin.update(robot, state)?;
+        let pelvis = kin.frame_pose(robot, body.pelvis)?;
+        for ((p, sum, max), (f_p, f)) in self.sums.iter_mut().zip(&body.points) {
+            debug_assert_eq!(p, f_p);
+            let Some((_, rel)) = plan.neutral[k].iter().find(|(q, _)| q == p) else {
+                continue;
+            };
+            let x = kin.frame_pose(robot, *f)?.translation.vector;
+            let e = (x - (pelvis.translation.vector + rel)).norm();
+            *sum += e;
+            *max = max.max(e);
+        }
+        let angle = |a: &UnitQuaternion<f64>, b: &UnitQuaternion<f64>| (a * b.inverse()).angle();
+        let e = angle(&plan.pelvis[k].rotation, &pelvis.rotation);
+        self.orient[0] = (self.orient[0].0 + e, self.orient[0].1.max(e));
+        if let Some(t) = body.torso {
+            let r = kin.frame_pose(robot, t)?.rotation;
+            let e = angle(&plan.torso[k].rotation, &r);
+            self.orient[1] = (self.orient[1].0 + e, self.orient[1].1.max(e));
+        }
+        let mut any = false;
+        for i in 0..2 {
+            let foot = kin.frame_pose(robot, body.feet[i])?;
+            let (hl, hw) = (0.5 * support.sole_length, 0.5 * support.sole_width);
+            for (sx, sy) in [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)] {
+                let c = foot
+                    * Point3::new(
+                        support.sole_offset_x + sx * hl,
+                        sy * hw,
+                        -support.ankle_height,
+                    );
+                self.below = self.below.max(-c.z);
+            }
+            let centre =
+                (foot * Point3::new(support.sole_offset_x, 0.0, -support.ankle_height)).coords;
+            if plan.contact[i][k] {
+                any = true;
+                let start = *self.stance_start[i].get_or_insert(centre);
+                let d = (centre - start).xy().norm();
+                self.slip = self.slip.max(d);
+            } else {
+                self.stance_start[i] = None;
+            }
+        }
+        if any {
+            self.stance_ticks += 1;
+        }
+        self.pos.resize(robot.nv(), 0.0);
+        state.dof_positions(robot, &mut self.pos)?;
+        let b = robot.base_nv();
+        self.q.push(self.pos[b..].to_vec());
+        self.qd.push(state.qd.as_slice()[b..].to_vec());
+        self.qdd.push(qdd[b..].to_vec());
+        self.ticks += 1;
+        Ok(())
+    }
+
+    /// The figures of the ticks recorded.
+    pub fn finish(&self, robot: &Robot) -> RetargetQuality {
+        let n = self.ticks.max(1) as f64;
+        let points: Vec<PointError> = self
+            .sums
+            .iter()
+            .map(|(p, s, m)| PointError {
+                point: p.name().into(),
+                mean_cm: 100.0 * s / n,
+                max_cm: 100.0 * m,
+            })
+            .collect();
+        let mean_cm = points.iter().map(|p| p.mean_cm).sum::<f64>() / points.len().max(1) as f64;
+        let mut orientations = vec![OrientationError {
+            frame: "pelvis".into(),
+            mean_deg: self.orient[0].0 / n * 180.0 / std::f64::consts::PI,
+            max_deg: self.orient[0].1.to_degrees(),
+        }];
+        if self.orient[1] != (0.0, 0.0) {
+            orientations.push(OrientationError {
+                frame: "torso".into(),
+                mean_deg: self.orient[1].0 / n * 180.0 / std::f64::consts::PI,
+                max_deg: self.orient[1].1.to_degrees(),
+            });
+        }
+        let joints = robot.n_active();
+        let (mut sum_sq, mut count, mut jerk_max) = (0.0, 0usize, 0.0_f64);
+        let (mut pm, mut vm, mut am) = (f64::NEG_INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY);
+        for (j, joint) in robot.active_joints().enumerate().take(joints) {
+            let col = |rows: &[Vec<f64>]| -> Vec<f64> {
+                rows.iter()
+                    .map(|r| r.get(j).copied().unwrap_or(0.0))
+                    .collect()
+            };
+            let (q, qd, qdd) = (col(&self.q), col(&self.qd), col(&self.qdd));
+            let sm = DofSmoothness::of(&qdd, self.dt);
+            let steps = qdd.len().saturating_sub(1);
+            sum_sq += sm.rms_jerk * sm.rms_jerk * steps as f64;
+            count += steps;
+            jerk_max = jerk_max.max(sm.max_jerk);
+            let m = dof_margins(j, &q, &qd, &qdd, self.dt, &joint.limit);
+            pm = pm.max(m.position);
+            vm = vm.max(m.velocity);
+            am = am.max(m.acceleration);
+        }
+        RetargetQuality {
+            route: self.route.clone(),
+            ticks: self.ticks,
+            points,
+            mean_cm,
+            orientations,
+            slip_mm: 1000.0 * self.slip,
+            below_ground_mm: 1000.0 * self.below.max(0.0),
+            stance_ticks: self.stance_ticks,
+            jerk_rms: (sum_sq / count.max(1) as f64).sqrt(),
+            jerk_max,
+            position_margin: pm,
+            velocity_margin: vm,
+            acceleration_margin: am,
+        }
+    }
+}

@@ -1,0 +1,209 @@
+//! Human keypoints scaled to the robot, segment by segment.
+//!
+//! Alignment: the clip is turned about the vertical so that the subject faces +x at the first
+//! frame and moved so that its first pelvis is above the origin and its lowest ankle at z = 0:
+//! `a(p) = R_z(−ψ₀) (p − (o_x, o_y, g))`, with `ψ₀ = atan2(l_y, l_x) − π/2` the heading of the
+//! hip axis `l = p_lhip − p_rhip` at frame 0, `o` the first pelvis and `g` the lowest ankle
+//! height of the clip \[m\].
+//!
+//! Scaling: the pelvis by the leg ratio `s_leg = L_robot / L_human` (hip–knee plus
+//! knee–ankle lengths), horizontally `p'_pelvis,xy = s_leg a(p_pelvis)_xy`, vertically from the
+//! middle of the hips (where the legs start, on both bodies):
+//! `p'_pelvis,z = h_a + s_leg a(p_hips)_z + (r_pelvis − r_hips)_z` with `h_a` the robot's ankle
+//! height above its sole and `r_hips` the middle of the robot's hips in its start posture; every
+//! other point from its parent along the
+//! segment tree (pelvis → hip → knee → ankle → toe, pelvis → shoulder → elbow → wrist,
+//! pelvis → head, chest, neck): `p'_c = p'_p + s_pc (a(p_c) − a(p_p))` with
+//! `s_pc = |r_c − r_p| / median_t |p_c(t) − p_p(t)|`, `r` the robot's points in its start
+//! posture. A segment without robot points takes its parent segment's ratio (toe: the shank's;
+//! chest, neck: the head's, else the leg's).
+
+use nalgebra::{Rotation3, Vector3};
+
+use super::body::RobotBody;
+use crate::error::{Error, Result};
+use crate::model::{Kinematics, Robot};
+use crate::motion::{BodyPoint, Keypoints};
+
+use BodyPoint as B;
+
+/// The segment tree, parents before children.
+pub(crate) const SEGMENTS: [(BodyPoint, BodyPoint); 17] = [
+    (B::Pelvis, B::LeftHip),
+    (B::LeftHip, B::LeftKnee),
+    (B::LeftKnee, B::LeftAnkle),
+    (B::LeftAnkle, B::LeftToe),
+    (B::Pelvis, B::RightHip),
+    (B::RightHip, B::RightKnee),
+    (B::RightKnee, B::RightAnkle),
+    (B::RightAnkle, B::RightToe),
+    (B::Pelvis, B::Head),
+    (B::Pelvis, B::Chest),
+    (B::Pelvis, B::Neck),
+    (B::Pelvis, B::LeftShoulder),
+    (B::LeftShoulder, B::LeftElbow),
+    (B::LeftElbow, B::LeftWrist),
+    (B::Pelvis, B::RightShoulder),
+    (B::RightShoulder, B::RightElbow),
+    (B::RightElbow, B::RightWrist),
+];
+
+/// How the clip was aligned and scaled (see the module documentation).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Scaling {
+    /// Heading of the subject at frame 0, ψ₀ \[rad\].
+    pub heading: f64,
+    /// The lowest ankle height of the clip, g \[m\] (file frame, after units and up axis).
+    pub ground: f64,
+    /// The leg ratio s_leg \[–\].
+    pub leg: f64,
+    /// The ratio of every segment present (parent, child, ratio \[–\]).
+    pub segments: Vec<(BodyPoint, BodyPoint, f64)>,
+}
+
+/// The aligned clip `a(p)` and its scaled points, frame-major like [`Keypoints::positions`].
+#[derive(Debug, Clone)]
+pub(crate) struct ScaledClip {
+    pub scaling: Scaling,
+    pub aligned: Vec<Vector3<f64>>,
+    pub scaled: Vec<Vector3<f64>>,
+}
+
+fn index(kp: &Keypoints, p: BodyPoint) -> Option<usize> {
+    kp.points.iter().position(|q| *q == p)
+}
+
+fn required(kp: &Keypoints, p: BodyPoint) -> Result<usize> {
+    index(kp, p).ok_or_else(|| Error::UnknownName {
+        kind: "body point (missing from the keypoints)",
+        name: format!("{p}` in `{}", kp.source),
+        valid: kp.points.iter().map(|q| q.name().to_string()).collect(),
+    })
+}
+
+/// Aligns and scales `kp` onto the robot whose body points are `body` at the kinematics `kin`
+/// (start posture); `ankle_height` is the robot's ankle above its sole \[m\].
+pub(crate) fn scale_clip(
+    robot: &Robot,
+    kin: &Kinematics,
+    body: &RobotBody,
+    kp: &Keypoints,
+    ankle_height: f64,
+) -> Result<ScaledClip> {
+    let n = kp.points.len();
+    let frames = kp.frame_count();
+    if frames == 0 || kp.positions.len() != frames * n {
+        return Err(Error::InsufficientData {
+            what: format!("keypoints of `{}`", kp.source),
+            message: format!(
+                "{frames} frames and {} positions for {n} points",
+                kp.positions.len()
+            ),
+        });
+    }
+    let at = |f: usize, k: usize| kp.positions[f * n + k];
+    let pelvis = required(kp, B::Pelvis)?;
+    let (lh, rh) = (required(kp, B::LeftHip)?, required(kp, B::RightHip)?);
+    let (la, ra) = (required(kp, B::LeftAnkle)?, required(kp, B::RightAnkle)?);
+    let left = at(0, lh) - at(0, rh);
+    let heading = left.y.atan2(left.x) - std::f64::consts::FRAC_PI_2;
+    let ground = (0..frames)
+        .map(|f| at(f, la).z.min(at(f, ra).z))
+        .fold(f64::INFINITY, f64::min);
+    let o = at(0, pelvis);
+    let rot = Rotation3::from_axis_angle(&Vector3::z_axis(), -heading);
+    let origin = Vector3::new(o.x, o.y, ground);
+    let aligned: Vec<Vector3<f64>> = kp.positions.iter().map(|p| rot * (p - origin)).collect();
+    let robot_at = |p: BodyPoint| -> Result<Option<Vector3<f64>>> {
+        match body.frame_of(p) {
+            Some(f) => Ok(Some(kin.frame_pose(robot, f)?.translation.vector)),
+            None => Ok(None),
+        }
+    };
+    let human_len = |a: usize, b: usize| {
+        let mut d: Vec<f64> = (0..frames).map(|f| (at(f, b) - at(f, a)).norm()).collect();
+        d.sort_by(f64::total_cmp);
+        d[d.len() / 2]
+    };
+    let ratio = |pa: BodyPoint, pb: BodyPoint, a: usize, b: usize| -> Result<Option<f64>> {
+        let (Some(ra), Some(rb)) = (robot_at(pa)?, robot_at(pb)?) else {
+            return Ok(None);
+        };
+        let h = human_len(a, b);
+        Ok((h > 0.0).then(|| (rb - ra).norm() / h))
+    };
+    let (lk, rk) = (required(kp, B::LeftKnee)?, required(kp, B::RightKnee)?);
+    let mut legs = Vec::new();
+    for (h, k, a, ph, pk, pa) in [
+        (lh, lk, la, B::LeftHip, B::LeftKnee, B::LeftAnkle),
+        (rh, rk, ra, B::RightHip, B::RightKnee, B::RightAnkle),
+    ] {
+        let (Some(rh), Some(rk), Some(ra)) = (robot_at(ph)?, robot_at(pk)?, robot_at(pa)?) else {
+            continue;
+        };
+        let human = human_len(h, k) + human_len(k, a);
+        if human > 0.0 {
+            legs.push(((rk - rh).norm() + (ra - rk).norm()) / human);
+        }
+    }
+    if legs.is_empty() {
+        return Err(Error::InsufficientData {
+            what: format!("leg lengths of `{}`", kp.source),
+            message: "the hips, knees and ankles coincide in every frame".into(),
+        });
+    }
+    let leg = legs.iter().sum::<f64>() / legs.len() as f64;
+    let mut segments: Vec<(BodyPoint, BodyPoint, f64)> = Vec::new();
+    for (pa, pb) in SEGMENTS {
+        let (Some(a), Some(b)) = (index(kp, pa), index(kp, pb)) else {
+            continue;
+        };
+        let fallback = match pb {
+            B::LeftToe | B::RightToe => {
+                let knee = if pb == B::LeftToe {
+                    B::LeftKnee
+                } else {
+                    B::RightKnee
+                };
+                segments.iter().find(|s| s.0 == knee).map_or(leg, |s| s.2)
+            }
+            B::Chest | B::Neck => segments
+                .iter()
+                .find(|s| s.1 == B::Head)
+                .map_or(leg, |s| s.2),
+            _ => leg,
+        };
+        let r = ratio(pa, pb, a, b)?.unwrap_or(fallback);
+        segments.push((pa, pb, r));
+    }
+    let mut scaled = vec![Vector3::zeros(); aligned.len()];
+    let robot_hips = match (
+        robot_at(B::LeftHip)?,
+        robot_at(B::RightHip)?,
+        robot_at(B::Pelvis)?,
+    ) {
+        (Some(l), Some(r), Some(p)) => p.z - 0.5 * (l.z + r.z),
+        _ => 0.0,
+    };
+    for f in 0..frames {
+        let row = f * n;
+        let hips = 0.5 * (aligned[row + lh] + aligned[row + rh]);
+        let p = leg * aligned[row + pelvis];
+        scaled[row + pelvis] = Vector3::new(p.x, p.y, ankle_height + leg * hips.z + robot_hips);
+        for &(pa, pb, r) in &segments {
+            if let (Some(a), Some(b)) = (index(kp, pa), index(kp, pb)) {
+                scaled[row + b] = scaled[row + a] + r * (aligned[row + b] - aligned[row + a]);
+            }
+        }
+    }
+    Ok(ScaledClip {
+        scaling: Scaling {
+            heading,
+            ground,
+            leg,
+            segments,
+        },
+        aligned,
+        scaled,
+    })
+}

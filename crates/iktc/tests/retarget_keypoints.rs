@@ -1,0 +1,123 @@
+//! Keypoint retargeting of every shared clip onto JVRC-1 and G1: no joint limit exceeded (by
+//! more than the solver's box tolerance), and the clip's contacts found. The quality figures per
+//! body point are printed beside the joint route's (run with `--nocapture` to read them).
+
+use std::path::{Path, PathBuf};
+
+use iktc::motion::{load_motion, Motion, MotionOptions, DEFAULT_MAX_GAP};
+use iktc::profile::RobotProfile;
+use iktc::retarget::{joint_route_quality, retarget_keypoints, KeypointSettings, RetargetQuality};
+use iktc::sim::{imitation_references, ImitateConfig};
+use iktc::solver::SolverSettings;
+
+/// Every shared clip: the DeepMimic clips shipped with the crate and the CMU test clips.
+fn clips() -> Vec<PathBuf> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut out = Vec::new();
+    for (dir, ext) in [
+        ("data/motions/deepmimic", "txt"),
+        ("tests/data/motions/cmu", "bvh"),
+    ] {
+        let mut v: Vec<PathBuf> = std::fs::read_dir(root.join(dir))
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.extension().is_some_and(|e| e == ext))
+            .collect();
+        v.sort();
+        out.extend(v);
+    }
+    out
+}
+
+fn format_key(m: &Motion) -> &'static str {
+    match m.format {
+        iktc::motion::MotionFormat::DeepMimic => "deepmimic",
+        _ => "bvh",
+    }
+}
+
+fn print(q: &RetargetQuality) {
+    eprintln!(
+        "  {:9} mean {:5.2} cm | slip {:6.2} mm | below {:5.2} mm | jerk rms {:8.1} max {:9.1} rad/s³ | margins pos {:+.2e} vel {:+.2e} acc {:+.2e}",
+        q.route, q.mean_cm, q.slip_mm, q.below_ground_mm, q.jerk_rms, q.jerk_max,
+        q.position_margin, q.velocity_margin, q.acceleration_margin
+    );
+    let pts: Vec<String> = q
+        .points
+        .iter()
+        .map(|p| format!("{} {:.1}/{:.1}", p.point, p.mean_cm, p.max_cm))
+        .collect();
+    eprintln!("    per point mean/max cm: {}", pts.join(", "));
+    let o: Vec<String> = q
+        .orientations
+        .iter()
+        .map(|o| format!("{} {:.1}/{:.1}°", o.frame, o.mean_deg, o.max_deg))
+        .collect();
+    eprintln!("    orientation mean/max: {}", o.join(", "));
+}
+
+/// Figures of every clip on one robot, and the checks.
+fn check_robot(name: &str) {
+    let profile = RobotProfile::builtin(name).unwrap();
+    let robot = profile.robot().unwrap();
+    let s = KeypointSettings::default();
+    let mut failures = Vec::new();
+    for path in clips() {
+        let motion = load_motion(&path, &MotionOptions::default()).unwrap();
+        let kp = motion.keypoints(DEFAULT_MAX_GAP).unwrap();
+        let clip = motion.clip().unwrap().unwrap();
+        let refs = match profile.retarget_map(format_key(&motion), &robot) {
+            Ok(map) => {
+                let cfg = ImitateConfig {
+                    narrow: Vec::new(),
+                    ..profile.imitate_config(ImitateConfig::default()).unwrap()
+                };
+                match imitation_references(&robot, &clip, &map, &cfg) {
+                    Ok(r) => Some(r),
+                    Err(e) => {
+                        eprintln!("  joint route references: {e}");
+                        None
+                    }
+                }
+            }
+            Err(_) => None,
+        };
+        let run = retarget_keypoints(&profile, &kp, refs.as_ref(), &s).unwrap();
+        let q = &run.quality;
+        eprintln!(
+            "{name} {}: {} ticks, stance {} ticks, leg ratio {:.3}, GF ticks {}, tick median {:.0} µs",
+            path.file_name().unwrap().to_string_lossy(),
+            q.ticks,
+            q.stance_ticks,
+            run.scaling.leg,
+            run.fallback_ticks,
+            run.tick_median_us
+        );
+        print(q);
+        match refs
+            .as_ref()
+            .map(|r| joint_route_quality(&profile, &kp, r, &s))
+        {
+            Some(Ok(q)) => print(&q),
+            Some(Err(e)) => eprintln!("  joints    failed: {e}"),
+            None => eprintln!("  joints    (no joint route for this clip on {name})"),
+        }
+        let file = path.display().to_string();
+        let tol = SolverSettings::default().box_tolerance;
+        if q.position_margin > tol || q.velocity_margin > tol || q.acceleration_margin > tol {
+            failures.push(format!("{file}: a limit exceeded"));
+        }
+        assert!(q.stance_ticks > 0, "{file}: no foot ever on the ground");
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+#[test]
+fn every_shared_clip_onto_jvrc1() {
+    check_robot("jvrc1");
+}
+
+#[test]
+fn every_shared_clip_onto_g1() {
+    check_robot("g1");
+}
