@@ -125,8 +125,10 @@ pub fn run(
     }
     let path = out.join("keypoints_trajectory.csv");
     std::fs::write(&path, csv).with_context(|| format!("writing {}", path.display()))?;
+    let viewer = iktc::retarget::keypoint_viewer(&robot, &kp, &run, cfg.dt)?;
+    crate::viewer::write_viewer(&out.join("viewer.html"), &viewer)?;
     crate::outln!(
-        "wrote keypoints_summary.json and keypoints_trajectory.csv to {}",
+        "wrote keypoints_summary.json, keypoints_trajectory.csv and viewer.html to {}",
         out.display()
     )?;
     Ok(())

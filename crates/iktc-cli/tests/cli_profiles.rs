@@ -90,9 +90,14 @@ fn g1_retargets_the_default_clip_by_keypoints_beside_the_joint_route() {
     }
     let csv = std::fs::read_to_string(out.join("keypoints_trajectory.csv")).unwrap();
     assert_eq!(csv.lines().next().unwrap().split(',').count(), 1 + 29);
+    let viewer = std::fs::read_to_string(out.join("viewer.html")).unwrap();
     assert!(
-        !out.join("viewer.html").exists(),
-        "the joint route's figures are not written"
+        viewer.contains("\"g1_29dof_rev_1_0\""),
+        "the viewer shows the G1"
+    );
+    assert!(
+        !out.join("summary.json").exists(),
+        "the joint route's own summary and figures are not written"
     );
 }
 

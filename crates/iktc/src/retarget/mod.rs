@@ -33,11 +33,13 @@ mod plan;
 mod quality;
 mod scale;
 mod tracker;
+mod viewer;
 
 pub use body::{BodyFrameNames, RobotBody, MIN_HEAD_HEIGHT};
 pub use quality::{OrientationError, PointError, QualityRecorder, RetargetQuality};
 pub use scale::Scaling;
 pub use tracker::{KeypointController, KEYPOINT_LEVELS};
+pub use viewer::{keypoint_viewer, ON_LIMIT};
 
 use std::sync::Arc;
 use std::time::Instant;
