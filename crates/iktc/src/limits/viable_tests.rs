@@ -362,3 +362,17 @@ fn recovery_returns_at_rest_within_the_limits() {
     );
     assert_eq!(recovery_acceleration(&lim, &settings, 0.0, 0.3, dt), None);
 }
+
+/// At rest a hair below the limit with `a_stop Δt² ≫ d`, the larger root is
+/// `(−aΔt + √(a²Δt² + 8ad))/(2Δt) ≈ 2d/Δt²` (relative error `4d/(aΔt²)`, here 1e-20), the
+/// difference of two nearly equal numbers if evaluated as printed: the bound must come from the
+/// cancellation-free form.
+#[test]
+fn the_larger_root_is_free_of_cancellation() {
+    let (d, a, dt) = (1e-15, 1e9, 1e-2);
+    let want = 2.0 * d / (dt * dt);
+    let got = viability_upper(0.0, 0.0, d, a, dt);
+    assert!((got - want).abs() <= 1e-9 * want, "{got} vs {want}");
+    let got = viability_lower(0.0, 0.0, -d, a, dt);
+    assert!((got + want).abs() <= 1e-9 * want, "{got} vs {want}");
+}
