@@ -12,6 +12,7 @@ pub mod switches;
 #[cfg(all(feature = "urdf", feature = "json", feature = "toml"))]
 pub mod viewer;
 pub mod walk_imitate;
+pub mod walk_plants;
 
 #[cfg(all(feature = "urdf", feature = "json", feature = "toml"))]
 pub use experiment::{load_clip, load_map, Experiment, LoadedClip};
@@ -30,3 +31,4 @@ pub use walk_imitate::{
     run_walk_imitate, Push, PushAxisMetrics, WalkImitateConfig, WalkPushSummary, WalkRun, WalkStep,
     WalkSummary, WalkTick, WalkingController,
 };
+pub use walk_plants::WalkPlants;
