@@ -21,7 +21,7 @@ pub use imitate::{
     imitation_references, run_imitate, ImitateConfig, ImitateRun, ImitateStep, ImitateSummary,
     ImitationController, ImitationTasks, NarrowedJoint,
 };
-pub use margins::{dof_margins, median, percentile, DofMargins};
+pub use margins::{dof_margins, held_limit, median, percentile, DofMargins, JointMargin};
 pub use planar3r::{
     run_planar3r, ArmTask, Planar3rConfig, Planar3rRun, Planar3rStep, Planar3rSummary,
 };

@@ -29,7 +29,7 @@ use serde::Serialize;
 
 use super::health::{HealthMonitor, HealthReport, Verdict};
 use super::imitate::{ImitateConfig, ImitationController};
-use super::margins::{dof_margins, median, percentile, DofMargins};
+use super::margins::{dof_margins, held_limit, median, percentile, JointMargin};
 use super::walk_plants::WalkPlants;
 use crate::balance::{
     analyse_response, BalanceController, BalanceSettings, CaseParams, FullModelParams,
@@ -191,7 +191,7 @@ pub struct WalkSummary {
     /// acceleration \[rad/s²\]); ≤ 0: no limit exceeded.
     pub worst_margins: [f64; 3],
     /// Margins of every joint (narrowed ranges).
-    pub margins: Vec<(String, DofMargins)>,
+    pub margins: Vec<JointMargin>,
     /// The response to the push, in both horizontal directions; absent (`None`, left out
     /// of the JSON) without a push.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -740,13 +740,7 @@ fn summarize(
     let mut worst = [f64::NEG_INFINITY; 3];
     for (d, lim) in ctl.limits().dofs().iter().enumerate().skip(robot.base_nv()) {
         let col = |f: &dyn Fn(&WalkStep) -> f64| steps.iter().map(f).collect::<Vec<f64>>();
-        let limit = crate::model::JointLimit {
-            lower: lim.position_min,
-            upper: lim.position_max,
-            velocity: lim.velocity_max,
-            acceleration: lim.acceleration_max,
-            effort: f64::INFINITY,
-        };
+        let limit = held_limit(lim, f64::INFINITY);
         let m = dof_margins(
             d,
             &col(&|s| s.q[d]),
@@ -758,7 +752,10 @@ fn summarize(
         worst[0] = worst[0].max(m.position);
         worst[1] = worst[1].max(m.velocity);
         worst[2] = worst[2].max(m.acceleration);
-        margins.push((names.get(d).cloned().unwrap_or_default(), m));
+        margins.push(JointMargin::new(
+            names.get(d).cloned().unwrap_or_default(),
+            &m,
+        ));
     }
     // Stance feet: error against the reference, and drift within each stance interval.
     let mut max_err = 0.0f64;
