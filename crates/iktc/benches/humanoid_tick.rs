@@ -13,7 +13,7 @@ use iktc::solver::Method;
 
 #[path = "common/walking.rs"]
 mod walking_common;
-use walking_common::{feed_plants, imitation_setup as setup, walking_setup};
+use walking_common::{imitation_setup as setup, walking_setup};
 
 fn bench(c: &mut Criterion) {
     let (robot, refs) = setup();
@@ -68,24 +68,23 @@ fn bench(c: &mut Criterion) {
 /// The walking tick (issue 6): walking pattern, damping controller and IK, with the ZMP of the
 /// simulated compliant robot fed back (the plant's step is outside the timed region).
 fn bench_walk(c: &mut Criterion) {
-    use iktc::balance::SimPlant;
-    use iktc::sim::WalkingController;
+    use iktc::sim::{WalkPlants, WalkingController};
     let (robot, refs) = setup();
     let (initial, plants0) = walking_setup(&robot, &refs);
     let n = initial.ticks();
     // One pass: returns the time of each tick [µs].
     let pass = |wc: &mut WalkingController,
-                plants: &mut [SimPlant; 2],
+                plants: &mut WalkPlants,
                 ticks: &mut Vec<f64>,
                 k: usize|
      -> Duration {
-        let dev = [plants[0].measure(), plants[1].measure()];
+        let dev = plants.measure();
         let start = Instant::now();
         let wt = std::hint::black_box(wc.tick(&robot, k, dev)).expect("tick");
-        let _ = wc.integrate(&robot);
+        wc.integrate(&robot).expect("integrate");
         let el = start.elapsed();
         ticks.push(el.as_secs_f64() * 1e6);
-        feed_plants(wc, &wt, plants);
+        plants.step(k, wc, &wt).expect("plant step");
         el
     };
     c.bench_function("humanoid_tick/walking_iktc", |b| {

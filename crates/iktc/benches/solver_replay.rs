@@ -14,7 +14,7 @@ use nalgebra::DVector;
 
 #[path = "common/walking.rs"]
 mod walking_common;
-use walking_common::{feed_plants, imitation_setup, walking_setup};
+use walking_common::{imitation_setup, walking_setup};
 
 /// The (levels, box) of every tick of the default walking imitation run.
 fn record() -> Vec<(Vec<TaskEquation>, AccelerationBox)> {
@@ -22,12 +22,12 @@ fn record() -> Vec<(Vec<TaskEquation>, AccelerationBox)> {
     let (mut wc, mut plants) = walking_setup(&robot, &refs);
     let mut out = Vec::with_capacity(wc.ticks());
     for k in 0..wc.ticks() {
-        let dev = [plants[0].measure(), plants[1].measure()];
+        let dev = plants.measure();
         let wt = wc.tick(&robot, k, dev).expect("tick");
         let im = wc.imitation();
         out.push((im.equations().to_vec(), im.acceleration_box().clone()));
+        plants.step(k, &wc, &wt).expect("plant step");
         wc.integrate(&robot).expect("integrate");
-        feed_plants(&wc, &wt, &mut plants);
     }
     out
 }

@@ -96,7 +96,7 @@ pub use points_csv::read_points_csv;
 pub use recognise::{
     builtin_body_map, recognise_markers, recognise_skeleton, BUILTIN_BODY_MAP_NAMES,
 };
-pub use retarget::{retarget, Retargeted, RobotReferences, Track};
+pub use retarget::{retarget, shrunk_range, Retargeted, RobotReferences, Track};
 #[cfg(feature = "toml")]
 pub use retarget_map::{builtin_map, builtin_map_text, BUILTIN_MAP_NAMES};
 pub use retarget_map::{HoldJoint, JointMap, RetargetMap, RootMap, TargetJoint};

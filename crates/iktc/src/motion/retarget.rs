@@ -335,6 +335,19 @@ pub fn retarget(clip: &Clip, robot: &Robot, map: &RetargetMap) -> Result<Retarge
     })
 }
 
+/// The range `[lower, upper]` \[rad\] shrunk by `margin` \[rad\] on each side,
+/// `[lower + margin, upper − margin]`; a range narrower than `2 · margin` becomes its middle
+/// `(lower + upper) / 2`. Every clamp of a joint reference into its (narrowed) range uses it.
+pub fn shrunk_range(lower: f64, upper: f64, margin: f64) -> (f64, f64) {
+    let (lo, hi) = (lower + margin, upper - margin);
+    if lo > hi {
+        let mid = 0.5 * (lower + upper);
+        (mid, mid)
+    } else {
+        (lo, hi)
+    }
+}
+
 impl Retargeted {
     /// Clamps every joint track into the robot's position range shrunk by `margin` \[rad\] on
     /// each side (a range narrower than `2 · margin` is clamped to its middle). References
@@ -348,12 +361,7 @@ impl Retargeted {
                 .nth(i)
                 .map(|j| j.limit)
                 .unwrap_or(crate::model::JointLimit::UNBOUNDED);
-            let (mut lo, mut hi) = (lim.lower + margin, lim.upper - margin);
-            if lo > hi {
-                let mid = 0.5 * (lim.lower + lim.upper);
-                lo = mid;
-                hi = mid;
-            }
+            let (lo, hi) = shrunk_range(lim.lower, lim.upper, margin);
             for v in track.iter_mut() {
                 *v = v.clamp(lo, hi);
             }

@@ -239,16 +239,7 @@ pub fn imitation_references(
     let mut r = crate::motion::retarget(clip, robot, map)?;
     r.clamp_to_limits(robot, cfg.reference_margin)?;
     for n in &cfg.narrow {
-        let (lo, hi) = (
-            n.lower + cfg.reference_margin,
-            n.upper - cfg.reference_margin,
-        );
-        let (lo, hi) = if lo > hi {
-            let mid = 0.5 * (n.lower + n.upper);
-            (mid, mid)
-        } else {
-            (lo, hi)
-        };
+        let (lo, hi) = crate::motion::shrunk_range(n.lower, n.upper, cfg.reference_margin);
         for (name, track) in r.joint_names.iter().zip(r.joint_angles.iter_mut()) {
             if *name == n.joint {
                 for v in track.iter_mut() {
@@ -339,14 +330,11 @@ impl ImitationController {
         for (name, track) in refs.joint_names.iter().zip(refs.joints.iter_mut()) {
             let v = robot.joint_v_index(name)?;
             if let Some(d) = limits.get(v) {
-                let (mut lo, mut hi) = (
-                    d.position_min + cfg.reference_margin,
-                    d.position_max - cfg.reference_margin,
+                let (lo, hi) = crate::motion::shrunk_range(
+                    d.position_min,
+                    d.position_max,
+                    cfg.reference_margin,
                 );
-                if lo > hi {
-                    lo = 0.5 * (d.position_min + d.position_max);
-                    hi = lo;
-                }
                 for (p, (v, a)) in track
                     .position
                     .iter_mut()

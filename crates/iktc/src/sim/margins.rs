@@ -1,6 +1,45 @@
 //! How close a recorded trajectory came to each joint limit, as signed margins.
 
-use crate::limits::peak_in_step;
+use crate::limits::{peak_in_step, DofLimits};
+use crate::model::JointLimit;
+
+/// The margins of one joint in a run's summary: the largest excursion beyond each limit
+/// (positive = exceeded, negative = the closest approach stayed that far inside).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct JointMargin {
+    /// Joint name.
+    pub joint: String,
+    /// \[rad\].
+    pub position: f64,
+    /// \[rad/s\].
+    pub velocity: f64,
+    /// \[rad/s²\].
+    pub acceleration: f64,
+}
+
+impl JointMargin {
+    /// The summary entry of the dof margins `m` of joint `joint`.
+    pub fn new(joint: String, m: &DofMargins) -> Self {
+        Self {
+            joint,
+            position: m.position,
+            velocity: m.velocity,
+            acceleration: m.acceleration,
+        }
+    }
+}
+
+/// The limits a run was held to (the controller's [`DofLimits`], narrowed ranges included) as
+/// the [`JointLimit`] the margins are measured against, with the given `effort` \[N·m or N\].
+pub fn held_limit(d: &DofLimits, effort: f64) -> JointLimit {
+    JointLimit {
+        lower: d.position_min,
+        upper: d.position_max,
+        velocity: d.velocity_max,
+        acceleration: d.acceleration_max,
+        effort,
+    }
+}
 
 /// Largest excursion beyond each limit of one dof over a run: positive = the limit was
 /// exceeded by that much, negative = the closest approach stayed that far inside.
@@ -25,7 +64,7 @@ pub fn dof_margins(
     qd: &[f64],
     qdd: &[f64],
     dt: f64,
-    limit: &crate::model::JointLimit,
+    limit: &JointLimit,
 ) -> DofMargins {
     let mut m = DofMargins {
         index,

@@ -12,6 +12,7 @@ pub mod switches;
 #[cfg(all(feature = "urdf", feature = "json", feature = "toml"))]
 pub mod viewer;
 pub mod walk_imitate;
+pub mod walk_plants;
 
 #[cfg(all(feature = "urdf", feature = "json", feature = "toml"))]
 pub use experiment::{load_clip, load_map, Experiment, LoadedClip};
@@ -20,7 +21,7 @@ pub use imitate::{
     imitation_references, run_imitate, ImitateConfig, ImitateRun, ImitateStep, ImitateSummary,
     ImitationController, ImitationTasks, NarrowedJoint,
 };
-pub use margins::{dof_margins, median, percentile, DofMargins};
+pub use margins::{dof_margins, held_limit, median, percentile, DofMargins, JointMargin};
 pub use planar3r::{
     run_planar3r, ArmTask, Planar3rConfig, Planar3rRun, Planar3rStep, Planar3rSummary,
 };
@@ -30,3 +31,4 @@ pub use walk_imitate::{
     run_walk_imitate, Push, PushAxisMetrics, WalkImitateConfig, WalkPushSummary, WalkRun, WalkStep,
     WalkSummary, WalkTick, WalkingController,
 };
+pub use walk_plants::WalkPlants;

@@ -29,10 +29,11 @@ use serde::Serialize;
 
 use super::health::{HealthMonitor, HealthReport, Verdict};
 use super::imitate::{ImitateConfig, ImitationController};
-use super::margins::{dof_margins, median, percentile, DofMargins};
+use super::margins::{dof_margins, held_limit, median, percentile, JointMargin};
+use super::walk_plants::WalkPlants;
 use crate::balance::{
-    analyse_response, BalanceController, BalanceSettings, CaseParams, FullModelParams, Plane,
-    PlantParams, ResponseSettings, SimPlant, SimSettings, SupportPhase,
+    analyse_response, BalanceController, BalanceSettings, CaseParams, FullModelParams,
+    ResponseSettings, SupportPhase,
 };
 use crate::controller::FrameHandle;
 use crate::error::{Error, Result};
@@ -190,7 +191,7 @@ pub struct WalkSummary {
     /// acceleration \[rad/s²\]); ≤ 0: no limit exceeded.
     pub worst_margins: [f64; 3],
     /// Margins of every joint (narrowed ranges).
-    pub margins: Vec<(String, DofMargins)>,
+    pub margins: Vec<JointMargin>,
     /// The response to the push, in both horizontal directions; absent (`None`, left out
     /// of the JSON) without a push.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -575,61 +576,25 @@ pub fn run_walk_imitate(
         .map(|f| robot.frame_id(f))
         .collect::<Result<Vec<_>>>()?;
     let origin = wc.origin();
-    let l = wc.pendulum_length();
-    let cases = *wc.cases();
-    let sim = SimSettings {
-        control_period: dt,
-        seed: cfg.seed,
-        ..SimSettings::default()
-    };
-    let mass = robot.total_mass();
-    let plant = |plane, seed| {
-        SimPlant::new(
-            PlantParams::from_model(*cases.get(plane, SupportPhase::Double), mass, cfg.noise_std),
-            &SimSettings { seed, ..sim },
-        )
-    };
-    let mut plants = [
-        plant(Plane::Xz, cfg.seed)?,
-        plant(Plane::Yz, cfg.seed.wrapping_add(1))?,
-    ];
+    let mut plants = WalkPlants::new(&wc, robot.total_mass(), cfg)?;
     let n = wc.ticks();
     let mut steps = Vec::with_capacity(n);
     let mut polygon = SupportPolygon::default();
-    let mut last_phase = SupportPhase::Double;
-    let push_tick = cfg.push.map(|p| (p.time / dt).round() as usize);
     let mut health = HealthMonitor::new(cfg.imitate.health)?;
     let dof_names = robot.dof_names();
     for k in 0..n {
         let t = k as f64 * dt;
         // Measured ZMP deviation of the simulated robot, local frame.
-        let dev = [plants[0].measure(), plants[1].measure()];
+        let dev = plants.measure();
         let start = Instant::now();
         let wt = wc.tick(robot, k, dev)?;
         let tick_us = start.elapsed().as_secs_f64() * 1e6;
         let s = wt.sample;
         let rot = Rotation2::new(wt.local_yaw);
-        // The simulated robot: commanded COM deviation from the nominal → pendulum command.
         let ctl = wc.imitation();
         let kin = ctl.kinematics();
         let com = kin.com();
-        let d_local = rot.inverse() * (Vector2::new(com.x, com.y) - wt.com_nominal);
-        if wt.phase != last_phase {
-            for (p, plane) in plants.iter_mut().zip(Plane::BOTH) {
-                p.switch_model(*cases.get(plane, wt.phase))?;
-            }
-            last_phase = wt.phase;
-        }
-        if Some(k) == push_tick {
-            if let Some(p) = cfg.push {
-                let j = rot.inverse() * Vector2::new(p.impulse[0], p.impulse[1]);
-                plants[0].push(j.x)?;
-                plants[1].push(j.y)?;
-            }
-        }
-        for (i, p) in plants.iter_mut().enumerate() {
-            p.advance(d_local[i] / l)?;
-        }
+        plants.step(k, &wc, &wt)?;
         // Record.
         let zdev = rot * Vector2::new(dev[0], dev[1]);
         let zm = (
@@ -775,13 +740,7 @@ fn summarize(
     let mut worst = [f64::NEG_INFINITY; 3];
     for (d, lim) in ctl.limits().dofs().iter().enumerate().skip(robot.base_nv()) {
         let col = |f: &dyn Fn(&WalkStep) -> f64| steps.iter().map(f).collect::<Vec<f64>>();
-        let limit = crate::model::JointLimit {
-            lower: lim.position_min,
-            upper: lim.position_max,
-            velocity: lim.velocity_max,
-            acceleration: lim.acceleration_max,
-            effort: f64::INFINITY,
-        };
+        let limit = held_limit(lim, f64::INFINITY);
         let m = dof_margins(
             d,
             &col(&|s| s.q[d]),
@@ -793,7 +752,10 @@ fn summarize(
         worst[0] = worst[0].max(m.position);
         worst[1] = worst[1].max(m.velocity);
         worst[2] = worst[2].max(m.acceleration);
-        margins.push((names.get(d).cloned().unwrap_or_default(), m));
+        margins.push(JointMargin::new(
+            names.get(d).cloned().unwrap_or_default(),
+            &m,
+        ));
     }
     // Stance feet: error against the reference, and drift within each stance interval.
     let mut max_err = 0.0f64;

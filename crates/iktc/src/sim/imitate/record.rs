@@ -11,7 +11,8 @@ use crate::error::Result;
 use crate::model::{JointLimit, Robot};
 use crate::motion::RobotReferences;
 use crate::sim::health::{HealthMonitor, HealthReport, Verdict};
-use crate::sim::margins::{dof_margins, median, percentile};
+pub use crate::sim::margins::JointMargin;
+use crate::sim::margins::{dof_margins, held_limit, median, percentile};
 use crate::solver::{Fallback, Method};
 
 /// One recorded tick (state at its start, command applied over it).
@@ -80,19 +81,6 @@ pub struct ImitateStep {
     pub fallback_kind: Option<Fallback>,
     /// Time of the tick (kinematics, tasks, bounds, solve) \[µs\].
     pub tick_us: f64,
-}
-
-/// Margins of one joint: the largest excursion beyond each limit (positive = exceeded).
-#[derive(Debug, Clone, Serialize)]
-pub struct JointMargin {
-    /// Joint name.
-    pub joint: String,
-    /// \[rad\].
-    pub position: f64,
-    /// \[rad/s\].
-    pub velocity: f64,
-    /// \[rad/s²\].
-    pub acceleration: f64,
 }
 
 /// Tracking of one level over the run.
@@ -257,13 +245,7 @@ pub fn run_imitate(
         .dofs()
         .iter()
         .zip(robot.dof_limits())
-        .map(|(d, l)| JointLimit {
-            lower: d.position_min,
-            upper: d.position_max,
-            velocity: d.velocity_max,
-            acceleration: d.acceleration_max,
-            effort: l.effort,
-        })
+        .map(|(d, l)| held_limit(d, l.effort))
         .collect();
     let feet_ids = cfg
         .feet
@@ -424,12 +406,7 @@ pub(crate) fn summarize(
             let qd = col(&|s| s.qd[d]);
             let qdd = col(&|s| s.qdd[d]);
             let m = dof_margins(d, &q, &qd, &qdd, cfg.dt, &limits[d]);
-            JointMargin {
-                joint: names.get(d).cloned().unwrap_or_default(),
-                position: m.position,
-                velocity: m.velocity,
-                acceleration: m.acceleration,
-            }
+            JointMargin::new(names.get(d).cloned().unwrap_or_default(), &m)
         })
         .collect();
     let worst =
