@@ -1,0 +1,56 @@
+//! The keypoint retargeting tick (references, kinematics, box, IKTC or its GF fallback,
+//! integration) allocates nothing after setup, checked with a counting global allocator (its
+//! own test binary).
+
+use iktc::motion::{
+    builtin_clip, motion_from_content, MotionContent, MotionFormat, MotionOptions, DEFAULT_MAX_GAP,
+};
+use iktc::profile::RobotProfile;
+use iktc::retarget::{keypoint_controller, KeypointSettings};
+
+mod common;
+use common::alloc as counting_alloc;
+use counting_alloc::allocations;
+
+#[global_allocator]
+static A: counting_alloc::Counting = counting_alloc::Counting;
+
+#[test]
+fn the_keypoint_tick_allocates_nothing_on_jvrc1_and_g1() {
+    let motion = motion_from_content(
+        "humanoid3d_dance_b".into(),
+        MotionFormat::DeepMimic,
+        MotionContent::Skeleton(builtin_clip("humanoid3d_dance_b").unwrap()),
+        &MotionOptions::default(),
+    )
+    .unwrap();
+    let kp = motion.keypoints(DEFAULT_MAX_GAP).unwrap();
+    let mut fallbacks = 0;
+    for robot in ["jvrc1", "g1"] {
+        let profile = RobotProfile::builtin(robot).unwrap();
+        let mut ctl =
+            keypoint_controller(&profile, &kp, None, &KeypointSettings::default()).unwrap();
+        let n = ctl.ticks();
+        let mut qps = 0;
+        let before = allocations();
+        for _ in 0..100 {
+            qps += ctl.tick(0, true).unwrap().qp_solves;
+            ctl.integrate().unwrap();
+        }
+        for k in 0..n {
+            qps += ctl.tick(k, false).unwrap().qp_solves;
+            ctl.integrate().unwrap();
+        }
+        let after = allocations();
+        fallbacks += ctl.fallback_ticks();
+        assert!(qps > 100, "{robot}: {qps} QPs: the box must bind");
+        assert_eq!(
+            after - before,
+            0,
+            "{robot}: {} allocations in {n} ticks",
+            after - before
+        );
+    }
+    // The GF fallback ran too (JVRC-1's elbow and torso level is rank-deficient).
+    assert!(fallbacks > 0, "no tick fell back to GF");
+}
