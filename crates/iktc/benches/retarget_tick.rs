@@ -9,25 +9,17 @@
 use std::time::{Duration, Instant};
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use iktc::motion::{
-    builtin_clip, motion_from_content, MotionContent, MotionFormat, MotionOptions, DEFAULT_MAX_GAP,
-};
+use iktc::motion::builtin_clip;
 use iktc::profile::RobotProfile;
-use iktc::retarget::{keypoint_controller, KeypointController, KeypointSettings};
+use iktc::retarget::{builtin_motion, keypoint_controller, KeypointController, KeypointSettings};
 use iktc::sim::{imitation_references, percentile, ImitateConfig, ImitationController};
 
 const CLIP: &str = "humanoid3d_dance_b";
 
 fn keypoints(profile: &RobotProfile) -> KeypointController {
-    let clip = builtin_clip(CLIP).expect("clip");
-    let motion = motion_from_content(
-        CLIP.into(),
-        MotionFormat::DeepMimic,
-        MotionContent::Skeleton(clip),
-        &MotionOptions::default(),
-    )
-    .expect("motion");
-    let kp = motion.keypoints(DEFAULT_MAX_GAP).expect("keypoints");
+    let kp = builtin_motion(CLIP)
+        .and_then(|m| m.keypoints(iktc::motion::DEFAULT_MAX_GAP))
+        .expect("keypoints");
     let mut ctl =
         keypoint_controller(profile, &kp, None, &KeypointSettings::default()).expect("controller");
     // Settled on the first frame, as a run starts the clip.
@@ -54,60 +46,37 @@ fn bench(c: &mut Criterion) {
     let imitation = ImitationController::new(&robot, &refs, &cfg).expect("imitation");
     let n = initial.ticks();
     let mut group = c.benchmark_group("retarget_tick");
+    let keypoint_tick = |ctl: &mut KeypointController, k: usize| {
+        let _ = std::hint::black_box(ctl.tick(k, false).map(|r| r.qp_solves));
+        let _ = ctl.integrate();
+    };
+    let imitation_tick = |ctl: &mut ImitationController, k: usize| {
+        let _ = std::hint::black_box(ctl.tick(&robot, k).map(|r| r.qp_solves));
+        let _ = ctl.integrate(&robot);
+    };
     group.bench_function("keypoints_g1", |b| {
         b.iter_custom(|iters| {
-            let mut ctl = initial.clone();
-            let (mut k, mut total) = (0, Duration::ZERO);
-            for _ in 0..iters {
-                if k == n {
-                    ctl = initial.clone();
-                    k = 0;
-                }
-                let start = Instant::now();
-                let _ = std::hint::black_box(ctl.tick(k, false).map(|r| r.qp_solves));
-                let _ = ctl.integrate();
-                total += start.elapsed();
-                k += 1;
-            }
-            total
+            timed(&initial, n, iters as usize, keypoint_tick)
+                .iter()
+                .sum()
         })
     });
     group.bench_function("imitation_g1", |b| {
         b.iter_custom(|iters| {
-            let mut ctl = imitation.clone();
-            let (mut k, mut total) = (0, Duration::ZERO);
-            for _ in 0..iters {
-                if k == refs.len() {
-                    ctl = imitation.clone();
-                    k = 0;
-                }
-                let start = Instant::now();
-                let _ = std::hint::black_box(ctl.tick(&robot, k).map(|r| r.qp_solves));
-                let _ = ctl.integrate(&robot);
-                total += start.elapsed();
-                k += 1;
-            }
-            total
+            timed(&imitation, refs.len(), iters as usize, imitation_tick)
+                .iter()
+                .sum()
         })
     });
     group.finish();
-    let (mut kp_ticks, mut im_ticks) = (Vec::new(), Vec::new());
-    for _ in 0..3 {
-        let mut ctl = initial.clone();
-        for k in 0..n {
-            let start = Instant::now();
-            let _ = std::hint::black_box(ctl.tick(k, false).map(|r| r.qp_solves));
-            let _ = ctl.integrate();
-            kp_ticks.push(start.elapsed().as_secs_f64() * 1e6);
-        }
-        let mut ctl = imitation.clone();
-        for k in 0..refs.len() {
-            let start = Instant::now();
-            let _ = std::hint::black_box(ctl.tick(&robot, k).map(|r| r.qp_solves));
-            let _ = ctl.integrate(&robot);
-            im_ticks.push(start.elapsed().as_secs_f64() * 1e6);
-        }
-    }
+    let us = |d: Vec<Duration>| -> Vec<f64> { d.iter().map(|t| t.as_secs_f64() * 1e6).collect() };
+    let kp_ticks = us(timed(&initial, n, 3 * n, keypoint_tick));
+    let im_ticks = us(timed(
+        &imitation,
+        refs.len(),
+        3 * refs.len(),
+        imitation_tick,
+    ));
     eprintln!(
         "retarget_tick: single ticks over 3 passes of {CLIP} on G1: keypoints median {:.1} µs (p99 {:.1}), imitation median {:.1} µs (p99 {:.1})",
         percentile(&kp_ticks, 0.5),
@@ -115,6 +84,30 @@ fn bench(c: &mut Criterion) {
         percentile(&im_ticks, 0.5),
         percentile(&im_ticks, 0.99)
     );
+}
+
+/// The time of each of `count` ticks of a clip of `n` ticks, restarting from `initial` at its
+/// end.
+fn timed<C: Clone>(
+    initial: &C,
+    n: usize,
+    count: usize,
+    mut tick: impl FnMut(&mut C, usize),
+) -> Vec<Duration> {
+    let mut ctl = initial.clone();
+    let mut k = 0;
+    (0..count)
+        .map(|_| {
+            if k == n {
+                ctl = initial.clone();
+                k = 0;
+            }
+            let start = Instant::now();
+            tick(&mut ctl, k);
+            k += 1;
+            start.elapsed()
+        })
+        .collect()
 }
 
 criterion_group!(benches, bench);

@@ -2,11 +2,8 @@
 //! integration) allocates nothing after setup, checked with a counting global allocator (its
 //! own test binary).
 
-use iktc::motion::{
-    builtin_clip, motion_from_content, MotionContent, MotionFormat, MotionOptions, DEFAULT_MAX_GAP,
-};
 use iktc::profile::RobotProfile;
-use iktc::retarget::{keypoint_controller, KeypointSettings};
+use iktc::retarget::{builtin_motion, keypoint_controller, KeypointSettings};
 
 mod common;
 use common::alloc as counting_alloc;
@@ -17,14 +14,10 @@ static A: counting_alloc::Counting = counting_alloc::Counting;
 
 #[test]
 fn the_keypoint_tick_allocates_nothing_on_jvrc1_and_g1() {
-    let motion = motion_from_content(
-        "humanoid3d_dance_b".into(),
-        MotionFormat::DeepMimic,
-        MotionContent::Skeleton(builtin_clip("humanoid3d_dance_b").unwrap()),
-        &MotionOptions::default(),
-    )
-    .unwrap();
-    let kp = motion.keypoints(DEFAULT_MAX_GAP).unwrap();
+    let kp = builtin_motion("humanoid3d_dance_b")
+        .unwrap()
+        .keypoints(iktc::motion::DEFAULT_MAX_GAP)
+        .unwrap();
     let mut fallbacks = 0;
     for robot in ["jvrc1", "g1"] {
         let profile = RobotProfile::builtin(robot).unwrap();
