@@ -5,13 +5,11 @@
 use std::path::Path;
 
 use anyhow::{Context, Result};
-use iktc::motion::{
-    builtin_clip, motion_from_content, Keypoints, MotionContent, MotionFormat, MotionOptions,
-    BUILTIN_CLIP_NAMES, DEFAULT_MAX_GAP,
-};
+use iktc::motion::{Keypoints, MotionFormat, BUILTIN_CLIP_NAMES, DEFAULT_MAX_GAP};
 use iktc::profile::RobotProfile;
 use iktc::retarget::{
-    joint_route_quality, retarget_keypoints, KeypointRun, KeypointSettings, RetargetQuality,
+    builtin_motion, joint_route_quality, retarget_keypoints, KeypointRun, KeypointSettings,
+    RetargetQuality,
 };
 use iktc::sim::{imitation_references, ImitateConfig};
 
@@ -31,12 +29,7 @@ fn load(
     options: &crate::cmd_map::MotionArgs,
 ) -> Result<(Keypoints, Option<(iktc::motion::Clip, MotionFormat)>)> {
     let motion = if BUILTIN_CLIP_NAMES.contains(&spec) {
-        motion_from_content(
-            spec.to_string(),
-            MotionFormat::DeepMimic,
-            MotionContent::Skeleton(builtin_clip(spec)?),
-            &MotionOptions::default(),
-        )?
+        builtin_motion(spec)?
     } else {
         crate::cmd_map::load(Path::new(spec), options, None)?
     };

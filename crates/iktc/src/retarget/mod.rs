@@ -102,7 +102,9 @@ pub struct KeypointSettings {
     pub contact_height: f64,
     /// ... and slow enough below this speed \[m/s\] (default 0.4 m/s).
     pub contact_speed: f64,
-    /// Contact and flight phases shorter than this are removed \[s\] (default 0.08 s).
+    /// Contact and flight phases shorter than this are removed \[s\] (default 0.2 s): a
+    /// shorter flight would have its foot travel between two holds in less time than the
+    /// feet level can follow. Longer values hold quick steps on the ground.
     pub min_phase: f64,
     /// The polygon the COM reference is kept over (default [`SupportArea::BothFeet`]).
     pub support_area: SupportArea,
@@ -143,7 +145,7 @@ impl Default for KeypointSettings {
             settle_time: 1.5,
             contact_height: 0.05,
             contact_speed: 0.4,
-            min_phase: 0.08,
+            min_phase: 0.2,
             support_area: SupportArea::BothFeet,
             com_margin: 0.02,
             com_smoothing: 0.2,
@@ -325,6 +327,20 @@ fn posture_tracks(
         tracks.push(track);
     }
     Ok((names, tracks))
+}
+
+/// A built-in DeepMimic clip ([`crate::motion::BUILTIN_CLIP_NAMES`]) as a loaded motion, its
+/// body map recognised and its units and up axis decided as for a file (its keypoints by
+/// [`Motion::keypoints`](crate::motion::Motion::keypoints)). Errors: an unknown name.
+#[cfg(feature = "json")]
+pub fn builtin_motion(name: &str) -> Result<crate::motion::Motion> {
+    use crate::motion::{builtin_clip, motion_from_content, MotionContent, MotionFormat};
+    motion_from_content(
+        name.to_string(),
+        MotionFormat::DeepMimic,
+        MotionContent::Skeleton(builtin_clip(name)?),
+        &crate::motion::MotionOptions::default(),
+    )
 }
 
 /// The keypoint controller of a clip on a profile's robot, set up and ready for its first

@@ -207,3 +207,56 @@ pub(crate) fn scale_clip(
         scaled,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::profile::RobotProfile;
+
+    /// Every limb segment (thigh, shank, upper arm, forearm) comes out exactly as long as the
+    /// robot's: the clip's limbs are rigid, so their median length is their length in every
+    /// frame. (Segments from the pelvis are not: the spine bends, and the pelvis is placed by
+    /// the hips' height.) The pelvis starts above the origin.
+    #[test]
+    fn scaled_segments_have_the_robots_lengths() {
+        let kp = super::super::builtin_motion("humanoid3d_punch")
+            .unwrap()
+            .keypoints(crate::motion::DEFAULT_MAX_GAP)
+            .unwrap();
+        let profile = RobotProfile::builtin("g1").unwrap();
+        let robot = profile.robot().unwrap();
+        let cfg = profile
+            .imitate_config(crate::sim::ImitateConfig::default())
+            .unwrap();
+        let names = super::super::frame_names(&profile, &cfg).unwrap();
+        let state = crate::model::State::neutral(&robot);
+        let kin = Kinematics::new(&robot, &state).unwrap();
+        let body = RobotBody::find(&robot, &kin, &names).unwrap();
+        let c = scale_clip(&robot, &kin, &body, &kp, 0.035).unwrap();
+        let n = kp.points.len();
+        let idx = |p: BodyPoint| kp.points.iter().position(|q| *q == p).unwrap();
+        let mut checked = 0;
+        for (pa, pb, _) in &c.scaling.segments {
+            let (Some(fa), Some(fb)) = (body.frame_of(*pa), body.frame_of(*pb)) else {
+                continue;
+            };
+            if *pa == BodyPoint::Pelvis {
+                continue;
+            }
+            let robot_len = (kin.frame_pose(&robot, fb).unwrap().translation.vector
+                - kin.frame_pose(&robot, fa).unwrap().translation.vector)
+                .norm();
+            for f in [0, kp.frame_count() / 2, kp.frame_count() - 1] {
+                let d = (c.scaled[f * n + idx(*pb)] - c.scaled[f * n + idx(*pa)]).norm();
+                assert!(
+                    (d - robot_len).abs() < 1e-9,
+                    "{pa}-{pb} frame {f}: {d} vs {robot_len}"
+                );
+            }
+            checked += 1;
+        }
+        assert_eq!(checked, 8, "limb segments checked");
+        let p0 = c.scaled[idx(BodyPoint::Pelvis)];
+        assert!(p0.xy().norm() < 1e-12, "{p0}");
+    }
+}
