@@ -79,6 +79,25 @@ fn choose_map(spec: Option<&str>, format: MotionFormat, r: &ResolvedRobot) -> Re
 
 /// The experiment and its configuration the arguments describe.
 pub fn prepare(a: &ScenarioArgs) -> Result<(Experiment, ImitateConfig)> {
+    let (resolved, cfg) = prepare_config(a)?;
+    let loaded = load_clip(&a.motion, &a.motion_options.options()?)
+        .with_context(|| format!("--motion `{}`", a.motion))?;
+    if let Some(decided) = &loaded.decided {
+        crate::outln!("{decided}")?;
+    }
+    let map = choose_map(a.map.as_deref(), loaded.format, &resolved)?;
+    Ok((
+        Experiment {
+            robot: resolved.robot,
+            clip: loaded.clip,
+            map,
+        },
+        cfg,
+    ))
+}
+
+/// The robot and the imitation settings the arguments describe (everything but the motion).
+pub fn prepare_config(a: &ScenarioArgs) -> Result<(ResolvedRobot, ImitateConfig)> {
     let mut ro = a.robot_options.clone();
     let path = std::path::Path::new(&a.robot);
     if path
@@ -89,12 +108,6 @@ pub fn prepare(a: &ScenarioArgs) -> Result<(Experiment, ImitateConfig)> {
         ro.floating = true;
     }
     let resolved = resolve_robot(&a.robot, &ro, Some(&a.profile))?;
-    let loaded = load_clip(&a.motion, &a.motion_options.options()?)
-        .with_context(|| format!("--motion `{}`", a.motion))?;
-    if let Some(decided) = &loaded.decided {
-        crate::outln!("{decided}")?;
-    }
-    let map = choose_map(a.map.as_deref(), loaded.format, &resolved)?;
     let profile = resolved
         .profile
         .as_ref()
@@ -121,14 +134,7 @@ pub fn prepare(a: &ScenarioArgs) -> Result<(Experiment, ImitateConfig)> {
         }
     }
     cfg.health.keep_going = a.keep_going;
-    Ok((
-        Experiment {
-            robot: resolved.robot,
-            clip: loaded.clip,
-            map,
-        },
-        cfg,
-    ))
+    Ok((resolved, cfg))
 }
 
 /// The health of a run in words: "healthy", or every failed check with its first and worst
