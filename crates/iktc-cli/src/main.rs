@@ -10,12 +10,14 @@ mod cmd_map;
 mod cmd_model;
 mod cmd_profile;
 mod cmd_reproduce;
+mod cmd_retarget;
 mod cmd_run;
 mod cmd_walk;
 mod columns;
 mod finite;
 mod out;
 mod pairs;
+mod retarget_report;
 mod robot_arg;
 mod scenario;
 mod viewer;
@@ -50,6 +52,9 @@ enum Command {
     Profile(cmd_profile::Args),
     /// Print a built-in map, or find the body points of a motion file and write a body map.
     Map(cmd_map::Args),
+    /// Retarget whole datasets on every core: per clip CSV, NPZ, quality summary and viewer,
+    /// and one dataset report, OUT/index.html.
+    Retarget(Box<cmd_retarget::Args>),
 }
 
 /// The command line's grammar, with every option value allowed to be a negative number
@@ -65,7 +70,8 @@ fn command() -> clap::Command {
         })
         .mut_subcommands(negatives)
     }
-    negatives(Cli::command())
+    // `iktc retarget` takes its motions as arguments: the shared --motion is hidden there.
+    negatives(Cli::command()).mut_subcommand("retarget", |c| c.mut_arg("motion", |a| a.hide(true)))
 }
 
 fn main() -> std::process::ExitCode {
@@ -82,6 +88,7 @@ fn main() -> std::process::ExitCode {
         Command::Walk(a) => cmd_walk::run(&a),
         Command::Profile(a) => cmd_profile::run(&a),
         Command::Map(a) => cmd_map::run(&a),
+        Command::Retarget(a) => cmd_retarget::run(&a),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

@@ -50,6 +50,8 @@
 #![warn(missing_docs)]
 
 pub mod balance;
+#[cfg(all(feature = "urdf", feature = "json", feature = "toml"))]
+pub mod batch;
 mod buffer;
 pub mod controller;
 pub mod error;

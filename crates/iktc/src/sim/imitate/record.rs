@@ -22,6 +22,9 @@ pub struct ImitateStep {
     pub t: f64,
     /// Dof positions \[rad\] (base entries 0), nv entries.
     pub q: Vec<f64>,
+    /// Pose of the root link in the world: position \[m\] then unit quaternion (x, y, z, w)
+    /// (identity for a fixed base).
+    pub base: [f64; 7],
     /// Dof rates \[rad/s\] (base: body twist \[m/s\], \[rad/s\]).
     pub qd: Vec<f64>,
     /// Commanded q̈ \[rad/s²\].
@@ -331,6 +334,11 @@ pub fn run_imitate(
         let bx = ctl.acceleration_box();
         steps.push(ImitateStep {
             t,
+            base: {
+                let b = state.base_pose(robot);
+                let (p, r) = (b.translation.vector, b.rotation.coords);
+                [p.x, p.y, p.z, r.x, r.y, r.z, r.w]
+            },
             box_lower: bx.lower.as_slice().to_vec(),
             box_upper: bx.upper.as_slice().to_vec(),
             q,

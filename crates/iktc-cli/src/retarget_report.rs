@@ -1,0 +1,179 @@
+//! The dataset report of `iktc retarget`, `OUT/index.html`: one offline page (inline CSS,
+//! script and SVG) with every clip's quality figures in a table sortable by any column (click a
+//! header), the worst first (failed run checks, then the largest upper-body RMS error), a
+//! histogram of each figure across the dataset, the failures with their errors, and a link to
+//! each clip's viewer and files.
+
+use iktc_report::escape_html;
+
+use crate::cmd_retarget::ClipStatus;
+
+/// The figures shown: key in `quality.json`'s `figures`, column label with its unit.
+const COLUMNS: [(&str, &str); 12] = [
+    ("duration", "duration [s]"),
+    ("rms_error_upper_body", "upper-body RMS error [rad]"),
+    ("max_error_upper_body", "upper-body max error [rad]"),
+    (
+        "rms_error_pelvis_attitude",
+        "pelvis attitude RMS error [rad]",
+    ),
+    ("rms_error_pelvis_height", "pelvis height RMS error [m]"),
+    ("rms_error_com", "COM RMS error [m]"),
+    ("foot_slip", "foot slip [m]"),
+    ("worst_position_margin", "worst position margin [rad]"),
+    ("worst_velocity_margin", "worst velocity margin [rad/s]"),
+    ("max_rms_jerk", "max RMS jerk [rad/s³]"),
+    ("com_min_margin", "COM min margin [m]"),
+    ("fallback_share", "fallback share [–]"),
+];
+
+/// Bins of each histogram.
+const BINS: usize = 12;
+
+fn figure(c: &ClipStatus, key: &str) -> Option<f64> {
+    c.figures.as_ref()?.get(key)?.as_f64()
+}
+
+fn healthy(c: &ClipStatus) -> bool {
+    c.figures
+        .as_ref()
+        .and_then(|f| f.get("healthy"))
+        .and_then(|h| h.as_bool())
+        .unwrap_or(true)
+}
+
+/// An inline SVG histogram of `values`.
+fn histogram(label: &str, values: &[f64]) -> String {
+    let (w, h) = (220.0, 90.0);
+    let lo = values.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let mut counts = [0usize; BINS];
+    let span = hi - lo;
+    for v in values {
+        let b = if span > 0.0 {
+            (((v - lo) / span) * BINS as f64) as usize
+        } else {
+            0
+        };
+        counts[b.min(BINS - 1)] += 1;
+    }
+    let top = counts.iter().copied().max().unwrap_or(1).max(1) as f64;
+    let bw = w / BINS as f64;
+    let bars: String = counts
+        .iter()
+        .enumerate()
+        .map(|(i, n)| {
+            let bh = (h - 20.0) * *n as f64 / top;
+            format!(
+                "<rect x=\"{:.1}\" y=\"{:.1}\" width=\"{:.1}\" height=\"{bh:.1}\" fill=\"#4a78c2\"><title>{n}</title></rect>",
+                i as f64 * bw + 1.0,
+                h - 14.0 - bh,
+                bw - 2.0
+            )
+        })
+        .collect();
+    format!(
+        "<figure><svg width=\"{w}\" height=\"{h}\" viewBox=\"0 0 {w} {h}\">{bars}\
+         <text x=\"0\" y=\"{h}\" font-size=\"10\">{lo:.3e}</text>\
+         <text x=\"{w}\" y=\"{h}\" font-size=\"10\" text-anchor=\"end\">{hi:.3e}</text></svg>\
+         <figcaption>{} ({} clips)</figcaption></figure>",
+        escape_html(label),
+        values.len()
+    )
+}
+
+/// The page.
+pub fn render(clips: &[ClipStatus], robot: &str, viewer: bool) -> String {
+    let mut ok: Vec<&ClipStatus> = clips.iter().filter(|c| c.status != "failed").collect();
+    let failed: Vec<&ClipStatus> = clips.iter().filter(|c| c.status == "failed").collect();
+    // Worst first: failed run checks, then the largest upper-body RMS error.
+    ok.sort_by(|a, b| {
+        healthy(a).cmp(&healthy(b)).then(
+            figure(b, "rms_error_upper_body")
+                .unwrap_or(f64::INFINITY)
+                .total_cmp(&figure(a, "rms_error_upper_body").unwrap_or(f64::INFINITY)),
+        )
+    });
+    let mut s = String::from(
+        "<!DOCTYPE html><html lang=\"en\"><head><meta charset=\"utf-8\"><title>iktc retarget: dataset report</title><style>\
+         body{font:13px sans-serif;margin:16px;color:#222}table{border-collapse:collapse}\
+         td,th{border:1px solid #ccc;padding:3px 6px;text-align:right}td:first-child,th:first-child{text-align:left}\
+         th{cursor:pointer;background:#f0f0f0}tr.bad td{background:#fde8e8}\
+         figure{display:inline-block;margin:6px}figcaption{font-size:11px}pre{white-space:pre-wrap}\
+         </style></head><body>",
+    );
+    s.push_str(&format!(
+        "<h1>Dataset report</h1><p>Robot: {}. {} clips: {} retargeted, {} up to date (skipped), {} failed. \
+         Rows are sorted worst first (run checks failed, then the largest upper-body RMS error); click a header to sort by it. \
+         Margins are signed: positive means a limit was exceeded.</p>",
+        escape_html(robot),
+        clips.len(),
+        clips.iter().filter(|c| c.status == "retargeted").count(),
+        clips.iter().filter(|c| c.status == "skipped").count(),
+        failed.len()
+    ));
+    s.push_str("<h2>Clips</h2><table id=\"clips\"><thead><tr><th>clip</th><th>checks</th>");
+    for (_, label) in COLUMNS {
+        s.push_str(&format!("<th>{}</th>", escape_html(label)));
+    }
+    s.push_str("<th>files</th></tr></thead><tbody>");
+    for c in &ok {
+        let h = healthy(c);
+        s.push_str(&format!(
+            "<tr{}><td>{}</td><td data-v=\"{}\">{}</td>",
+            if h { "" } else { " class=\"bad\"" },
+            escape_html(&c.name),
+            u8::from(h),
+            if h { "passed" } else { "FAILED" }
+        ));
+        for (key, _) in COLUMNS {
+            match figure(c, key) {
+                Some(v) => s.push_str(&format!("<td data-v=\"{v:e}\">{v:.4}</td>")),
+                None => s.push_str("<td data-v=\"\">–</td>"),
+            }
+        }
+        let dir = escape_html(&c.name);
+        let mut links = format!(
+            "<a href=\"{dir}/motion.csv\">csv</a> <a href=\"{dir}/motion.npz\">npz</a> <a href=\"{dir}/quality.json\">quality</a>"
+        );
+        if viewer {
+            links = format!("<a href=\"{dir}/viewer.html\">viewer</a> {links}");
+        }
+        s.push_str(&format!("<td>{links}</td></tr>"));
+    }
+    s.push_str("</tbody></table><h2>Distributions across the dataset</h2>");
+    for (key, label) in COLUMNS {
+        let v: Vec<f64> = ok.iter().filter_map(|c| figure(c, key)).collect();
+        if !v.is_empty() {
+            s.push_str(&histogram(label, &v));
+        }
+    }
+    s.push_str(&format!("<h2>Failures ({})</h2>", failed.len()));
+    if failed.is_empty() {
+        s.push_str("<p>None.</p>");
+    } else {
+        s.push_str("<table id=\"failures\"><thead><tr><th>clip</th><th>input</th><th>error</th></tr></thead><tbody>");
+        for c in &failed {
+            s.push_str(&format!(
+                "<tr><td>{}</td><td>{}</td><td><pre>{}</pre></td></tr>",
+                escape_html(&c.name),
+                escape_html(&c.input),
+                escape_html(c.error.as_deref().unwrap_or(""))
+            ));
+        }
+        s.push_str("</tbody></table>");
+    }
+    s.push_str(
+        "<script>\"use strict\";\
+         const t=document.getElementById('clips');let dir={};\
+         t.querySelectorAll('th').forEach((th,i)=>th.onclick=()=>{\
+         const rows=[...t.tBodies[0].rows];dir[i]=-(dir[i]||1);\
+         const key=r=>{const c=r.cells[i];const v=c.dataset.v;return v===undefined?c.textContent:(v===''?NaN:parseFloat(v));};\
+         rows.sort((a,b)=>{const x=key(a),y=key(b);\
+         if(typeof x==='string')return dir[i]*x.localeCompare(y);\
+         if(isNaN(x))return 1;if(isNaN(y))return -1;return dir[i]*(x-y);});\
+         rows.forEach(r=>t.tBodies[0].appendChild(r));});\
+         </script></body></html>",
+    );
+    s
+}

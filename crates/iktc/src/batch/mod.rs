@@ -1,0 +1,17 @@
+//! Retargeting whole datasets: one clip end to end in memory ([`BatchRetarget::retarget`]),
+//! its outputs for training code ([`TrainingTrajectory`] as CSV and NPZ, written by
+//! [`npz`] without a dependency), its quality figures ([`ClipQuality`]), and a pool of worker
+//! threads over the clips ([`run_parallel`]). Files, progress and the dataset report are the
+//! command line's (`iktc retarget`).
+
+pub mod npz;
+pub mod pool;
+pub mod quality;
+pub mod retarget;
+pub mod training;
+
+pub use npz::{crc32, npz_bytes, zip_stored, NpyArray, NpyData};
+pub use pool::run_parallel;
+pub use quality::ClipQuality;
+pub use retarget::{BatchRetarget, ClipOutcome, RetargetMethod, DEFAULT_RETARGET_METHOD};
+pub use training::TrainingTrajectory;

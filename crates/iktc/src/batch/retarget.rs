@@ -1,0 +1,149 @@
+//! One clip of a batch, end to end in memory: read the motion file, retarget it onto the
+//! robot, run the imitation, resample it for training and measure its quality
+//! ([`BatchRetarget::retarget`]); and the fingerprint of the settings a re-run compares
+//! ([`BatchRetarget::settings_hash`]).
+
+use std::path::Path;
+
+use super::quality::ClipQuality;
+use super::training::TrainingTrajectory;
+use crate::error::Result;
+use crate::model::Robot;
+use crate::motion::{MotionFormat, MotionOptions, RetargetMap};
+use crate::profile::RobotProfile;
+use crate::sim::{load_clip, Experiment, ImitateConfig, ImitateRun};
+
+/// How a clip becomes robot references.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RetargetMethod {
+    /// Joint angles through a [`RetargetMap`] ([`Experiment::references`]), as `iktc imitate`.
+    Joints,
+}
+
+/// The method a batch uses unless told otherwise: the one place to switch the default.
+pub const DEFAULT_RETARGET_METHOD: RetargetMethod = RetargetMethod::Joints;
+
+/// Everything a batch shares across its clips.
+#[derive(Debug, Clone)]
+pub struct BatchRetarget {
+    /// The robot.
+    pub robot: Robot,
+    /// Its profile (feet, pelvis, body frames, maps per motion format).
+    pub profile: RobotProfile,
+    /// A map for every clip; `None`: the profile's map for each clip's format.
+    pub map: Option<RetargetMap>,
+    /// The imitation settings (from the profile, with the command's options).
+    pub config: ImitateConfig,
+    /// How motion files are read.
+    pub motion_options: MotionOptions,
+    /// Output rate \[Hz\]; `None`: the control rate `1 / config.dt`.
+    pub rate: Option<f64>,
+    /// How clips are retargeted.
+    pub method: RetargetMethod,
+}
+
+/// One retargeted clip.
+#[derive(Debug, Clone)]
+pub struct ClipOutcome {
+    /// The robot, clip and map of the run.
+    pub experiment: Experiment,
+    /// The recorded run.
+    pub run: ImitateRun,
+    /// The training trajectory at the output rate.
+    pub trajectory: TrainingTrajectory,
+    /// Its quality figures.
+    pub quality: ClipQuality,
+}
+
+impl BatchRetarget {
+    /// The output rate \[Hz\].
+    pub fn output_rate(&self) -> f64 {
+        self.rate.unwrap_or(1.0 / self.config.dt)
+    }
+
+    /// The body frames whose world positions are written: the profile's named frames (pelvis,
+    /// torso, head, hands) that are set, then the feet of the imitation.
+    pub fn body_frames(&self) -> Vec<String> {
+        let f = &self.profile.frames;
+        let mut v: Vec<String> = [&f.pelvis, &f.torso, &f.head, &f.left_hand, &f.right_hand]
+            .into_iter()
+            .flatten()
+            .cloned()
+            .collect();
+        for foot in &self.config.feet {
+            if !v.contains(foot) {
+                v.push(foot.clone());
+            }
+        }
+        v
+    }
+
+    /// A text that changes whenever an output could: the crate version, the method, the
+    /// profile, the map, the imitation settings, the motion options and the output rate.
+    pub fn settings_text(&self) -> String {
+        format!(
+            "iktc {}\nmethod {:?}\nprofile {:?}\nmap {:?}\nconfig {:?}\nmotion {:?}\nrate {}\nbodies {:?}\n",
+            env!("CARGO_PKG_VERSION"),
+            self.method,
+            self.profile,
+            self.map,
+            self.config,
+            self.motion_options,
+            self.output_rate(),
+            self.body_frames()
+        )
+    }
+
+    /// FNV-1a (64 bit) of [`Self::settings_text`], as 16 hex digits.
+    pub fn settings_hash(&self) -> String {
+        let h = self
+            .settings_text()
+            .bytes()
+            .fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
+                (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+            });
+        format!("{h:016x}")
+    }
+
+    /// Retargets the motion file `path`: [`load_clip`], the map ([`Self::map`] or the
+    /// profile's for the file's format), [`Experiment::imitate`] with [`Self::config`],
+    /// [`TrainingTrajectory::from_run`] at [`Self::output_rate`] and [`ClipQuality`].
+    ///
+    /// Errors: whatever reading, mapping, the run or the resampling give.
+    pub fn retarget(&self, path: &Path) -> Result<ClipOutcome> {
+        let spec = path.to_string_lossy();
+        let loaded = load_clip(&spec, &self.motion_options)?;
+        let map = match &self.map {
+            Some(m) => m.clone(),
+            None => {
+                let format = if loaded.format == MotionFormat::DeepMimic {
+                    "deepmimic"
+                } else {
+                    "bvh"
+                };
+                self.profile.retarget_map(format, &self.robot)?
+            }
+        };
+        let experiment = Experiment {
+            robot: self.robot.clone(),
+            clip: loaded.clip,
+            map,
+        };
+        let run = match self.method {
+            RetargetMethod::Joints => experiment.imitate(&self.config)?,
+        };
+        let trajectory = TrainingTrajectory::from_run(
+            &self.robot,
+            &run,
+            &self.body_frames(),
+            self.output_rate(),
+        )?;
+        let quality = ClipQuality::from_summary(&run.summary);
+        Ok(ClipOutcome {
+            experiment,
+            run,
+            trajectory,
+            quality,
+        })
+    }
+}
