@@ -442,6 +442,10 @@ mod tests {
         let (lo, hi) = ([0.0, 0.0, 1.0], [0.0, 0.0, 2.0]);
         let mut screen = Screen::new(1, 2);
         assert!(!screen.proves_infeasible(0, &g.as_view(), &lo, &hi, 0.0));
+        // A full certificate first (it fills the factors), then one row for two variables:
+        // the stale factors must not be used.
+        screen.remember(0, &active(&[0, 1], false), None);
+        assert!(screen.proves_infeasible(0, &g.as_view(), &lo, &hi, 0.0));
         screen.remember(0, &active(&[0], false), None);
         assert!(!screen.proves_infeasible(0, &g.as_view(), &lo, &hi, 0.0));
         // Three active rows into room for two: the list is dropped.
