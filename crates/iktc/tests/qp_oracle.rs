@@ -155,7 +155,7 @@ fn run_with(kind: Kind, count: u64, seed0: u64, sizes: Sizes, scaled: bool) -> S
                     "{ctx}: the named constraint holds at x"
                 );
             }
-            QpStatus::MaxIterations => panic!("{ctx}"),
+            QpStatus::MaxIterations | QpStatus::Inaccurate { .. } => panic!("{ctx}"),
         }
         match oracle {
             Verdict::Solved { x: xo, objective } => {

@@ -108,6 +108,16 @@ fn check_robot(name: &str) {
             failures.push(format!("{file}: a limit exceeded"));
         }
         assert!(q.stance_ticks > 0, "{file}: no foot ever on the ground");
+        // IKTC's answers stay in the box beyond rounding on every tick, so the tracker never
+        // re-solves by GF on JVRC-1 (with the QP's blown-up iterates once reported as
+        // optimal, 188 of dance_b's 508 ticks left the box by up to 1.3e4 rad/s²). On G1 a
+        // few ticks exceed the tracker's 1e-9 rad/s² by rounding (≤ 1e-8).
+        if name == "jvrc1" && run.fallback_ticks > 0 {
+            failures.push(format!(
+                "{file}: {} ticks re-solved by GF",
+                run.fallback_ticks
+            ));
+        }
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }

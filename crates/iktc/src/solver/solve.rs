@@ -4,6 +4,7 @@ use nalgebra::{DMatrix, DVector};
 
 use super::continuity::LevelHold;
 use super::hierarchy::Hierarchy;
+use super::qp::INACCURATE_FACTOR;
 use super::qp::{Hessian, QpProblem, QpStatus, QpWorkspace};
 use super::rebase::Rebase;
 use super::report::{Fallback, Method, SolveReport};
@@ -135,6 +136,14 @@ impl Solver {
         }
         solved?;
         self.report.violation = self.violation(qdd);
+        // The box is the promise: a q̈ of IKTC or GF outside it by more than rounding (a QP
+        // that lost its accuracy) is clamped into it and reported, never returned silently.
+        let limit = INACCURATE_FACTOR * self.settings.box_tolerance;
+        if matches!(method, Method::Iktc | Method::Cascade) && self.report.violation > limit {
+            self.clamp_into_box(qdd);
+            self.report.fallback = Some(Fallback::ClampedToBox);
+            self.report.violation = self.violation(qdd);
+        }
         for (i, l) in levels.iter().enumerate() {
             // e = J q̈ − h, by columns of J (contiguous).
             let e = &mut self.report.task_errors[i];
@@ -209,6 +218,13 @@ impl Solver {
             v = v.max(self.lo[d] - q[d]).max(q[d] - self.hi[d]);
         }
         v
+    }
+
+    /// Clamps `qdd` itself (not the prioritized solution) into the box.
+    fn clamp_into_box(&self, qdd: &mut DVector<f64>) {
+        for d in 0..qdd.len() {
+            qdd[d] = qdd[d].clamp(self.lo[d], self.hi[d]);
+        }
     }
 
     fn clamp(&self, qdd: &mut DVector<f64>) {

@@ -117,4 +117,4 @@ mod workspace;
 pub use problem::{Hessian, QpProblem};
 pub use report::{ActiveConstraint, QpConstraint, QpReport, QpStatus};
 pub use settings::QpSettings;
-pub use workspace::QpWorkspace;
+pub use workspace::{QpWorkspace, INACCURATE_FACTOR};

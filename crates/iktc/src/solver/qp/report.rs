@@ -39,6 +39,15 @@ pub enum QpStatus {
     /// without reaching the optimum. `x` is the last iterate: the minimiser over the active
     /// constraints, which may violate others.
     MaxIterations,
+    /// Nothing was left to add, but the last iterate violates a row by `max_violation`, more
+    /// than [`INACCURATE_FACTOR`](super::INACCURATE_FACTOR) times the feasibility tolerance:
+    /// near-dependent constraint normals made the iterate grow until rounding dominates the
+    /// active rows (seen with rank-deficient task levels, ‖x‖ ≈ 1e18). Not a solution; callers
+    /// treat it as a failed solve.
+    Inaccurate {
+        /// The largest row violation at the last iterate [units of the constraint row].
+        max_violation: f64,
+    },
 }
 
 /// An active constraint at the returned point with its Lagrange multiplier.

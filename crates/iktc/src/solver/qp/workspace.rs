@@ -10,6 +10,14 @@ use crate::buffer::Buffer;
 use crate::error::check_dim;
 use crate::{Error, Result};
 
+/// A solve that ends with nothing left to add is [`QpStatus::Optimal`] only if no row is
+/// violated by more than this many times the feasibility tolerance \[–\]; beyond it the
+/// status is [`QpStatus::Inaccurate`]. Active rows carry the rounding of `aᵀx` (≈ 1e-16 ‖a‖‖x‖):
+/// far below the tolerance for a sane iterate, and hundreds of units for the blown-up iterates
+/// (‖x‖ ≈ 1e18) of near-dependent normals. Large enough never to reject a sane solve, small
+/// enough to catch every blow-up seen.
+pub const INACCURATE_FACTOR: f64 = 1e3;
+
 /// A constraint row as the solver sees it (before choosing a side).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Row {
@@ -231,7 +239,7 @@ impl QpWorkspace {
         if outcome.is_none() {
             outcome = Some(self.add_inequalities(problem, settings, x, &mut iterations));
         }
-        let status = match outcome.unwrap_or(Outcome::Optimal) {
+        let mut status = match outcome.unwrap_or(Outcome::Optimal) {
             Outcome::Optimal => QpStatus::Optimal,
             Outcome::Infeasible(constraint) => QpStatus::Infeasible { constraint },
             Outcome::MaxIterations => QpStatus::MaxIterations,
@@ -247,13 +255,19 @@ impl QpWorkspace {
                 value: objective,
             });
         }
+        let max_violation = self.max_violation(problem, x);
+        if status == QpStatus::Optimal
+            && max_violation > INACCURATE_FACTOR * settings.feasibility_tolerance
+        {
+            status = QpStatus::Inaccurate { max_violation };
+        }
         Ok(QpReport {
             status,
             iterations,
             objective,
             active_count: self.active.len(),
             redundant_equalities: redundant,
-            max_violation: self.max_violation(problem, x),
+            max_violation,
         })
     }
 
