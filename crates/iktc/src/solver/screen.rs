@@ -406,15 +406,31 @@ mod tests {
         let g = DMatrix::from_row_slice(2, 1, &[1.0, 1.0]);
         let mut screen = Screen::new(1, 1);
         screen.remember(0, &active(&[0], true), None);
-        // Row 0 pins x to 1e3; row 1 asks x ≥ 1e3 + d.
+        // Row 0 pins x to 1e3; row 1 asks x ≥ 1e3 + δ (mirrored below), δ a multiple d of
+        // the margin: the magnitudes summed are 2x (the interval) + x + 1e4 (row 1's ends).
         let x = 1e3;
-        let mag = 2.0 * x;
-        for (d, want) in [(0.5, false), (2.0, true)] {
-            let lo = [x, x + d * ROUNDING_MARGIN * (mag + x + 1e4)];
+        let margin = ROUNDING_MARGIN * (2.0 * x + x + 1e4);
+        for (d, want) in [(0.9, false), (1.1, true)] {
+            let lo = [x, x + d * margin];
             let hi = [x, 1e4];
             let got = screen.proves_infeasible(0, &g.as_view(), &lo, &hi, 0.0);
-            assert_eq!(got, want, "miss {d} × margin");
+            assert_eq!(got, want, "above: miss {d} × margin");
+            // Mirrored (x pinned to −1e3, so that row 1 is violated at Δh = 0).
+            let lo = [-x, -1e4];
+            let hi = [-x, -x - d * margin];
+            let got = screen.proves_infeasible(0, &g.as_view(), &lo, &hi, 0.0);
+            assert_eq!(got, want, "below: miss {d} × margin");
         }
+    }
+
+    /// A certificate whose LU needs a row exchange (G_S a permutation) is proven.
+    #[test]
+    fn a_certificate_needing_a_pivot_exchange_is_proven() {
+        let g = DMatrix::from_row_slice(3, 2, &[0.0, 1.0, 1.0, 0.0, 1.0, 1.0]);
+        let mut screen = Screen::new(1, 2);
+        screen.remember(0, &active(&[0, 1], false), None);
+        let (lo, hi) = ([0.0, 0.0, 1.0], [0.0, 0.0, 2.0]);
+        assert!(screen.proves_infeasible(0, &g.as_view(), &lo, &hi, 0.0));
     }
 
     /// G_S singular or nearly so (a pivot below `PIVOT_TOLERANCE` of the largest entry): the
@@ -493,6 +509,10 @@ mod tests {
             &active(&[0, 1], false),
             Some(QpConstraint::Lower { row: 9 }),
         );
+        assert!(!screen.proves_infeasible(0, &g.as_view(), &lo, &hi, 0.0));
+        // One past the last row (n = 3): ignored.
+        let past = Some(QpConstraint::Lower { row: 3 });
+        screen.remember(0, &active(&[0, 1], false), past);
         assert!(!screen.proves_infeasible(0, &g.as_view(), &lo, &hi, 0.0));
         screen.remember(
             0,
