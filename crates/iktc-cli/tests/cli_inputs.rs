@@ -88,6 +88,23 @@ fn tick_bounds_name_their_option() {
             "--max-ticks",
         ],
     );
+    // Walking is its own command; `imitate --walk` says so instead of running.
+    assert_error(
+        &["imitate", "--walk", "--out", out],
+        &["iktc walk", "--steps"],
+    );
+    // Walking options exist only on `iktc walk` (a usage error, exit 2).
+    let o = run(&["imitate", "--steps", "3", "--out", out]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("'--steps'"));
+    assert_error(
+        &["walk", "--push", "1,2", "--out", out],
+        &["--push `1,2`", "TIME,IMPULSE_X,IMPULSE_Y"],
+    );
+    assert_error(
+        &["walk", "--narrow", "L_KNEE=0.5", "--out", out],
+        &["--narrow `L_KNEE=0.5`", "is not lo:hi"],
+    );
     assert_error(
         &["run", "planar3r", "--max-ticks", "100", "--out", out],
         &["ticks of the 3R run", "= 400", "limit 100", "--max-ticks"],

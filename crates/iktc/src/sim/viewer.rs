@@ -12,10 +12,10 @@ use crate::sim::{ImitateRun, WalkRun};
 use crate::walk::{sole_corners, Phase, Pose2, Side};
 
 /// Where the captured skeleton stands in the viewer: this far along +y (the robot's left) of
-/// the robot [m].
+/// the robot \[m\].
 pub const SKELETON_OFFSET: f64 = 1.2;
 
-/// Time between two viewer frames [s] (the run's ticks are decimated to it).
+/// Time between two viewer frames \[s\] (the run's ticks are decimated to it).
 pub const FRAME_PERIOD: f64 = 0.02;
 
 /// A stick figure: segments between points, and the points of every frame.
@@ -25,7 +25,7 @@ pub struct Figure3d {
     pub name: String,
     /// Pairs of point indices joined by a segment.
     pub segments: Vec<[usize; 2]>,
-    /// Points of every frame [m], world axes (z up).
+    /// Points of every frame \[m\], world axes (z up).
     pub frames: Vec<Vec<[f32; 3]>>,
 }
 
@@ -34,15 +34,15 @@ pub struct Figure3d {
 pub struct ViewerData {
     /// Page title.
     pub title: String,
-    /// Time between frames [s].
+    /// Time between frames \[s\].
     pub dt: f64,
     /// The robot.
     pub robot: Figure3d,
     /// The captured skeleton (drawn beside the robot).
     pub skeleton: Figure3d,
-    /// COM of every frame [m].
+    /// COM of every frame \[m\].
     pub com: Vec<[f32; 3]>,
-    /// Support polygon [m] (counter-clockwise, on the ground).
+    /// Support polygon \[m\] (counter-clockwise, on the ground).
     pub support: Vec<[f32; 3]>,
     /// Per frame: indices of robot segments whose joint sits on a limit.
     pub on_limit: Vec<Vec<usize>>,
@@ -73,7 +73,7 @@ fn point(p: &[f64; 3]) -> [f32; 3] {
     [p[0] as f32, p[1] as f32, p[2] as f32]
 }
 
-/// Ticks between viewer frames for a control period `dt` [s].
+/// Ticks between viewer frames for a control period `dt` \[s\].
 fn stride(dt: f64) -> usize {
     ((FRAME_PERIOD / dt).round() as usize).max(1)
 }
@@ -92,7 +92,7 @@ fn robot_figure(e: &Experiment) -> Figure3d {
     }
 }
 
-/// The skeleton's stick figure at the run times `times` [s] (clamped to the clip's end), in the
+/// The skeleton's stick figure at the run times `times` \[s\] (clamped to the clip's end), in the
 /// robot's world axes (the map's basis), [`SKELETON_OFFSET`] to the robot's left.
 fn skeleton_figure(e: &Experiment, times: &[f64], root: RootMotion) -> Result<Figure3d> {
     let clip: &Clip = &e.clip;
