@@ -7,7 +7,7 @@ use std::path::Path;
 
 use super::quality::ClipQuality;
 use super::training::TrainingTrajectory;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::model::Robot;
 use crate::motion::{MotionFormat, MotionOptions, RetargetMap};
 use crate::profile::RobotProfile;
@@ -22,6 +22,10 @@ pub enum RetargetMethod {
 
 /// The method a batch uses unless told otherwise: the one place to switch the default.
 pub const DEFAULT_RETARGET_METHOD: RetargetMethod = RetargetMethod::Joints;
+
+/// The fewest frames a clip needs: resampling it at the control period interpolates between
+/// samples, so one frame (no interval) is too short.
+pub const MIN_CLIP_FRAMES: usize = 2;
 
 /// Everything a batch shares across its clips.
 #[derive(Debug, Clone)]
@@ -109,10 +113,20 @@ impl BatchRetarget {
     /// profile's for the file's format), [`Experiment::imitate`] with [`Self::config`],
     /// [`TrainingTrajectory::from_run`] at [`Self::output_rate`] and [`ClipQuality`].
     ///
-    /// Errors: whatever reading, mapping, the run or the resampling give.
+    /// Errors: [`Error::InsufficientData`] for a clip of fewer than [`MIN_CLIP_FRAMES`]
+    /// frames; whatever reading, mapping, the run or the resampling give.
     pub fn retarget(&self, path: &Path) -> Result<ClipOutcome> {
         let spec = path.to_string_lossy();
         let loaded = load_clip(&spec, &self.motion_options)?;
+        let frames = loaded.clip.frame_count();
+        if frames < MIN_CLIP_FRAMES {
+            return Err(Error::InsufficientData {
+                what: format!("resampling clip `{spec}`"),
+                message: format!(
+                    "it has {frames} frame(s); at least {MIN_CLIP_FRAMES} are needed (an interval to interpolate over)"
+                ),
+            });
+        }
         let map = match &self.map {
             Some(m) => m.clone(),
             None => {
