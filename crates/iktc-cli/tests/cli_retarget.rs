@@ -420,3 +420,158 @@ fn batch_of_good_and_bad_clips_skip_force_and_formats() {
         }
     }
 }
+
+/// Joint positions (frames × joints), times and base positions of an `.npz`.
+fn trajectory(p: &Path) -> (Vec<f64>, usize, Vec<f64>, Vec<f64>, Vec<f64>) {
+    let npz = read_npz(&std::fs::read(p).unwrap());
+    let (_, t) = floats(&npz, "time");
+    let (s, q) = floats(&npz, "joint_pos");
+    let (_, b) = floats(&npz, "base_pos");
+    let (bs, body) = floats(&npz, "body_pos_w");
+    // The pelvis (root link, first body frame) is the base: FK of the resampled configuration.
+    for k in 0..t.len() {
+        for i in 0..3 {
+            assert!((body[3 * bs[1] * k + i] - b[3 * k + i]).abs() < 1e-12);
+        }
+    }
+    (t.to_vec(), s[1], q.to_vec(), b.to_vec(), body.to_vec())
+}
+
+#[test]
+fn output_rate_interpolates_the_control_ticks_linearly() {
+    let dir = tmp("rate");
+    let clip = data().join("humanoid3d_walk.txt");
+    let run = |rate: &str, sub: &str| {
+        let o = retarget(&[
+            clip.to_str().unwrap(),
+            "--out",
+            dir.join(sub).to_str().unwrap(),
+            "--rate",
+            rate,
+            "--no-viewer",
+        ]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        trajectory(&dir.join(sub).join("humanoid3d_walk/motion.npz"))
+    };
+    let (t100, m, q100, b100, _) = run("100", "r100");
+    let dt: f64 = DT.parse().unwrap();
+    for rate in [50.0, 30.0, 37.5] {
+        let (t, m2, q, b, _) = run(&rate.to_string(), &format!("r{rate}"));
+        assert_eq!(m2, m);
+        let last = t100[t100.len() - 1];
+        assert_eq!(
+            t.len(),
+            (last * rate + 1e-9).floor() as usize + 1,
+            "{rate} Hz"
+        );
+        for (j, tj) in t.iter().enumerate() {
+            assert!((tj - j as f64 / rate).abs() < 1e-12);
+            // The ticks around t_j and the linear weight, from the 100 Hz output.
+            let k = ((tj / dt + 1e-9).floor() as usize).min(t100.len() - 1);
+            let s = if k + 1 < t100.len() {
+                tj / dt - k as f64
+            } else {
+                0.0
+            };
+            let k1 = (k + 1).min(t100.len() - 1);
+            for d in 0..m {
+                let want = q100[m * k + d] + s * (q100[m * k1 + d] - q100[m * k + d]);
+                assert!(
+                    (q[m * j + d] - want).abs() < 1e-9,
+                    "{rate} Hz frame {j} joint {d}"
+                );
+            }
+            for i in 0..3 {
+                let want = b100[3 * k + i] + s * (b100[3 * k1 + i] - b100[3 * k + i]);
+                assert!((b[3 * j + i] - want).abs() < 1e-9);
+            }
+        }
+    }
+}
+
+#[test]
+fn killed_batch_leaves_only_complete_files() {
+    let dir = tmp("kill");
+    let input = dir.join("in");
+    std::fs::create_dir_all(&input).unwrap();
+    // Eight clips, one worker: a kill after the first lands mid-batch.
+    for i in 0..2 {
+        for c in CLIPS {
+            std::fs::copy(
+                data().join(format!("{c}.txt")),
+                input.join(format!("{c}_{i}.txt")),
+            )
+            .unwrap();
+        }
+    }
+    let out = dir.join("out");
+    let mut child = iktc()
+        .args([
+            "retarget",
+            input.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .args(["--jobs", "1", "--dt", DT])
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let start = std::time::Instant::now();
+    let marked = |out: &Path| {
+        files(out)
+            .iter()
+            .filter(|f| f.ends_with(".settings"))
+            .count()
+    };
+    while out.is_dir().then(|| marked(&out)).unwrap_or(0) == 0 {
+        assert!(child.try_wait().unwrap().is_none(), "the batch ended first");
+        assert!(start.elapsed().as_secs() < 120);
+        std::thread::sleep(std::time::Duration::from_millis(2));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    let done = marked(&out);
+    assert!(done < 8, "the kill came after the whole batch");
+    // Every file under its final name is complete; a marked clip has all its files.
+    for f in files(&out) {
+        let name = f.file_name().unwrap().to_string_lossy().into_owned();
+        if name.ends_with(".tmp") {
+            continue;
+        }
+        match name.as_str() {
+            "motion.npz" => {
+                trajectory(&f);
+            }
+            "quality.json" | "batch.json" => {
+                serde_json::from_str::<serde_json::Value>(&std::fs::read_to_string(&f).unwrap())
+                    .unwrap();
+            }
+            "motion.csv" => {
+                let (h, rows) = read_csv(&f);
+                assert!(rows.iter().all(|r| r.len() == h.len()));
+            }
+            "viewer.html" => {
+                assert!(std::fs::read_to_string(&f)
+                    .unwrap()
+                    .trim_end()
+                    .ends_with("</html>"))
+            }
+            ".settings" => {
+                let d = f.parent().unwrap();
+                for o in ["motion.csv", "motion.npz", "quality.json", "viewer.html"] {
+                    assert!(d.join(o).is_file(), "{}", d.join(o).display());
+                }
+            }
+            other => panic!("unexpected file {other}"),
+        }
+    }
+    // The re-run does the rest, skips what was done, and leaves no temporary file.
+    let o = retarget(&[input.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let st = statuses(&out);
+    assert_eq!(st.values().filter(|s| *s == "skipped").count(), done);
+    assert_eq!(st.values().filter(|s| *s == "retargeted").count(), 8 - done);
+    assert!(files(&out)
+        .iter()
+        .all(|f| !f.to_string_lossy().ends_with(".tmp")));
+}
