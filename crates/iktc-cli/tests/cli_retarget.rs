@@ -523,7 +523,7 @@ fn killed_batch_leaves_only_complete_files() {
             .filter(|f| f.ends_with(".settings"))
             .count()
     };
-    while out.is_dir().then(|| marked(&out)).unwrap_or(0) == 0 {
+    while !out.is_dir() || marked(&out) == 0 {
         assert!(child.try_wait().unwrap().is_none(), "the batch ended first");
         assert!(start.elapsed().as_secs() < 120);
         std::thread::sleep(std::time::Duration::from_millis(2));
