@@ -60,6 +60,23 @@ pub struct ClipOutcome {
 }
 
 impl BatchRetarget {
+    /// A batch of `profile`'s robot ([`RobotProfile::robot`]) with the imitation settings
+    /// [`RobotProfile::imitate_config`] makes of `base`, the profile's map for each clip's
+    /// format, default motion options and the control rate as output rate.
+    ///
+    /// Errors: those of building the robot and the settings.
+    pub fn from_profile(profile: RobotProfile, base: ImitateConfig) -> Result<Self> {
+        Ok(Self {
+            robot: profile.robot()?,
+            config: profile.imitate_config(base)?,
+            profile,
+            map: None,
+            motion_options: MotionOptions::default(),
+            rate: None,
+            method: DEFAULT_RETARGET_METHOD,
+        })
+    }
+
     /// The output rate \[Hz\].
     pub fn output_rate(&self) -> f64 {
         self.rate.unwrap_or(1.0 / self.config.dt)
