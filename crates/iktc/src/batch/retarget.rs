@@ -178,3 +178,49 @@ impl BatchRetarget {
         })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::batch::TrainingTrajectory;
+
+    fn batch() -> BatchRetarget {
+        let profile = RobotProfile::builtin("jvrc1").unwrap();
+        BatchRetarget::from_profile(profile, ImitateConfig::default()).unwrap()
+    }
+
+    #[test]
+    fn settings_hash_follows_every_setting() {
+        let b = batch();
+        let h = b.settings_hash();
+        assert_eq!(h.len(), 16);
+        assert_eq!(h, batch().settings_hash());
+        let mut r = batch();
+        r.rate = Some(50.0);
+        assert_ne!(r.settings_hash(), h);
+        let mut c = batch();
+        c.config.dt = 0.01;
+        assert_ne!(c.settings_hash(), h);
+    }
+
+    #[test]
+    fn bad_rates_and_unknown_bodies_are_errors() {
+        let b = batch();
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("data/motions/deepmimic/humanoid3d_walk.txt");
+        let o = b.retarget(&path).unwrap();
+        let bodies = b.body_frames();
+        assert_eq!(o.trajectory.len(), o.run.steps.len());
+        for rate in [0.0, -5.0, f64::NAN, f64::INFINITY] {
+            let e = TrainingTrajectory::from_run(&b.robot, &o.run, &bodies, rate).unwrap_err();
+            assert!(e.to_string().contains("output rate"), "{rate}: {e}");
+        }
+        let e = TrainingTrajectory::from_run(&b.robot, &o.run, &["no_such_frame".into()], 100.0)
+            .unwrap_err();
+        assert!(e.to_string().contains("no_such_frame"), "{e}");
+        let mut empty = o.run.clone();
+        empty.steps.clear();
+        let e = TrainingTrajectory::from_run(&b.robot, &empty, &bodies, 100.0).unwrap_err();
+        assert!(matches!(e, Error::InsufficientData { .. }), "{e}");
+    }
+}
