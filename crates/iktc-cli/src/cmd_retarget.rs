@@ -128,6 +128,7 @@ pub fn run(a: &Args) -> Result<()> {
     };
     let (clips, mut statuses) = discover(&a.inputs);
     std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
+    remove_temporaries(&a.out)?;
     let hash = batch.settings_hash();
     let (todo, skipped): (Vec<ClipInput>, Vec<ClipInput>) = clips
         .into_iter()
@@ -230,6 +231,11 @@ fn retarget_one(
     hash: &str,
     viewer: bool,
 ) -> Result<(usize, serde_json::Value)> {
+    // A stale marker must not vouch for files being replaced, nor for a clip that now fails.
+    let marker = dir.join(SETTINGS_FILE);
+    if marker.exists() {
+        std::fs::remove_file(&marker).with_context(|| format!("removing {}", marker.display()))?;
+    }
     let ClipOutcome {
         experiment,
         run,
@@ -237,11 +243,7 @@ fn retarget_one(
         quality,
     } = batch.retarget(&c.path)?;
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    // A stale marker must not vouch for files being replaced.
-    let marker = dir.join(SETTINGS_FILE);
-    if marker.exists() {
-        std::fs::remove_file(&marker).with_context(|| format!("removing {}", marker.display()))?;
-    }
+    remove_temporaries(dir)?;
     write_atomic(&dir.join(OUTPUTS[0]), trajectory.csv().as_bytes())?;
     write_atomic(&dir.join(OUTPUTS[1]), &trajectory.npz()?)?;
     let figures = serde_json::to_value(&quality)?;
@@ -278,6 +280,18 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     std::fs::write(&tmp, bytes).with_context(|| format!("writing {}", tmp.display()))?;
     std::fs::rename(&tmp, path)
         .with_context(|| format!("renaming {} to {}", tmp.display(), path.display()))
+}
+
+/// Removes the temporary files an interrupted batch left in `dir` (`.NAME.PID.tmp`).
+fn remove_temporaries(dir: &Path) -> Result<()> {
+    for e in std::fs::read_dir(dir).with_context(|| format!("reading {}", dir.display()))? {
+        let p = e?.path();
+        let name = p.file_name().map(|n| n.to_string_lossy().into_owned());
+        if name.is_some_and(|n| n.starts_with('.') && n.ends_with(".tmp")) && p.is_file() {
+            std::fs::remove_file(&p).with_context(|| format!("removing {}", p.display()))?;
+        }
+    }
+    Ok(())
 }
 
 fn modified(p: &Path) -> Option<SystemTime> {

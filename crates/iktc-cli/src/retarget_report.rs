@@ -42,6 +42,15 @@ fn healthy(c: &ClipStatus) -> bool {
         .unwrap_or(true)
 }
 
+/// A figure as a table cell: four decimals for magnitudes in [0.01, 10⁴), scientific otherwise.
+fn cell(v: f64) -> String {
+    if v == 0.0 || (0.01..1e4).contains(&v.abs()) {
+        format!("{v:.4}")
+    } else {
+        format!("{v:.3e}")
+    }
+}
+
 /// An inline SVG histogram of `values`.
 fn histogram(label: &str, values: &[f64]) -> String {
     let (w, h) = (220.0, 90.0);
@@ -128,7 +137,7 @@ pub fn render(clips: &[ClipStatus], robot: &str, viewer: bool) -> String {
         ));
         for (key, _) in COLUMNS {
             match figure(c, key) {
-                Some(v) => s.push_str(&format!("<td data-v=\"{v:e}\">{v:.4}</td>")),
+                Some(v) => s.push_str(&format!("<td data-v=\"{v:e}\">{}</td>", cell(v))),
                 None => s.push_str("<td data-v=\"\">–</td>"),
             }
         }

@@ -13,5 +13,7 @@ pub mod training;
 pub use npz::{crc32, npz_bytes, zip_stored, NpyArray, NpyData};
 pub use pool::run_parallel;
 pub use quality::ClipQuality;
-pub use retarget::{BatchRetarget, ClipOutcome, RetargetMethod, DEFAULT_RETARGET_METHOD};
+pub use retarget::{
+    BatchRetarget, ClipOutcome, RetargetMethod, DEFAULT_RETARGET_METHOD, MIN_CLIP_FRAMES,
+};
 pub use training::TrainingTrajectory;

@@ -7,7 +7,7 @@ use std::path::Path;
 
 use super::quality::ClipQuality;
 use super::training::TrainingTrajectory;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::model::Robot;
 use crate::motion::{MotionFormat, MotionOptions, RetargetMap};
 use crate::profile::RobotProfile;
@@ -22,6 +22,10 @@ pub enum RetargetMethod {
 
 /// The method a batch uses unless told otherwise: the one place to switch the default.
 pub const DEFAULT_RETARGET_METHOD: RetargetMethod = RetargetMethod::Joints;
+
+/// The fewest frames a clip needs: resampling it at the control period interpolates between
+/// samples, so one frame (no interval) is too short.
+pub const MIN_CLIP_FRAMES: usize = 2;
 
 /// Everything a batch shares across its clips.
 #[derive(Debug, Clone)]
@@ -56,6 +60,23 @@ pub struct ClipOutcome {
 }
 
 impl BatchRetarget {
+    /// A batch of `profile`'s robot ([`RobotProfile::robot`]) with the imitation settings
+    /// [`RobotProfile::imitate_config`] makes of `base`, the profile's map for each clip's
+    /// format, default motion options and the control rate as output rate.
+    ///
+    /// Errors: those of building the robot and the settings.
+    pub fn from_profile(profile: RobotProfile, base: ImitateConfig) -> Result<Self> {
+        Ok(Self {
+            robot: profile.robot()?,
+            config: profile.imitate_config(base)?,
+            profile,
+            map: None,
+            motion_options: MotionOptions::default(),
+            rate: None,
+            method: DEFAULT_RETARGET_METHOD,
+        })
+    }
+
     /// The output rate \[Hz\].
     pub fn output_rate(&self) -> f64 {
         self.rate.unwrap_or(1.0 / self.config.dt)
@@ -109,10 +130,20 @@ impl BatchRetarget {
     /// profile's for the file's format), [`Experiment::imitate`] with [`Self::config`],
     /// [`TrainingTrajectory::from_run`] at [`Self::output_rate`] and [`ClipQuality`].
     ///
-    /// Errors: whatever reading, mapping, the run or the resampling give.
+    /// Errors: [`Error::InsufficientData`] for a clip of fewer than [`MIN_CLIP_FRAMES`]
+    /// frames; whatever reading, mapping, the run or the resampling give.
     pub fn retarget(&self, path: &Path) -> Result<ClipOutcome> {
         let spec = path.to_string_lossy();
         let loaded = load_clip(&spec, &self.motion_options)?;
+        let frames = loaded.clip.frame_count();
+        if frames < MIN_CLIP_FRAMES {
+            return Err(Error::InsufficientData {
+                what: format!("resampling clip `{spec}`"),
+                message: format!(
+                    "it has {frames} frame(s); at least {MIN_CLIP_FRAMES} are needed (an interval to interpolate over)"
+                ),
+            });
+        }
         let map = match &self.map {
             Some(m) => m.clone(),
             None => {
@@ -145,5 +176,51 @@ impl BatchRetarget {
             trajectory,
             quality,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::batch::TrainingTrajectory;
+
+    fn batch() -> BatchRetarget {
+        let profile = RobotProfile::builtin("jvrc1").unwrap();
+        BatchRetarget::from_profile(profile, ImitateConfig::default()).unwrap()
+    }
+
+    #[test]
+    fn settings_hash_follows_every_setting() {
+        let b = batch();
+        let h = b.settings_hash();
+        assert_eq!(h.len(), 16);
+        assert_eq!(h, batch().settings_hash());
+        let mut r = batch();
+        r.rate = Some(50.0);
+        assert_ne!(r.settings_hash(), h);
+        let mut c = batch();
+        c.config.dt = 0.01;
+        assert_ne!(c.settings_hash(), h);
+    }
+
+    #[test]
+    fn bad_rates_and_unknown_bodies_are_errors() {
+        let b = batch();
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("data/motions/deepmimic/humanoid3d_walk.txt");
+        let o = b.retarget(&path).unwrap();
+        let bodies = b.body_frames();
+        assert_eq!(o.trajectory.len(), o.run.steps.len());
+        for rate in [0.0, -5.0, f64::NAN, f64::INFINITY] {
+            let e = TrainingTrajectory::from_run(&b.robot, &o.run, &bodies, rate).unwrap_err();
+            assert!(e.to_string().contains("output rate"), "{rate}: {e}");
+        }
+        let e = TrainingTrajectory::from_run(&b.robot, &o.run, &["no_such_frame".into()], 100.0)
+            .unwrap_err();
+        assert!(e.to_string().contains("no_such_frame"), "{e}");
+        let mut empty = o.run.clone();
+        empty.steps.clear();
+        let e = TrainingTrajectory::from_run(&b.robot, &empty, &bodies, 100.0).unwrap_err();
+        assert!(matches!(e, Error::InsufficientData { .. }), "{e}");
     }
 }

@@ -114,7 +114,16 @@ impl TrainingTrajectory {
                 UnitQuaternion::from_quaternion(Quaternion::new(v[6], v[3], v[4], v[5]))
             };
             let (ra, rb) = (quat(&a.base), quat(&b.base));
-            let r = ra.try_slerp(&rb, s, 0.0).unwrap_or(ra);
+            // Exactly the recorded tick at s = 0; a slerp renormalised against round-off
+            // otherwise (and the nearer end for opposite orientations, where it is undefined).
+            let r = if s == 0.0 {
+                ra
+            } else {
+                let r = ra
+                    .try_slerp(&rb, s, 0.0)
+                    .unwrap_or(if s < 0.5 { ra } else { rb });
+                UnitQuaternion::new_normalize(r.into_inner())
+            };
             let q: Vec<f64> = (nb..nv).map(|d| lerp(a.q[d], b.q[d], s)).collect();
             let qd: Vec<f64> = (0..nv).map(|d| lerp(a.qd[d], b.qd[d], s)).collect();
             // Forward kinematics of the resampled configuration.

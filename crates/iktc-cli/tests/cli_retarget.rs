@@ -1,0 +1,577 @@
+//! `iktc retarget` over the shared DeepMimic clips plus generated bad ones (a corrupt file, an
+//! empty file, a one-frame clip): good clips written, bad ones listed with their errors, exit
+//! status 1, a second run skipping the good clips, `--force` redoing them, a killed batch
+//! leaving only complete files; the NPZ read back by the independent reader below (zip central
+//! directory and `.npy` headers parsed from their specifications) equals the CSV by its stated
+//! columns and the joint trajectories `iktc imitate` writes for the same clip.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::time::SystemTime;
+
+const CLIPS: [&str; 4] = [
+    "humanoid3d_dance_a",
+    "humanoid3d_dance_b",
+    "humanoid3d_punch",
+    "humanoid3d_walk",
+];
+const BAD: [&str; 3] = ["bad/corrupt", "bad/empty", "bad/short"];
+/// Control period of the test runs [s] (twice the default: half the ticks).
+const DT: &str = "0.01";
+/// Two runs of one clip (`iktc retarget` and `iktc imitate`) agree to this relative tolerance
+/// [–]: rounding may differ between processes, far below any tracking figure.
+const SAME_RUN: f64 = 1e-9;
+
+fn iktc() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_iktc"))
+}
+
+fn data() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../iktc/data/motions/deepmimic")
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("iktc-retarget-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// The shared clips and the bad ones under `dir/in`.
+fn inputs(dir: &Path) -> PathBuf {
+    let input = dir.join("in");
+    std::fs::create_dir_all(input.join("bad")).unwrap();
+    for c in CLIPS {
+        std::fs::copy(
+            data().join(format!("{c}.txt")),
+            input.join(format!("{c}.txt")),
+        )
+        .unwrap();
+    }
+    let walk = std::fs::read_to_string(data().join("humanoid3d_walk.txt")).unwrap();
+    std::fs::write(input.join("bad/corrupt.txt"), &walk[..walk.len() / 2]).unwrap();
+    std::fs::write(input.join("bad/empty.txt"), "").unwrap();
+    let mut v: serde_json::Value = serde_json::from_str(&walk).unwrap();
+    let frames = v["Frames"].as_array_mut().unwrap();
+    frames.truncate(1);
+    std::fs::write(input.join("bad/short.txt"), v.to_string()).unwrap();
+    input
+}
+
+fn retarget(args: &[&str]) -> Output {
+    iktc()
+        .arg("retarget")
+        .args(args)
+        .args(["--dt", DT, "--jobs", "2"])
+        .output()
+        .unwrap()
+}
+
+fn batch_json(out: &Path) -> BTreeMap<String, serde_json::Value> {
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("batch.json")).unwrap()).unwrap();
+    v["clips"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| (c["name"].as_str().unwrap().to_string(), c.clone()))
+        .collect()
+}
+
+fn statuses(out: &Path) -> BTreeMap<String, String> {
+    batch_json(out)
+        .into_iter()
+        .map(|(k, v)| (k, v["status"].as_str().unwrap().to_string()))
+        .collect()
+}
+
+fn mtime(p: &Path) -> SystemTime {
+    std::fs::metadata(p).unwrap().modified().unwrap()
+}
+
+/// Every file under `dir`, recursively.
+fn files(dir: &Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+            } else {
+                out.push(p);
+            }
+        }
+    }
+    out
+}
+
+// ---- an independent reader of NumPy's .npz (zip of .npy) ----
+
+fn u16_at(b: &[u8], i: usize) -> usize {
+    u16::from_le_bytes([b[i], b[i + 1]]) as usize
+}
+
+fn u32_at(b: &[u8], i: usize) -> usize {
+    u32::from_le_bytes([b[i], b[i + 1], b[i + 2], b[i + 3]]) as usize
+}
+
+/// A value read from an `.npy` member.
+#[derive(Debug)]
+enum Npy {
+    F64(Vec<usize>, Vec<f64>),
+    Str(Vec<String>),
+}
+
+/// Reads the archive from its end-of-central-directory record, as zip readers do.
+fn read_npz(bytes: &[u8]) -> BTreeMap<String, Npy> {
+    let eocd = (0..=bytes.len() - 22)
+        .rev()
+        .find(|&i| u32_at(bytes, i) == 0x0605_4b50)
+        .expect("end of central directory");
+    let count = u16_at(bytes, eocd + 10);
+    let mut at = u32_at(bytes, eocd + 16);
+    let mut out = BTreeMap::new();
+    for _ in 0..count {
+        assert_eq!(u32_at(bytes, at), 0x0201_4b50, "central header");
+        assert_eq!(u16_at(bytes, at + 10), 0, "stored");
+        let size = u32_at(bytes, at + 24);
+        let nlen = u16_at(bytes, at + 28);
+        let (elen, clen) = (u16_at(bytes, at + 30), u16_at(bytes, at + 32));
+        let local = u32_at(bytes, at + 42);
+        let name = std::str::from_utf8(&bytes[at + 46..at + 46 + nlen]).unwrap();
+        at += 46 + nlen + elen + clen;
+        assert_eq!(u32_at(bytes, local), 0x0403_4b50, "local header");
+        let start = local + 30 + u16_at(bytes, local + 26) + u16_at(bytes, local + 28);
+        let npy = &bytes[start..start + size];
+        out.insert(name.trim_end_matches(".npy").to_string(), parse_npy(npy));
+    }
+    out
+}
+
+fn parse_npy(b: &[u8]) -> Npy {
+    assert_eq!(&b[..6], b"\x93NUMPY");
+    let hlen = u16_at(b, 8);
+    let header = std::str::from_utf8(&b[10..10 + hlen]).unwrap();
+    let field = |key: &str| {
+        let i = header.find(key).unwrap() + key.len();
+        header[i..].trim_start_matches([':', ' ', '\''])
+    };
+    let descr: String = field("'descr'")
+        .chars()
+        .take_while(|c| *c != '\'')
+        .collect();
+    assert!(field("'fortran_order'").starts_with("False"));
+    let shape_text = field("'shape'");
+    let shape: Vec<usize> = shape_text[1..shape_text.find(')').unwrap()]
+        .split(',')
+        .filter(|s| !s.trim().is_empty())
+        .map(|s| s.trim().parse().unwrap())
+        .collect();
+    let data = &b[10 + hlen..];
+    let n: usize = shape.iter().product();
+    if descr == "<f8" {
+        assert_eq!(data.len(), 8 * n);
+        let v = data
+            .chunks(8)
+            .map(|c| f64::from_le_bytes(c.try_into().unwrap()))
+            .collect();
+        Npy::F64(shape, v)
+    } else {
+        let width: usize = descr.strip_prefix("<U").unwrap().parse().unwrap();
+        assert_eq!(data.len(), 4 * width * n);
+        Npy::Str(
+            data.chunks(4 * width)
+                .map(|c| {
+                    c.chunks(4)
+                        .map(|u| u32::from_le_bytes(u.try_into().unwrap()))
+                        .filter(|u| *u != 0)
+                        .map(|u| char::from_u32(u).unwrap())
+                        .collect()
+                })
+                .collect(),
+        )
+    }
+}
+
+fn floats<'a>(npz: &'a BTreeMap<String, Npy>, name: &str) -> (&'a [usize], &'a [f64]) {
+    match &npz[name] {
+        Npy::F64(s, v) => (s, v),
+        other => panic!("{name}: {other:?}"),
+    }
+}
+
+fn strings<'a>(npz: &'a BTreeMap<String, Npy>, name: &str) -> &'a [String] {
+    match &npz[name] {
+        Npy::Str(v) => v,
+        other => panic!("{name}: {other:?}"),
+    }
+}
+
+/// A CSV of numbers: header and rows.
+fn read_csv(p: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
+    let text = std::fs::read_to_string(p).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap().split(',').map(String::from).collect();
+    let rows = lines
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    (header, rows)
+}
+
+#[test]
+fn batch_of_good_and_bad_clips_skip_force_and_formats() {
+    let dir = tmp("batch");
+    let input = inputs(&dir);
+    let out = dir.join("out");
+    let o = retarget(&[input.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    let st = statuses(&out);
+    for c in CLIPS {
+        assert_eq!(st[c], "retargeted", "{c}: {err}");
+        for f in [
+            "motion.csv",
+            "motion.npz",
+            "quality.json",
+            "viewer.html",
+            ".settings",
+        ] {
+            assert!(out.join(c).join(f).is_file(), "{c}/{f}");
+        }
+    }
+    let bj = batch_json(&out);
+    for (b, why) in BAD
+        .iter()
+        .zip(["EOF while parsing", "EOF while parsing", "1 frame"])
+    {
+        assert_eq!(st[*b], "failed", "{b}");
+        let e = bj[*b]["error"].as_str().unwrap();
+        assert!(
+            e.contains(why) && e.contains(&b.replace("bad/", "")),
+            "{b}: {e}"
+        );
+        assert!(err.contains(&format!("{b}: FAILED")), "{err}");
+        assert!(!out.join(b).join(".settings").exists());
+    }
+    let index = std::fs::read_to_string(out.join("index.html")).unwrap();
+    assert!(index.contains("Failures (3)"));
+    for c in CLIPS {
+        assert!(index.contains(&format!("href=\"{c}/viewer.html\"")), "{c}");
+    }
+    assert!(
+        files(&out)
+            .iter()
+            .all(|f| !f.to_string_lossy().ends_with(".tmp")),
+        "temporary files left"
+    );
+
+    // A second run skips every good clip (their files untouched); the bad ones fail again.
+    let before: Vec<SystemTime> = CLIPS
+        .iter()
+        .map(|c| mtime(&out.join(c).join("motion.npz")))
+        .collect();
+    let o = retarget(&[input.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(1));
+    let st = statuses(&out);
+    for (c, t) in CLIPS.iter().zip(&before) {
+        assert_eq!(st[*c], "skipped", "{c}");
+        assert_eq!(mtime(&out.join(c).join("motion.npz")), *t, "{c}");
+    }
+    // The report of a run that skipped everything still shows every clip's figures.
+    let index = std::fs::read_to_string(out.join("index.html")).unwrap();
+    assert!(index.contains("humanoid3d_walk") && index.contains("data-v="));
+
+    // A touched input is redone, the others skipped.
+    let walk = input.join("humanoid3d_walk.txt");
+    std::fs::File::options()
+        .append(true)
+        .open(&walk)
+        .unwrap()
+        .set_modified(SystemTime::now() + std::time::Duration::from_secs(5))
+        .unwrap();
+    let o = retarget(&[input.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(1));
+    let st = statuses(&out);
+    assert_eq!(st["humanoid3d_walk"], "retargeted");
+    assert_eq!(st["humanoid3d_punch"], "skipped");
+
+    // --force redoes every clip; the good ones alone exit 0.
+    let goods: Vec<String> = CLIPS
+        .iter()
+        .map(|c| input.join(format!("{c}.txt")).display().to_string())
+        .collect();
+    let mut args: Vec<&str> = goods.iter().map(|s| s.as_str()).collect();
+    args.extend(["--out", out.to_str().unwrap(), "--force"]);
+    let o = retarget(&args);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let st = statuses(&out);
+    for c in CLIPS {
+        assert_eq!(st[c], "retargeted", "{c}");
+    }
+
+    // The NPZ, the CSV and `iktc imitate`'s joints.csv of the same clip agree.
+    let clip = "humanoid3d_punch";
+    let npz = read_npz(&std::fs::read(out.join(clip).join("motion.npz")).unwrap());
+    let (csv_header, csv_rows) = read_csv(&out.join(clip).join("motion.csv"));
+    let imitate_dir = dir.join("imitate");
+    let o = iktc()
+        .args(["imitate", "--motion"])
+        .arg(input.join(format!("{clip}.txt")))
+        .args(["--dt", DT, "--out"])
+        .arg(&imitate_dir)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (jh, jrows) = read_csv(&imitate_dir.join("joints.csv"));
+    let names = strings(&npz, "joint_names");
+    let (fps_shape, fps) = floats(&npz, "fps");
+    assert!(fps_shape.is_empty());
+    assert_eq!(fps[0], 100.0);
+    let (tshape, time) = floats(&npz, "time");
+    let n = tshape[0];
+    assert_eq!(
+        n,
+        jrows.len(),
+        "one frame per control tick at the control rate"
+    );
+    assert_eq!(n, csv_rows.len());
+    let (qshape, q) = floats(&npz, "joint_pos");
+    let (_, qd) = floats(&npz, "joint_vel");
+    assert_eq!(qshape, [n, names.len()]);
+    assert_eq!(
+        &csv_header[8..],
+        names,
+        "CSV joint columns in the NPZ's order"
+    );
+    assert_eq!(
+        &csv_header[..8],
+        ["t", "base_x", "base_y", "base_z", "base_qx", "base_qy", "base_qz", "base_qw"]
+    );
+    let (_, base_pos) = floats(&npz, "base_pos");
+    let (_, quat) = floats(&npz, "base_quat_xyzw");
+    let m = names.len();
+    for k in 0..n {
+        let row = &csv_rows[k];
+        assert_eq!(row[0], time[k]);
+        assert_eq!(&row[1..4], &base_pos[3 * k..3 * k + 3]);
+        assert_eq!(&row[4..8], &quat[4 * k..4 * k + 4]);
+        let norm: f64 = quat[4 * k..4 * k + 4].iter().map(|x| x * x).sum();
+        assert!((norm - 1.0).abs() < 1e-12);
+        assert_eq!(&row[8..], &q[m * k..m * (k + 1)]);
+        // joints.csv of `iktc imitate`, by column name.
+        // Frame times are j / rate, the run's ticks k Δt: equal to rounding.
+        assert!((jrows[k][0] - time[k]).abs() < 1e-12);
+        for (j, name) in names.iter().enumerate() {
+            let col = jh.iter().position(|h| h == name).unwrap();
+            // Two runs of the same clip agree to rounding (not always bit for bit).
+            let (a, b) = (jrows[k][col], q[m * k + j]);
+            assert!(
+                (a - b).abs() <= SAME_RUN * (1.0 + a.abs()),
+                "{name} at tick {k}: {a} {b}"
+            );
+        }
+    }
+    // Constant acceleration over a tick: (q⁺ − q)/Δt = (q̇ + q̇⁺)/2 for every joint.
+    let dt: f64 = DT.parse().unwrap();
+    for k in 0..n - 1 {
+        for j in 0..m {
+            let fd = (q[m * (k + 1) + j] - q[m * k + j]) / dt;
+            let mean = 0.5 * (qd[m * (k + 1) + j] + qd[m * k + j]);
+            assert!(
+                (fd - mean).abs() < 1e-9 * (1.0 + mean.abs()),
+                "{k} {j}: {fd} {mean}"
+            );
+        }
+    }
+    // Body positions: the pelvis is the root link (its position is the base's), the feet are
+    // held within the run's measured foot slip.
+    let bodies = strings(&npz, "body_names");
+    let (bshape, body) = floats(&npz, "body_pos_w");
+    assert_eq!(bshape, [n, bodies.len(), 3]);
+    let nb = bodies.len();
+    let pelvis = bodies.iter().position(|b| b == "PELVIS_S").unwrap();
+    let quality: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(out.join(clip).join("quality.json")).unwrap(),
+    )
+    .unwrap();
+    let slip = quality["figures"]["foot_slip"].as_f64().unwrap();
+    for k in 0..n {
+        let p = &body[3 * (nb * k + pelvis)..3 * (nb * k + pelvis) + 3];
+        for i in 0..3 {
+            assert!((p[i] - base_pos[3 * k + i]).abs() < 1e-12);
+        }
+        for foot in ["r_ankle", "l_ankle"] {
+            let f = bodies.iter().position(|b| b == foot).unwrap();
+            let (p, p0) = (
+                &body[3 * (nb * k + f)..3 * (nb * k + f) + 3],
+                &body[3 * f..3 * f + 3],
+            );
+            let d =
+                ((p[0] - p0[0]).powi(2) + (p[1] - p0[1]).powi(2) + (p[2] - p0[2]).powi(2)).sqrt();
+            assert!(d <= slip + 1e-9, "{foot} at {k}: {d} > {slip}");
+        }
+    }
+}
+
+/// Joint positions (frames × joints), times and base positions of an `.npz`.
+fn trajectory(p: &Path) -> (Vec<f64>, usize, Vec<f64>, Vec<f64>, Vec<f64>) {
+    let npz = read_npz(&std::fs::read(p).unwrap());
+    let (_, t) = floats(&npz, "time");
+    let (s, q) = floats(&npz, "joint_pos");
+    let (_, b) = floats(&npz, "base_pos");
+    let (bs, body) = floats(&npz, "body_pos_w");
+    // The pelvis (root link, first body frame) is the base: FK of the resampled configuration.
+    for k in 0..t.len() {
+        for i in 0..3 {
+            assert!((body[3 * bs[1] * k + i] - b[3 * k + i]).abs() < 1e-12);
+        }
+    }
+    (t.to_vec(), s[1], q.to_vec(), b.to_vec(), body.to_vec())
+}
+
+#[test]
+fn output_rate_interpolates_the_control_ticks_linearly() {
+    let dir = tmp("rate");
+    let clip = data().join("humanoid3d_walk.txt");
+    let run = |rate: &str, sub: &str| {
+        let o = retarget(&[
+            clip.to_str().unwrap(),
+            "--out",
+            dir.join(sub).to_str().unwrap(),
+            "--rate",
+            rate,
+            "--no-viewer",
+        ]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        trajectory(&dir.join(sub).join("humanoid3d_walk/motion.npz"))
+    };
+    let (t100, m, q100, b100, _) = run("100", "r100");
+    let dt: f64 = DT.parse().unwrap();
+    for rate in [50.0, 30.0, 37.5] {
+        let (t, m2, q, b, _) = run(&rate.to_string(), &format!("r{rate}"));
+        assert_eq!(m2, m);
+        let last = t100[t100.len() - 1];
+        assert_eq!(
+            t.len(),
+            (last * rate + 1e-9).floor() as usize + 1,
+            "{rate} Hz"
+        );
+        for (j, tj) in t.iter().enumerate() {
+            assert!((tj - j as f64 / rate).abs() < 1e-12);
+            // The ticks around t_j and the linear weight, from the 100 Hz output.
+            let k = ((tj / dt + 1e-9).floor() as usize).min(t100.len() - 1);
+            let s = if k + 1 < t100.len() {
+                tj / dt - k as f64
+            } else {
+                0.0
+            };
+            let k1 = (k + 1).min(t100.len() - 1);
+            for d in 0..m {
+                let want = q100[m * k + d] + s * (q100[m * k1 + d] - q100[m * k + d]);
+                assert!(
+                    (q[m * j + d] - want).abs() < 1e-9,
+                    "{rate} Hz frame {j} joint {d}"
+                );
+            }
+            for i in 0..3 {
+                let want = b100[3 * k + i] + s * (b100[3 * k1 + i] - b100[3 * k + i]);
+                assert!((b[3 * j + i] - want).abs() < 1e-9);
+            }
+        }
+    }
+}
+
+#[test]
+fn killed_batch_leaves_only_complete_files() {
+    let dir = tmp("kill");
+    let input = dir.join("in");
+    std::fs::create_dir_all(&input).unwrap();
+    // Eight clips, one worker: a kill after the first lands mid-batch.
+    for i in 0..2 {
+        for c in CLIPS {
+            std::fs::copy(
+                data().join(format!("{c}.txt")),
+                input.join(format!("{c}_{i}.txt")),
+            )
+            .unwrap();
+        }
+    }
+    let out = dir.join("out");
+    let mut child = iktc()
+        .args([
+            "retarget",
+            input.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .args(["--jobs", "1", "--dt", DT])
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let start = std::time::Instant::now();
+    let marked = |out: &Path| {
+        files(out)
+            .iter()
+            .filter(|f| f.ends_with(".settings"))
+            .count()
+    };
+    while !out.is_dir() || marked(&out) == 0 {
+        assert!(child.try_wait().unwrap().is_none(), "the batch ended first");
+        assert!(start.elapsed().as_secs() < 120);
+        std::thread::sleep(std::time::Duration::from_millis(2));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    let done = marked(&out);
+    assert!(done < 8, "the kill came after the whole batch");
+    // Every file under its final name is complete; a marked clip has all its files.
+    for f in files(&out) {
+        let name = f.file_name().unwrap().to_string_lossy().into_owned();
+        if name.ends_with(".tmp") {
+            continue;
+        }
+        match name.as_str() {
+            "motion.npz" => {
+                trajectory(&f);
+            }
+            "quality.json" | "batch.json" => {
+                serde_json::from_str::<serde_json::Value>(&std::fs::read_to_string(&f).unwrap())
+                    .unwrap();
+            }
+            "motion.csv" => {
+                let (h, rows) = read_csv(&f);
+                assert!(rows.iter().all(|r| r.len() == h.len()));
+            }
+            "viewer.html" => {
+                assert!(std::fs::read_to_string(&f)
+                    .unwrap()
+                    .trim_end()
+                    .ends_with("</html>"))
+            }
+            ".settings" => {
+                let d = f.parent().unwrap();
+                for o in ["motion.csv", "motion.npz", "quality.json", "viewer.html"] {
+                    assert!(d.join(o).is_file(), "{}", d.join(o).display());
+                }
+            }
+            other => panic!("unexpected file {other}"),
+        }
+    }
+    // The re-run does the rest, skips what was done, and leaves no temporary file.
+    let o = retarget(&[input.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let st = statuses(&out);
+    assert_eq!(st.values().filter(|s| *s == "skipped").count(), done);
+    assert_eq!(st.values().filter(|s| *s == "retargeted").count(), 8 - done);
+    assert!(files(&out)
+        .iter()
+        .all(|f| !f.to_string_lossy().ends_with(".tmp")));
+}
