@@ -57,6 +57,7 @@ pub mod controller;
 pub mod error;
 pub mod limits;
 pub mod model;
+#[cfg(all(feature = "urdf", feature = "json", feature = "toml"))]
 pub mod motion;
 pub mod prelude;
 #[cfg(all(feature = "urdf", feature = "toml"))]

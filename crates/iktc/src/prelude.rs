@@ -5,7 +5,9 @@ pub use crate::controller::{
 };
 pub use crate::error::{Error, Result};
 pub use crate::limits::{BoundMethod, DofLimits, JointLimits};
-pub use crate::model::{jvrc1, planar3r, Kinematics, ModelOptions, Robot, State};
+#[cfg(feature = "urdf")]
+pub use crate::model::jvrc1;
+pub use crate::model::{planar3r, Kinematics, ModelOptions, Robot, State};
 pub use crate::solver::{Damping, Method, SolveReport, SolverSettings};
 pub use crate::task::{Axes, ComReference, FrameReference, Gains};
 pub use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3, Vector6};

@@ -85,6 +85,7 @@ fn check_magnitude(what: &str, v: &[f64]) -> Result<()> {
 
 impl StateConfig {
     /// Parses JSON text; `source_name` names it in errors.
+    #[cfg(feature = "json")]
     pub fn from_json_str(text: &str, source_name: &str) -> Result<Self> {
         serde_json::from_str(text).map_err(|e| Error::Parse {
             source_name: source_name.into(),
@@ -94,6 +95,7 @@ impl StateConfig {
     }
 
     /// Parses TOML text; `source_name` names it in errors.
+    #[cfg(feature = "toml")]
     pub fn from_toml_str(text: &str, source_name: &str) -> Result<Self> {
         toml::from_str(text).map_err(|e| Error::Parse {
             source_name: source_name.into(),

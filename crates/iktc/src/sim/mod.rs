@@ -3,20 +3,25 @@
 #[cfg(all(feature = "urdf", feature = "json", feature = "toml"))]
 pub mod experiment;
 pub mod health;
+#[cfg(all(feature = "urdf", feature = "json", feature = "toml"))]
 pub mod imitate;
 pub mod margins;
 pub mod planar3r;
 pub mod smoothness;
+#[cfg(all(feature = "urdf", feature = "json", feature = "toml"))]
 pub mod sweep;
 pub mod switches;
 #[cfg(all(feature = "urdf", feature = "json", feature = "toml"))]
 pub mod viewer;
+#[cfg(all(feature = "urdf", feature = "json", feature = "toml"))]
 pub mod walk_imitate;
+#[cfg(all(feature = "urdf", feature = "json", feature = "toml"))]
 pub mod walk_plants;
 
 #[cfg(all(feature = "urdf", feature = "json", feature = "toml"))]
 pub use experiment::{load_clip, load_map, Experiment, LoadedClip};
 pub use health::{HealthCheck, HealthIssue, HealthMonitor, HealthReport, HealthSettings, Verdict};
+#[cfg(all(feature = "urdf", feature = "json", feature = "toml"))]
 pub use imitate::{
     imitation_references, run_imitate, ImitateConfig, ImitateRun, ImitateStep, ImitateSummary,
     ImitationController, ImitationTasks, NarrowedJoint,
@@ -27,8 +32,10 @@ pub use planar3r::{
 };
 pub use smoothness::{DofSmoothness, JointSmoothness};
 pub use switches::LevelSwitches;
+#[cfg(all(feature = "urdf", feature = "json", feature = "toml"))]
 pub use walk_imitate::{
     run_walk_imitate, Push, PushAxisMetrics, WalkImitateConfig, WalkPushSummary, WalkRun, WalkStep,
     WalkSummary, WalkTick, WalkingController,
 };
+#[cfg(all(feature = "urdf", feature = "json", feature = "toml"))]
 pub use walk_plants::WalkPlants;
