@@ -323,7 +323,7 @@ fn batch_of_good_and_bad_clips_skip_force_and_formats() {
     let (csv_header, csv_rows) = read_csv(&out.join(clip).join("motion.csv"));
     let imitate_dir = dir.join("imitate");
     let o = iktc()
-        .args(["imitate", "--motion"])
+        .args(["imitate", "--retarget", "joints", "--motion"])
         .arg(input.join(format!("{clip}.txt")))
         .args(["--dt", DT, "--out"])
         .arg(&imitate_dir)

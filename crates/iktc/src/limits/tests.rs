@@ -533,6 +533,12 @@ fn recovery_replaces_the_box_only_outside_the_range() {
     compute_box(&lim, &recover, &[0.5], &[0.0], dt, &mut out).expect("valid");
     assert_eq!(out.recovering_dofs().count(), 0);
     assert!(!out.any_dropped());
+    // Faster than v_max (2 rad/s over 1): only a = (v_max − q̇)/Δt = −100 rad/s² brings the
+    // velocity back, beyond a_max = 10: the acceleration limit is dropped, and says so.
+    let fast = JointLimits::new(vec![dof(-1.0, 1.0, 1.0, 10.0)]).expect("valid");
+    compute_box(&fast, &BoundMethod::viable(), &[0.0], &[2.0], dt, &mut out).expect("valid");
+    assert!(out.any_dropped());
+    assert!(out.dropped[0].acceleration);
     assert_eq!(out.get(0).map(|b| b.upper), Some(out.upper[0]));
     assert_eq!(out.get(1), None);
 }
