@@ -94,8 +94,9 @@ def test_a_map_is_needed_without_a_profile_and_the_profile_map_is_the_builtin_on
 
 def test_the_imitation_from_python_equals_the_rust_command_line():
     out = tempfile.mkdtemp()
-    subprocess.run([iktc_binary(), "imitate", "--robot", "g1", "--out", out], check=True,
-                   stdout=subprocess.DEVNULL)
+    # The joint route: the one the Python `Imitation` runs.
+    subprocess.run([iktc_binary(), "imitate", "--retarget", "joints", "--robot", "g1",
+                    "--out", out], check=True, stdout=subprocess.DEVNULL)
     with open(os.path.join(out, "joints.csv")) as f:
         rows = list(csv.DictReader(f))
     robot = iktc.Robot("g1")
