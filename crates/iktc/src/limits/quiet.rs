@@ -166,6 +166,20 @@ mod tests {
     const DT: f64 = 0.005;
     const A: f64 = 15.0;
 
+    /// No range end or no acceleration limit: the viability source does not bound (each on
+    /// its own).
+    #[test]
+    fn without_a_range_end_or_an_acceleration_limit_it_is_unbounded() {
+        assert_eq!(
+            quiet_viability_upper(0.0, 0.5, f64::INFINITY, A, DT),
+            f64::INFINITY
+        );
+        assert_eq!(
+            quiet_viability_upper(0.0, 0.5, 1.0, f64::INFINITY, DT),
+            f64::INFINITY
+        );
+    }
+
     #[test]
     fn rest_on_the_limit_is_a_fixed_point() {
         assert_eq!(quiet_viability_upper(1.0, 0.0, 1.0, A, DT), 0.0);
