@@ -166,6 +166,49 @@ mod tests {
     const DT: f64 = 0.005;
     const A: f64 = 15.0;
 
+    /// The lower side mirrors the upper one, and the sources are the viable ones with the
+    /// quiet bound, at `a_stop = braking_fraction · a_max`, in the viability slot.
+    #[test]
+    fn the_lower_side_mirrors_and_the_sources_hold_the_quiet_bound() {
+        use super::{quiet_sources, quiet_viability_lower};
+        use crate::limits::{viable_sources, DofLimits, OutsideLimits, ViableSettings};
+        for (q, qd) in [(0.3, 0.4), (-0.45, -0.9), (0.0, 0.0), (0.49, 0.05)] {
+            let up = quiet_viability_upper(-q, -qd, 0.5, A, DT);
+            assert_eq!(quiet_viability_lower(q, qd, -0.5, A, DT), -up);
+        }
+        let lim = DofLimits {
+            position_min: -0.5,
+            position_max: 0.5,
+            velocity_max: 2.0,
+            acceleration_max: 40.0,
+        };
+        let settings = ViableSettings {
+            braking_fraction: 0.25,
+            outside: OutsideLimits::Error,
+        };
+        let (q, qd) = (0.45, 0.6);
+        let s = quiet_sources(&lim, &settings, q, qd, DT);
+        let v = viable_sources(&lim, &settings, q, qd, DT);
+        assert_eq!(
+            s.upper.viability,
+            quiet_viability_upper(q, qd, 0.5, 10.0, DT)
+        );
+        assert_eq!(
+            s.lower.viability,
+            quiet_viability_lower(q, qd, -0.5, 10.0, DT)
+        );
+        assert_ne!(s.upper.viability, v.upper.viability);
+        assert_eq!(
+            (s.upper.position, s.upper.velocity),
+            (v.upper.position, v.upper.velocity)
+        );
+        assert_eq!(
+            (s.lower.position, s.lower.velocity),
+            (v.lower.position, v.lower.velocity)
+        );
+        assert_eq!((s.lower.acceleration, s.upper.acceleration), (-40.0, 40.0));
+    }
+
     /// No range end or no acceleration limit: the viability source does not bound (each on
     /// its own).
     #[test]
