@@ -126,7 +126,9 @@ def test_a_push_in_double_support_is_damped_more_with_the_damping_controller(ide
     assert ratios["damped"] > ratios["open"] + 0.2, ratios
 
 
-@pytest.mark.xfail(strict=True, reason="the measured damping ratio with the controller is "
+# Not strict: the measured ratio misses the ±0.15 band by only 0.01, so another MuJoCo build
+# or CPU may tip it inside; the figure is reported either way.
+@pytest.mark.xfail(strict=False, reason="the measured damping ratio with the controller is "
                    "≈ 0.56 against the design 0.72 (see the example's README section)")
 def test_a_push_in_double_support_is_damped_to_the_design_ratio(identified):
     loop, t, y = g1_sim.push_test(model=identified[0], damping=0.72)
