@@ -8,7 +8,7 @@ use crate::error::Result;
 use crate::limits::JointLimits;
 use crate::model::{Kinematics, Robot, State};
 use crate::motion::{BodyPoint, Keypoints};
-use crate::sim::viewer::{Figure3d, ViewerData, FRAME_PERIOD, SKELETON_OFFSET};
+use crate::sim::viewer::{point, robot_figure, stride, Figure3d, ViewerData, SKELETON_OFFSET};
 
 use super::KeypointRun;
 
@@ -42,7 +42,7 @@ const SEGMENTS: [(BodyPoint, BodyPoint); 17] = {
 };
 
 /// The viewer data of `run` (a keypoint retargeting of `kp` onto `robot` at the control period
-/// `dt` \[s\]), decimated to [`FRAME_PERIOD`].
+/// `dt` \[s\]), decimated to [`FRAME_PERIOD`](crate::sim::viewer::FRAME_PERIOD).
 ///
 /// # Errors
 /// The kinematics' errors for a configuration of the wrong size or with a non-finite entry.
@@ -52,7 +52,7 @@ pub fn keypoint_viewer(
     run: &KeypointRun,
     dt: f64,
 ) -> Result<ViewerData> {
-    let stride = ((FRAME_PERIOD / dt).round() as usize).max(1);
+    let stride = stride(dt);
     let limits = JointLimits::from_robot(robot)?;
     let names = robot.dof_names();
     let joint_of_dof: Vec<Option<usize>> = names
@@ -62,11 +62,7 @@ pub fn keypoint_viewer(
     let (base_nv, nq, n_active) = (robot.base_nv(), robot.nq(), robot.n_active());
     let mut state = State::neutral(robot);
     let mut kin = Kinematics::new(robot, &state)?;
-    let mut figure = Figure3d {
-        name: robot.name().into(),
-        segments: robot.joints().iter().map(|j| [j.parent, j.child]).collect(),
-        frames: Vec::new(),
-    };
+    let mut figure = robot_figure(robot);
     let (mut com, mut on_limit, mut on_limit_names, mut times) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for (t, q) in run.times.iter().zip(&run.trajectory).step_by(stride) {
@@ -75,10 +71,10 @@ pub fn keypoint_viewer(
         figure.frames.push(
             kin.link_poses()
                 .iter()
-                .map(|p| point(&p.translation.vector))
+                .map(|p| point(&p.translation.vector.into()))
                 .collect(),
         );
-        com.push(point(&kin.com()));
+        com.push(point(&kin.com().into()));
         let mut idx = Vec::new();
         let mut nm = Vec::new();
         for (j, &x) in q[nq - n_active..].iter().enumerate() {
@@ -151,8 +147,4 @@ fn person(kp: &Keypoints, run: &KeypointRun, times: &[f64]) -> Figure3d {
         segments,
         frames,
     }
-}
-
-fn point(p: &Vector3<f64>) -> [f32; 3] {
-    [p.x as f32, p.y as f32, p.z as f32]
 }

@@ -6,6 +6,7 @@
 use serde::Serialize;
 
 use crate::error::Result;
+use crate::model::Robot;
 use crate::motion::Clip;
 use crate::sim::experiment::Experiment;
 use crate::sim::{ImitateRun, WalkRun};
@@ -69,25 +70,20 @@ enum RootMotion {
     Free,
 }
 
-fn point(p: &[f64; 3]) -> [f32; 3] {
+pub(crate) fn point(p: &[f64; 3]) -> [f32; 3] {
     [p[0] as f32, p[1] as f32, p[2] as f32]
 }
 
 /// Ticks between viewer frames for a control period `dt` \[s\].
-fn stride(dt: f64) -> usize {
+pub(crate) fn stride(dt: f64) -> usize {
     ((FRAME_PERIOD / dt).round() as usize).max(1)
 }
 
-/// The robot's stick figure with no frames yet.
-fn robot_figure(e: &Experiment) -> Figure3d {
+/// The robot's stick figure (a segment per joint, parent link to child link), no frames yet.
+pub(crate) fn robot_figure(robot: &Robot) -> Figure3d {
     Figure3d {
-        name: e.robot.name().into(),
-        segments: e
-            .robot
-            .joints()
-            .iter()
-            .map(|j| [j.parent, j.child])
-            .collect(),
+        name: robot.name().into(),
+        segments: robot.joints().iter().map(|j| [j.parent, j.child]).collect(),
         frames: Vec::new(),
     }
 }
@@ -148,7 +144,7 @@ pub fn imitation_viewer(r: &ImitateRun, e: &Experiment) -> Result<ViewerData> {
             robot.joints().iter().position(|j| &j.name == name)
         })
         .collect();
-    let mut figure = robot_figure(e);
+    let mut figure = robot_figure(&e.robot);
     let (mut com, mut on_limit, mut on_limit_names, mut times) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for st in r.steps.iter().step_by(stride) {
@@ -210,7 +206,7 @@ pub fn walking_viewer(
 ) -> Result<ViewerData> {
     let stride = stride(dt);
     let [length, width] = sole_size;
-    let mut figure = robot_figure(e);
+    let mut figure = robot_figure(&e.robot);
     let (mut com, mut support_frames, mut phases, mut times) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for st in r.steps.iter().step_by(stride) {
