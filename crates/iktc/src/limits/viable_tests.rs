@@ -144,17 +144,19 @@ fn stopping_distance_is_the_simulated_braking_policy() {
     assert_eq!(stopping_distance(2.0, f64::INFINITY, 0.1), 0.1);
 }
 
-/// The largest admissible `q̈` for the no-reversal viability condition by bisection:
-/// `D(q̇⁺) ≤ q_max − q⁺` with `D` simulated.
-fn bisect_no_reversal(q: f64, qd: f64, hi: f64, a: f64, dt: f64) -> f64 {
-    let ok = |qdd: f64| {
-        let v = qd + dt * qdd;
-        let next = q + dt * qd + 0.5 * dt * dt * qdd;
-        v < 0.0 || simulated_stopping_distance(v, a, dt) <= (hi - q).max(0.0) - (next - q)
-    };
-    let mut lo = -qd / dt;
-    let mut up = lo + 4.0 * ((hi - q).max(0.0) / (dt * dt) + a + qd.abs() / dt);
-    assert!(ok(lo) && !ok(up));
+/// The bracket of the bisections \[rad/s²\]: from `−q̇/Δt` (the joint at rest after the step,
+/// admissible) to far above every source.
+fn bracket(q: f64, qd: f64, hi: f64, a: f64, dt: f64) -> (f64, f64) {
+    let lo = -qd / dt;
+    (
+        lo,
+        lo + 4.0 * ((hi - q).max(0.0) / (dt * dt) + a + qd.abs() / dt),
+    )
+}
+
+/// The boundary of a condition `ok` that holds at `lo` and fails at `up`, to machine
+/// precision (200 halvings).
+fn bisect(ok: impl Fn(f64) -> bool, mut lo: f64, mut up: f64) -> f64 {
     for _ in 0..200 {
         let mid = 0.5 * (lo + up);
         if ok(mid) {
@@ -164,6 +166,19 @@ fn bisect_no_reversal(q: f64, qd: f64, hi: f64, a: f64, dt: f64) -> f64 {
         }
     }
     lo
+}
+
+/// The largest admissible `q̈` for the no-reversal viability condition by bisection:
+/// `D(q̇⁺) ≤ q_max − q⁺` with `D` simulated.
+fn bisect_no_reversal(q: f64, qd: f64, hi: f64, a: f64, dt: f64) -> f64 {
+    let ok = |qdd: f64| {
+        let v = qd + dt * qdd;
+        let next = q + dt * qd + 0.5 * dt * dt * qdd;
+        v < 0.0 || simulated_stopping_distance(v, a, dt) <= (hi - q).max(0.0) - (next - q)
+    };
+    let (lo, up) = bracket(q, qd, hi, a, dt);
+    assert!(ok(lo) && !ok(up));
+    bisect(ok, lo, up)
 }
 
 #[test]
@@ -210,20 +225,11 @@ fn bisect_braking_curve(q: f64, qd: f64, hi: f64, a: f64, dt: f64) -> f64 {
         let next = q + dt * qd + 0.5 * dt * dt * qdd;
         v <= 0.0 || v * v <= 2.0 * a * ((hi - q).max(0.0) - (next - q))
     };
-    let mut lo = -qd / dt;
-    let mut up = lo + 4.0 * ((hi - q).max(0.0) / (dt * dt) + a + qd.abs() / dt);
+    let (lo, up) = bracket(q, qd, hi, a, dt);
     if !ok(lo) {
         return lo;
     }
-    for _ in 0..200 {
-        let mid = 0.5 * (lo + up);
-        if ok(mid) {
-            lo = mid;
-        } else {
-            up = mid;
-        }
-    }
-    lo
+    bisect(ok, lo, up)
 }
 
 #[test]
