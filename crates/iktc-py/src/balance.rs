@@ -162,7 +162,9 @@ fn py_identify<'py>(
 /// The damping controller of one plane (Section 4.3): observer on the full model and state
 /// feedback placing the IPCJ poles at damping ratio `damping_ratio` and natural frequency
 /// `natural_frequency` [rad/s] (None keeps the open-loop w_n, so only damping is added),
-/// discretised at `control_period` [s].
+/// discretised at `control_period` [s]; the observer's poles are `observer_pole_scale` [–] times
+/// the controller's (faster observers follow a push sooner and act further above the band the
+/// model was identified in).
 #[pyclass(name = "DampingController", module = "iktc")]
 pub struct PyDampingController {
     inner: DampingController,
@@ -171,12 +173,13 @@ pub struct PyDampingController {
 #[pymethods]
 impl PyDampingController {
     #[new]
-    #[pyo3(signature = (model, damping_ratio=0.72, natural_frequency=None, control_period=0.005))]
+    #[pyo3(signature = (model, damping_ratio=0.72, natural_frequency=None, control_period=0.005, observer_pole_scale=2.0))]
     fn new(
         model: &PyPlaneModel,
         damping_ratio: f64,
         natural_frequency: Option<f64>,
         control_period: f64,
+        observer_pole_scale: f64,
     ) -> PyResult<Self> {
         let design = design_discrete(
             &model.params(),
@@ -186,7 +189,7 @@ impl PyDampingController {
             },
             &DiscreteSettings {
                 control_period,
-                ..DiscreteSettings::default()
+                observer_pole_scale,
             },
         )
         .map_err(to_py)?;

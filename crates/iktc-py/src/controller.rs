@@ -106,8 +106,9 @@ pub(crate) fn parse_bounds(bounds: &str) -> PyResult<BoundMethod> {
     match bounds {
         "viable" => Ok(BoundMethod::viable()),
         "paper" => Ok(BoundMethod::Paper),
+        "quiet" => Ok(BoundMethod::quiet()),
         _ => Err(IktcError::new_err(format!(
-            "bounds `{bounds}`: expected one of viable, paper"
+            "bounds `{bounds}`: expected one of viable, paper, quiet"
         ))),
     }
 }

@@ -7,6 +7,7 @@
 use iktc::motion::Clip;
 use iktc::sim::imitate::support_polygon;
 use iktc::sim::{imitation_references, ImitateConfig, ImitationController};
+use iktc::solver::SolverSettings;
 use iktc::task::ComReference;
 use nalgebra::{Isometry3, Matrix4, Rotation3, Translation3, UnitQuaternion, Vector3};
 use numpy::{PyArray1, PyArray2, PyReadonlyArray2};
@@ -34,7 +35,8 @@ pub struct PyImitation {
     robot: std::sync::Arc<iktc::model::Robot>,
     cfg: ImitateConfig,
     k: usize,
-    com_offset: Option<[f64; 2]>,
+    /// COM offset: position (x, y) [m], velocity [m/s], acceleration [m/s²].
+    com_offset: Option<[f64; 6]>,
 }
 
 /// `clip` played `time_scale` times slower (its frame times multiplied) and cut after the first
@@ -101,12 +103,16 @@ fn pose_of(m: &PyReadonlyArray2<'_, f64>) -> PyResult<Isometry3<f64>> {
 impl PyImitation {
     /// `robot` must have a profile (feet, pelvis, posture, narrowed ranges, soles); `motion` a
     /// skeleton. `map`: a built-in map or TOML file (default: the profile's); `dt` the control
-    /// period [s]; `method` iktc, gf, clamp or prioritized; `bounds` viable or paper;
+    /// period [s]; `method` iktc, gf, clamp or prioritized; `bounds` viable, paper or quiet
+    /// (viable bounds that come to rest on a limit without chatter); `level_hold` [ticks] and
+    /// `rebase_release` [–] the solver's hold on IKTC's corrected level and the release rate of
+    /// its corrected levels' demands (`iktc::solver::SolverSettings`; 1 and 1.0 are Algorithm 2
+    /// as printed);
     /// `duration` [s] keeps the clip's frames up to the first at or past it (default: all);
     /// `time_scale` [–] plays the clip that many times slower (its frame times multiplied:
     /// rates divided by it, accelerations by its square), before the cut.
     #[new]
-    #[pyo3(signature = (robot, motion, *, map=None, dt=0.005, method="iktc", bounds="viable", duration=None, time_scale=1.0))]
+    #[pyo3(signature = (robot, motion, *, map=None, dt=0.005, method="iktc", bounds="viable", duration=None, time_scale=1.0, level_hold=1, rebase_release=1.0))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -118,6 +124,8 @@ impl PyImitation {
         bounds: &str,
         duration: Option<f64>,
         time_scale: f64,
+        level_hold: usize,
+        rebase_release: f64,
     ) -> PyResult<Self> {
         let profile = robot.profile.as_ref().ok_or_else(|| {
             IktcError::new_err(format!(
@@ -130,6 +138,14 @@ impl PyImitation {
             bounds: parse_bounds(bounds)?,
             dt,
             ..ImitateConfig::default()
+        };
+        let base = ImitateConfig {
+            solver: SolverSettings {
+                level_hold,
+                rebase_release,
+                ..base.solver
+            },
+            ..base
         };
         let cfg = profile.imitate_config(base).map_err(to_py)?;
         let map = resolve_map(robot, motion, map)?;
@@ -174,11 +190,12 @@ impl PyImitation {
     /// solve, then constant-acceleration integration over dt; k advances. The GIL is released.
     fn tick(&mut self, py: Python<'_>) -> PyResult<PySolveReport> {
         let t = self.k as f64 * self.cfg.dt;
-        let com = self.com_offset.map(|[dx, dy]| {
+        let com = self.com_offset.map(|[dx, dy, vx, vy, ax, ay]| {
             let c = self.ctl.com_reference_at(t);
             ComReference {
                 position: c.position + Vector3::new(dx, dy, 0.0),
-                ..c
+                velocity: c.velocity + Vector3::new(vx, vy, 0.0),
+                acceleration: c.acceleration + Vector3::new(ax, ay, 0.0),
             }
         });
         self.ctl.set_com_override(com);
@@ -195,17 +212,37 @@ impl PyImitation {
     }
 
     /// Offsets the COM reference of the next ticks by (dx, dy) [m] in the horizontal plane (the
-    /// damping controller's `com_offset`); `None` returns to the standing reference.
-    #[pyo3(signature = (offset=None))]
-    fn set_com_offset(&mut self, offset: Option<(f64, f64)>) -> PyResult<()> {
-        if let Some((dx, dy)) = offset {
-            if !(dx.is_finite() && dy.is_finite()) {
+    /// damping controller's `com_offset`), its rate by `velocity` [m/s] and its acceleration by
+    /// `acceleration` [m/s²] (default 0). The COM task's CLIK
+    /// `c̈ = c̈_ref + k_v (ċ_ref − ċ) + k_p (c_ref − c)` follows an offset given by its position
+    /// alone as a critically damped second-order lag (`k_p = 100 s⁻²`: about 0.2 s); with the
+    /// offset's rate and acceleration it follows within a tick. `None` returns to the standing
+    /// reference.
+    #[pyo3(signature = (offset=None, velocity=None, acceleration=None))]
+    fn set_com_offset(
+        &mut self,
+        offset: Option<(f64, f64)>,
+        velocity: Option<(f64, f64)>,
+        acceleration: Option<(f64, f64)>,
+    ) -> PyResult<()> {
+        let Some((dx, dy)) = offset else {
+            self.com_offset = None;
+            return Ok(());
+        };
+        let (vx, vy) = velocity.unwrap_or((0.0, 0.0));
+        let (ax, ay) = acceleration.unwrap_or((0.0, 0.0));
+        for (what, unit, (x, y)) in [
+            ("COM offset", "m", (dx, dy)),
+            ("COM offset velocity", "m/s", (vx, vy)),
+            ("COM offset acceleration", "m/s²", (ax, ay)),
+        ] {
+            if !(x.is_finite() && y.is_finite()) {
                 return Err(IktcError::new_err(format!(
-                    "COM offset ({dx}, {dy}) is not finite"
+                    "{what} ({x}, {y}) [{unit}] is not finite"
                 )));
             }
         }
-        self.com_offset = offset.map(|(dx, dy)| [dx, dy]);
+        self.com_offset = Some([dx, dy, vx, vy, ax, ay]);
         Ok(())
     }
 

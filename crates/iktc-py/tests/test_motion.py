@@ -92,15 +92,16 @@ def test_a_map_is_needed_without_a_profile_and_the_profile_map_is_the_builtin_on
     assert np.array_equal(by_name.joint_angles, by_profile.joint_angles)
 
 
-def test_the_imitation_from_python_equals_the_rust_command_line():
+@pytest.mark.parametrize("bounds", ["viable", "quiet"])
+def test_the_imitation_from_python_equals_the_rust_command_line(bounds):
     out = tempfile.mkdtemp()
     # The joint route: the one the Python `Imitation` runs.
     subprocess.run([iktc_binary(), "imitate", "--retarget", "joints", "--robot", "g1",
-                    "--out", out], check=True, stdout=subprocess.DEVNULL)
+                    "--bounds", bounds, "--out", out], check=True, stdout=subprocess.DEVNULL)
     with open(os.path.join(out, "joints.csv")) as f:
         rows = list(csv.DictReader(f))
     robot = iktc.Robot("g1")
-    sim = iktc.Imitation(robot, iktc.load_motion("humanoid3d_dance_b"))
+    sim = iktc.Imitation(robot, iktc.load_motion("humanoid3d_dance_b"), bounds=bounds)
     assert sim.ticks == len(rows)
     names = robot.joint_names
     worst = 0.0
@@ -136,3 +137,37 @@ def test_the_imitation_holds_the_feet_and_moves_the_com_by_the_offset():
     assert sim.support_margin(tuple(centre)) == pytest.approx(0.5 * sim.sole()["sole_length"])
     with pytest.raises(iktc.IktcError, match="no profile"):
         iktc.Imitation(iktc.Robot("planar3r"), iktc.load_motion("humanoid3d_dance_b"))
+
+
+def test_the_imitation_refuses_unknown_bounds_and_solver_settings_out_of_range():
+    robot, motion = iktc.Robot("g1"), iktc.load_motion("humanoid3d_dance_b")
+    with pytest.raises(iktc.IktcError, match="expected one of viable, paper, quiet"):
+        iktc.Imitation(robot, motion, bounds="soft")
+    with pytest.raises(iktc.IktcError, match="rebase_release"):
+        iktc.Imitation(robot, motion, duration=0.1, rebase_release=0.0)
+
+
+def test_a_com_offset_ramp_lags_by_kv_over_kp_unless_its_rates_are_fed_forward():
+    robot = iktc.Robot("g1")
+    rate = 0.05  # [m/s]
+    errors = {}
+    for feedforward in (False, True):
+        sim = iktc.Imitation(robot, iktc.load_motion("humanoid3d_dance_b"), duration=1.0)
+        for _ in range(100):
+            sim.tick()
+        for k in range(100):
+            off = (rate * k * DT, 0.0)
+            if feedforward:
+                sim.set_com_offset(off, (rate, 0.0), (0.0, 0.0))
+            else:
+                sim.set_com_offset(off)
+            sim.tick()
+        # The COM after the last tick against the offset reference of that tick.
+        target = sim.com_reference()[0] + rate * 99 * DT
+        errors[feedforward] = target - robot.com(sim.q)[0]
+    # CLIK c̈ = k_v (ċ_ref − ċ) + k_p (c_ref − c) follows a ramp with the steady error
+    # rate · k_v / k_p (k_p = 100 s⁻², k_v = 20 s⁻¹: 1 cm; 0.5 s = 5 time constants in).
+    assert errors[False] == pytest.approx(rate * 20.0 / 100.0, rel=0.1), errors
+    assert abs(errors[True]) < 1e-3, errors
+    with pytest.raises(iktc.IktcError, match="velocity"):
+        sim.set_com_offset((0.0, 0.0), (float("nan"), 0.0))

@@ -97,6 +97,63 @@ def test_the_damping_ratio_estimate_recovers_a_known_damped_sinusoid(zeta, wn):
     assert z == pytest.approx(zeta, abs=0.01) and w == pytest.approx(wn, rel=0.01)
 
 
+def test_the_damping_ratio_estimate_picks_the_dominant_mode_of_several():
+    # The shape of a damped closed loop after a push: the designed pair, the observer's pair at
+    # twice its frequency, a real lag pole, a lightly damped faster resonance and an offset.
+    t = np.arange(0.0, 2.0, g1_sim.CONTROL_PERIOD)
+
+    def mode(zeta, wn, amp, phase):
+        return amp * np.exp(-zeta * wn * t) * np.cos(wn * np.sqrt(1 - zeta ** 2) * t + phase)
+
+    y = (0.002 + mode(0.72, 4.9, 0.02, 0.3) + mode(0.72, 9.8, -0.006, 1.0)
+         + 0.008 * np.exp(-6.0 * t) + mode(0.15, 30.0, 0.001, 0.0))
+    z, w = g1_sim.damping_ratio(t, y)
+    assert z == pytest.approx(0.72, abs=0.01) and w == pytest.approx(4.9, rel=0.01)
+
+
+def _expm(m):
+    """exp(m) by scaling and squaring of the Taylor series (small, well-scaled matrices)."""
+    s = max(0, int(np.ceil(np.log2(max(np.linalg.norm(m, 1), 1e-300)))) + 1)
+    a, e, term = m / 2 ** s, np.eye(len(m)), np.eye(len(m))
+    for k in range(1, 20):
+        term = term @ a / k
+        e = e + term
+    for _ in range(s):
+        e = e @ e
+    return e
+
+
+@pytest.mark.parametrize("design", [0.3, 0.5, 0.72, 0.9])
+def test_the_damping_controller_on_its_own_model_measures_its_design_ratio(design):
+    # Plant = the model itself (eq. 31 written out here from the corrected eqs. 27–28: IPCJ,
+    # lag τ_s driven by its ZMP, Padé (−s + 1/T)/(s + 1/T)), discretised exactly (ZOH) at
+    # 5 ms; a push = an initial θ̇. The estimate of the closed loop's dominant pair must be the
+    # design: this checks the pole placement and the estimate, with no MuJoCo in between.
+    l, km, bm, ts, tp, g = 0.62, 15.5, 0.55, 0.17, 0.002, 9.81
+    a = np.zeros((4, 4))
+    a[0, 1] = 1.0
+    a[1] = [g / l - km / l ** 2, -bm / l ** 2, 0.0, 0.0]
+    a[2] = [km / g / ts, bm / g / ts, -1.0 / ts, 0.0]
+    a[3, 2:] = [2.0 / tp, -1.0 / tp]
+    b = np.array([0.0, km / l ** 2, -km / g / ts, 0.0])
+    c = np.array([0.0, 0.0, -1.0, 1.0])
+    m = np.zeros((5, 5))
+    m[:4, :4], m[:4, 4] = a, b
+    e = _expm(m * g1_sim.CONTROL_PERIOD)
+    ad, bd = e[:4, :4], e[:4, 4]
+    ctrl = iktc.DampingController(iktc.PlaneModel(l, km, bm, ts, tp), damping_ratio=design)
+    x = np.array([0.0, 0.05, 0.0, 0.0])
+    ys = []
+    for _ in range(400):
+        y = float(c @ x)
+        ys.append(y)
+        x = ad @ x + bd * ctrl.step(0.0, y)[0]
+    t = np.arange(len(ys)) * g1_sim.CONTROL_PERIOD
+    z, w = g1_sim.damping_ratio(t, np.array(ys))
+    wn = np.sqrt(km / l ** 2 - g / l)  # errata eq. 32: the design keeps w_n
+    assert z == pytest.approx(design, abs=0.01) and w == pytest.approx(wn, rel=0.01)
+
+
 @pytest.fixture(scope="module")
 def identified():
     """The IPCJ model identified on MuJoCo by a short sweep (6 frequencies over the band)."""
@@ -126,10 +183,11 @@ def test_a_push_in_double_support_is_damped_more_with_the_damping_controller(ide
     assert ratios["damped"] > ratios["open"] + 0.2, ratios
 
 
-# Not strict: the measured ratio misses the ±0.15 band by only 0.01, so another MuJoCo build
-# or CPU may tip it inside; the figure is reported either way.
-@pytest.mark.xfail(strict=False, reason="the measured damping ratio with the controller is "
-                   "≈ 0.56 against the design 0.72 (see the example's README section)")
+# The dominant closed-loop pair measured on MuJoCo (Prony) sits at ζ ≈ 0.47 for the design
+# 0.72, where the same estimate on the identified model's own closed loop reads 0.72: the plant
+# departs from eq. (31) above the identified band, where the observer acts.
+@pytest.mark.xfail(strict=True, reason="the measured damping ratio with the controller is "
+                   "≈ 0.47 against the design 0.72 (see the example's README section)")
 def test_a_push_in_double_support_is_damped_to_the_design_ratio(identified):
     loop, t, y = g1_sim.push_test(model=identified[0], damping=0.72)
     assert abs(g1_sim.damping_ratio(t, y)[0] - 0.72) <= 0.15
