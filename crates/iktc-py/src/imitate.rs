@@ -6,7 +6,7 @@
 
 use iktc::motion::Clip;
 use iktc::sim::imitate::support_polygon;
-use iktc::sim::{imitation_references, ImitateConfig, ImitationController};
+use iktc::sim::{imitation_references, ImitateConfig, ImitationController, NarrowedJoint};
 use iktc::solver::SolverSettings;
 use iktc::task::ComReference;
 use nalgebra::{Isometry3, Matrix4, Rotation3, Translation3, UnitQuaternion, Vector3};
@@ -79,6 +79,18 @@ fn clip_part(clip: &Clip, time_scale: f64, duration: Option<f64>) -> iktc::Resul
     .map(Some)
 }
 
+/// Narrowed joint ranges from (joint, lower [rad], upper [rad]) triples; the controller checks
+/// the names and that each range lies inside the joint's own.
+pub(crate) fn narrowed(n: Vec<(String, f64, f64)>) -> Vec<NarrowedJoint> {
+    n.into_iter()
+        .map(|(joint, lower, upper)| NarrowedJoint {
+            joint,
+            lower,
+            upper,
+        })
+        .collect()
+}
+
 /// A pose from a 4 × 4 homogeneous matrix (its rotation block re-orthonormalised).
 fn pose_of(m: &PyReadonlyArray2<'_, f64>) -> PyResult<Isometry3<f64>> {
     let a = m.as_array();
@@ -107,12 +119,13 @@ impl PyImitation {
     /// (viable bounds that come to rest on a limit without chatter); `level_hold` [ticks] and
     /// `rebase_release` [–] the solver's hold on IKTC's corrected level and the release rate of
     /// its corrected levels' demands (`iktc::solver::SolverSettings`; 1 and 1.0 are Algorithm 2
-    /// as printed);
+    /// as printed); `narrow` a list of (joint, lower, upper) [rad] replacing the profile's
+    /// narrowed ranges (the tasks below the level a narrowed joint blocks are corrected);
     /// `duration` [s] keeps the clip's frames up to the first at or past it (default: all);
     /// `time_scale` [–] plays the clip that many times slower (its frame times multiplied:
     /// rates divided by it, accelerations by its square), before the cut.
     #[new]
-    #[pyo3(signature = (robot, motion, *, map=None, dt=0.005, method="iktc", bounds="viable", duration=None, time_scale=1.0, level_hold=1, rebase_release=1.0))]
+    #[pyo3(signature = (robot, motion, *, map=None, dt=0.005, method="iktc", bounds="viable", duration=None, time_scale=1.0, level_hold=1, rebase_release=1.0, narrow=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -126,6 +139,7 @@ impl PyImitation {
         time_scale: f64,
         level_hold: usize,
         rebase_release: f64,
+        narrow: Option<Vec<(String, f64, f64)>>,
     ) -> PyResult<Self> {
         let profile = robot.profile.as_ref().ok_or_else(|| {
             IktcError::new_err(format!(
@@ -147,7 +161,10 @@ impl PyImitation {
             },
             ..base
         };
-        let cfg = profile.imitate_config(base).map_err(to_py)?;
+        let mut cfg = profile.imitate_config(base).map_err(to_py)?;
+        if let Some(n) = narrow {
+            cfg.narrow = narrowed(n);
+        }
         let map = resolve_map(robot, motion, map)?;
         let clip = motion.clip()?;
         let part = clip_part(clip, time_scale, duration).map_err(to_py)?;

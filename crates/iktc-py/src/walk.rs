@@ -10,13 +10,15 @@ use pyo3::prelude::*;
 
 use crate::controller::PySolveReport;
 use crate::convert::{array, pose_matrix};
+use crate::imitate::narrowed;
 use crate::motion::{resolve_map, PyMotion};
 use crate::robot::PyRobot;
 use crate::{to_py, IktcError};
 
 /// Walking while imitating: `steps` footsteps of `step_length` [m] (the library's default
 /// timing: 0.8 s initial and final double support, 0.6 s single, 0.1 s double, 4 cm swing),
-/// the upper body imitating `motion`, the damping controller off.
+/// the upper body imitating `motion`, the damping controller off; `narrow` a list of
+/// (joint, lower, upper) [rad] replacing the profile's narrowed ranges.
 #[pyclass(name = "Walking", module = "iktc")]
 pub struct PyWalking {
     ctl: WalkingController,
@@ -29,7 +31,7 @@ pub struct PyWalking {
 #[pymethods]
 impl PyWalking {
     #[new]
-    #[pyo3(signature = (robot, motion, *, map=None, steps=4, step_length=0.1))]
+    #[pyo3(signature = (robot, motion, *, map=None, steps=4, step_length=0.1, narrow=None))]
     fn new(
         py: Python<'_>,
         robot: &PyRobot,
@@ -37,6 +39,7 @@ impl PyWalking {
         map: Option<&str>,
         steps: usize,
         step_length: f64,
+        narrow: Option<Vec<(String, f64, f64)>>,
     ) -> PyResult<Self> {
         let profile = robot.profile.as_ref().ok_or_else(|| {
             IktcError::new_err(format!(
@@ -46,6 +49,9 @@ impl PyWalking {
         })?;
         let mut cfg = WalkImitateConfig::jvrc1().map_err(to_py)?;
         cfg.imitate = profile.imitate_config(cfg.imitate).map_err(to_py)?;
+        if let Some(n) = narrow {
+            cfg.imitate.narrow = narrowed(n);
+        }
         cfg.steps = steps;
         cfg.step_length = step_length;
         cfg.push = None;

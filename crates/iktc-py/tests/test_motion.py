@@ -171,3 +171,24 @@ def test_a_com_offset_ramp_lags_by_kv_over_kp_unless_its_rates_are_fed_forward()
     assert abs(errors[True]) < 1e-3, errors
     with pytest.raises(iktc.IktcError, match="velocity"):
         sim.set_com_offset((0.0, 0.0), (float("nan"), 0.0))
+
+
+def test_a_narrowed_knee_keeps_the_g1_leg_from_straightening():
+    # The clip's pelvis rises up to 0.13 m above its first frame; G1 at its posture (knee
+    # 0.6 rad) reaches only ≈ 0.03 m higher with straight legs, so the right knee is driven to
+    # straight (its lower limit is −0.087 rad). Narrowed, it stays in its range.
+    robot, motion = iktc.Robot("g1"), iktc.load_motion("humanoid3d_dance_b")
+    i = robot.q_index("right_knee_joint")
+    lowest = {}
+    for narrow in (None, [("right_knee_joint", 0.3, 2.8), ("left_knee_joint", 0.3, 2.8)]):
+        sim = iktc.Imitation(robot, motion, narrow=narrow)
+        low = np.inf
+        for _ in range(sim.ticks):
+            sim.tick()
+            low = min(low, sim.q[i])
+        lowest[narrow is not None] = low
+    assert lowest[False] < 0.05 and lowest[True] >= 0.3 - 1e-9, lowest
+    with pytest.raises(iktc.IktcError, match="no_such_joint"):
+        iktc.Imitation(robot, motion, narrow=[("no_such_joint", 0.0, 1.0)])
+    with pytest.raises(iktc.IktcError, match="no_such_joint"):
+        iktc.Walking(robot, motion, narrow=[("no_such_joint", 0.0, 1.0)])

@@ -177,7 +177,8 @@ class Imitation:
     def __init__(self, robot: Robot, motion: Motion, *, map: Optional[str] = None,
                  dt: float = 0.005, method: str = "iktc", bounds: str = "viable",
                  duration: Optional[float] = None, time_scale: float = 1.0,
-                 level_hold: int = 1, rebase_release: float = 1.0) -> None: ...
+                 level_hold: int = 1, rebase_release: float = 1.0,
+                 narrow: Optional[Sequence[Tuple[str, float, float]]] = None) -> None: ...
     @property
     def ticks(self) -> int: ...
     @property
@@ -208,7 +209,8 @@ class Imitation:
 
 class Walking:
     def __init__(self, robot: Robot, motion: Motion, *, map: Optional[str] = None,
-                 steps: int = 4, step_length: float = 0.1) -> None: ...
+                 steps: int = 4, step_length: float = 0.1,
+                 narrow: Optional[Sequence[Tuple[str, float, float]]] = None) -> None: ...
     @property
     def ticks(self) -> int: ...
     @property
