@@ -64,6 +64,7 @@ mod glob;
 mod init;
 mod load;
 mod schema;
+mod walk;
 
 pub use build::{check_map_joints, MISSING};
 pub use glob::glob_match;
@@ -71,5 +72,6 @@ pub use init::init_profile_toml;
 pub use load::{builtin_profile_text, BUILTIN_PROFILES};
 pub use schema::{
     AccelerationProfile, BodyFrames, Feet, Foot, ImitateProfile, LockRule, ProfileOrigin,
-    RobotProfile, Sole, DEFAULT_ACCELERATION_PER_VELOCITY,
+    PushProfile, RobotProfile, Sole, WalkProfile, DEFAULT_ACCELERATION_PER_VELOCITY,
 };
+pub use walk::DEFAULT_PUSH_VELOCITY_CHANGE;
