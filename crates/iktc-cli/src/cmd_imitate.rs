@@ -47,7 +47,7 @@ pub fn run(a: &Args) -> Result<()> {
         let sc = &a.scenario;
         return crate::cmd_keypoints::run(profile, &sc.motion, &sc.motion_options, &cfg, &a.out);
     }
-    let (e, cfg) = prepare(&a.scenario)?;
+    let (e, cfg, _) = prepare(&a.scenario)?;
     let r = e.imitate(&cfg)?;
     let files = write_imitate(&r, &e, &a.out)?;
     print_summary(&r)?;

@@ -5,6 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
+use iktc::profile::RobotProfile;
 use iktc::sim::viewer::walking_viewer;
 use iktc::sim::{
     Experiment, ImitateConfig, Push, PushAxisMetrics, WalkImitateConfig, WalkRun, WalkStep,
@@ -35,16 +36,18 @@ pub struct WalkArgs {
     /// Number of footsteps.
     #[arg(long, default_value_t = 4)]
     pub steps: usize,
-    /// Step length [m]; 0 steps in place.
-    #[arg(long, default_value_t = 0.1)]
-    pub step_length: f64,
+    /// Step length [m]; 0 steps in place [default: the profile's `walk.step_length`, else 0.1].
+    #[arg(long)]
+    pub step_length: Option<f64>,
     /// Leave the damping controller out of the loop (the run without it is still made, for
     /// the comparison).
     #[arg(long)]
     pub no_damping: bool,
-    /// Push on the COM: TIME,IMPULSE_X,IMPULSE_Y [s, N·s, N·s], or `none`.
-    #[arg(long, default_value = "2.15,5,0")]
-    pub push: String,
+    /// Push on the COM: TIME,IMPULSE_X,IMPULSE_Y [s, N·s, N·s], or `none` [default: the
+    /// profile's `walk.push`, else a forward push at 2.15 s that changes the COM velocity by
+    /// 0.080 m/s (5 N·s on JVRC-1's 62.4 kg)].
+    #[arg(long)]
+    pub push: Option<String>,
 }
 
 fn parse_push(s: &str) -> Result<Option<Push>> {
@@ -67,15 +70,31 @@ fn parse_push(s: &str) -> Result<Option<Push>> {
     }))
 }
 
-fn config(imitate: &ImitateConfig, w: &WalkArgs) -> Result<WalkImitateConfig> {
-    Ok(WalkImitateConfig {
-        imitate: imitate.clone(),
-        steps: w.steps,
-        step_length: w.step_length,
-        damping: !w.no_damping,
-        push: parse_push(&w.push)?,
-        ..WalkImitateConfig::jvrc1()?
-    })
+/// The walking settings: the profile's ([`RobotProfile::walk_config`]), then the flags.
+fn config(
+    e: &Experiment,
+    profile: &RobotProfile,
+    imitate: &ImitateConfig,
+    w: &WalkArgs,
+) -> Result<WalkImitateConfig> {
+    let mut cfg = profile
+        .walk_config(
+            &e.robot,
+            WalkImitateConfig {
+                imitate: imitate.clone(),
+                ..WalkImitateConfig::jvrc1()?
+            },
+        )
+        .context("the robot profile's walking settings")?;
+    cfg.steps = w.steps;
+    cfg.damping = !w.no_damping;
+    if let Some(l) = w.step_length {
+        cfg.step_length = l;
+    }
+    if let Some(p) = &w.push {
+        cfg.push = parse_push(p)?;
+    }
+    Ok(cfg)
 }
 
 /// Figures written (path relative to the output directory, caption).
@@ -86,19 +105,20 @@ pub type Figures = Vec<(String, String)>;
 /// two runs (with, without).
 fn run_walk(
     e: &Experiment,
+    profile: &RobotProfile,
     imitate: &ImitateConfig,
     w: &WalkArgs,
     dir: &Path,
 ) -> Result<(Figures, WalkRun, WalkRun)> {
-    let (with, without) = e.walk_with_and_without_damping(&config(imitate, w)?)?;
+    let (with, without) = e.walk_with_and_without_damping(&config(e, profile, imitate, w)?)?;
     let figs = write_walk(&with, &without, e, imitate, dir)?;
     Ok((figs, with, without))
 }
 
 /// Runs `iktc walk`.
 pub fn run(a: &Args) -> Result<()> {
-    let (e, cfg) = prepare(&a.scenario)?;
-    let (figs, with, without) = run_walk(&e, &cfg, &a.walk, &a.out)?;
+    let (e, cfg, profile) = prepare(&a.scenario)?;
+    let (figs, with, without) = run_walk(&e, &profile, &cfg, &a.walk, &a.out)?;
     print_walk(&with, &without)?;
     crate::outln!(
         "wrote {} figures, walk.csv, walk_summary.json and walk_viewer.html to {}",
@@ -445,14 +465,15 @@ pub fn write_walk(
 /// Runs the default walking imitation into `out/walk` and returns its report section.
 pub fn walk_section(out: &Path) -> Result<Section> {
     let (e, imitate) = Experiment::jvrc1()?;
+    let profile = RobotProfile::builtin("jvrc1")?;
     let w = WalkArgs {
         steps: 4,
-        step_length: 0.1,
+        step_length: None,
         no_damping: false,
-        push: "2.15,5,0".into(),
+        push: None,
     };
     let dir = out.join("walk");
-    let (figs, with, without) = run_walk(&e, &imitate, &w, &dir)?;
+    let (figs, with, without) = run_walk(&e, &profile, &imitate, &w, &dir)?;
     let mut sec = Section::new("Walking while imitating, with the damping controller (Sections 4 and 5.3)").intro(
         "<p>The legs follow a walking pattern (4 steps of 0.1 m; ZMP preview control on the cart-table model, \
          quintic swing feet) while the upper body imitates <code>humanoid3d_dance_b</code> under the Table 1 stack \

@@ -126,6 +126,7 @@ fn base_profile(spec: &str) -> Result<(RobotProfile, String)> {
             narrow: Default::default(),
             acceleration: Default::default(),
             imitate: Default::default(),
+            walk: Default::default(),
             origin: ProfileOrigin::Directory(PathBuf::new()),
         };
         return Ok((p, format!("URDF {spec}")));
@@ -240,7 +241,14 @@ fn apply_flags(
             std::slice::from_ref(s),
             "lo:hi with numbers [rad]",
             range,
-        )?;
+        )?
+        .into_iter()
+        .map(|(joint, [lower, upper])| iktc::limits::NarrowedJoint {
+            joint,
+            lower,
+            upper,
+        })
+        .collect();
         keys.push(("narrow".into(), "--narrow"));
     }
     Ok(keys)

@@ -5,6 +5,7 @@
 use anyhow::{Context, Result};
 use iktc::limits::{BoundMethod, OutsideLimits};
 use iktc::motion::{MotionFormat, RetargetMap};
+use iktc::profile::RobotProfile;
 use iktc::resources::RunLimits;
 use iktc::sim::{load_clip, load_map, Experiment, ImitateConfig};
 
@@ -119,8 +120,8 @@ pub fn prepare_config(a: &ScenarioArgs) -> Result<(ResolvedRobot, ImitateConfig)
     Ok((resolved, cfg))
 }
 
-/// The experiment and its configuration the arguments describe.
-pub fn prepare(a: &ScenarioArgs) -> Result<(Experiment, ImitateConfig)> {
+/// The experiment, its configuration and the robot's profile the arguments describe.
+pub fn prepare(a: &ScenarioArgs) -> Result<(Experiment, ImitateConfig, RobotProfile)> {
     let (resolved, cfg) = prepare_config(a)?;
     let loaded = load_clip(&a.motion, &a.motion_options.options()?)
         .with_context(|| format!("--motion `{}`", a.motion))?;
@@ -128,6 +129,9 @@ pub fn prepare(a: &ScenarioArgs) -> Result<(Experiment, ImitateConfig)> {
         crate::outln!("{decided}")?;
     }
     let map = choose_map(a.map.as_deref(), loaded.format, &resolved)?;
+    let profile = resolved
+        .profile
+        .context("`planar3r` has no profile and cannot imitate a motion")?;
     Ok((
         Experiment {
             robot: resolved.robot,
@@ -135,6 +139,7 @@ pub fn prepare(a: &ScenarioArgs) -> Result<(Experiment, ImitateConfig)> {
             map,
         },
         cfg,
+        profile,
     ))
 }
 

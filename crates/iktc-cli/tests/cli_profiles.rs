@@ -131,21 +131,24 @@ fn g1_walk(name: &str, extra: &[&str]) -> (serde_json::Value, PathBuf) {
 
 #[test]
 fn g1_walks_while_imitating_within_its_limits() {
-    // The default push (5 N·s, sized for the 62 kg JVRC-1) moves the 33 kg G1's ZMP about
-    // 3.6 cm past the front of its sole: the run's health check reports it, so the run is
-    // asked to go on and the limits are checked.
-    let (s, _) = g1_walk("g1walk", &["--keep-going"]);
+    // JVRC-1's push (5 N·s, sized for its 62.4 kg) moves the 33 kg G1's ZMP about 3.6 cm
+    // past the front of its sole: the run's health check reports it, so the run is asked to
+    // go on and the limits are checked.
+    let (s, _) = g1_walk("g1walk", &["--push", "2.15,5,0", "--keep-going"]);
     assert_eq!(s["with_damping"]["health"]["healthy"], false);
 }
 
 #[test]
-fn g1_walks_healthily_under_a_push_scaled_to_its_mass() {
-    // The same change of COM velocity as the default push on JVRC-1 (5 N·s / 62.4 kg =
-    // 0.080 m/s → 2.67 N·s on 33.3 kg): every run check passes, no --keep-going, and the
-    // measured ZMP stays inside the support polygon of the soles (sole offset included).
-    let (s, _) = g1_walk("g1walkscaled", &["--push", "2.15,2.67,0"]);
+fn g1_walks_healthily_under_its_default_push_scaled_to_its_mass() {
+    // The G1 profile gives no push: the default one changes the COM velocity as much as 5 N·s
+    // changes JVRC-1's (5 N·s / 62.4 kg = 0.080 m/s → 2.67 N·s on 33.3 kg). Every run check
+    // passes, no --keep-going, and the measured ZMP stays inside the support polygon of the
+    // soles (sole offset included).
+    let (s, _) = g1_walk("g1walkscaled", &[]);
     for run in ["with_damping", "without_damping"] {
         let r = &s[run];
+        let impulse = r["push"]["push"]["impulse"][0].as_f64().unwrap();
+        assert!((impulse - 2.67).abs() < 0.01, "{run}: push {impulse} N·s");
         assert_eq!(r["health"]["healthy"], true, "{run}: {}", r["health"]);
         assert!(
             r["zmp_inside"].as_bool().unwrap(),

@@ -4,9 +4,10 @@
 //! controller's output) and the support-polygon margin of a measured ZMP is computed from the
 //! profile's soles.
 
+use iktc::limits::NarrowedJoint;
 use iktc::motion::Clip;
 use iktc::sim::imitate::support_polygon;
-use iktc::sim::{imitation_references, ImitateConfig, ImitationController, NarrowedJoint};
+use iktc::sim::{imitation_references, ImitateConfig, ImitationController};
 use iktc::solver::SolverSettings;
 use iktc::task::ComReference;
 use nalgebra::{Isometry3, Matrix4, Rotation3, Translation3, UnitQuaternion, Vector3};

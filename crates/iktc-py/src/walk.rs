@@ -15,10 +15,11 @@ use crate::motion::{resolve_map, PyMotion};
 use crate::robot::PyRobot;
 use crate::{to_py, IktcError};
 
-/// Walking while imitating: `steps` footsteps of `step_length` [m] (the library's default
-/// timing: 0.8 s initial and final double support, 0.6 s single, 0.1 s double, 4 cm swing),
-/// the upper body imitating `motion`, the damping controller off; `narrow` a list of
-/// (joint, lower, upper) [rad] replacing the profile's narrowed ranges.
+/// Walking while imitating: `steps` footsteps of `step_length` [m] (default: the robot
+/// profile's `walk` settings, else 0.1 m steps, 0.8 s initial and final double support, 0.6 s
+/// single, 0.1 s double, 4 cm swing), the upper body imitating `motion`, the damping
+/// controller off; `narrow` a list of (joint, lower, upper) [rad] replacing the
+/// profile's narrowed ranges.
 #[pyclass(name = "Walking", module = "iktc")]
 pub struct PyWalking {
     ctl: WalkingController,
@@ -31,14 +32,14 @@ pub struct PyWalking {
 #[pymethods]
 impl PyWalking {
     #[new]
-    #[pyo3(signature = (robot, motion, *, map=None, steps=4, step_length=0.1, narrow=None))]
+    #[pyo3(signature = (robot, motion, *, map=None, steps=4, step_length=None, narrow=None))]
     fn new(
         py: Python<'_>,
         robot: &PyRobot,
         motion: &PyMotion,
         map: Option<&str>,
         steps: usize,
-        step_length: f64,
+        step_length: Option<f64>,
         narrow: Option<Vec<(String, f64, f64)>>,
     ) -> PyResult<Self> {
         let profile = robot.profile.as_ref().ok_or_else(|| {
@@ -47,13 +48,16 @@ impl PyWalking {
                 robot.robot.name()
             ))
         })?;
-        let mut cfg = WalkImitateConfig::jvrc1().map_err(to_py)?;
-        cfg.imitate = profile.imitate_config(cfg.imitate).map_err(to_py)?;
+        let mut cfg = profile
+            .walk_config(&robot.robot, WalkImitateConfig::jvrc1().map_err(to_py)?)
+            .map_err(to_py)?;
         if let Some(n) = narrow {
             cfg.imitate.narrow = narrowed(n);
         }
         cfg.steps = steps;
-        cfg.step_length = step_length;
+        if let Some(l) = step_length {
+            cfg.step_length = l;
+        }
         cfg.push = None;
         cfg.damping = false;
         cfg.noise_std = 0.0;

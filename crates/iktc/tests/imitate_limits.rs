@@ -2,10 +2,11 @@
 //! acceleration limit on a narrowed joint, coarse control periods, a zero-width range; and a
 //! start outside the limits, refused by default and recovered on request.
 
+use iktc::limits::NarrowedJoint;
 use iktc::limits::{BoundMethod, OutsideLimits, ViableSettings};
 use iktc::model::{jvrc1, ModelOptions, Robot};
 use iktc::motion::{builtin_clip, builtin_map, RobotReferences};
-use iktc::sim::{imitation_references, run_imitate, ImitateConfig, ImitateRun, NarrowedJoint};
+use iktc::sim::{imitation_references, run_imitate, ImitateConfig, ImitateRun};
 use iktc::solver::Method;
 use iktc::Error;
 

@@ -4,8 +4,9 @@
 use iktc::model::{jvrc1, JointRole, ModelOptions};
 use iktc::profile::{
     builtin_profile_text, init_profile_toml, ProfileOrigin, RobotProfile, BUILTIN_PROFILES,
+    DEFAULT_PUSH_VELOCITY_CHANGE,
 };
-use iktc::sim::ImitateConfig;
+use iktc::sim::{ImitateConfig, WalkImitateConfig};
 use iktc::Error;
 
 /// A JVRC-1 profile text with `extra` appended (built-in origin: the embedded URDF).
@@ -202,6 +203,18 @@ fn every_number_key_names_itself() {
         ),
         ("[narrow]\nL_KNEE = [0.9, 0.5]", "narrow.L_KNEE"),
         ("[posture]\nL_KNEE = nan", "posture.L_KNEE"),
+        ("[walk]\nssp_duration = 0.0", "walk.ssp_duration"),
+        ("[walk]\ndsp_duration = -0.1", "walk.dsp_duration"),
+        ("[walk]\nstep_length = nan", "walk.step_length"),
+        ("[walk]\nswing_height = -0.01", "walk.swing_height"),
+        (
+            "[walk]\npush = { time = -1.0, impulse = [1.0, 0.0] }",
+            "walk.push.time",
+        ),
+        (
+            "[walk]\npush = { time = 1.0, impulse = [inf, 0.0] }",
+            "walk.push.impulse",
+        ),
     ] {
         let e = build_error(&jvrc1_with("", extra));
         assert_key(&e, key, &e_value(&e), "expected");
@@ -357,4 +370,65 @@ fn init_on_jvrc1_finds_its_ankles_and_fingers() {
     );
     assert_eq!(p.lock.len(), 12, "{toml}");
     assert_eq!(p.robot().unwrap().nv(), 6 + 32);
+}
+
+#[test]
+fn walking_settings_come_from_the_profile_and_the_default_push_scales_with_the_mass() {
+    let base = WalkImitateConfig::jvrc1().unwrap();
+    // Every walking key given: each lands in the walking settings.
+    let p = parse(&jvrc1_with(
+        "",
+        "[frames]\npelvis = \"PELVIS_S\"\n[walk]\nstep_length = 0.07\nswing_height = 0.03\nssp_duration = 0.5\n\
+         dsp_duration = 0.2\npush = { time = 1.5, impulse = [1.0, -2.0] }",
+    ))
+    .unwrap();
+    let robot = p.robot().unwrap();
+    let cfg = p.walk_config(&robot, base.clone()).unwrap();
+    assert_eq!(cfg.step_length, 0.07);
+    assert_eq!(cfg.walk.swing_height, 0.03);
+    assert_eq!(cfg.walk.ssp_duration, 0.5);
+    assert_eq!(cfg.walk.dsp_duration, 0.2);
+    let push = cfg.push.unwrap();
+    assert_eq!((push.time, push.impulse), (1.5, [1.0, -2.0]));
+    // The imitation's robot-specific fields are the profile's.
+    assert_eq!(
+        cfg.imitate.feet,
+        vec!["r_ankle".to_string(), "l_ankle".into()]
+    );
+    // A base without a push stays without one.
+    let none = p
+        .walk_config(
+            &robot,
+            WalkImitateConfig {
+                push: None,
+                ..base.clone()
+            },
+        )
+        .unwrap();
+    assert_eq!(none.push, None);
+
+    // No key: the default push changes the COM velocity by the same Δv on any robot,
+    // Δv = impulse / m, with m summed here from the URDF's links.
+    for name in ["g1", "jvrc1"] {
+        let p = RobotProfile::builtin(name).unwrap();
+        let robot = p.robot().unwrap();
+        let mut bare = p.clone();
+        bare.walk = Default::default();
+        let mass: f64 = robot.links().iter().map(|l| l.mass).sum();
+        let push = bare
+            .walk_config(&robot, base.clone())
+            .unwrap()
+            .push
+            .unwrap();
+        let dv = push.impulse[0] / mass;
+        assert!(
+            (dv - DEFAULT_PUSH_VELOCITY_CHANGE).abs() < 1e-12,
+            "{name}: Δv {dv} m/s"
+        );
+        assert_eq!(push.impulse[1], 0.0);
+    }
+    // The built-in JVRC-1 profile states the paper's 5 N·s.
+    let p = RobotProfile::builtin("jvrc1").unwrap();
+    let cfg = p.walk_config(&p.robot().unwrap(), base).unwrap();
+    assert_eq!(cfg.push.unwrap().impulse, [5.0, 0.0]);
 }

@@ -209,7 +209,7 @@ class Imitation:
 
 class Walking:
     def __init__(self, robot: Robot, motion: Motion, *, map: Optional[str] = None,
-                 steps: int = 4, step_length: float = 0.1,
+                 steps: int = 4, step_length: Optional[float] = None,
                  narrow: Optional[Sequence[Tuple[str, float, float]]] = None) -> None: ...
     @property
     def ticks(self) -> int: ...

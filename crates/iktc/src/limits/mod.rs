@@ -48,6 +48,7 @@ mod integrator;
 mod intersect;
 mod joint_limits;
 mod method;
+mod narrow;
 pub mod paper;
 pub mod quiet;
 mod source;
@@ -60,6 +61,7 @@ pub use integrator::{integrate_constant_acceleration, peak_in_step, StepExtremes
 pub use intersect::{intersect, DofBounds};
 pub use joint_limits::{DofLimits, JointLimits};
 pub use method::{BoundMethod, OutsideLimits, ViableSettings};
+pub use narrow::NarrowedJoint;
 pub use paper::paper_sources;
 pub use quiet::quiet_sources;
 pub use source::{BoundSource, DofBoundSources, DroppedSources, SourceBounds};

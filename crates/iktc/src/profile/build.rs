@@ -7,12 +7,12 @@ use crate::error::{Error, Result};
 use crate::model::{JointKind, ModelOptions, Robot};
 use crate::motion::RetargetMap;
 use crate::sim::imitate::SupportSettings;
-use crate::sim::{ImitateConfig, NarrowedJoint};
+use crate::sim::ImitateConfig;
 
 /// The value written in an error when a key is absent.
 pub const MISSING: &str = "(missing)";
 
-fn profile_error(key: &str, value: impl ToString, message: impl Into<String>) -> Error {
+pub(super) fn profile_error(key: &str, value: impl ToString, message: impl Into<String>) -> Error {
     Error::Profile {
         key: key.into(),
         value: value.to_string(),
@@ -28,7 +28,7 @@ fn list(names: impl IntoIterator<Item = impl AsRef<str>>) -> String {
         .join(", ")
 }
 
-fn check_number(key: &str, v: f64, ok: bool, expected: &str) -> Result<()> {
+pub(super) fn check_number(key: &str, v: f64, ok: bool, expected: &str) -> Result<()> {
     if v.is_finite() && ok {
         Ok(())
     } else {
@@ -66,7 +66,8 @@ fn check_foot(side: &str, f: &Foot) -> Result<()> {
 
 impl RobotProfile {
     /// Checks the numbers that do not need the robot: soles, ankle heights, posture angles,
-    /// narrowed ranges (`lower ≤ upper`), acceleration limits and ratio (`> 0`).
+    /// narrowed ranges (`lower ≤ upper`), acceleration limits and ratio (`> 0`), walking
+    /// settings.
     pub fn check_values(&self) -> Result<()> {
         for (i, l) in self.lock.iter().enumerate() {
             check_number(&format!("lock[{i}].value"), l.value, true, "a finite value")?;
@@ -78,11 +79,11 @@ impl RobotProfile {
         for (j, v) in &self.posture {
             check_number(&format!("posture.{j}"), *v, true, "a finite angle [rad]")?;
         }
-        for (j, [lo, hi]) in &self.narrow {
-            if !(lo.is_finite() && hi.is_finite() && lo <= hi) {
+        for n in &self.narrow {
+            if n.validate("narrow").is_err() {
                 return Err(profile_error(
-                    &format!("narrow.{j}"),
-                    format!("[{lo}, {hi}]"),
+                    &format!("narrow.{}", n.joint),
+                    format!("[{}, {}]", n.lower, n.upper),
                     "expected finite [lower, upper] with lower <= upper [rad]",
                 ));
             }
@@ -102,7 +103,7 @@ impl RobotProfile {
                 "a limit > 0 [rad/s² or m/s²]",
             )?;
         }
-        Ok(())
+        self.check_walk()
     }
 
     /// The joints each `lock` rule holds, expanded over the movable joints of `joints` (first
@@ -220,7 +221,8 @@ impl RobotProfile {
             })?;
         }
         let limits = robot.dof_limits();
-        for (j, [lo, hi]) in &self.narrow {
+        for n in &self.narrow {
+            let (j, lo, hi) = (&n.joint, &n.lower, &n.upper);
             let key = format!("narrow.{j}");
             let v = robot.joint_v_index(j).map_err(|_| {
                 profile_error(
@@ -284,15 +286,7 @@ impl RobotProfile {
             feet: vec![r.frame.clone(), l.frame.clone()],
             pelvis,
             initial_posture: self.posture.iter().map(|(k, v)| (k.clone(), *v)).collect(),
-            narrow: self
-                .narrow
-                .iter()
-                .map(|(k, [lo, hi])| NarrowedJoint {
-                    joint: k.clone(),
-                    lower: *lo,
-                    upper: *hi,
-                })
-                .collect(),
+            narrow: self.narrow.clone(),
             support: SupportSettings {
                 sole_length: l.sole.length,
                 sole_width: l.sole.width,

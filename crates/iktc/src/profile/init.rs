@@ -272,6 +272,10 @@ pub fn init_profile_toml(text: &str, urdf_path: &str) -> Result<String> {
         "\n# Initial joint angles [rad] (joint = angle), e.g. bent knees for a humanoid.\n[posture]\n\n\
          # Default narrowed ranges [rad] (joint = [lower, upper]).\n[narrow]\n\n\
          [acceleration]\nper_velocity = 10.0 # guessed: the paper's ratio (180°/s, 1800°/s²)\n\n\
+         # Walking settings (`iktc walk`); left out: 0.1 m steps, 4 cm swing, 0.6 s single and\n\
+         # 0.1 s double support, a push changing the COM velocity by 0.08 m/s.\n\
+         [walk]\n# step_length = 0.1\n# swing_height = 0.04\n# ssp_duration = 0.6\n# dsp_duration = 0.1\n\
+         # push = { time = 2.15, impulse = [5.0, 0.0] }\n\n\
          # Retargeting maps per motion format (built-in name or TOML file relative to this file).\n\
          [imitate.maps]\n# deepmimic = \"my_deepmimic_map.toml\"\n",
     );

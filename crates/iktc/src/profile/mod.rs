@@ -36,6 +36,13 @@
 //! per_velocity = 10.0                            # default limit / velocity limit [1/s]
 //! limits = { left_knee_joint = 200.0 }           # [rad/s²]
 //!
+//! [walk]                                         # all optional (iktc walk)
+//! step_length = 0.1                              # [m]
+//! swing_height = 0.04                            # [m]
+//! ssp_duration = 0.6                             # single support [s]
+//! dsp_duration = 0.1                             # double support between steps [s]
+//! push = { time = 2.15, impulse = [2.67, 0.0] }  # [s], [N·s]; default: m × 0.080 m/s
+//!
 //! [imitate.maps]                                 # retargeting map per motion format
 //! deepmimic = "deepmimic_g1"                     # built-in name or file relative to this one
 //! ```
@@ -64,6 +71,7 @@ mod glob;
 mod init;
 mod load;
 mod schema;
+mod walk;
 
 pub use build::{check_map_joints, MISSING};
 pub use glob::glob_match;
@@ -71,5 +79,6 @@ pub use init::init_profile_toml;
 pub use load::{builtin_profile_text, BUILTIN_PROFILES};
 pub use schema::{
     AccelerationProfile, BodyFrames, Feet, Foot, ImitateProfile, LockRule, ProfileOrigin,
-    RobotProfile, Sole, DEFAULT_ACCELERATION_PER_VELOCITY,
+    PushProfile, RobotProfile, Sole, WalkProfile, DEFAULT_ACCELERATION_PER_VELOCITY,
 };
+pub use walk::DEFAULT_PUSH_VELOCITY_CHANGE;

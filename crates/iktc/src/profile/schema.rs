@@ -4,6 +4,7 @@ use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
 
+use crate::limits::NarrowedJoint;
 use crate::model::BaseKind;
 
 /// Everything iktc needs about a robot beyond its URDF (one TOML file per robot; see the
@@ -30,16 +31,21 @@ pub struct RobotProfile {
     /// at 0.
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub posture: BTreeMap<String, f64>,
-    /// Default narrowed joint ranges \[rad\] (key `narrow`, joint name → `[lower, upper]`),
-    /// inside the joints' own ranges; in the order the TOML reader gives (sorted by name).
-    #[serde(default, skip_serializing_if = "Vec::is_empty", with = "ordered_map")]
-    pub narrow: Vec<(String, [f64; 2])>,
+    /// Default narrowed joint ranges \[rad\] (key `narrow`, a table joint name →
+    /// `[lower, upper]`), inside the joints' own ranges; in the order the TOML reader gives
+    /// (sorted by name).
+    #[serde(default, skip_serializing_if = "Vec::is_empty", with = "narrow_table")]
+    pub narrow: Vec<NarrowedJoint>,
     /// Acceleration limits (key `acceleration`).
     #[serde(default)]
     pub acceleration: AccelerationProfile,
     /// Imitation settings (key `imitate`).
     #[serde(default)]
     pub imitate: ImitateProfile,
+    /// Walking settings (key `walk`); keys left out keep the defaults of
+    /// [`RobotProfile::walk_config`](super::RobotProfile::walk_config).
+    #[serde(default, skip_serializing_if = "WalkProfile::is_empty")]
+    pub walk: WalkProfile,
     /// Where the profile was read from (not a key): relative paths are resolved against it.
     #[serde(skip)]
     pub origin: ProfileOrigin,
@@ -174,49 +180,91 @@ pub struct ImitateProfile {
     pub maps: BTreeMap<String, String>,
 }
 
-/// A TOML table read and written as `(key, value)` pairs in the order the reader gives them
-/// (the TOML reader sorts keys), rejecting a key given twice.
-mod ordered_map {
-    use std::marker::PhantomData;
+/// Walking settings of a robot (key `walk`); every key is optional.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WalkProfile {
+    /// Step length along x \[m\] (key `walk.step_length`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub step_length: Option<f64>,
+    /// Peak height of the swing foot \[m\] (key `walk.swing_height`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub swing_height: Option<f64>,
+    /// Duration of one single-support phase \[s\] (key `walk.ssp_duration`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ssp_duration: Option<f64>,
+    /// Duration of one double-support phase between steps \[s\] (key `walk.dsp_duration`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dsp_duration: Option<f64>,
+    /// The push of the walking experiment (key `walk.push`, `{ time = s, impulse = [x, y] }`
+    /// in \[s\] and \[N·s\]); left out, the push changes the COM velocity by
+    /// [`DEFAULT_PUSH_VELOCITY_CHANGE`](super::DEFAULT_PUSH_VELOCITY_CHANGE) whatever the
+    /// robot's mass.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub push: Option<PushProfile>,
+}
 
-    use serde::de::{Deserialize, Deserializer, MapAccess, Visitor};
-    use serde::ser::{Serialize, SerializeMap, Serializer};
+impl WalkProfile {
+    /// No key given.
+    pub fn is_empty(&self) -> bool {
+        *self == Self::default()
+    }
+}
 
-    pub fn serialize<S: Serializer, V: Serialize>(
-        entries: &[(String, V)],
-        s: S,
-    ) -> Result<S::Ok, S::Error> {
+/// The push of the walking experiment (key `walk.push`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PushProfile {
+    /// When \[s\] (key `walk.push.time`).
+    pub time: f64,
+    /// Horizontal impulse on the COM (world x, y) \[N·s\] (key `walk.push.impulse`).
+    pub impulse: [f64; 2],
+}
+
+/// The key `narrow` as a TOML table `JOINT = [lower, upper]`, read into [`NarrowedJoint`]s in
+/// the order the reader gives them (the TOML reader sorts keys), rejecting a joint given twice.
+mod narrow_table {
+    use serde::de::{Deserializer, MapAccess, Visitor};
+    use serde::ser::{SerializeMap, Serializer};
+
+    use crate::limits::NarrowedJoint;
+
+    pub fn serialize<S: Serializer>(entries: &[NarrowedJoint], s: S) -> Result<S::Ok, S::Error> {
         let mut m = s.serialize_map(Some(entries.len()))?;
-        for (k, v) in entries {
-            m.serialize_entry(k, v)?;
+        for n in entries {
+            m.serialize_entry(&n.joint, &[n.lower, n.upper])?;
         }
         m.end()
     }
 
-    struct Entries<V>(PhantomData<V>);
+    struct Entries;
 
-    impl<'de, V: Deserialize<'de>> Visitor<'de> for Entries<V> {
-        type Value = Vec<(String, V)>;
+    impl<'de> Visitor<'de> for Entries {
+        type Value = Vec<NarrowedJoint>;
 
         fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-            f.write_str("a table of joint names")
+            f.write_str("a table of joint names, each with [lower, upper] in rad")
         }
 
         fn visit_map<A: MapAccess<'de>>(self, mut a: A) -> Result<Self::Value, A::Error> {
-            let mut out: Vec<(String, V)> = Vec::new();
-            while let Some((k, v)) = a.next_entry::<String, V>()? {
-                if out.iter().any(|(n, _)| *n == k) {
-                    return Err(serde::de::Error::custom(format!("joint `{k}` given twice")));
+            let mut out: Vec<NarrowedJoint> = Vec::new();
+            while let Some((joint, [lower, upper])) = a.next_entry::<String, [f64; 2]>()? {
+                if out.iter().any(|n| n.joint == joint) {
+                    return Err(serde::de::Error::custom(format!(
+                        "joint `{joint}` given twice"
+                    )));
                 }
-                out.push((k, v));
+                out.push(NarrowedJoint {
+                    joint,
+                    lower,
+                    upper,
+                });
             }
             Ok(out)
         }
     }
 
-    pub fn deserialize<'de, D: Deserializer<'de>, V: Deserialize<'de>>(
-        d: D,
-    ) -> Result<Vec<(String, V)>, D::Error> {
-        d.deserialize_map(Entries(PhantomData))
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<NarrowedJoint>, D::Error> {
+        d.deserialize_map(Entries)
     }
 }

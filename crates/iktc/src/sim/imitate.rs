@@ -25,7 +25,7 @@ use crate::controller::{
     ComHandle, Controller, ControllerBuilder, ControllerSettings, FrameHandle, JointsHandle,
 };
 use crate::error::{check_dim, Error, Result};
-use crate::limits::{AccelerationBox, BoundMethod, DofLimits, JointLimits, OutsideLimits};
+use crate::limits::{AccelerationBox, BoundMethod, JointLimits, NarrowedJoint, OutsideLimits};
 use crate::model::{Kinematics, Robot, State};
 use crate::motion::RobotReferences;
 use crate::resources::RunLimits;
@@ -40,17 +40,6 @@ pub const LEVEL_NAMES: [&str; 5] = [
     "pelvis_height",
     "upper_body",
 ];
-
-/// A joint range narrowed for the experiment (the paper narrows LKN and LHR).
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
-pub struct NarrowedJoint {
-    /// Active joint name.
-    pub joint: String,
-    /// New lower limit \[rad\].
-    pub lower: f64,
-    /// New upper limit \[rad\].
-    pub upper: f64,
-}
 
 /// Settings of the imitation run.
 #[derive(Debug, Clone, PartialEq)]
@@ -165,13 +154,7 @@ impl ImitateConfig {
             ));
         }
         for n in &self.narrow {
-            if !(n.lower.is_finite() && n.upper.is_finite() && n.lower <= n.upper) {
-                return Err(Error::InvalidSetting {
-                    name: format!("narrowed range of {}", n.joint),
-                    value: format!("{}:{}", n.lower, n.upper),
-                    expected: "finite lo:hi with lo <= hi [rad]".into(),
-                });
-            }
+            n.validate(&format!("narrowed range of {}", n.joint))?;
         }
         if !(self.com_settle_time.is_finite() && self.com_settle_time >= 0.0) {
             return Err(bad(
@@ -307,25 +290,7 @@ impl ImitationController {
         }
         let mut refs = refs.clone();
         // Limits, with the narrowed ranges.
-        let mut dofs: Vec<DofLimits> = JointLimits::from_robot(robot)?.dofs().to_vec();
-        for n in &cfg.narrow {
-            let v = robot.joint_v_index(&n.joint)?;
-            if let Some(d) = dofs.get_mut(v) {
-                if n.lower < d.position_min || n.upper > d.position_max {
-                    return Err(Error::InvalidSetting {
-                        name: format!("narrowed range of {}", n.joint),
-                        value: format!("{}:{}", n.lower, n.upper),
-                        expected: format!(
-                            "a range inside the joint's own [{}, {}] rad",
-                            d.position_min, d.position_max
-                        ),
-                    });
-                }
-                d.position_min = n.lower;
-                d.position_max = n.upper;
-            }
-        }
-        let limits = JointLimits::new(dofs)?.with_names(robot.dof_names())?;
+        let limits = JointLimits::from_robot(robot)?.narrowed(&cfg.narrow)?;
         // Clamp the joint references into the (narrowed) ranges.
         for (name, track) in refs.joint_names.iter().zip(refs.joints.iter_mut()) {
             let v = robot.joint_v_index(name)?;

@@ -6,8 +6,9 @@ use nalgebra::{DMatrix, UnitQuaternion};
 use serde::Serialize;
 
 use super::support::support_polygon;
-use super::{ImitateConfig, ImitationController, NarrowedJoint, LEVEL_NAMES};
+use super::{ImitateConfig, ImitationController, LEVEL_NAMES};
 use crate::error::Result;
+use crate::limits::NarrowedJoint;
 use crate::model::{JointLimit, Robot};
 use crate::motion::RobotReferences;
 use crate::sim::health::{HealthMonitor, HealthReport, Verdict};
