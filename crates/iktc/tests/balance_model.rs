@@ -209,4 +209,11 @@ fn invalid_parameters_are_errors() {
         natural_frequency: None,
     };
     assert!(place_poles(&plant(), &bad).is_err());
+    // A Padé time that overflows the discretisation (an identification at its bound returned
+    // T = 4.8e-142 s): an error naming the times, not a controller that outputs NaN.
+    let mut tiny = plant();
+    tiny.pade = 4.8e-142;
+    let e = design_discrete(&tiny, &PoleSpec::default(), &DiscreteSettings::default())
+        .expect_err("a design with NaN gains must be refused");
+    assert!(e.to_string().contains("4.8e-142"), "{e}");
 }

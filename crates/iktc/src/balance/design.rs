@@ -218,6 +218,20 @@ pub fn design_discrete(
             .ok_or_else(|| singular("I − A_d + B_d K_d"))?
         * bd)[0];
     let feedforward = ol / cl;
+    // A lag or Padé time far below Δt (an identification that ran into its bound: T = 5e-142 s
+    // was seen) overflows exp(A h); the inverses above may still "succeed" on NaN entries.
+    let finite = ad.iter().chain(bd.iter()).all(|x| x.is_finite())
+        && gain.iter().chain(m.iter()).all(|x| x.is_finite())
+        && feedforward.is_finite();
+    if !finite {
+        return Err(Error::InvalidSetting {
+            name: "FullModelParams (τ_s, T) [s]".into(),
+            value: format!("({:e}, {:e})", params.lag, params.pade),
+            expected: format!(
+                "times whose discrete design at Δt = {h} s is finite (the controller or observer came out NaN or infinite)"
+            ),
+        });
+    }
     let pair = |z: &Complex<f64>| [z.re, z.im];
     Ok(DiscreteDesign {
         params: *params,
