@@ -128,7 +128,10 @@ mod tests {
             (narrow("B", 0.5, 2.5), "inside the joint's own [0, 2]"),
             (narrow("C", 0.0, 0.1), "joints are A, B"),
         ] {
-            let e = limits().narrowed(std::slice::from_ref(&n)).unwrap_err().to_string();
+            let e = limits()
+                .narrowed(std::slice::from_ref(&n))
+                .unwrap_err()
+                .to_string();
             assert!(e.contains(needle) && e.contains(&n.joint), "{e}");
         }
     }
