@@ -218,11 +218,14 @@ class Loop:
     def __init__(self, clip: str = "humanoid3d_dance_b", duration: float | None = None,
                  kp: float = KP, kv: float = KV, physics_step: float = PHYSICS_STEP,
                  rate_feedforward: bool = True, time_scale: float = 1.0,
-                 robot: iktc.Robot | None = None, offset_feedforward: bool = False):
+                 robot: iktc.Robot | None = None, offset_feedforward: bool = False,
+                 **imitation):
+        """`imitation`: further keywords of `iktc.Imitation` (map, bounds, level_hold,
+        rebase_release, narrow)."""
         self.rate_feedforward = rate_feedforward
         self.robot = iktc.Robot("g1") if robot is None else robot
         self.sim = iktc.Imitation(self.robot, iktc.load_motion(clip), dt=CONTROL_PERIOD,
-                                  duration=duration, time_scale=time_scale)
+                                  duration=duration, time_scale=time_scale, **imitation)
         self.plant = Plant(self.robot, kp=kp, kv=kv, physics_step=physics_step)
         self.plant.set_state(self.sim.q)
         self.upper = [self.robot.q_index(n) - 7 for n in self.sim.upper_body_joints]
@@ -299,10 +302,11 @@ class Loop:
 
 def run_standing(duration: float | None = None, settle: float = 0.5,
                  clip: str = "humanoid3d_dance_b", rate_feedforward: bool = True,
-                 time_scale: float = 1.0):
-    """(a) Standing imitation of the clip's upper body with the feet held; returns the loop."""
+                 time_scale: float = 1.0, robot: iktc.Robot | None = None, **imitation):
+    """(a) Standing imitation of the clip's upper body with the feet held; returns the loop.
+    `imitation`: further keywords of `iktc.Imitation`."""
     loop = Loop(clip=clip, duration=duration, rate_feedforward=rate_feedforward,
-                time_scale=time_scale)
+                time_scale=time_scale, robot=robot, **imitation)
     loop.settle(settle)
     for _ in range(loop.sim.ticks):
         loop.step()
@@ -535,14 +539,17 @@ ON_GROUND = 1e-3
 
 
 def run_walking(steps: int = 4, step_length: float = 0.1, clip: str = "humanoid3d_dance_b",
-                settle: float = 0.5, rate_feedforward: bool = True) -> dict:
+                settle: float = 0.5, rate_feedforward: bool = True, narrow=None,
+                kp: float = KP, kv: float = KV) -> dict:
     """Walking `steps` footsteps while imitating the clip, on the MuJoCo G1, the damping
-    controller off. Returns the figures: stayed up, pelvis height, base tilt, the largest
-    horizontal error of a standing foot against its reference (slip), the ZMP from the ankle
-    sensors against the pattern's support polygon, servo tracking."""
+    controller off (`narrow`: narrowed joint ranges, as for `iktc.Walking`). Returns the
+    figures: stayed up, pelvis height, base tilt, the largest horizontal error of a standing
+    foot against its reference (slip), the ZMP from the ankle sensors against the pattern's
+    support polygon, servo tracking."""
     robot = iktc.Robot("g1")
-    walk = iktc.Walking(robot, iktc.load_motion(clip), steps=steps, step_length=step_length)
-    plant = Plant(robot)
+    walk = iktc.Walking(robot, iktc.load_motion(clip), steps=steps, step_length=step_length,
+                        narrow=narrow)
+    plant = Plant(robot, kp=kp, kv=kv)
     plant.set_state(walk.q)
     z0 = [f[2, 3] for f in walk.feet0()]
     for _ in range(int(round(settle / CONTROL_PERIOD))):
@@ -583,6 +590,102 @@ def run_walking(steps: int = 4, step_length: float = 0.1, clip: str = "humanoid3
         "joint_error_max_rad": float(np.max(errs)),
         "forward_progress_m": float(plant.data.xpos[plant.pelvis][0] - walk.feet0()[0][0, 3]),
     }
+
+
+# --- causes of the failures (diagnostic settings, not defaults) ----------------------------
+
+#: G1's knees narrowed [rad]: 0.3 rad (17°) short of straight, so that the pelvis height task is
+#: corrected before a leg straightens (its lower limit is −0.087 rad); the upper end is the
+#: joint's own 2.88 rad less a margin. A diagnostic setting: the clip's pelvis height rises up to
+#: 0.13 m above its first frame, where G1 at its posture (knee 0.6 rad) has 0.03 m of leg left.
+G1_KNEES = (("left_knee_joint", 0.3, 2.8), ("right_knee_joint", 0.3, 2.8))
+
+
+def held_pelvis_map(path) -> str:
+    """Writes the built-in `deepmimic_g1` map with the pelvis height, pitch and roll scales set
+    to 0 (the pelvis held at its start) to `path`; returns the path."""
+    text = (REPO / "crates" / "iktc" / "data" / "maps" / "deepmimic_g1.toml").read_text()
+    for key in ("height_scale", "pitch_scale", "roll_scale"):
+        lines = [f"{key} = 0.0" if ln.startswith(f"{key} =") else ln for ln in text.splitlines()]
+        text = "\n".join(lines) + "\n"
+    pathlib.Path(path).write_text(text)
+    return str(path)
+
+
+def g1_profile_with_acceleration(path, per_velocity: float) -> str:
+    """Writes the built-in G1 profile with every acceleration limit `per_velocity` [1/s] times
+    the joint's velocity limit (the profile's 10 gives 200–370 rad/s²) to `path`; returns it."""
+    data = REPO / "crates" / "iktc" / "data"
+    text = (data / "profiles" / "g1.toml").read_text()
+    urdf = data / "robots" / "g1" / "g1_29dof_rev_1_0.urdf"
+    lines = []
+    for ln in text.splitlines():
+        if ln.startswith("urdf ="):
+            ln = f'urdf = "{urdf}"'
+        elif ln.startswith("per_velocity ="):
+            ln = f"per_velocity = {per_velocity!r}"
+        lines.append(ln)
+    pathlib.Path(path).write_text("\n".join(lines) + "\n")
+    return str(path)
+
+
+def plan_outside(plant: Plant, qs: list, margin) -> int:
+    """Ticks on which the plan's ZMP (``planned_zmp``) is outside the support polygon, with
+    `margin(k, point)` the signed margin of tick k."""
+    plan = planned_zmp(plant, qs)
+    return int(sum(margin(k, tuple(p)) < 0 for k, p in enumerate(plan) if np.all(np.isfinite(p))))
+
+
+def standing_figures(frozen=(), **kw) -> dict:
+    """Slip, the plan's ZMP ticks outside and the legs' largest |q̈| of one standing run
+    (`run_standing` keywords); `frozen`: joint names held at their first angle in the plan
+    before its ZMP is computed (what those joints' motion contributes)."""
+    peak = 0.0
+    loop = Loop(**{k: v for k, v in kw.items() if k not in ("settle",)})
+    loop.settle(kw.get("settle", 0.5))
+    names = loop.robot.joint_names
+    legs = [6 + i for i, n in enumerate(names) if any(x in n for x in ("hip", "knee", "ankle"))]
+    for _ in range(loop.sim.ticks):
+        loop.step()
+        peak = max(peak, float(np.abs(loop.sim.qdd[legs]).max()))
+    s = loop.summary()
+    qs = [q.copy() for q in loop.log.q_cmd]
+    idx = [7 + names.index(n) for n in frozen]
+    for q in qs:
+        q[idx] = loop.log.q_cmd[0][idx]
+    return {"foot_slip_max_m": s["foot_slip_max_m"], "stayed_up": s["stayed_up"],
+            "plan_zmp_ticks_outside": plan_outside(loop.plant, qs,
+                                                   lambda k, p: loop.sim.support_margin(p)),
+            "ticks": s["ticks"], "legs_qdd_max_rad_s2": peak}
+
+
+def walking_plan_figures(clip: str = "humanoid3d_dance_b", narrow=None) -> dict:
+    """The walking plan alone (no physics): its ZMP against the pattern's support polygon per
+    phase, and the lowest angle of each knee [rad] with the first time at its lower limit [s]."""
+    robot = iktc.Robot("g1")
+    qs, phases = [], []
+    walk = iktc.Walking(robot, iktc.load_motion(clip), narrow=narrow)
+    for _ in range(walk.ticks):
+        phases.append(walk.tick()[1])
+        qs.append(walk.q.copy())
+    plan = planned_zmp(Plant(robot), qs)
+    replay = iktc.Walking(robot, iktc.load_motion(clip), narrow=narrow)
+    out = {}
+    for k, p in enumerate(plan):
+        replay.tick()
+        if np.all(np.isfinite(p)):
+            n_out, n = out.get(phases[k], (0, 0))
+            out[phases[k]] = (n_out + int(replay.support_margin(tuple(p)) < 0), n + 1)
+    fig = {f"plan_zmp_outside_{ph}": f"{o} of {n}" for ph, (o, n) in out.items()}
+    lower = robot.limits()[0]
+    for side in ("left", "right"):
+        name = f"{side}_knee_joint"
+        q = np.array([x[robot.q_index(name)] for x in qs])
+        # At its lower limit: within 0.01 rad of it (the leg straight).
+        at = np.nonzero(q < lower[robot.v_index(name)] + 0.01)[0]
+        fig[f"{side}_knee_min_rad"] = float(q.min())
+        fig[f"{side}_knee_straight_from_s"] = float(at[0] * CONTROL_PERIOD) if at.size else None
+    return fig
 
 
 # --- replay -------------------------------------------------------------------------------

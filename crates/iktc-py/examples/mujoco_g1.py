@@ -2,8 +2,10 @@
 
     python crates/iktc-py/examples/mujoco_g1.py standing [--clip humanoid3d_dance_b]
         [--time-scale 1] [--robot g1|profile.toml] [--json out.json] [--replay out.html]
-    python crates/iktc-py/examples/mujoco_g1.py balance [--damping 0.72] [--json out.json]
+    python crates/iktc-py/examples/mujoco_g1.py balance [--damping 0.72] [--designs 0.3,0.9]
+        [--json out.json]
     python crates/iktc-py/examples/mujoco_g1.py walking [--steps 4] [--json out.json]
+    python crates/iktc-py/examples/mujoco_g1.py causes [--json out.json]
 
 `standing` prints the run's figures (stayed up, pelvis height, base tilt, foot slip, ZMP margin
 from the ankle force/torque sensors, tracking errors) and the ZMP that iktc's kinematic plan asks
@@ -12,10 +14,14 @@ without tipping. `balance` identifies the IPCJ model of the sagittal plane on Mu
 sweep of Section 4.2, places the poles, and pushes the standing robot at the pelvis with and
 without the damping controller, printing the fit and the damping ratios. `walking` walks
 while imitating the clip (damping controller off) and prints whether the robot stayed up, the
-standing feet's errors and the ZMP against the pattern's support polygon. See ``g1_sim.py``.
+standing feet's errors and the ZMP against the pattern's support polygon. `causes` prints the
+figures behind the expected failures: the standing run with the knees narrowed, quiet bounds,
+the pelvis held, the clip slower, the arms frozen in the plan; the walking plan's ZMP and knees
+with and without narrowed knees; the walk in MuJoCo with stiffer servos. See ``g1_sim.py``.
 """
 import argparse
 import json
+import pathlib
 
 import numpy as np
 
@@ -44,14 +50,51 @@ def balance(a) -> dict:
                                "zmp_peak_m": float(np.abs(y).max()),
                                "stayed_up": s["stayed_up"], "foot_slip_max_m": s["foot_slip_max_m"],
                                "zmp_margin_min_m": s["zmp_margin_min_m"]}
+    if a.designs:
+        out["push_damped_by_design"] = {}
+        for z in (float(x) for x in a.designs.split(",")):
+            loop, t, y = g1_sim.push_test(model=model, damping=z)
+            out["push_damped_by_design"][str(z)] = g1_sim.damping_ratio(t, y)[0]
+    return out
+
+
+def causes(a) -> dict:
+    """The figures behind the expected failures (diagnostic settings, not defaults)."""
+    import tempfile
+    tmp = pathlib.Path(tempfile.mkdtemp())
+    names = iktc.Robot("g1").joint_names
+    slow = iktc.Robot(g1_sim.g1_profile_with_acceleration(tmp / "g1_accel_1x.toml", 1.0))
+    upper = [n for n in names if any(x in n for x in ("shoulder", "elbow", "wrist"))]
+    held = g1_sim.held_pelvis_map(tmp / "held_pelvis.toml")
+    runs = {
+        "default": {},
+        "arms_frozen_in_the_plan": {"frozen": upper},
+        "knees_narrowed": {"narrow": g1_sim.G1_KNEES},
+        "knees_narrowed_accel_1x_velocity_limit": {"narrow": g1_sim.G1_KNEES, "robot": slow},
+        "quiet_bounds_level_hold_5": {"bounds": "quiet", "level_hold": 5},
+        "pelvis_held": {"map": held},
+        "clip_4x_slower": {"time_scale": 4.0},
+    }
+    out = {"standing": {k: g1_sim.standing_figures(**kw) for k, kw in runs.items()}}
+    out["walking_plan"] = {f"{clip} {'knees narrowed' if n else 'default'}":
+                           g1_sim.walking_plan_figures(clip, n)
+                           for clip in ("humanoid3d_dance_b", "humanoid3d_walk")
+                           for n in (None, g1_sim.G1_KNEES)}
+    out["walking_mujoco_walk_clip_knees_narrowed"] = {
+        f"kp {kp}": g1_sim.run_walking(clip="humanoid3d_walk", narrow=g1_sim.G1_KNEES, kp=kp,
+                                       kv=kv)["stayed_up"]
+        for kp, kv in ((500.0, 20.0), (2000.0, 40.0), (5000.0, 100.0))}
     return out
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("run", nargs="?", default="standing", choices=["standing", "balance", "walking"])
+    ap.add_argument("run", nargs="?", default="standing",
+                    choices=["standing", "balance", "walking", "causes"])
     ap.add_argument("--steps", type=int, default=4, help="footsteps of the walking run")
     ap.add_argument("--damping", type=float, default=0.72, help="design damping ratio [–]")
+    ap.add_argument("--designs", help="balance: also push with these design ratios, e.g. "
+                    "0.3,0.5,0.72,0.9, and print the measured ones")
     ap.add_argument("--clip", default="humanoid3d_dance_b")
     ap.add_argument("--time-scale", type=float, default=1.0, help="play the clip this many times slower")
     ap.add_argument("--robot", default="g1", help="the built-in g1 or a G1 profile file (.toml)")
@@ -62,6 +105,8 @@ def main() -> None:
     a = ap.parse_args()
     if a.run == "balance":
         s = balance(a)
+    elif a.run == "causes":
+        s = causes(a)
     elif a.run == "walking":
         s = g1_sim.run_walking(steps=a.steps, clip=a.clip)
     else:

@@ -240,3 +240,19 @@ def test_the_replay_holds_both_runs_tick_by_tick(tmp_path):
         b = m.body(name).id - 1
         assert np.allclose(data["plan"][-1][b], loop.robot.frame_pose(loop.log.q_cmd[-1], name)[:3, 3],
                            atol=1e-4)
+
+
+def test_the_walking_plan_straightens_a_knee_unless_the_knees_are_narrowed():
+    # The cause recorded for the walking failure: the pelvis height reference drives a knee to
+    # its lower limit (the leg straight); narrowed, the knees stay off it and the plan's ZMP
+    # (MuJoCo's inverse dynamics) leaves the single-support polygon on fewer ticks.
+    plain = g1_sim.walking_plan_figures("humanoid3d_walk")
+    narrowed = g1_sim.walking_plan_figures("humanoid3d_walk", g1_sim.G1_KNEES)
+    assert plain["right_knee_straight_from_s"] is not None, plain
+    assert narrowed["right_knee_straight_from_s"] is None, narrowed
+    assert min(narrowed["left_knee_min_rad"], narrowed["right_knee_min_rad"]) >= 0.3 - 1e-6
+
+    def outside(f):
+        return int(f["plan_zmp_outside_single"].split(" of ")[0])
+
+    assert outside(narrowed) < outside(plain) / 2, (plain, narrowed)
