@@ -506,9 +506,13 @@ def push_test(model=None, damping: float = 0.72, push_force: float = 60.0,
     """A push in double support: `push_force` [N] along `axis` at the pelvis for `push_time`
     [s], then `after` [s] observed. With `model` (an identified PlaneModel) the damping
     controller (Section 4.3, pole damping ratio `damping`, natural frequency kept) feeds the
-    measured ZMP back into a COM offset; without, the COM reference stays. Returns
-    (loop, t [s], ZMP deviation [m] after the push)."""
+    measured ZMP back into a COM offset; without, the COM reference stays. The controller's
+    command u [rad] becomes the COM offset l·u with the l of the identification's sweep
+    (``pendulum_length``, the kinematic COM height), not the fitted pendulum length the
+    controller's own `com_offset` uses: the plant the model was fitted to took its input
+    through that l. Returns (loop, t [s], ZMP deviation [m] after the push)."""
     loop = standing_loop()
+    length = pendulum_length(loop)
     ctrl = None if model is None else iktc.DampingController(model, damping_ratio=damping,
                                                              control_period=CONTROL_PERIOD)
     zmp0, _ = loop.plant.zmp()
@@ -520,7 +524,7 @@ def push_test(model=None, damping: float = 0.72, push_force: float = 60.0,
         y = (zmp[axis] - y0) if zmp is not None else 0.0
         off = [0.0, 0.0]
         if ctrl is not None:
-            off[axis] = ctrl.step(0.0, y)[1]
+            off[axis] = length * ctrl.step(0.0, y)[0]
         force = None
         if k < n_push:
             force = np.zeros(3)
