@@ -103,9 +103,9 @@ fn summary() {
     /// A joint this close to its velocity limit, as a fraction of it, has reached it \[–\].
     const VELOCITY_REACHED: f64 = 1e-3;
     let mut p = PeerProblem::new(Method::Iktc, SolverSettings::default()).expect("peer problem");
-    let names = p.robot.dof_names();
-    let nb = p.robot.base_nv();
-    let dofs = p.limits.dofs().to_vec();
+    let names = p.robot().dof_names();
+    let (nb, nqb) = (p.robot().base_nv(), p.robot().base_nq());
+    let dofs = p.limits().dofs().to_vec();
     let nv = names.len();
     let mut closest = vec![f64::INFINITY; nv];
     let mut fastest = vec![0.0_f64; nv];
@@ -124,7 +124,7 @@ fn summary() {
         warm += r.qp_warm_started;
         iterations += r.qp_iterations;
         for d in nb..nv {
-            let q = p.state.q[d + p.robot.base_nq() - nb];
+            let q = p.state.q[d + nqb - nb];
             let qd = p.state.qd[d];
             let l = &dofs[d];
             closest[d] = closest[d].min((q - l.position_min).min(l.position_max - q));

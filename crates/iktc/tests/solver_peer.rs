@@ -25,11 +25,8 @@ fn record() -> Vec<(Vec<TaskEquation>, AccelerationBox)> {
     let mut out = Vec::with_capacity(WARMUP + TIMED);
     for _ in 0..WARMUP + TIMED {
         p.prepare().expect("prepare");
-        out.push((p.eqs.clone(), p.bx.clone()));
-        p.solver
-            .solve(p.method, &p.eqs, &p.bx, &mut p.qdd)
-            .expect("solve");
-        p.finish().expect("integrate");
+        out.push((p.ctl.equations().to_vec(), p.ctl.bounds().clone()));
+        p.finish().expect("solve and integrate");
     }
     out
 }
@@ -111,9 +108,9 @@ fn the_peer_problem_binds_the_limits_the_issue_names() {
     /// A joint within this fraction of its velocity limit has reached it \[–\].
     const VELOCITY_REACHED: f64 = 1e-3;
     let mut p = PeerProblem::new(Method::Iktc, SolverSettings::default()).expect("problem");
-    let names = p.robot.dof_names();
-    let (nb, nqb) = (p.robot.base_nv(), p.robot.base_nq());
-    let dofs = p.limits.dofs().to_vec();
+    let names = p.robot().dof_names();
+    let (nb, nqb) = (p.robot().base_nv(), p.robot().base_nq());
+    let dofs = p.limits().dofs().to_vec();
     let nv = names.len();
     let mut closest = vec![f64::INFINITY; nv];
     let mut fastest = vec![0.0_f64; nv];

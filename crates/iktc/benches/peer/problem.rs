@@ -15,18 +15,17 @@
 //! - φ_j: uniform in [0, 2π) from `rand_chacha::ChaCha8Rng::seed_from_u64(PHASE_SEED)`
 //!   (rand 0.9, `random_range(0.0..TAU)`), drawn in the order of [`UPPER_BODY`].
 //! - One step = kinematics update, task linearisation, acceleration box, solve, integration
-//!   ([`PeerProblem::step`]); it allocates nothing.
+//!   ([`PeerProblem::step`], [`Controller::step`]); it allocates nothing.
 #![allow(dead_code)]
 
 use std::f64::consts::{PI, TAU};
 
-use iktc::limits::{compute_box, AccelerationBox, BoundMethod, JointLimits};
-use iktc::model::{jvrc1, Kinematics, ModelOptions, Robot, State};
-use iktc::solver::{Method, SolveReport, Solver, SolverSettings};
-use iktc::task::{
-    Axes, ComReference, ComTask, FrameReference, FrameTask, Gains, JointTask, Task, TaskEquation,
-    TaskStack,
-};
+use iktc::controller::{ControllerSettings, JointsHandle};
+use iktc::limits::{BoundMethod, JointLimits};
+use iktc::model::{jvrc1, ModelOptions, Robot, State};
+use iktc::solver::{Method, SolveReport, SolverSettings};
+use iktc::task::{Axes, Gains};
+use iktc::Controller;
 use nalgebra::DVector;
 use rand::{Rng, SeedableRng};
 
@@ -88,21 +87,12 @@ pub const INITIAL_POSE: [(&str, f64); 10] = [
     ("L_ELBOW_P", -0.5),
 ];
 
-/// The closed loop of the peer problem.
+/// The closed loop of the peer problem: a [`Controller`] with the five levels and its state.
 #[derive(Debug, Clone)]
 pub struct PeerProblem {
-    pub robot: Robot,
+    pub ctl: Controller,
     pub state: State,
-    pub kin: Kinematics,
-    pub stack: TaskStack,
-    pub eqs: Vec<TaskEquation>,
-    pub limits: JointLimits,
-    pub bounds: BoundMethod,
-    pub bx: AccelerationBox,
-    pub solver: Solver,
-    pub method: Method,
-    pub qdd: DVector<f64>,
-    pos: Vec<f64>,
+    upper: JointsHandle,
     /// q0,j and φ_j of the upper-body joints \[rad\].
     q0: Vec<f64>,
     pub phases: Vec<f64>,
@@ -112,68 +102,68 @@ pub struct PeerProblem {
 }
 
 impl PeerProblem {
-    /// The problem at t = 0, solved by `method` with `settings`.
+    /// The problem at t = 0 with the viable bounds, solved by `method` with `settings`.
     pub fn new(method: Method, settings: SolverSettings) -> iktc::Result<Self> {
+        Self::with_bounds(method, settings, BoundMethod::viable())
+    }
+
+    /// The problem at t = 0 with `bounds`, solved by `method` with `settings`.
+    pub fn with_bounds(
+        method: Method,
+        settings: SolverSettings,
+        bounds: BoundMethod,
+    ) -> iktc::Result<Self> {
         let robot = jvrc1(&ModelOptions::default())?;
         let mut state = State::neutral(&robot);
         for (name, v) in INITIAL_POSE {
             state.set_joint(&robot, name, v)?;
         }
-        let kin = Kinematics::new(&robot, &state)?;
-        let mut feet = Vec::new();
-        for f in ["r_ankle", "l_ankle"] {
-            let mut t = FrameTask::new(&robot, f, Axes::ALL, GAINS)?;
-            t.set_reference(FrameReference::hold(kin.frame_pose(&robot, t.frame())?))?;
-            feet.push(Task::Frame(t));
-        }
-        let mut com = ComTask::new(&robot, [true, true, false], GAINS)?;
-        com.set_reference(ComReference {
-            position: kin.com(),
-            velocity: Default::default(),
-            acceleration: Default::default(),
-        })?;
-        let mut attitude = FrameTask::new(&robot, "PELVIS_S", Axes::ORIENTATION, GAINS)?;
-        let pelvis = kin.frame_pose(&robot, attitude.frame())?;
-        attitude.set_reference(FrameReference::hold(pelvis))?;
-        let mut height = FrameTask::new(&robot, "PELVIS_S", Axes::Z, GAINS)?;
-        height.set_reference(FrameReference::hold(pelvis))?;
-        let upper = JointTask::new(&robot, &UPPER_BODY, GAINS)?;
+        let mut b = Controller::builder(robot, &state)?;
+        b.gains(GAINS).settings(ControllerSettings {
+            method,
+            bounds,
+            solver: settings,
+        });
+        b.level("feet").frame("r_ankle", Axes::ALL)?;
+        b.frame("l_ankle", Axes::ALL)?;
+        b.level("com_xy").com([true, true, false])?;
+        b.level("pelvis_attitude")
+            .frame("PELVIS_S", Axes::ORIENTATION)?;
+        b.level("pelvis_height").frame("PELVIS_S", Axes::Z)?;
+        let upper = b.level("upper_body").joints(&UPPER_BODY)?;
+        let ctl = b.build()?;
         let q0 = UPPER_BODY
             .iter()
-            .map(|j| state.joint(&robot, j))
+            .map(|j| state.joint(ctl.robot(), j))
             .collect::<iktc::Result<Vec<_>>>()?;
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(PHASE_SEED);
         let phases = (0..UPPER_BODY.len())
             .map(|_| rng.random_range(0.0..TAU))
             .collect();
-        let mut stack = TaskStack::default();
-        stack
-            .push("feet", feet)
-            .push("com_xy", vec![Task::Com(com)])
-            .push("pelvis_attitude", vec![Task::Frame(attitude)])
-            .push("pelvis_height", vec![Task::Frame(height)])
-            .push("upper_body", vec![Task::Joint(upper)]);
-        let eqs = stack.equations(&robot);
-        let dims: Vec<usize> = eqs.iter().map(|e| e.dim()).collect();
-        let nv = robot.nv();
         Ok(Self {
-            limits: JointLimits::from_robot(&robot)?,
-            bounds: BoundMethod::viable(),
-            bx: AccelerationBox::new(nv),
-            solver: Solver::new(nv, &dims, settings)?,
-            method,
-            qdd: DVector::zeros(nv),
-            pos: vec![0.0; nv],
+            ctl,
+            state,
+            upper,
             q0,
             phases,
             qr: std::array::from_fn(|_| vec![0.0; UPPER_BODY.len()]),
             k: 0,
-            robot,
-            state,
-            kin,
-            stack,
-            eqs,
         })
+    }
+
+    /// The robot.
+    pub fn robot(&self) -> &Robot {
+        self.ctl.robot()
+    }
+
+    /// Its joint limits.
+    pub fn limits(&self) -> &JointLimits {
+        self.ctl.limits()
+    }
+
+    /// The q̈ of the last solve \[rad/s² or m/s²\].
+    pub fn qdd(&self) -> &DVector<f64> {
+        self.ctl.qdd()
     }
 
     /// The upper-body reference at time t \[s\]: positions \[rad\], rates \[rad/s\] and
@@ -189,39 +179,27 @@ impl PeerProblem {
         }
     }
 
-    /// Kinematics, references and task linearisation, and the box of step k, without solving.
+    /// The reference of step k, then kinematics, task linearisation and the box, without
+    /// solving ([`Controller::prepare`]; read them with [`Controller::equations`] and
+    /// [`Controller::bounds`]).
     pub fn prepare(&mut self) -> iktc::Result<()> {
-        self.kin.update(&self.robot, &self.state)?;
         self.reference(self.k as f64 * DT);
-        if let Some(Task::Joint(j)) = self.stack.levels[4].tasks.first_mut() {
-            j.set_reference(&self.qr[0], &self.qr[1], &self.qr[2])?;
-        }
-        self.stack
-            .linearize(&self.robot, &self.kin, &self.state, &mut self.eqs)?;
-        self.state.dof_positions(&self.robot, &mut self.pos)?;
-        compute_box(
-            &self.limits,
-            &self.bounds,
-            &self.pos,
-            self.state.qd.as_slice(),
-            DT,
-            &mut self.bx,
-        )
+        self.ctl
+            .set_joints_reference(self.upper, &self.qr[0], &self.qr[1], &self.qr[2])?;
+        self.ctl.prepare(&self.state, DT)
     }
 
-    /// Integrates the q̈ of the last solve over Δt and advances k.
-    pub fn finish(&mut self) -> iktc::Result<()> {
-        self.state.integrate(&self.robot, &self.qdd, DT)?;
+    /// Solves the prepared step, integrates its q̈ over Δt and advances k.
+    pub fn finish(&mut self) -> iktc::Result<&SolveReport> {
+        self.ctl.solve()?;
+        self.ctl.integrate(&mut self.state)?;
         self.k += 1;
-        Ok(())
+        Ok(self.ctl.report())
     }
 
     /// One step: kinematics, linearisation, box, solve, integration. Allocates nothing.
     pub fn step(&mut self) -> iktc::Result<&SolveReport> {
         self.prepare()?;
-        self.solver
-            .solve(self.method, &self.eqs, &self.bx, &mut self.qdd)?;
-        self.finish()?;
-        Ok(self.solver.report())
+        self.finish()
     }
 }
