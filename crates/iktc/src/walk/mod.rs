@@ -45,7 +45,7 @@ pub mod timeline;
 pub use dare::{dare_residual, solve_dare, DareSettings, DareSolution, DareStatus};
 pub use footstep::{Footstep, FootstepPlan, Pose2, RootPlanParams, RootSample};
 pub use pattern::{ComState, WalkSample, WalkingPattern, MAX_PATTERN_SAMPLES};
-pub use polygon::{sole_corners, PolygonEdge, SupportPolygon, MAX_POLYGON_VERTICES};
+pub use polygon::{sole_corners, PolygonEdge, SupportPolygon, MAX_POLYGON_VERTICES, MAX_SOLES};
 pub use preview::{
     CartSample, CartTable, PreviewAxis, PreviewController, PreviewSettings, MAX_PREVIEW_SAMPLES,
 };

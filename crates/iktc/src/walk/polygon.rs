@@ -4,8 +4,11 @@ use serde::Serialize;
 
 use super::footstep::Pose2;
 
-/// Most vertices a support polygon can have (two rectangles).
-pub const MAX_POLYGON_VERTICES: usize = 8;
+/// Most soles a support polygon can be the hull of (two feet and two hands, or four feet).
+pub const MAX_SOLES: usize = 4;
+
+/// Most vertices a support polygon can have (four corners per sole).
+pub const MAX_POLYGON_VERTICES: usize = 4 * MAX_SOLES;
 
 /// A convex polygon on the ground, counter-clockwise, without allocation: up to
 /// [`MAX_POLYGON_VERTICES`] vertices `(x, y)` \[m\] in a fixed array.
@@ -66,15 +69,24 @@ impl SupportPolygon {
         self.len = 4;
     }
 
-    /// Sets the polygon to the convex hull of two sole rectangles (Andrew's monotone chain:
-    /// sort by `x` then `y`, build the lower and upper chains, dropping points that do not
-    /// turn left; collinear points are dropped). Allocation-free.
+    /// Sets the polygon to the convex hull of two sole rectangles
+    /// ([`SupportPolygon::set_hull_of_sole_poses`]). Allocation-free.
     pub fn set_hull_of_soles(&mut self, a: &Pose2, b: &Pose2, length: f64, width: f64) {
-        let ca = sole_corners(a, length, width);
-        let cb = sole_corners(b, length, width);
+        self.set_hull_of_sole_poses(&[*a, *b], length, width);
+    }
+
+    /// Sets the polygon to the convex hull of the sole rectangles at `soles` (Andrew's
+    /// monotone chain: sort the corners by `x` then `y`, build the lower and upper chains,
+    /// dropping points that do not turn left; collinear points are dropped). Soles beyond
+    /// [`MAX_SOLES`] are ignored (callers check the count); none empties the polygon.
+    /// Allocation-free.
+    pub fn set_hull_of_sole_poses(&mut self, soles: &[Pose2], length: f64, width: f64) {
+        let soles = &soles[..soles.len().min(MAX_SOLES)];
         let mut pts = [(0.0, 0.0); MAX_POLYGON_VERTICES];
-        pts[..4].copy_from_slice(&ca);
-        pts[4..].copy_from_slice(&cb);
+        for (chunk, pose) in pts.chunks_exact_mut(4).zip(soles) {
+            chunk.copy_from_slice(&sole_corners(pose, length, width));
+        }
+        let pts = &mut pts[..4 * soles.len()];
         pts.sort_by(|p, q| p.0.total_cmp(&q.0).then(p.1.total_cmp(&q.1)));
         // Hull buffer: at most 2n points during construction.
         let mut hull = [(0.0, 0.0); 2 * MAX_POLYGON_VERTICES];
@@ -95,7 +107,7 @@ impl SupportPolygon {
             k += 1;
         }
         // The last point repeats the first.
-        let n = (k - 1).min(MAX_POLYGON_VERTICES);
+        let n = k.saturating_sub(1).min(MAX_POLYGON_VERTICES);
         self.points[..n].copy_from_slice(&hull[..n]);
         self.len = n;
     }

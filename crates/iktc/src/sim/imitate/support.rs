@@ -2,7 +2,7 @@
 
 use nalgebra::{Isometry3, Point3};
 
-use crate::walk::{Pose2, SupportPolygon};
+use crate::walk::{Pose2, SupportPolygon, MAX_SOLES};
 
 use crate::error::{Error, Result};
 
@@ -67,26 +67,31 @@ pub fn sole_pose(ankle: &Isometry3<f64>, settings: &SupportSettings) -> Pose2 {
     Pose2::new(c.x, c.y, r[(1, 0)].atan2(r[(0, 0)]))
 }
 
-/// The support polygon of one or two feet at poses `feet` (ankle frames): the convex hull of
-/// their sole rectangles on the ground, [`SupportPolygon::set_hull_of_soles`] (foot yaw
-/// included). Errors: no foot, or more than two.
+/// The support polygon of the feet at poses `feet` (ankle frames): the convex hull of their
+/// sole rectangles on the ground, [`SupportPolygon::set_hull_of_sole_poses`] (foot yaw
+/// included). Errors: no foot, or more than [`MAX_SOLES`].
 pub fn support_polygon(
     feet: &[Isometry3<f64>],
     settings: &SupportSettings,
 ) -> Result<SupportPolygon> {
-    let (l, w) = (settings.sole_length, settings.sole_width);
-    let mut p = SupportPolygon::default();
-    match feet {
-        [a] => p.set_sole(&sole_pose(a, settings), l, w),
-        [a, b] => p.set_hull_of_soles(&sole_pose(a, settings), &sole_pose(b, settings), l, w),
-        _ => {
-            return Err(Error::InvalidSetting {
-                name: "feet".into(),
-                value: format!("{} frames", feet.len()),
-                expected: "one or two foot frames (the support polygon is the hull of their soles)"
-                    .into(),
-            })
-        }
+    if feet.is_empty() || feet.len() > MAX_SOLES {
+        return Err(Error::InvalidSetting {
+            name: "feet".into(),
+            value: format!("{} frames", feet.len()),
+            expected: format!(
+                "1 to {MAX_SOLES} foot frames (the support polygon is the hull of their soles)"
+            ),
+        });
     }
+    let mut soles = [Pose2::default(); MAX_SOLES];
+    for (slot, foot) in soles.iter_mut().zip(feet) {
+        *slot = sole_pose(foot, settings);
+    }
+    let mut p = SupportPolygon::default();
+    p.set_hull_of_sole_poses(
+        &soles[..feet.len()],
+        settings.sole_length,
+        settings.sole_width,
+    );
     Ok(p)
 }
