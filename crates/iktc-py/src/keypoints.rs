@@ -11,7 +11,7 @@ use pyo3::prelude::*;
 use crate::convert::{array, table};
 use crate::motion::PyMotion;
 use crate::robot::PyRobot;
-use crate::{to_py, IktcError};
+use crate::to_py;
 
 /// A keypoint retargeting run, one row per control tick from the clip's start (the settling
 /// phase before it is not recorded; row 0 is the state it ends in).
@@ -44,12 +44,7 @@ pub fn py_retarget_keypoints(
     dt: f64,
     hold_feet: bool,
 ) -> PyResult<PyKeypointTrajectory> {
-    let profile = robot.profile.as_ref().ok_or_else(|| {
-        IktcError::new_err(format!(
-            "robot `{}` has no profile: keypoint retargeting needs its feet, pelvis and hands",
-            robot.robot.name()
-        ))
-    })?;
+    let profile = robot.required_profile("keypoint retargeting", "feet, pelvis and hands")?;
     let mut settings = KeypointSettings {
         dt,
         ..KeypointSettings::default()

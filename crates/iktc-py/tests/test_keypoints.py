@@ -45,3 +45,8 @@ def test_hold_feet_keeps_both_feet_where_the_clip_steps(runs):
 def test_a_robot_without_a_profile_is_an_error():
     with pytest.raises(iktc.IktcError, match="no profile"):
         iktc.retarget_keypoints(iktc.load_motion("humanoid3d_dance_b"), iktc.Robot("planar3r"))
+
+
+def test_a_bad_control_period_is_an_error_naming_it():
+    with pytest.raises(iktc.IktcError, match="dt"):
+        iktc.retarget_keypoints(iktc.load_motion("humanoid3d_dance_b"), iktc.Robot("g1"), dt=0.0)

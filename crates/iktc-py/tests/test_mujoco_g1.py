@@ -72,7 +72,8 @@ def test_standing_imitation_of_the_default_clip_keeps_the_feet_within_5_mm():
 # The keypoint route (body points scaled to G1, feet held, COM over the polygon), its q and v
 # the servos' set points, is no gentler: its joint accelerations (second differences) change
 # sign every 4 ticks (rms 129 rad/s² against the joint route's 60) and G1 falls (README).
-@pytest.mark.xfail(strict=True, reason="G1 on MuJoCo falls following the keypoint route's plan "
+@pytest.mark.xfail(strict=True, raises=AssertionError,
+                   reason="G1 on MuJoCo falls following the keypoint route's plan "
                    "of humanoid3d_dance_b with its feet held (see the example's README section)")
 def test_standing_imitation_by_the_keypoint_route_keeps_the_feet_within_5_mm():
     s = g1_sim.run_standing_keypoints().summary()
