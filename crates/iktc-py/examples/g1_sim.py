@@ -275,7 +275,9 @@ class Loop:
         self.t += CONTROL_PERIOD
         self.record(q, com_offset)
 
-    def record(self, q, com_offset) -> None:
+    def record(self, q, com_offset, upper_reference=None) -> None:
+        """Logs the tick; `upper_reference` [rad] (default: the imitation's upper-body
+        reference) is what the upper-body joints are measured against."""
         p, log = self.plant, self.log
         log.t.append(self.t)
         log.pelvis_height.append(p.pelvis_height())
@@ -289,7 +291,7 @@ class Loop:
         qj = p.joint_positions()
         err = qj - q[7:]
         log.joint_error.append(float(np.abs(err).max()))
-        up = self.sim.upper_body_reference()
+        up = self.sim.upper_body_reference() if upper_reference is None else upper_reference
         log.upper_error.append(float(np.abs(qj[self.upper] - up).max()))
         log.com_offset.append(com_offset)
         log.qpos.append(p.data.qpos.copy())
@@ -311,6 +313,41 @@ def run_standing(duration: float | None = None, settle: float = 0.5,
     for _ in range(loop.sim.ticks):
         loop.step()
     return loop
+
+
+def run_standing_keypoints(clip: str = "humanoid3d_dance_b", settle: float = 0.5,
+                           robot: iktc.Robot | None = None) -> Loop:
+    """(a′) Standing imitation by the keypoint route (``iktc.retarget_keypoints(...,
+    hold_feet=True)``: the clip's body points scaled to G1, both feet held where they stand,
+    the COM reference over the support polygon); its q and v per tick are the servos' set
+    points, the plan computed beforehand (it does not see the plant). The loop's imitation
+    (one tick long) serves only for the support polygon; the upper body is measured against
+    the plan's own upper-body angles. Returns the loop."""
+    loop = Loop(clip=clip, duration=CONTROL_PERIOD, robot=robot)
+    plan = iktc.retarget_keypoints(iktc.load_motion(clip), loop.robot, dt=CONTROL_PERIOD,
+                                   hold_feet=True)
+    qs, vs = plan.q, plan.v
+    loop.plant.set_state(qs[0])
+    for _ in range(int(round(settle / CONTROL_PERIOD))):
+        loop.plant.command(qs[0])
+        loop.plant.advance()
+    loop.feet0 = [loop.plant.foot_pose(i) for i in range(2)]
+    for q, v in zip(qs, vs):
+        loop.plant.command(q, v)
+        loop.plant.advance()
+        loop.t += CONTROL_PERIOD
+        loop.record(q, None, upper_reference=q[7:][loop.upper])
+    return loop
+
+
+def plan_chatter(qs: np.ndarray, dt: float = CONTROL_PERIOD) -> dict:
+    """How a plan's joint accelerations [rad/s²] behave: their rms over the joints and ticks,
+    and the median over the joints of how often q̈ changes sign (second differences of the
+    tick-by-tick joint angles `qs`, one row per tick: base 7, then joints)."""
+    a = np.diff(np.asarray(qs)[:, 7:], 2, axis=0) / dt ** 2
+    flips = np.sum(np.sign(a[1:]) != np.sign(a[:-1]), axis=0)
+    return {"joint_acceleration_rms_rad_s2": float(np.sqrt(np.mean(a ** 2))),
+            "joint_acceleration_sign_changes_median": f"{int(np.median(flips))} of {len(a) - 1}"}
 
 
 def planned_zmp(plant: Plant, qs: list, dt: float = CONTROL_PERIOD) -> np.ndarray:

@@ -1,7 +1,8 @@
 """The Unitree G1 in MuJoCo driven by iktc tick by tick: standing imitation, identification, push.
 
     python crates/iktc-py/examples/mujoco_g1.py standing [--clip humanoid3d_dance_b]
-        [--time-scale 1] [--robot g1|profile.toml] [--json out.json] [--replay out.html]
+        [--plan joints|keypoints] [--time-scale 1] [--robot g1|profile.toml]
+        [--json out.json] [--replay out.html]
     python crates/iktc-py/examples/mujoco_g1.py balance [--damping 0.72] [--designs 0.3,0.9]
         [--json out.json]
     python crates/iktc-py/examples/mujoco_g1.py walking [--steps 4] [--json out.json]
@@ -96,6 +97,9 @@ def main() -> None:
     ap.add_argument("--designs", help="balance: also push with these design ratios, e.g. "
                     "0.3,0.5,0.72,0.9, and print the measured ones")
     ap.add_argument("--clip", default="humanoid3d_dance_b")
+    ap.add_argument("--plan", default="joints", choices=["joints", "keypoints"],
+                    help="standing: the imitation of Table 1 ticking in the loop (joint route), "
+                    "or the keypoint retargeting with the feet held, computed beforehand")
     ap.add_argument("--time-scale", type=float, default=1.0, help="play the clip this many times slower")
     ap.add_argument("--robot", default="g1", help="the built-in g1 or a G1 profile file (.toml)")
     ap.add_argument("--settle", type=float, default=0.5, help="time holding the start posture [s]")
@@ -118,13 +122,22 @@ def main() -> None:
 
 
 def standing(a) -> dict:
-    loop = g1_sim.Loop(clip=a.clip, time_scale=a.time_scale, robot=iktc.Robot(a.robot))
-    loop.settle(a.settle)
-    for _ in range(loop.sim.ticks):
-        loop.step()
+    if a.plan == "keypoints":
+        if a.time_scale != 1.0:
+            raise SystemExit("--time-scale applies to --plan joints only")
+        loop = g1_sim.run_standing_keypoints(clip=a.clip, settle=a.settle,
+                                             robot=iktc.Robot(a.robot))
+    else:
+        loop = g1_sim.Loop(clip=a.clip, time_scale=a.time_scale, robot=iktc.Robot(a.robot))
+        loop.settle(a.settle)
+        for _ in range(loop.sim.ticks):
+            loop.step()
     s = loop.summary()
+    s["plan"] = a.plan
+    s.update(g1_sim.plan_chatter(loop.log.q_cmd))
     plan = g1_sim.planned_zmp(loop.plant, loop.log.q_cmd)
-    margins = [loop.sim.support_margin(tuple(p)) for p in plan if np.all(np.isfinite(p))]
+    feet = [loop.robot.frame_pose(loop.log.q_cmd[0], f) for f in g1_sim.FEET]  # held
+    margins = [loop.sim.support_margin(tuple(p), feet) for p in plan if np.all(np.isfinite(p))]
     s["planned_zmp_margin_min_m"] = float(min(margins))
     s["planned_zmp_ticks_outside"] = int(sum(m < 0 for m in margins))
     if a.replay:

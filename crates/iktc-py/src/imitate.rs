@@ -142,12 +142,7 @@ impl PyImitation {
         rebase_release: f64,
         narrow: Option<Vec<(String, f64, f64)>>,
     ) -> PyResult<Self> {
-        let profile = robot.profile.as_ref().ok_or_else(|| {
-            IktcError::new_err(format!(
-                "robot `{}` has no profile: the imitation needs its feet, pelvis and posture (load it by a built-in name or a profile file)",
-                robot.robot.name()
-            ))
-        })?;
+        let profile = robot.required_profile("the imitation", "feet, pelvis and posture")?;
         let base = ImitateConfig {
             method: parse_method(method)?,
             bounds: parse_bounds(bounds)?,

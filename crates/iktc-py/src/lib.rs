@@ -13,6 +13,7 @@ mod balance;
 mod controller;
 mod convert;
 mod imitate;
+mod keypoints;
 mod motion;
 mod robot;
 mod walk;
@@ -43,6 +44,7 @@ fn _iktc(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<imitate::PyImitation>()?;
     m.add_class::<walk::PyWalking>()?;
     motion::register(m)?;
+    keypoints::register(m)?;
     balance::register(m)?;
     Ok(())
 }

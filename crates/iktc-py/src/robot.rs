@@ -231,4 +231,15 @@ impl PyRobot {
         let s = self.state(q, None)?;
         Kinematics::new(&self.robot, &s).map_err(to_py)
     }
+
+    /// The robot's profile, or an error saying that `what` (e.g. "the imitation") needs its
+    /// `parts` (e.g. "feet, pelvis and posture").
+    pub(crate) fn required_profile(&self, what: &str, parts: &str) -> PyResult<&RobotProfile> {
+        self.profile.as_deref().ok_or_else(|| {
+            crate::IktcError::new_err(format!(
+                "robot `{}` has no profile: {what} needs its {parts} (load it by a built-in name or a profile file)",
+                self.robot.name()
+            ))
+        })
+    }
 }

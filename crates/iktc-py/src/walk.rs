@@ -13,7 +13,7 @@ use crate::convert::{array, pose_matrix};
 use crate::imitate::narrowed;
 use crate::motion::{resolve_map, PyMotion};
 use crate::robot::PyRobot;
-use crate::{to_py, IktcError};
+use crate::to_py;
 
 /// Walking while imitating: `steps` footsteps of `step_length` [m] (default: the robot
 /// profile's `walk` settings, else 0.1 m steps, 0.8 s initial and final double support, 0.6 s
@@ -42,12 +42,7 @@ impl PyWalking {
         step_length: Option<f64>,
         narrow: Option<Vec<(String, f64, f64)>>,
     ) -> PyResult<Self> {
-        let profile = robot.profile.as_ref().ok_or_else(|| {
-            IktcError::new_err(format!(
-                "robot `{}` has no profile: walking needs its feet, pelvis and posture",
-                robot.robot.name()
-            ))
-        })?;
+        let profile = robot.required_profile("walking", "feet, pelvis and posture")?;
         let mut cfg = profile
             .walk_config(&robot.robot, WalkImitateConfig::jvrc1().map_err(to_py)?)
             .map_err(to_py)?;

@@ -69,6 +69,17 @@ def test_standing_imitation_of_the_default_clip_keeps_the_feet_within_5_mm():
     assert s["foot_slip_max_m"] <= 5e-3, s
 
 
+# The keypoint route (body points scaled to G1, feet held, COM over the polygon), its q and v
+# the servos' set points, is no gentler: its joint accelerations (second differences) change
+# sign every 4 ticks (rms 129 rad/s² against the joint route's 60) and G1 falls (README).
+@pytest.mark.xfail(strict=True, raises=AssertionError,
+                   reason="G1 on MuJoCo falls following the keypoint route's plan "
+                   "of humanoid3d_dance_b with its feet held (see the example's README section)")
+def test_standing_imitation_by_the_keypoint_route_keeps_the_feet_within_5_mm():
+    s = g1_sim.run_standing_keypoints().summary()
+    assert s["foot_slip_max_m"] <= 5e-3, s
+
+
 def test_the_planned_zmp_is_the_com_standing_and_shifts_by_z_a_over_g_when_accelerated():
     loop = g1_sim.Loop(duration=0.1)
     q0 = loop.sim.q

@@ -13,7 +13,8 @@ Quick start::
     report = ctrl.step(q, v, 0.005)     # q and v advanced in place
 
 Motions (``load_motion``: a built-in DeepMimic clip or a BVH, ASF/AMC, DeepMimic, C3D or
-points-CSV file) retarget to a robot with ``retarget`` (numpy arrays); ``Imitation`` steps the
+points-CSV file) retarget to a robot with ``retarget`` (joint angles) or ``retarget_keypoints`` (body points,
+the robot's q, v, q̈ per tick), numpy arrays; ``Imitation`` steps the
 imitation of Section 5.3 tick by tick.
 
 Every error of the library is raised as ``iktc.IktcError`` (a ``ValueError``) with the
@@ -40,6 +41,8 @@ from ._iktc import (
     Walking,
     load_motion,
     retarget,
+    retarget_keypoints,
+    KeypointTrajectory,
 )
 
 __all__ = [
@@ -63,4 +66,6 @@ __all__ = [
     "Walking",
     "load_motion",
     "retarget",
+    "retarget_keypoints",
+    "KeypointTrajectory",
 ]

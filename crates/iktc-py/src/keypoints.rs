@@ -1,0 +1,154 @@
+//! `iktc.retarget_keypoints`: the keypoint retargeting of `iktc::retarget` (the default route of
+//! `iktc imitate`) run from Python, its state recorded tick by tick (q, v, q̈) as numpy arrays,
+//! e.g. as the set points of a simulated robot's servos.
+
+use iktc::motion::{MotionFormat, DEFAULT_MAX_GAP};
+use iktc::retarget::{keypoint_controller, KeypointSettings};
+use iktc::sim::{imitation_references, ImitateConfig};
+use numpy::{PyArray1, PyArray2};
+use pyo3::prelude::*;
+
+use crate::convert::{array, table};
+use crate::motion::PyMotion;
+use crate::robot::PyRobot;
+use crate::to_py;
+
+/// A keypoint retargeting run, one row per control tick from the clip's start (the settling
+/// phase before it is not recorded; row 0 is the state it ends in).
+#[pyclass(name = "KeypointTrajectory", module = "iktc", frozen)]
+pub struct PyKeypointTrajectory {
+    dt: f64,
+    times: Vec<f64>,
+    nq: usize,
+    nv: usize,
+    q: Vec<f64>,
+    v: Vec<f64>,
+    qdd: Vec<f64>,
+    fallback_ticks: usize,
+}
+
+/// Runs the keypoint retargeting of `motion` on `robot` (which must have a profile) as
+/// `iktc imitate` does by default (see `iktc::retarget`): the clip's body points scaled to the
+/// robot, stance feet held, the COM reference kept over the support polygon, the strict-priority
+/// keypoint stack solved by IKTC under the viable bounds, integrated with constant acceleration
+/// over `dt` [s]; the posture level follows the joint route's references where the profile has
+/// a map for the motion's format. `hold_feet`: every frame counts as stance, so both feet are
+/// held where they stand for the whole clip (a standing imitation) instead of stepping where
+/// the clip's feet leave the ground.
+#[pyfunction]
+#[pyo3(name = "retarget_keypoints", signature = (motion, robot, *, dt=0.005, hold_feet=false))]
+pub fn py_retarget_keypoints(
+    py: Python<'_>,
+    motion: &PyMotion,
+    robot: &PyRobot,
+    dt: f64,
+    hold_feet: bool,
+) -> PyResult<PyKeypointTrajectory> {
+    let profile = robot.required_profile("keypoint retargeting", "feet, pelvis and hands")?;
+    let mut settings = KeypointSettings {
+        dt,
+        ..KeypointSettings::default()
+    };
+    if hold_feet {
+        // Any height above the clip's lowest ankle and any speed count as on the ground.
+        settings.contact_height = f64::MAX;
+        settings.contact_speed = f64::MAX;
+    }
+    py.detach(|| -> iktc::Result<PyKeypointTrajectory> {
+        let kp = motion.motion.keypoints(DEFAULT_MAX_GAP)?;
+        let cfg = ImitateConfig {
+            dt,
+            narrow: Vec::new(),
+            ..profile.imitate_config(ImitateConfig::default())?
+        };
+        let key = if motion.motion.format == MotionFormat::DeepMimic {
+            "deepmimic"
+        } else {
+            "bvh"
+        };
+        let refs = match (&motion.clip, profile.retarget_map(key, &robot.robot)) {
+            (Some(clip), Ok(map)) => Some(imitation_references(&robot.robot, clip, &map, &cfg)?),
+            _ => None,
+        };
+        let mut ctl = keypoint_controller(profile, &kp, refs.as_ref(), &settings)?;
+        for _ in 0..(settings.settle_time / dt).round() as usize {
+            ctl.tick(0, true)?;
+            ctl.integrate()?;
+        }
+        let ticks = ctl.ticks();
+        let (nq, nv) = (robot.robot.nq(), robot.robot.nv());
+        let t0 = kp.times.first().copied().unwrap_or(0.0);
+        let mut out = PyKeypointTrajectory {
+            dt,
+            times: Vec::with_capacity(ticks),
+            nq,
+            nv,
+            q: Vec::with_capacity(ticks * nq),
+            v: Vec::with_capacity(ticks * nv),
+            qdd: Vec::with_capacity(ticks * nv),
+            fallback_ticks: 0,
+        };
+        for k in 0..ticks {
+            out.times.push(t0 + k as f64 * dt);
+            out.q.extend(ctl.state().q.iter());
+            out.v.extend(ctl.state().qd.iter());
+            ctl.tick(k, false)?;
+            out.qdd.extend(ctl.qdd().iter());
+            ctl.integrate()?;
+        }
+        out.fallback_ticks = ctl.fallback_ticks();
+        Ok(out)
+    })
+    .map_err(to_py)
+}
+
+#[pymethods]
+impl PyKeypointTrajectory {
+    /// Control period [s].
+    #[getter]
+    fn dt(&self) -> f64 {
+        self.dt
+    }
+
+    /// Tick times from the clip's start [s], shape (N,).
+    #[getter]
+    fn times<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        array(py, &self.times)
+    }
+
+    /// Configurations q at the start of each tick, shape (N, nq): base position [m],
+    /// quaternion (x, y, z, w), joints [rad].
+    #[getter]
+    fn q<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        table(py, [self.times.len(), self.nq], self.q.clone())
+    }
+
+    /// Velocities v at the start of each tick, shape (N, nv): base twist [m/s], [rad/s] (base
+    /// axes), joint rates [rad/s].
+    #[getter]
+    fn v<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        table(py, [self.times.len(), self.nv], self.v.clone())
+    }
+
+    /// The accelerations q̈ solved at each tick, shape (N, nv) [m/s²], [rad/s²].
+    #[getter]
+    fn qdd<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        table(py, [self.times.len(), self.nv], self.qdd.clone())
+    }
+
+    /// Ticks solved by GF because IKTC's answer left the box.
+    #[getter]
+    fn fallback_ticks(&self) -> usize {
+        self.fallback_ticks
+    }
+
+    fn __len__(&self) -> usize {
+        self.times.len()
+    }
+}
+
+pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(py_retarget_keypoints, m)?)?;
+    m.add_class::<PyKeypointTrajectory>()?;
+    Ok(())
+}

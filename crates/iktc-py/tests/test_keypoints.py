@@ -1,0 +1,52 @@
+"""`iktc.retarget_keypoints`: the keypoint retargeting's tick-by-tick states from Python."""
+import numpy as np
+import pytest
+
+import iktc
+
+FEET = ("right_ankle_roll_link", "left_ankle_roll_link")
+
+
+@pytest.fixture(scope="module")
+def runs():
+    robot = iktc.Robot("g1")
+    motion = iktc.load_motion("humanoid3d_dance_b")
+    return robot, {hold: iktc.retarget_keypoints(motion, robot, hold_feet=hold)
+                   for hold in (False, True)}
+
+
+def test_the_states_are_integrated_with_constant_acceleration(runs):
+    robot, r = runs
+    t = r[True]
+    n, dt = len(t), t.dt
+    assert t.q.shape == (n, robot.nq) and t.v.shape == t.qdd.shape == (n, robot.nv)
+    assert t.q.dtype == np.float64 and np.allclose(np.diff(t.times), dt)
+    # Joints (after the base's 7 q and 6 v): q⁺ = q + v Δt + ½ q̈ Δt², v⁺ = v + q̈ Δt.
+    q, v, a = t.q[:, 7:], t.v[:, 6:], t.qdd[:, 6:]
+    assert np.allclose(q[1:], q[:-1] + v[:-1] * dt + 0.5 * a[:-1] * dt ** 2, atol=1e-12)
+    assert np.allclose(v[1:], v[:-1] + a[:-1] * dt, atol=1e-10)
+    lo, hi, _, _ = robot.limits()
+    assert np.all(q >= lo[6:] - 1e-9) and np.all(q <= hi[6:] + 1e-9)
+
+
+def test_hold_feet_keeps_both_feet_where_the_clip_steps(runs):
+    robot, r = runs
+
+    def travel(t):
+        p = np.array([[robot.frame_pose(q, f)[:3, 3] for f in FEET] for q in t.q])
+        return np.abs(p - p[0]).max()
+
+    # The dancer steps: by default the robot's feet follow (tens of cm); held, they stay within
+    # the feet level's tracking error (≈ 1 mm).
+    assert travel(r[False]) > 0.1
+    assert travel(r[True]) < 2e-3
+
+
+def test_a_robot_without_a_profile_is_an_error():
+    with pytest.raises(iktc.IktcError, match="no profile"):
+        iktc.retarget_keypoints(iktc.load_motion("humanoid3d_dance_b"), iktc.Robot("planar3r"))
+
+
+def test_a_bad_control_period_is_an_error_naming_it():
+    with pytest.raises(iktc.IktcError, match="dt"):
+        iktc.retarget_keypoints(iktc.load_motion("humanoid3d_dance_b"), iktc.Robot("g1"), dt=0.0)
