@@ -11,9 +11,11 @@
 //! complete orthogonal decomposition of the stacked Jacobian: with Q = H_0 H_1 ⋯ (all
 //! reflectors so far) and u = Qᵀ q̈, the levels above level i occupy the first p_i reduced
 //! coordinates, and the null space of the levels above is spanned by the remaining columns
-//! Z = Q\[:, p_i..n\], so N_{i−1} = Z Zᵀ. The rows of every lower level are kept multiplied by
-//! the reflectors found so far, W_j = J_j Q, so the reduced Jacobian of level i is simply
-//! A_iᵀ = W_i\[:, p_i..n\] = J_i Z (m_i × k, k = n − p_i) — no product with a basis.
+//! Z = Q\[:, p_i..n\], so N_{i−1} = Z Zᵀ. When level i is reached its rows are multiplied by
+//! the reflectors of the levels above, W_i = J_i H_0 ⋯ H_{p_i−1} (left-looking: one blocked
+//! pass over all of them instead of one pass per level above), so the reduced Jacobian of
+//! level i is simply A_iᵀ = W_i\[:, p_i..n\] = J_i Z (m_i × k, k = n − p_i) — no product with
+//! a basis.
 //!
 //! The column-pivoted Householder QR A_i Π = H_{p_i} ⋯ H_{p_i+r−1} R keeps the r pivots with
 //! |R_jj| above the rank threshold. Then J_i Z = Π R_rᵀ Q_rᵀ and
@@ -36,7 +38,7 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use super::kernels::{axpy, dot};
+use super::kernels::{axpy, axpy2, dot, reflect2};
 use super::reflectors::Reflectors;
 use super::settings::{Damping, SolverSettings};
 use crate::error::{check_dim, Error, Result};
@@ -58,8 +60,8 @@ pub struct Hierarchy {
     ranks: Vec<usize>,
     /// First reduced coordinate p_i of level i.
     starts: Vec<usize>,
-    /// Wᵀ (n × Σm_i): column j is stacked task row j multiplied by the reflectors of the
-    /// levels above its own.
+    /// Wᵀ (n × Σm_i): column j is stacked task row j, multiplied by the reflectors of the
+    /// levels above its own once its level has been reached.
     w: DMatrix<f64>,
     /// The Householder reflectors of all levels so far, one per kept pivot (Σ r_i ≤ n); their
     /// number is the next free reduced coordinate.
@@ -194,10 +196,12 @@ impl Hierarchy {
         for (i, lvl) in levels.iter().enumerate() {
             let off = self.offsets[i];
             let ws = self.w.as_mut_slice();
-            for r in 0..lvl.dim() {
-                let col = &mut ws[(off + r) * wr..(off + r + 1) * wr];
-                for (d, x) in col.iter_mut().enumerate() {
-                    *x = lvl.jacobian[(r, d)];
+            let m = lvl.dim();
+            let block = &mut ws[off * wr..(off + m) * wr];
+            // Column d of the column-major J holds entry d of every row.
+            for (d, jc) in lvl.jacobian.as_slice().chunks_exact(m.max(1)).enumerate() {
+                for (r, &j) in jc.iter().enumerate() {
+                    block[r * wr + d] = j;
                 }
             }
         }
@@ -238,11 +242,16 @@ impl Hierarchy {
         let (n, m, p) = (self.n, self.dims[i], self.refl.len());
         let k = n - p;
         self.ranks[i] = 0;
+        let off = self.offsets[i];
+        let wr = self.w.nrows();
+        // The rows of this level under the reflectors of the levels above:
+        // W_i = J_i H_0 ⋯ H_{p−1}, applied when the level is reached (left-looking), in the
+        // blocks of four of all levels above at once.
+        self.refl
+            .apply_forward(p, &mut self.w.as_mut_slice()[off * wr..(off + m) * wr]);
         if m == 0 || k == 0 {
             return;
         }
-        let off = self.offsets[i];
-        let wr = self.w.nrows();
         let ar = self.a.nrows();
         {
             let ws = self.w.as_slice();
@@ -303,12 +312,21 @@ impl Hierarchy {
             // Apply H to the remaining columns of A: column st becomes α e1.
             asl[st * ar + st] = alpha;
             asl[st * ar + st + 1..st * ar + k].fill(0.0);
-            for c in st + 1..m {
+            // Two columns per pass over v, then the odd one out.
+            let mut c = st + 1;
+            while c + 1 < m {
+                let (x, y) = asl[c * ar + st..].split_at_mut(ar);
+                reflect2(v, tau, x, y);
+                c += 2;
+            }
+            if c < m {
                 let col = &mut asl[c * ar + st..c * ar + st + end];
                 let f = tau * dot(v, col);
                 if f != 0.0 {
                     axpy(-f, v, col);
                 }
+            }
+            for c in st + 1..m {
                 let top = asl[c * ar + st];
                 self.colnorm[c] -= top * top;
                 if self.colnorm[c] <= NORM_DOWNDATE_TOL * self.colnorm_ref[c] {
@@ -323,11 +341,6 @@ impl Hierarchy {
         if rank == 0 {
             return;
         }
-        // The rows of the lower levels: w ← H_{p+r−1} ⋯ H_p w on the coordinates p..n.
-        let total = self.w.ncols();
-        let ws = self.w.as_mut_slice();
-        self.refl
-            .apply_forward(p, p + rank, &mut ws[(off + m) * wr..total * wr]);
         // λ² from the damping rule; σ_min estimated by the last kept pivot |R_rr|.
         let sigma = self.a[(rank - 1, rank - 1)].abs();
         let lambda2 = match settings.damping {
@@ -343,10 +356,11 @@ impl Hierarchy {
         };
         // R_r = rows 0..r of R (upper trapezoidal, r × m).
         let f = &mut self.fac[i];
-        for c in 0..m {
-            for q in 0..rank {
-                f.r[(q, c)] = if q <= c { self.a[(q, c)] } else { 0.0 };
-            }
+        let (fr, asl) = (f.r.nrows(), self.a.as_slice());
+        for (c, col) in f.r.as_mut_slice().chunks_exact_mut(fr).take(m).enumerate() {
+            let top = rank.min(c + 1);
+            col[..top].copy_from_slice(&asl[c * ar..c * ar + top]);
+            col[top..rank].fill(0.0);
         }
         f.factor(rank, m, lambda2);
     }
@@ -358,11 +372,14 @@ impl Hierarchy {
     fn reduced_block(&mut self, i: usize, propagate: bool) {
         let (n, nc, r, p) = (self.n, self.dims[i], self.ranks[i], self.starts[i]);
         let yb = &mut self.yb[..n * nc];
-        yb.fill(0.0);
         if r == 0 || nc == 0 {
             // Level i moves nothing, so nothing below it moves either.
+            yb.fill(0.0);
             return;
         }
+        // Rows p..p + r are written below (and the lower levels' rows, when propagating).
+        yb[..p * nc].fill(0.0);
+        yb[(p + r) * nc..].fill(0.0);
         // B = Πᵀ I: row j is e_{perm[j]}.
         let f = &self.fac[i];
         let bb = &mut self.bb[..nc * nc];
@@ -511,7 +528,16 @@ impl LevelFactor {
                 let (done, rest) = out.split_at_mut(q * nc);
                 let row = &mut rest[..nc];
                 row.copy_from_slice(&b[q * nc..(q + 1) * nc]);
-                for t in 0..q {
+                // Two rows of X per pass over the row (same order of the sums).
+                let mut t = 0;
+                while t + 1 < q {
+                    let (c0, c1) = (rs[q * rr + t], rs[q * rr + t + 1]);
+                    let x0 = &done[t * nc..(t + 1) * nc];
+                    let x1 = &done[(t + 1) * nc..(t + 2) * nc];
+                    axpy2(-c0, x0, -c1, x1, row);
+                    t += 2;
+                }
+                if t < q {
                     let c = rs[q * rr + t];
                     if c != 0.0 {
                         axpy(-c, &done[t * nc..(t + 1) * nc], row);
