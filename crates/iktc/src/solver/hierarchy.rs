@@ -60,9 +60,13 @@ pub struct Hierarchy {
     ranks: Vec<usize>,
     /// First reduced coordinate p_i of level i.
     starts: Vec<usize>,
-    /// Wᵀ (n × Σm_i): column j is stacked task row j, multiplied by the reflectors of the
-    /// levels above its own once its level has been reached.
-    w: DMatrix<f64>,
+    /// W, stored by coordinate: entry (j, t) of the stacked task rows j (Σm_i of them) in the
+    /// coordinates t (n) at `w[t * wld + j]`, so that the rows of one level are a block of
+    /// adjacent columns. Row j is multiplied by the reflectors of the levels above its own
+    /// once its level has been reached.
+    w: Vec<f64>,
+    /// Leading dimension of `w` (Σm_i).
+    wld: usize,
     /// The Householder reflectors of all levels so far, one per kept pivot (Σ r_i ≤ n); their
     /// number is the next free reduced coordinate.
     refl: Reflectors,
@@ -106,7 +110,8 @@ impl Hierarchy {
             offsets,
             ranks: vec![0; dims.len()],
             starts: vec![0; dims.len()],
-            w: DMatrix::zeros(n, total.max(1)),
+            w: vec![0.0; n * total],
+            wld: total,
             refl: Reflectors::new(n),
             fac: dims.iter().map(|&m| LevelFactor::new(m)).collect(),
             a: DMatrix::zeros(n.max(1), mmax),
@@ -191,18 +196,15 @@ impl Hierarchy {
     ) -> Result<()> {
         self.check(levels)?;
         check_dim("q̈", self.n, qdd.len())?;
-        // Wᵀ ← Jᵀ of every level.
-        let wr = self.w.nrows();
+        // W ← J of every level: column t of the column-major J_i is coordinate t of its rows.
+        let wld = self.wld;
         for (i, lvl) in levels.iter().enumerate() {
-            let off = self.offsets[i];
-            let ws = self.w.as_mut_slice();
-            let m = lvl.dim();
-            let block = &mut ws[off * wr..(off + m) * wr];
-            // Column d of the column-major J holds entry d of every row.
-            for (d, jc) in lvl.jacobian.as_slice().chunks_exact(m.max(1)).enumerate() {
-                for (r, &j) in jc.iter().enumerate() {
-                    block[r * wr + d] = j;
-                }
+            let (off, m) = (self.offsets[i], lvl.dim());
+            if m == 0 {
+                continue;
+            }
+            for (t, jc) in lvl.jacobian.as_slice().chunks_exact(m).enumerate() {
+                self.w[t * wld + off..t * wld + off + m].copy_from_slice(jc);
             }
         }
         self.u.fill(0.0);
@@ -215,13 +217,15 @@ impl Hierarchy {
             if r == 0 {
                 continue;
             }
-            // residual = h_i − W_i[:, 0..p] u[0..p] (u is zero from p on).
+            // residual = h_i − W_i[:, 0..p] u[0..p] (u is zero from p on), coordinate by
+            // coordinate over the level's rows.
             let off = self.offsets[i];
-            let ws = self.w.as_slice();
-            let us = &self.u.as_slice()[..p];
-            for c in 0..m {
-                let wc = &ws[(off + c) * wr..(off + c) * wr + p];
-                self.res[c] = lvl.rhs[c] - dot(wc, us);
+            let res = &mut self.res[..m];
+            res.copy_from_slice(lvl.rhs.as_slice());
+            for (t, &ut) in self.u.as_slice()[..p].iter().enumerate() {
+                if ut != 0.0 {
+                    axpy(-ut, &self.w[t * wld + off..t * wld + off + m], res);
+                }
             }
             // u[p..p+r] = S⁻¹ R_r Πᵀ residual.
             let f = &self.fac[i];
@@ -242,23 +246,23 @@ impl Hierarchy {
         let (n, m, p) = (self.n, self.dims[i], self.refl.len());
         let k = n - p;
         self.ranks[i] = 0;
-        let off = self.offsets[i];
-        let wr = self.w.nrows();
+        let (off, wld) = (self.offsets[i], self.wld);
         // The rows of this level under the reflectors of the levels above:
         // W_i = J_i H_0 ⋯ H_{p−1}, applied when the level is reached (left-looking), in the
-        // blocks of four of all levels above at once.
+        // blocks of four of all levels above at once, to all the level's rows together.
         self.refl
-            .apply_forward(p, &mut self.w.as_mut_slice()[off * wr..(off + m) * wr]);
+            .apply_forward_rows(p, &mut self.w, wld, off, m, &mut self.qscratch);
         if m == 0 || k == 0 {
             return;
         }
         let ar = self.a.nrows();
         {
-            let ws = self.w.as_slice();
             let asl = self.a.as_mut_slice();
-            for c in 0..m {
-                asl[c * ar..c * ar + k]
-                    .copy_from_slice(&ws[(off + c) * wr + p..(off + c + 1) * wr]);
+            for t in 0..k {
+                let wrow = &self.w[(p + t) * wld + off..(p + t) * wld + off + m];
+                for (c, &x) in wrow.iter().enumerate() {
+                    asl[c * ar + t] = x;
+                }
             }
         }
         let perm = &mut self.fac[i].perm;
@@ -380,19 +384,22 @@ impl Hierarchy {
         // Rows p..p + r are written below (and the lower levels' rows, when propagating).
         yb[..p * nc].fill(0.0);
         yb[(p + r) * nc..].fill(0.0);
-        // B = Πᵀ I: row j is e_{perm[j]}.
         let f = &self.fac[i];
         let bb = &mut self.bb[..nc * nc];
-        bb.fill(0.0);
-        for (j, &pj) in f.perm.iter().enumerate() {
-            bb[j * nc + pj] = 1.0;
+        if f.direct {
+            f.inverse_rows(nc, bb, &mut yb[p * nc..(p + r) * nc]);
+        } else {
+            // B = Πᵀ I: row j is e_{perm[j]}.
+            bb.fill(0.0);
+            for (j, &pj) in f.perm.iter().enumerate() {
+                bb[j * nc + pj] = 1.0;
+            }
+            f.apply_rows(r, nc, nc, bb, &mut yb[p * nc..(p + r) * nc]);
         }
-        f.apply_rows(r, nc, nc, bb, &mut yb[p * nc..(p + r) * nc]);
         if !propagate {
             return;
         }
-        let wr = self.w.nrows();
-        let ws = self.w.as_slice();
+        let (ws, wld) = (&self.w, self.wld);
         for k in i + 1..self.dims.len() {
             let (mk, rk, pk) = (self.dims[k], self.ranks[k], self.starts[k]);
             if rk == 0 {
@@ -404,10 +411,9 @@ impl Hierarchy {
             let bb = &mut self.bb[..mk * nc];
             bb.fill(0.0);
             for (j, &pj) in f.perm.iter().enumerate() {
-                let wc = &ws[(off + pj) * wr..(off + pj + 1) * wr];
                 let brow = &mut bb[j * nc..(j + 1) * nc];
                 for sidx in p..pk {
-                    let c = wc[sidx];
+                    let c = ws[sidx * wld + off + pj];
                     if c != 0.0 {
                         axpy(-c, &yb[sidx * nc..(sidx + 1) * nc], brow);
                     }
@@ -579,6 +585,36 @@ impl LevelFactor {
             }
             let inv = 1.0 / ls[q * lr + q];
             row.iter_mut().for_each(|x| *x *= inv);
+        }
+    }
+
+    /// `out` (row-major m × m) = R⁻ᵀ Πᵀ, what [`LevelFactor::apply_rows`] gives for B = Πᵀ I
+    /// when `direct` (r = m). In the pivoted column order X' = R⁻ᵀ is lower triangular: row q
+    /// is (e_q − Σ_{t<q} R\[t, q\] X'\[t\]) / R\[q, q\] with X'\[t\] zero from column t + 1
+    /// on, so each row costs q + 1 instead of m; then column c of X' is column perm\[c\] of
+    /// `out`. The same sums as the full forward substitution, without its additions of zeros.
+    /// `tri`: m × m scratch.
+    fn inverse_rows(&self, m: usize, tri: &mut [f64], out: &mut [f64]) {
+        let rr = self.r.nrows();
+        let rs = self.r.as_slice();
+        for q in 0..m {
+            let (done, rest) = tri.split_at_mut(q * m);
+            let row = &mut rest[..q + 1];
+            row.fill(0.0);
+            row[q] = 1.0;
+            for t in 0..q {
+                let c = rs[q * rr + t];
+                if c != 0.0 {
+                    axpy(-c, &done[t * m..t * m + t + 1], &mut row[..t + 1]);
+                }
+            }
+            let inv = 1.0 / rs[q * rr + q];
+            row.iter_mut().for_each(|x| *x *= inv);
+            let orow = &mut out[q * m..(q + 1) * m];
+            orow.fill(0.0);
+            for (c, &x) in row.iter().enumerate() {
+                orow[self.perm[c]] = x;
+            }
         }
     }
 

@@ -143,16 +143,17 @@ impl Reflectors {
         std::array::from_fn(|j| &vs[(b.s + j) * n + b.s..][..len])
     }
 
-    fn apply_block(&self, b: &Block, forward: bool, x: &mut [f64]) {
+    /// H_s ⋯ H_{s+k−1} x (the last reflector of block `b` first).
+    fn apply_block(&self, b: &Block, x: &mut [f64]) {
         match b.k {
-            4 => self.apply_block_k::<4>(b, forward, x),
-            3 => self.apply_block_k::<3>(b, forward, x),
-            2 => self.apply_block_k::<2>(b, forward, x),
+            4 => self.apply_block_k::<4>(b, x),
+            3 => self.apply_block_k::<3>(b, x),
+            2 => self.apply_block_k::<2>(b, x),
             _ => self.apply_one(b.s, x),
         }
     }
 
-    fn apply_block_k<const K: usize>(&self, b: &Block, forward: bool, x: &mut [f64]) {
+    fn apply_block_k<const K: usize>(&self, b: &Block, x: &mut [f64]) {
         let x = &mut x[b.s..b.end];
         if x.iter().all(|v| *v == 0.0) {
             // x is zero on the block's support (a sparse task row, e.g. a joint task's unit
@@ -163,16 +164,9 @@ impl Reflectors {
         let v = self.block_vectors::<K>(b);
         let d = dots(v, x);
         let mut f = [0.0; K];
-        if forward {
-            for j in 0..K {
-                let t = d[j] - (0..j).map(|i| f[i] * b.c[j][i]).sum::<f64>();
-                f[j] = b.tau[j] * t;
-            }
-        } else {
-            for j in (0..K).rev() {
-                let t = d[j] - (j + 1..K).map(|i| f[i] * b.c[j][i]).sum::<f64>();
-                f[j] = b.tau[j] * t;
-            }
+        for j in (0..K).rev() {
+            let t = d[j] - (j + 1..K).map(|i| f[i] * b.c[j][i]).sum::<f64>();
+            f[j] = b.tau[j] * t;
         }
         if f == [0.0; K] {
             return;
@@ -199,21 +193,6 @@ impl Reflectors {
         }
     }
 
-    /// Applies H_{to−1} ⋯ H_0 (H_0 first) to every column of `cols` (column-major, columns of
-    /// length n).
-    pub(crate) fn apply_forward(&self, to: usize, cols: &mut [f64]) {
-        let n = self.n;
-        if cols.is_empty() {
-            return;
-        }
-        for s in (0..to).step_by(4) {
-            let b = self.block(s, to);
-            for x in cols.chunks_exact_mut(n) {
-                self.apply_block(&b, true, x);
-            }
-        }
-    }
-
     /// Applies Q = H_0 H_1 ⋯ H_{len−1} (the last reflector first) to every column of `cols`
     /// (column-major, columns of length n); for one vector or a few (blocks of columns go
     /// through [`Reflectors::apply_q_rows`]).
@@ -222,7 +201,7 @@ impl Reflectors {
         for s in (0..len).step_by(4).rev() {
             let b = self.block(s, len);
             for x in cols.chunks_exact_mut(self.n.max(1)) {
-                self.apply_block(&b, false, x);
+                self.apply_block(&b, x);
             }
         }
     }
@@ -261,7 +240,7 @@ impl Reflectors {
         let w = &mut scratch[..K * nc];
         let v = self.block_vectors::<K>(b);
         let rows = &mut y[b.s * nc..b.end * nc];
-        block_products(v, rows, nc, w);
+        block_products(v, rows, nc, nc, w);
         for j in (0..K).rev() {
             let (head, tail) = w.split_at_mut((j + 1) * nc);
             let fj = &mut head[j * nc..];
@@ -271,7 +250,68 @@ impl Reflectors {
             let tau = b.tau[j];
             fj.iter_mut().for_each(|x| *x *= tau);
         }
-        block_update(v, w, nc, rows);
+        block_update(v, w, nc, nc, rows);
+    }
+
+    /// Applies H_{to−1} ⋯ H_0 (H_0 first) to the columns c0..c0 + nc of the row-major n × ld
+    /// block `y`, block by block as in [`Reflectors::apply_q_rows`] with the coefficients in
+    /// the forward order, F_j = τ_j (w_j − Σ_{i<j} (v_j·v_i) F_i). The leading rows that are
+    /// zero in all nc columns are skipped: a block whose support ends above the first
+    /// non-zero row leaves the columns as they are. `scratch` holds at least 4 nc entries.
+    pub(crate) fn apply_forward_rows(
+        &self,
+        to: usize,
+        y: &mut [f64],
+        ld: usize,
+        c0: usize,
+        nc: usize,
+        scratch: &mut [f64],
+    ) {
+        if nc == 0 || to == 0 {
+            return;
+        }
+        let mut lead = (0..self.n)
+            .find(|&t| y[t * ld + c0..t * ld + c0 + nc].iter().any(|x| *x != 0.0))
+            .unwrap_or(self.n);
+        for s in (0..to).step_by(4) {
+            let b = self.block(s, to);
+            if b.end <= lead {
+                continue;
+            }
+            lead = lead.min(b.s);
+            let rows = &mut y[b.s * ld + c0..(b.end - 1) * ld + c0 + nc];
+            match b.k {
+                4 => self.forward_rows_block::<4>(&b, rows, ld, nc, scratch),
+                3 => self.forward_rows_block::<3>(&b, rows, ld, nc, scratch),
+                2 => self.forward_rows_block::<2>(&b, rows, ld, nc, scratch),
+                _ => self.forward_rows_block::<1>(&b, rows, ld, nc, scratch),
+            }
+        }
+    }
+
+    /// The block `b` of K reflectors (first first) on `rows` (row t of the support at
+    /// t · ld, nc columns each).
+    fn forward_rows_block<const K: usize>(
+        &self,
+        b: &Block,
+        rows: &mut [f64],
+        ld: usize,
+        nc: usize,
+        scratch: &mut [f64],
+    ) {
+        let w = &mut scratch[..K * nc];
+        let v = self.block_vectors::<K>(b);
+        block_products(v, rows, ld, nc, w);
+        for j in 0..K {
+            let (head, tail) = w.split_at_mut(j * nc);
+            let fj = &mut tail[..nc];
+            for i in 0..j {
+                axpy(-b.c[j][i], &head[i * nc..(i + 1) * nc], fj);
+            }
+            let tau = b.tau[j];
+            fj.iter_mut().for_each(|x| *x *= tau);
+        }
+        block_update(v, w, ld, nc, rows);
     }
 }
 
@@ -280,17 +320,26 @@ impl Reflectors {
 /// spare.
 const CHUNK: usize = 4;
 
-/// W_j = Σ_t v_j\[t\] Y\[t, :\] for the K reflectors of a block (`rows`: row-major, `nc`
-/// columns, one row per coordinate of the block's support; `w`: K rows of `nc`). Each W_j
+/// W_j = Σ_t v_j\[t\] Y\[t, :\] for the K reflectors of a block (`rows`: row-major, row t at
+/// t · ld, `nc` columns, one row per coordinate of the block's support; `w`: K rows of `nc`). Each W_j
 /// entry sums over t in order from 0, as one axpy per row would; the columns are taken
 /// [`CHUNK`] at a time so that the sums stay in registers.
-fn block_products<const K: usize>(v: [&[f64]; K], rows: &[f64], nc: usize, w: &mut [f64]) {
+fn block_products<const K: usize>(
+    v: [&[f64]; K],
+    rows: &[f64],
+    ld: usize,
+    nc: usize,
+    w: &mut [f64],
+) {
+    // Slices of known length and rows taken by chunks, so that the loops check no bounds.
     let len = v[0].len();
+    let v: [&[f64]; K] = std::array::from_fn(|j| &v[j][..len]);
     let full = nc / CHUNK * CHUNK;
     for c0 in (0..full).step_by(CHUNK) {
         let mut acc = [[0.0_f64; CHUNK]; K];
-        for t in 0..len {
-            let yr: [f64; CHUNK] = std::array::from_fn(|l| rows[t * nc + c0 + l]);
+        for (t, yrow) in rows.chunks(ld).take(len).enumerate() {
+            let yc = &yrow[c0..c0 + CHUNK];
+            let yr: [f64; CHUNK] = std::array::from_fn(|l| yc[l]);
             for j in 0..K {
                 let a = v[j][t];
                 for l in 0..CHUNK {
@@ -304,8 +353,8 @@ fn block_products<const K: usize>(v: [&[f64]; K], rows: &[f64], nc: usize, w: &m
     }
     for c in full..nc {
         let mut acc = [0.0_f64; K];
-        for t in 0..len {
-            let yv = rows[t * nc + c];
+        for (t, yrow) in rows.chunks(ld).take(len).enumerate() {
+            let yv = yrow[c];
             for j in 0..K {
                 acc[j] += v[j][t] * yv;
             }
@@ -317,15 +366,16 @@ fn block_products<const K: usize>(v: [&[f64]; K], rows: &[f64], nc: usize, w: &m
 }
 
 /// Y\[t, :\] ← Y\[t, :\] − v_0\[t\] F_0 − … − v_{K−1}\[t\] F_{K−1}, subtracted in that order
-/// (`f`: K rows of `nc`), [`CHUNK`] columns at a time.
-fn block_update<const K: usize>(v: [&[f64]; K], f: &[f64], nc: usize, rows: &mut [f64]) {
+/// (`f`: K rows of `nc`; `rows` as in [`block_products`]), [`CHUNK`] columns at a time.
+fn block_update<const K: usize>(v: [&[f64]; K], f: &[f64], ld: usize, nc: usize, rows: &mut [f64]) {
     let len = v[0].len();
+    let v: [&[f64]; K] = std::array::from_fn(|j| &v[j][..len]);
     let full = nc / CHUNK * CHUNK;
     for c0 in (0..full).step_by(CHUNK) {
         let fr: [[f64; CHUNK]; K] =
             std::array::from_fn(|j| std::array::from_fn(|l| f[j * nc + c0 + l]));
-        for t in 0..len {
-            let yr = &mut rows[t * nc + c0..t * nc + c0 + CHUNK];
+        for (t, yrow) in rows.chunks_mut(ld).take(len).enumerate() {
+            let yr = &mut yrow[c0..c0 + CHUNK];
             let a: [f64; K] = std::array::from_fn(|j| v[j][t]);
             for l in 0..CHUNK {
                 let mut x = yr[l];
@@ -337,12 +387,13 @@ fn block_update<const K: usize>(v: [&[f64]; K], f: &[f64], nc: usize, rows: &mut
         }
     }
     for c in full..nc {
-        for t in 0..len {
-            let mut x = rows[t * nc + c];
+        let fc: [f64; K] = std::array::from_fn(|j| f[j * nc + c]);
+        for (t, yrow) in rows.chunks_mut(ld).take(len).enumerate() {
+            let mut x = yrow[c];
             for j in 0..K {
-                x -= v[j][t] * f[j * nc + c];
+                x -= v[j][t] * fc[j];
             }
-            rows[t * nc + c] = x;
+            yrow[c] = x;
         }
     }
 }
