@@ -27,8 +27,8 @@
 //!
 //! u\[p_i..p_i+r\] = S_i⁻¹ R_r Πᵀ (h_i − W_i\[:, 0..p_i\] u\[0..p_i\]),  S_i = R_r R_rᵀ + λ² I,
 //!
-//! the new reflectors are applied to the rows of the lower levels, and p_{i+1} = p_i + r. At
-//! the end q̈ = Q u. Cost: one Householder reduction of the stacked Jacobian, O(n² Σm_i),
+//! and p_{i+1} = p_i + r (the lower levels' rows receive the new reflectors when they are
+//! reached). At the end q̈ = Q u. Cost: one Householder reduction of the stacked Jacobian, O(n² Σm_i),
 //! instead of the O(n² Σm_i) products with an explicit basis on top of it; no SVD.
 //!
 //! Algorithm 1 builds G = \[g_1 … g_{n_T}\] with g_i = (Π_{k>i} (I − J̄_k^{λ+} J_k)) J̄_i^{λ+},
@@ -38,7 +38,7 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use super::kernels::{axpy, axpy2, dot, reflect2};
+use super::kernels::{axpy, axpy2, dot};
 use super::reflectors::Reflectors;
 use super::settings::{Damping, SolverSettings};
 use crate::error::{check_dim, Error, Result};
@@ -240,8 +240,8 @@ impl Hierarchy {
         Ok(())
     }
 
-    /// Reduces level i: pivoted QR of A_i = (W_i\[:, p..n\])ᵀ, the factors R_r, L and Π, the
-    /// damping, and the new reflectors applied to the rows of the lower levels.
+    /// Reduces level i: its rows multiplied by the reflectors of the levels above, pivoted QR
+    /// of A_i = (W_i\[:, p..n\])ᵀ, the factors R_r, L and Π, and the damping.
     fn reduce_level(&mut self, i: usize, settings: &SolverSettings) {
         let (n, m, p) = (self.n, self.dims[i], self.refl.len());
         let k = n - p;
@@ -316,14 +316,7 @@ impl Hierarchy {
             // Apply H to the remaining columns of A: column st becomes α e1.
             asl[st * ar + st] = alpha;
             asl[st * ar + st + 1..st * ar + k].fill(0.0);
-            // Two columns per pass over v, then the odd one out.
-            let mut c = st + 1;
-            while c + 1 < m {
-                let (x, y) = asl[c * ar + st..].split_at_mut(ar);
-                reflect2(v, tau, x, y);
-                c += 2;
-            }
-            if c < m {
+            for c in st + 1..m {
                 let col = &mut asl[c * ar + st..c * ar + st + end];
                 let f = tau * dot(v, col);
                 if f != 0.0 {

@@ -38,31 +38,3 @@ pub(crate) fn axpy2(a: f64, x: &[f64], b: f64, z: &[f64], y: &mut [f64]) {
         *yi = (*yi + a * xi) + b * zi;
     }
 }
-
-/// Applies the reflector I − τ v vᵀ to the two vectors `x` and `y` (their first `v.len()`
-/// entries) in one pass over v for the products and one for the updates: x ← x − τ (vᵀx) v,
-/// the same for y. The products sum in two partial sums each.
-#[inline]
-pub(crate) fn reflect2(v: &[f64], tau: f64, x: &mut [f64], y: &mut [f64]) {
-    let n = v.len();
-    let (x, y) = (&mut x[..n], &mut y[..n]);
-    let (mut a, mut b) = ([0.0_f64; 2], [0.0_f64; 2]);
-    let (vc, xc, yc) = (v.chunks_exact(2), x.chunks_exact(2), y.chunks_exact(2));
-    let (vr, xr, yr) = (vc.remainder(), xc.remainder(), yc.remainder());
-    for ((vv, xx), yy) in vc.zip(xc).zip(yc) {
-        for l in 0..2 {
-            a[l] += vv[l] * xx[l];
-            b[l] += vv[l] * yy[l];
-        }
-    }
-    let (mut dx, mut dy) = (a[0] + a[1], b[0] + b[1]);
-    for ((vv, xx), yy) in vr.iter().zip(xr).zip(yr) {
-        dx += vv * xx;
-        dy += vv * yy;
-    }
-    let (fx, fy) = (tau * dx, tau * dy);
-    for ((xi, yi), &vi) in x.iter_mut().zip(y.iter_mut()).zip(v) {
-        *xi -= fx * vi;
-        *yi -= fy * vi;
-    }
-}
