@@ -206,7 +206,7 @@ impl Kinematics {
         check_dim("frame Jacobian columns (nv)", self.nv, out.ncols())?;
         let fr = frame(robot, f)?;
         let p = (self.link_pose[fr.link] * fr.offset).translation.vector;
-        out.fill(0.0);
+        out.as_mut_slice().fill(0.0);
         let mut add = |col: usize, s: &Motion| {
             let lin = s.point_velocity(&p);
             for r in 0..3 {
@@ -254,7 +254,7 @@ impl Kinematics {
     pub fn com_jacobian(&self, robot: &Robot, out: &mut DMatrix<f64>) -> Result<()> {
         check_dim("COM Jacobian rows", 3, out.nrows())?;
         check_dim("COM Jacobian columns (nv)", self.nv, out.ncols())?;
-        out.fill(0.0);
+        out.as_mut_slice().fill(0.0);
         let mtot = self.total_mass;
         if mtot <= 0.0 {
             return Ok(());

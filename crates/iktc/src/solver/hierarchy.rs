@@ -11,9 +11,11 @@
 //! complete orthogonal decomposition of the stacked Jacobian: with Q = H_0 H_1 ⋯ (all
 //! reflectors so far) and u = Qᵀ q̈, the levels above level i occupy the first p_i reduced
 //! coordinates, and the null space of the levels above is spanned by the remaining columns
-//! Z = Q\[:, p_i..n\], so N_{i−1} = Z Zᵀ. The rows of every lower level are kept multiplied by
-//! the reflectors found so far, W_j = J_j Q, so the reduced Jacobian of level i is simply
-//! A_iᵀ = W_i\[:, p_i..n\] = J_i Z (m_i × k, k = n − p_i) — no product with a basis.
+//! Z = Q\[:, p_i..n\], so N_{i−1} = Z Zᵀ. When level i is reached its rows are multiplied by
+//! the reflectors of the levels above, W_i = J_i H_0 ⋯ H_{p_i−1} (left-looking: one blocked
+//! pass over all of them instead of one pass per level above), so the reduced Jacobian of
+//! level i is simply A_iᵀ = W_i\[:, p_i..n\] = J_i Z (m_i × k, k = n − p_i) — no product with
+//! a basis.
 //!
 //! The column-pivoted Householder QR A_i Π = H_{p_i} ⋯ H_{p_i+r−1} R keeps the r pivots with
 //! |R_jj| above the rank threshold. Then J_i Z = Π R_rᵀ Q_rᵀ and
@@ -25,8 +27,8 @@
 //!
 //! u\[p_i..p_i+r\] = S_i⁻¹ R_r Πᵀ (h_i − W_i\[:, 0..p_i\] u\[0..p_i\]),  S_i = R_r R_rᵀ + λ² I,
 //!
-//! the new reflectors are applied to the rows of the lower levels, and p_{i+1} = p_i + r. At
-//! the end q̈ = Q u. Cost: one Householder reduction of the stacked Jacobian, O(n² Σm_i),
+//! and p_{i+1} = p_i + r (the lower levels' rows receive the new reflectors when they are
+//! reached). At the end q̈ = Q u. Cost: one Householder reduction of the stacked Jacobian, O(n² Σm_i),
 //! instead of the O(n² Σm_i) products with an explicit basis on top of it; no SVD.
 //!
 //! Algorithm 1 builds G = \[g_1 … g_{n_T}\] with g_i = (Π_{k>i} (I − J̄_k^{λ+} J_k)) J̄_i^{λ+},
@@ -36,7 +38,7 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use super::kernels::{axpy, dot};
+use super::kernels::{axpy, axpy2, dot};
 use super::reflectors::Reflectors;
 use super::settings::{Damping, SolverSettings};
 use crate::error::{check_dim, Error, Result};
@@ -58,9 +60,13 @@ pub struct Hierarchy {
     ranks: Vec<usize>,
     /// First reduced coordinate p_i of level i.
     starts: Vec<usize>,
-    /// Wᵀ (n × Σm_i): column j is stacked task row j multiplied by the reflectors of the
-    /// levels above its own.
-    w: DMatrix<f64>,
+    /// W, stored by coordinate: entry (j, t) of the stacked task rows j (Σm_i of them) in the
+    /// coordinates t (n) at `w[t * wld + j]`, so that the rows of one level are a block of
+    /// adjacent columns. Row j is multiplied by the reflectors of the levels above its own
+    /// once its level has been reached.
+    w: Vec<f64>,
+    /// Leading dimension of `w` (Σm_i).
+    wld: usize,
     /// The Householder reflectors of all levels so far, one per kept pivot (Σ r_i ≤ n); their
     /// number is the next free reduced coordinate.
     refl: Reflectors,
@@ -104,7 +110,8 @@ impl Hierarchy {
             offsets,
             ranks: vec![0; dims.len()],
             starts: vec![0; dims.len()],
-            w: DMatrix::zeros(n, total.max(1)),
+            w: vec![0.0; n * total],
+            wld: total,
             refl: Reflectors::new(n),
             fac: dims.iter().map(|&m| LevelFactor::new(m)).collect(),
             a: DMatrix::zeros(n.max(1), mmax),
@@ -189,16 +196,15 @@ impl Hierarchy {
     ) -> Result<()> {
         self.check(levels)?;
         check_dim("q̈", self.n, qdd.len())?;
-        // Wᵀ ← Jᵀ of every level.
-        let wr = self.w.nrows();
+        // W ← J of every level: column t of the column-major J_i is coordinate t of its rows.
+        let wld = self.wld;
         for (i, lvl) in levels.iter().enumerate() {
-            let off = self.offsets[i];
-            let ws = self.w.as_mut_slice();
-            for r in 0..lvl.dim() {
-                let col = &mut ws[(off + r) * wr..(off + r + 1) * wr];
-                for (d, x) in col.iter_mut().enumerate() {
-                    *x = lvl.jacobian[(r, d)];
-                }
+            let (off, m) = (self.offsets[i], lvl.dim());
+            if m == 0 {
+                continue;
+            }
+            for (t, jc) in lvl.jacobian.as_slice().chunks_exact(m).enumerate() {
+                self.w[t * wld + off..t * wld + off + m].copy_from_slice(jc);
             }
         }
         self.u.fill(0.0);
@@ -211,13 +217,15 @@ impl Hierarchy {
             if r == 0 {
                 continue;
             }
-            // residual = h_i − W_i[:, 0..p] u[0..p] (u is zero from p on).
+            // residual = h_i − W_i[:, 0..p] u[0..p] (u is zero from p on), coordinate by
+            // coordinate over the level's rows.
             let off = self.offsets[i];
-            let ws = self.w.as_slice();
-            let us = &self.u.as_slice()[..p];
-            for c in 0..m {
-                let wc = &ws[(off + c) * wr..(off + c) * wr + p];
-                self.res[c] = lvl.rhs[c] - dot(wc, us);
+            let res = &mut self.res[..m];
+            res.copy_from_slice(lvl.rhs.as_slice());
+            for (t, &ut) in self.u.as_slice()[..p].iter().enumerate() {
+                if ut != 0.0 {
+                    axpy(-ut, &self.w[t * wld + off..t * wld + off + m], res);
+                }
             }
             // u[p..p+r] = S⁻¹ R_r Πᵀ residual.
             let f = &self.fac[i];
@@ -232,24 +240,29 @@ impl Hierarchy {
         Ok(())
     }
 
-    /// Reduces level i: pivoted QR of A_i = (W_i\[:, p..n\])ᵀ, the factors R_r, L and Π, the
-    /// damping, and the new reflectors applied to the rows of the lower levels.
+    /// Reduces level i: its rows multiplied by the reflectors of the levels above, pivoted QR
+    /// of A_i = (W_i\[:, p..n\])ᵀ, the factors R_r, L and Π, and the damping.
     fn reduce_level(&mut self, i: usize, settings: &SolverSettings) {
         let (n, m, p) = (self.n, self.dims[i], self.refl.len());
         let k = n - p;
         self.ranks[i] = 0;
+        let (off, wld) = (self.offsets[i], self.wld);
+        // The rows of this level under the reflectors of the levels above:
+        // W_i = J_i H_0 ⋯ H_{p−1}, applied when the level is reached (left-looking), in the
+        // blocks of four of all levels above at once, to all the level's rows together.
+        self.refl
+            .apply_forward_rows(p, &mut self.w, wld, off, m, &mut self.qscratch);
         if m == 0 || k == 0 {
             return;
         }
-        let off = self.offsets[i];
-        let wr = self.w.nrows();
         let ar = self.a.nrows();
         {
-            let ws = self.w.as_slice();
             let asl = self.a.as_mut_slice();
-            for c in 0..m {
-                asl[c * ar..c * ar + k]
-                    .copy_from_slice(&ws[(off + c) * wr + p..(off + c + 1) * wr]);
+            for t in 0..k {
+                let wrow = &self.w[(p + t) * wld + off..(p + t) * wld + off + m];
+                for (c, &x) in wrow.iter().enumerate() {
+                    asl[c * ar + t] = x;
+                }
             }
         }
         let perm = &mut self.fac[i].perm;
@@ -309,6 +322,8 @@ impl Hierarchy {
                 if f != 0.0 {
                     axpy(-f, v, col);
                 }
+            }
+            for c in st + 1..m {
                 let top = asl[c * ar + st];
                 self.colnorm[c] -= top * top;
                 if self.colnorm[c] <= NORM_DOWNDATE_TOL * self.colnorm_ref[c] {
@@ -323,11 +338,6 @@ impl Hierarchy {
         if rank == 0 {
             return;
         }
-        // The rows of the lower levels: w ← H_{p+r−1} ⋯ H_p w on the coordinates p..n.
-        let total = self.w.ncols();
-        let ws = self.w.as_mut_slice();
-        self.refl
-            .apply_forward(p, p + rank, &mut ws[(off + m) * wr..total * wr]);
         // λ² from the damping rule; σ_min estimated by the last kept pivot |R_rr|.
         let sigma = self.a[(rank - 1, rank - 1)].abs();
         let lambda2 = match settings.damping {
@@ -343,10 +353,11 @@ impl Hierarchy {
         };
         // R_r = rows 0..r of R (upper trapezoidal, r × m).
         let f = &mut self.fac[i];
-        for c in 0..m {
-            for q in 0..rank {
-                f.r[(q, c)] = if q <= c { self.a[(q, c)] } else { 0.0 };
-            }
+        let (fr, asl) = (f.r.nrows(), self.a.as_slice());
+        for (c, col) in f.r.as_mut_slice().chunks_exact_mut(fr).take(m).enumerate() {
+            let top = rank.min(c + 1);
+            col[..top].copy_from_slice(&asl[c * ar..c * ar + top]);
+            col[top..rank].fill(0.0);
         }
         f.factor(rank, m, lambda2);
     }
@@ -358,24 +369,30 @@ impl Hierarchy {
     fn reduced_block(&mut self, i: usize, propagate: bool) {
         let (n, nc, r, p) = (self.n, self.dims[i], self.ranks[i], self.starts[i]);
         let yb = &mut self.yb[..n * nc];
-        yb.fill(0.0);
         if r == 0 || nc == 0 {
             // Level i moves nothing, so nothing below it moves either.
+            yb.fill(0.0);
             return;
         }
-        // B = Πᵀ I: row j is e_{perm[j]}.
+        // Rows p..p + r are written below (and the lower levels' rows, when propagating).
+        yb[..p * nc].fill(0.0);
+        yb[(p + r) * nc..].fill(0.0);
         let f = &self.fac[i];
         let bb = &mut self.bb[..nc * nc];
-        bb.fill(0.0);
-        for (j, &pj) in f.perm.iter().enumerate() {
-            bb[j * nc + pj] = 1.0;
+        if f.direct {
+            f.inverse_rows(nc, bb, &mut yb[p * nc..(p + r) * nc]);
+        } else {
+            // B = Πᵀ I: row j is e_{perm[j]}.
+            bb.fill(0.0);
+            for (j, &pj) in f.perm.iter().enumerate() {
+                bb[j * nc + pj] = 1.0;
+            }
+            f.apply_rows(r, nc, nc, bb, &mut yb[p * nc..(p + r) * nc]);
         }
-        f.apply_rows(r, nc, nc, bb, &mut yb[p * nc..(p + r) * nc]);
         if !propagate {
             return;
         }
-        let wr = self.w.nrows();
-        let ws = self.w.as_slice();
+        let (ws, wld) = (&self.w, self.wld);
         for k in i + 1..self.dims.len() {
             let (mk, rk, pk) = (self.dims[k], self.ranks[k], self.starts[k]);
             if rk == 0 {
@@ -387,10 +404,9 @@ impl Hierarchy {
             let bb = &mut self.bb[..mk * nc];
             bb.fill(0.0);
             for (j, &pj) in f.perm.iter().enumerate() {
-                let wc = &ws[(off + pj) * wr..(off + pj + 1) * wr];
                 let brow = &mut bb[j * nc..(j + 1) * nc];
                 for sidx in p..pk {
-                    let c = wc[sidx];
+                    let c = ws[sidx * wld + off + pj];
                     if c != 0.0 {
                         axpy(-c, &yb[sidx * nc..(sidx + 1) * nc], brow);
                     }
@@ -511,7 +527,16 @@ impl LevelFactor {
                 let (done, rest) = out.split_at_mut(q * nc);
                 let row = &mut rest[..nc];
                 row.copy_from_slice(&b[q * nc..(q + 1) * nc]);
-                for t in 0..q {
+                // Two rows of X per pass over the row (same order of the sums).
+                let mut t = 0;
+                while t + 1 < q {
+                    let (c0, c1) = (rs[q * rr + t], rs[q * rr + t + 1]);
+                    let x0 = &done[t * nc..(t + 1) * nc];
+                    let x1 = &done[(t + 1) * nc..(t + 2) * nc];
+                    axpy2(-c0, x0, -c1, x1, row);
+                    t += 2;
+                }
+                if t < q {
                     let c = rs[q * rr + t];
                     if c != 0.0 {
                         axpy(-c, &done[t * nc..(t + 1) * nc], row);
@@ -553,6 +578,36 @@ impl LevelFactor {
             }
             let inv = 1.0 / ls[q * lr + q];
             row.iter_mut().for_each(|x| *x *= inv);
+        }
+    }
+
+    /// `out` (row-major m × m) = R⁻ᵀ Πᵀ, what [`LevelFactor::apply_rows`] gives for B = Πᵀ I
+    /// when `direct` (r = m). In the pivoted column order X' = R⁻ᵀ is lower triangular: row q
+    /// is (e_q − Σ_{t<q} R\[t, q\] X'\[t\]) / R\[q, q\] with X'\[t\] zero from column t + 1
+    /// on, so each row costs q + 1 instead of m; then column c of X' is column perm\[c\] of
+    /// `out`. The same sums as the full forward substitution, without its additions of zeros.
+    /// `tri`: m × m scratch.
+    fn inverse_rows(&self, m: usize, tri: &mut [f64], out: &mut [f64]) {
+        let rr = self.r.nrows();
+        let rs = self.r.as_slice();
+        for q in 0..m {
+            let (done, rest) = tri.split_at_mut(q * m);
+            let row = &mut rest[..q + 1];
+            row.fill(0.0);
+            row[q] = 1.0;
+            for t in 0..q {
+                let c = rs[q * rr + t];
+                if c != 0.0 {
+                    axpy(-c, &done[t * m..t * m + t + 1], &mut row[..t + 1]);
+                }
+            }
+            let inv = 1.0 / rs[q * rr + q];
+            row.iter_mut().for_each(|x| *x *= inv);
+            let orow = &mut out[q * m..(q + 1) * m];
+            orow.fill(0.0);
+            for (c, &x) in row.iter().enumerate() {
+                orow[self.perm[c]] = x;
+            }
         }
     }
 

@@ -29,3 +29,12 @@ pub(crate) fn axpy(a: f64, x: &[f64], y: &mut [f64]) {
         *yi += a * xi;
     }
 }
+
+/// `y ← (y + a x) + b z` over the common length: two axpys in one pass over y (the same sums
+/// in the same order as two [`axpy`] calls).
+#[inline]
+pub(crate) fn axpy2(a: f64, x: &[f64], b: f64, z: &[f64], y: &mut [f64]) {
+    for ((yi, &xi), &zi) in y.iter_mut().zip(x).zip(z) {
+        *yi = (*yi + a * xi) + b * zi;
+    }
+}

@@ -2,7 +2,7 @@
 
 use nalgebra::{DMatrix, Vector3};
 
-use super::equation::{write_row, Gains, TaskEquation};
+use super::equation::{copy_jacobian_row, write_row, Gains, TaskEquation};
 use crate::error::{check_all_finite, Error, Result};
 use crate::model::{Kinematics, Robot, State};
 
@@ -96,10 +96,10 @@ impl ComTask {
             if !self.axes[k] {
                 continue;
             }
+            copy_jacobian_row(out, r, &self.scratch, k);
             write_row(
                 out,
                 r,
-                self.scratch.row(k).iter().copied(),
                 e[k],
                 edot[k],
                 self.reference.acceleration[k],

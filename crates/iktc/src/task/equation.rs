@@ -130,23 +130,29 @@ impl TaskEquation {
     }
 }
 
-/// Writes row `r` of a task: J row, error e, error rate ė, reference acceleration a_d and
-/// drift d, so that h = a_d + k_v ė + k_p e − d.
-#[allow(clippy::too_many_arguments)]
+/// Copies row `k` of `src` (a column-major Jacobian of nv columns, e.g. a frame's 6 × nv)
+/// into row `r` of `out`'s J, column by column over the two column-major storages.
+#[inline]
+pub(crate) fn copy_jacobian_row(out: &mut TaskEquation, r: usize, src: &DMatrix<f64>, k: usize) {
+    let (m, sr) = (out.jacobian.nrows(), src.nrows());
+    let dst = out.jacobian.as_mut_slice().chunks_exact_mut(m);
+    for (jc, sc) in dst.zip(src.as_slice().chunks_exact(sr)) {
+        jc[r] = sc[k];
+    }
+}
+
+/// Writes row `r` of a task but its J row: error e, error rate ė, reference acceleration
+/// a_d and drift d, so that h = a_d + k_v ė + k_p e − d.
 #[inline]
 pub(crate) fn write_row(
     out: &mut TaskEquation,
     r: usize,
-    jrow: impl Iterator<Item = f64>,
     e: f64,
     edot: f64,
     acc_ref: f64,
     drift: f64,
     gains: &Gains,
 ) {
-    for (c, v) in jrow.enumerate() {
-        out.jacobian[(r, c)] = v;
-    }
     out.error[r] = e;
     out.error_rate[r] = edot;
     out.rhs[r] = acc_ref + gains.kv * edot + gains.kp * e - drift;

@@ -2,7 +2,7 @@
 
 use nalgebra::{DMatrix, Isometry3, Vector6};
 
-use super::equation::{write_row, Gains, TaskEquation};
+use super::equation::{copy_jacobian_row, write_row, Gains, TaskEquation};
 use crate::error::{check_all_finite, Error, Result};
 use crate::model::{FrameId, Kinematics, Robot, State};
 
@@ -149,11 +149,10 @@ impl FrameTask {
             if !self.axes.0[k] {
                 continue;
             }
-            let row = self.scratch.row(k);
+            copy_jacobian_row(out, r, &self.scratch, k);
             write_row(
                 out,
                 r,
-                row.iter().copied(),
                 e[k],
                 edot[k],
                 self.reference.acceleration[k],

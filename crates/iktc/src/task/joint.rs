@@ -96,13 +96,21 @@ impl JointTask {
         out.check_room(robot.nv(), offset, self.dim(), || {
             "a joint task".to_string()
         })?;
-        let nv = robot.nv();
-        for k in 0..self.dim() {
+        // J: the rows offset..offset + dim are zero but for a 1 in each joint's column
+        // (column-major J: column c holds entry c of every row).
+        let (nv, m, dim) = (robot.nv(), out.jacobian.nrows(), self.dim());
+        let js = out.jacobian.as_mut_slice();
+        for c in 0..nv {
+            js[c * m + offset..c * m + offset + dim].fill(0.0);
+        }
+        for (k, &iv) in self.v_index.iter().enumerate() {
+            js[iv * m + offset + k] = 1.0;
+        }
+        for k in 0..dim {
             let (iv, iq) = (self.v_index[k], self.q_index[k]);
             write_row(
                 out,
                 offset + k,
-                (0..nv).map(|c| if c == iv { 1.0 } else { 0.0 }),
                 self.position[k] - state.q[iq],
                 self.velocity[k] - state.qd[iv],
                 self.acceleration[k],
