@@ -15,11 +15,14 @@
 //! cannot follow (a kick faster than its joint limits allow) then costs the hands' level
 //! accuracy, never the stance foot's hold.
 //!
-//! The hold is closed-loop: at the tick a foot touches down, the offset `δ = (x, y, ψ)_robot −
+//! The hold is closed-loop. A foot the clip puts on the ground is first brought to the plan's
+//! hold in the swing levels; it lands (moves to the first level) once its ankle is within
+//! `land_height` of the hold's height and slower than `land_speed`, or after
+//! `max_landing_delay` ([`KeypointSettings`]). At landing the offset `δ = (x, y, ψ)_robot −
 //! (x, y, ψ)_plan` of the robot's foot from the plan's hold (horizontal position \[m\] and yaw
 //! \[rad\]) is latched and added to the foot's reference with the weight
 //! [`Plan::latch_weight`] (1 in stance, fading to 0 over the next swing): the foot is held
-//! where it landed, not pulled to where the plan wanted it.
+//! where it landed, at rest, not pulled to where the plan wanted it.
 //!
 //! Each level is linearised as in the controller (`J_i q̈ = ẍ_d + k_v(ẋ_d − ẋ) + k_p(x_d − x)
 //! − J̇_i q̇`, eqs. 3, 11) and solved under the viable box of the robot's own joint limits with
@@ -36,7 +39,7 @@ use crate::controller::{
     ComHandle, Controller, ControllerBuilder, ControllerSettings, FrameHandle, JointsHandle,
 };
 use crate::error::Result;
-use crate::model::{FrameId, Robot, State};
+use crate::model::{FrameId, Kinematics, Robot, State};
 use crate::motion::BodyPoint;
 use crate::solver::{Method, SolveReport};
 use crate::task::{Axes, ComReference, FrameReference};
@@ -63,8 +66,10 @@ pub struct KeypointController {
     active: usize,
     /// Whether the last tick was solved by the active stack's GF fallback.
     used_fallback: bool,
-    /// Ticks solved by GF so far.
+    /// Ticks solved by GF so far because IKTC's answer left the box.
     fallback_ticks: usize,
+    /// Ticks solved by GF so far because it kept the stance feet better than IKTC.
+    stance_gf_ticks: usize,
     plan: Plan,
     state: State,
     dt: f64,
@@ -72,12 +77,21 @@ pub struct KeypointController {
     /// The offset latched at each foot's last touch-down: horizontal position \[m\] (z = 0)
     /// and yaw \[rad\].
     latch: [(Vector3<f64>, f64); 2],
+    /// Whether each foot has landed (is in the first level).
+    stance: [bool; 2],
+    /// Ticks each foot has waited to land since the clip put it on the ground.
+    waiting: [usize; 2],
+    /// Landing thresholds: height \[m\], speed \[m/s\], largest wait \[ticks\].
+    landing: (f64, f64, usize),
+    /// Kinematics of the state, updated while a foot waits to land.
+    kin: Kinematics,
+    robot: Arc<Robot>,
     posture_track: Vec<[Vec<f64>; 3]>,
     posture_ref: [Vec<f64>; 3],
 }
 
 /// The controllers of one contact state: IKTC, and GF for the ticks where IKTC's answer leaves
-/// the box.
+/// the box or corrects the stance feet ([`KeypointController::tick`]).
 #[derive(Debug, Clone)]
 struct Stack {
     ctl: Controller,
@@ -259,6 +273,7 @@ impl KeypointController {
         s: &KeypointSettings,
     ) -> Result<Self> {
         let build = |stance| build_stack(&robot, &state, body, &plan, &posture.0, s, stance);
+        let kin = Kinematics::new(&robot, &state)?;
         let stacks = Box::new([
             build([false, false])?,
             build([true, false])?,
@@ -271,11 +286,21 @@ impl KeypointController {
             active: 3,
             used_fallback: false,
             fallback_ticks: 0,
+            stance_gf_ticks: 0,
             plan,
             state,
             dt: s.dt,
             feet: body.feet,
             latch: [(Vector3::zeros(), 0.0); 2],
+            kin,
+            robot: robot.clone(),
+            stance: [true; 2],
+            waiting: [0; 2],
+            landing: (
+                s.land_height,
+                s.land_speed,
+                (s.max_landing_delay / s.dt).round() as usize,
+            ),
             posture_track: posture.1,
             posture_ref: [vec![0.0; m], vec![0.0; m], vec![0.0; m]],
         })
@@ -287,38 +312,57 @@ impl KeypointController {
     }
 
     /// Sets the references of tick `k` (clamped to the last; with `hold`, at rest: zero rates
-    /// and accelerations) on the stack of the tick's contacts, latching the offset of a foot
-    /// that touches down at `k` (not while holding), and solves; q̈ is then in
-    /// [`KeypointController::qdd`], applied by [`KeypointController::integrate`]. When IKTC's
+    /// and accelerations) on the stack of the feet that have landed (a foot the clip puts on
+    /// the ground lands once low and slow, see the module documentation; not while holding,
+    /// when the clip's contacts are taken), and solves; q̈ is then in
+    /// [`KeypointController::qdd`], applied by [`KeypointController::integrate`]. The tick is
+    /// solved again by GF on the same stack ([`KeypointController::used_fallback`]) when IKTC's
     /// answer leaves the box by more than the solver's `box_tolerance` without a fallback of
-    /// its own (seen with rank-deficient levels below the corrected one), the tick is solved
-    /// again by GF on the same stack ([`KeypointController::used_fallback`]); nothing is
-    /// clipped. Allocates nothing.
+    /// its own (seen with rank-deficient levels below the corrected one), and when IKTC had to
+    /// correct the stance feet's level: GF's answer is then taken if it keeps the stance
+    /// feet's level more exactly (on CMU 131_01 on G1 IKTC's corrections of a double stance
+    /// made the held feet slide by 0.9 m, GF's by 0.1 m). Nothing is clipped. Allocates
+    /// nothing.
     pub fn tick(&mut self, k: usize, hold: bool) -> Result<&SolveReport> {
         let k = k.min(self.plan.ticks.saturating_sub(1));
         let on = self.contacts(k);
-        let c = &self.plan.contact;
-        self.active = usize::from(on[0]) + 2 * usize::from(on[1]);
         self.used_fallback = false;
-        let landing = |i: usize| !hold && on[i] && (k == 0 || !c[i][k - 1]);
-        let (land_l, land_r) = (landing(0), landing(1));
-        let stack = &mut self.stacks[self.active & 3];
-        if land_l || land_r {
-            // The robot's feet where they are now.
-            stack.ctl.prepare(&self.state, self.dt)?;
-            let kin = stack.ctl.kinematics();
-            for (i, land) in [land_l, land_r].into_iter().enumerate() {
-                if !land {
-                    continue;
-                }
-                let pose = kin.frame_pose(stack.ctl.robot(), self.feet[i])?;
-                let plan = &self.plan.feet[i][k];
-                let mut d = pose.translation.vector - plan.position.position;
-                d.z = 0.0;
-                let x = (pose.rotation * plan.rotation.inverse()) * Vector3::x();
-                self.latch[i] = (d, x.y.atan2(x.x));
+        let c = &self.plan.contact;
+        for i in 0..2 {
+            if hold || !on[i] {
+                self.stance[i] = on[i];
+                self.waiting[i] = 0;
+            } else if !self.stance[i] && (k == 0 || !c[i][k - 1]) {
+                // The clip's touch-down: the foot goes to the plan's hold, then lands.
+                self.latch[i] = (Vector3::zeros(), 0.0);
+                self.waiting[i] = 0;
             }
         }
+        if (0..2).any(|i| on[i] && !self.stance[i]) {
+            // The robot's feet where they are now.
+            self.kin.update(&self.robot, &self.state)?;
+            let (kin, robot) = (&self.kin, &*self.robot);
+            let (height, speed, max_wait) = self.landing;
+            let waiting = [on[0] && !self.stance[0], on[1] && !self.stance[1]];
+            for i in (0..2).filter(|i| waiting[*i]) {
+                let pose = kin.frame_pose(robot, self.feet[i])?;
+                let v = kin.frame_velocity(robot, self.feet[i])?;
+                let plan = &self.plan.feet[i][k];
+                let mut d = pose.translation.vector - plan.position.position;
+                let low = d.z <= height;
+                let slow = v.fixed_rows::<3>(0).norm() <= speed;
+                if (low && slow) || self.waiting[i] >= max_wait {
+                    d.z = 0.0;
+                    let x = (pose.rotation * plan.rotation.inverse()) * Vector3::x();
+                    self.latch[i] = (d, x.y.atan2(x.x));
+                    self.stance[i] = true;
+                } else {
+                    self.waiting[i] += 1;
+                }
+            }
+        }
+        self.active = usize::from(self.stance[0]) + 2 * usize::from(self.stance[1]);
+        let stack = &mut self.stacks[self.active & 3];
         let tolerance = stack.ctl.settings().solver.box_tolerance;
         let (p, l, pt) = (&self.plan, &self.latch, &self.posture_track);
         set_references(
@@ -332,16 +376,28 @@ impl KeypointController {
             hold,
         )?;
         stack.ctl.prepare(&self.state, self.dt)?;
+        let iktc = stack.ctl.settings().method == Method::Iktc;
         let r = stack.ctl.solve()?;
-        if r.violation <= tolerance || stack.ctl.settings().method != Method::Iktc {
+        let held = self.active != 0 && r.corrected_from == Some(0);
+        let stance_error = r.task_error_norms.first().copied().unwrap_or(0.0);
+        let violation = r.violation;
+        if (violation <= tolerance && !held) || !iktc {
             return Ok(stack.ctl.report());
         }
         let f = &mut stack.fallback;
         set_references(f, &stack.tasks, p, l, pt, &mut self.posture_ref, k, hold)?;
         f.prepare(&self.state, self.dt)?;
-        f.solve()?;
+        let g = f.solve()?;
+        let gf_error = g.task_error_norms.first().copied().unwrap_or(0.0);
+        if violation <= tolerance {
+            if gf_error >= stance_error {
+                return Ok(stack.ctl.report());
+            }
+            self.stance_gf_ticks += 1;
+        } else {
+            self.fallback_ticks += 1;
+        }
         self.used_fallback = true;
-        self.fallback_ticks += 1;
         Ok(f.report())
     }
 
@@ -376,14 +432,26 @@ impl KeypointController {
         ]
     }
 
+    /// Whether the (left, right) foot is held on the ground by the first level after the last
+    /// tick (it landed; see the module documentation).
+    pub fn stance(&self) -> [bool; 2] {
+        self.stance
+    }
+
     /// Whether the last tick was solved by GF (see [`KeypointController::tick`]).
     pub fn used_fallback(&self) -> bool {
         self.used_fallback
     }
 
-    /// Ticks solved by GF so far.
+    /// Ticks solved by GF so far because IKTC's answer left the box.
     pub fn fallback_ticks(&self) -> usize {
         self.fallback_ticks
+    }
+
+    /// Ticks solved by GF so far because IKTC corrected the stance feet's level and GF kept it
+    /// more exactly ([`KeypointController::tick`]).
+    pub fn stance_gf_ticks(&self) -> usize {
+        self.stance_gf_ticks
     }
 
     /// Applies the last q̈ over Δt (constant acceleration). Errors: no tick solved since the
