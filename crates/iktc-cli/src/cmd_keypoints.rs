@@ -95,6 +95,7 @@ pub fn run(
         "source": kp.source,
         "leg_ratio": run.scaling.leg,
         "gf_ticks": run.fallback_ticks,
+        "stance_gf_ticks": run.stance_gf_ticks,
         "tick_median_us": run.tick_median_us,
         "keypoints": run.quality,
         "joints": joints,
@@ -130,10 +131,11 @@ pub fn run(
 fn print(run: &KeypointRun, joints: Option<&RetargetQuality>) -> std::io::Result<()> {
     let k = &run.quality;
     crate::outln!(
-        "keypoint retargeting: {} ticks, leg ratio {:.3}, {} ticks solved by GF, tick median {:.1} µs",
+        "keypoint retargeting: {} ticks, leg ratio {:.3}, {} ticks solved by GF (+{} for the stance feet), tick median {:.1} µs",
         k.ticks,
         run.scaling.leg,
         run.fallback_ticks,
+        run.stance_gf_ticks,
         run.tick_median_us
     )?;
     crate::outln!(

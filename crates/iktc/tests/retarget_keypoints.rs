@@ -10,6 +10,20 @@ use iktc::retarget::{joint_route_quality, retarget_keypoints, KeypointSettings, 
 use iktc::sim::{imitation_references, ImitateConfig};
 use iktc::solver::SolverSettings;
 
+/// Largest pelvis orientation error on the CMU clips \[deg\] (0.2.0: 60°, from a twist the robot
+/// follows with its feet held; 154° when the base spun).
+const CMU_MAX_PELVIS_DEG: f64 = 90.0;
+
+/// Largest stance slip on the CMU clips \[mm\] (0.2.0: up to 102 mm; 1337 mm before): a bound
+/// against the spinning base, far above the target of 2 mm
+/// ([`stance_feet_hold_and_stay_above_ground`]).
+const CMU_MAX_SLIP_MM: f64 = 150.0;
+
+/// The targets for every clip and robot: stance slip at most this \[mm\] ...
+const TARGET_SLIP_MM: f64 = 2.0;
+/// ... and no sole corner deeper below the ground than this \[mm\] (rounding, not contact).
+const TARGET_BELOW_MM: f64 = 0.1;
+
 /// Every shared clip: the DeepMimic clips shipped with the crate and the CMU test clips.
 fn clips() -> Vec<PathBuf> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
@@ -85,12 +99,13 @@ fn check_robot(name: &str) {
         let run = retarget_keypoints(&profile, &kp, refs.as_ref(), &s).unwrap();
         let q = &run.quality;
         eprintln!(
-            "{name} {}: {} ticks, stance {} ticks, leg ratio {:.3}, GF ticks {}, tick median {:.0} µs",
+            "{name} {}: {} ticks, stance {} ticks, leg ratio {:.3}, GF ticks {} (stance {}), tick median {:.0} µs",
             path.file_name().unwrap().to_string_lossy(),
             q.ticks,
             q.stance_ticks,
             run.scaling.leg,
             run.fallback_ticks,
+            run.stance_gf_ticks,
             run.tick_median_us
         );
         print(q);
@@ -108,6 +123,19 @@ fn check_robot(name: &str) {
             failures.push(format!("{file}: a limit exceeded"));
         }
         assert!(q.stance_ticks > 0, "{file}: no foot ever on the ground");
+        // The CMU clips once spun the robot's floating base (pelvis orientation errors up to
+        // 154°) and slid its held feet by up to 1.3 m: a swing foot at the top level made the
+        // stack infeasible on the clips' kicks. Both stay bounded now.
+        if file.contains("cmu") {
+            let pelvis = q.orientations.iter().find(|o| o.frame == "pelvis");
+            let worst = pelvis.map_or(f64::INFINITY, |o| o.max_deg);
+            if worst > CMU_MAX_PELVIS_DEG {
+                failures.push(format!("{file}: pelvis orientation error {worst:.1}°"));
+            }
+            if q.slip_mm > CMU_MAX_SLIP_MM {
+                failures.push(format!("{file}: stance slip {:.1} mm", q.slip_mm));
+            }
+        }
         // IKTC's answers stay in the box beyond rounding on every tick, so the tracker never
         // re-solves by GF on JVRC-1 (with the QP's blown-up iterates once reported as
         // optimal, 188 of dance_b's 508 ticks left the box by up to 1.3e4 rad/s²). On G1 a
@@ -130,4 +158,33 @@ fn every_shared_clip_onto_jvrc1() {
 #[test]
 fn every_shared_clip_onto_g1() {
     check_robot("g1");
+}
+
+/// The targets: stance feet slip at most [`TARGET_SLIP_MM`] and never go below the
+/// ground, on every shared clip and both robots. Not met in 0.2.0 (slip up to 102 mm, soles
+/// up to 0.3 m below the ground): the robot's swing feet lag the captured ones under its
+/// joint limits and land late, or dip below the ground while lagging.
+#[test]
+#[ignore = "target not met in 0.2.0: slip up to 102 mm, soles up to 0.3 m below the ground"]
+fn stance_feet_hold_and_stay_above_ground() {
+    let mut failures = Vec::new();
+    for name in ["jvrc1", "g1"] {
+        let profile = RobotProfile::builtin(name).unwrap();
+        for path in clips() {
+            let motion = load_motion(&path, &MotionOptions::default()).unwrap();
+            let kp = motion.keypoints(DEFAULT_MAX_GAP).unwrap();
+            let q = retarget_keypoints(&profile, &kp, None, &KeypointSettings::default())
+                .unwrap()
+                .quality;
+            if q.slip_mm > TARGET_SLIP_MM || q.below_ground_mm > TARGET_BELOW_MM {
+                failures.push(format!(
+                    "{name} {}: slip {:.1} mm, below the ground {:.1} mm",
+                    path.display(),
+                    q.slip_mm,
+                    q.below_ground_mm
+                ));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
 }

@@ -7,11 +7,14 @@
 //! 2. The clip is aligned (facing +x, first pelvis over the origin, lowest ankle on the
 //!    ground) and scaled segment by segment ([`Scaling`], module `scale`).
 //! 3. Foot contacts are detected from the clip's foot heights and speeds; every task's
-//!    references are computed at the control rate, the stance feet held where they touched
-//!    down and the COM pulled over the support polygon (module `plan`).
+//!    references are computed at the control rate, the stance feet held, the swings leaving
+//!    and reaching the holds at rest, and the COM pulled over the support polygon (module
+//!    `plan`).
 //! 4. The stack of [`KEYPOINT_LEVELS`] is tracked ([`KeypointController`]): after a settling
 //!    phase at rest on the first frame's references, one tick per control period; IKTC under
-//!    the viable box of the robot's own limits, nothing clipped after the solve.
+//!    the viable box of the robot's own limits, nothing clipped after the solve. Only the feet
+//!    that have landed are in the first level (one stack per contact state), held where the
+//!    robot's foot landed.
 //! 5. The same quality figures ([`RetargetQuality`]) measure this run and, for comparison, the
 //!    joint-angle route ([`joint_route_quality`]).
 //!
@@ -122,6 +125,16 @@ pub struct KeypointSettings {
     /// Posture references from the joint route are kept this far inside the joint ranges
     /// \[rad\] (default 0.05 rad).
     pub posture_margin: f64,
+    /// A foot the clip puts on the ground lands (is held by the first level) once its ankle is
+    /// within this height of its hold \[m\] (default 0.01 m) ...
+    pub land_height: f64,
+    /// ... and slower than this \[m/s\] (default 0.03 m/s). A held foot decelerates under the
+    /// first level's gains: a foot landing at speed `v` slides about `v / (e ω)` (`ω = √k_p`),
+    /// about 1 mm at the default; faster landings slide more, slower ones land later.
+    pub land_speed: f64,
+    /// A foot lands at the latest this long after the clip puts it on the ground \[s\]
+    /// (default 0.3 s), wherever it is.
+    pub max_landing_delay: f64,
 }
 
 impl Default for KeypointSettings {
@@ -151,6 +164,9 @@ impl Default for KeypointSettings {
             com_smoothing: 0.2,
             max_leg_extension: 0.85,
             posture_margin: 0.05,
+            land_height: 0.02,
+            land_speed: 0.1,
+            max_landing_delay: 0.2,
         }
     }
 }
@@ -167,6 +183,13 @@ impl KeypointSettings {
             ("com_margin", self.com_margin, "a distance >= 0 [m]"),
             ("com_smoothing", self.com_smoothing, "a time >= 0 [s]"),
             ("posture_margin", self.posture_margin, "an angle >= 0 [rad]"),
+            ("land_height", self.land_height, "a height >= 0 [m]"),
+            ("land_speed", self.land_speed, "a speed >= 0 [m/s]"),
+            (
+                "max_landing_delay",
+                self.max_landing_delay,
+                "a time >= 0 [s]",
+            ),
             (
                 "max_leg_extension",
                 self.max_leg_extension,
@@ -197,12 +220,18 @@ pub struct KeypointRun {
     /// The robot's configuration q at every recorded tick (base position \[m\] and quaternion,
     /// then joints \[rad\]).
     pub trajectory: Vec<Vec<f64>>,
-    /// Contacts per tick, left and right foot.
+    /// The clip's contacts per tick, left and right foot.
     pub contacts: [Vec<bool>; 2],
+    /// The robot's stance per tick, left and right foot: the foot landed and held by the first
+    /// level (it lands after the clip's touch-down, once low and slow).
+    pub stance: [Vec<bool>; 2],
     /// Quality figures.
     pub quality: RetargetQuality,
     /// Ticks solved by GF because IKTC's answer left the box ([`KeypointController::tick`]).
     pub fallback_ticks: usize,
+    /// Ticks solved by GF because IKTC corrected the stance feet's level and GF kept it more
+    /// exactly ([`KeypointController::tick`]).
+    pub stance_gf_ticks: usize,
     /// Median time of one control tick (references, kinematics, box, solve, integration) \[µs\].
     pub tick_median_us: f64,
 }
@@ -385,6 +414,7 @@ pub fn retarget_keypoints(
     let mut trajectory = Vec::with_capacity(ticks);
     let mut times = Vec::with_capacity(ticks);
     let mut tick_us = Vec::with_capacity(ticks);
+    let mut stance = [Vec::with_capacity(ticks), Vec::with_capacity(ticks)];
     let t0 = kp.times.first().copied().unwrap_or(0.0);
     for k in 0..ticks {
         let state = controller.state().clone();
@@ -392,13 +422,16 @@ pub fn retarget_keypoints(
         controller.tick(k, false)?;
         tick_us.push(start.elapsed().as_secs_f64() * 1e6);
         let plan = controller.plan();
+        let on = controller.stance();
+        stance[0].push(on[0]);
+        stance[1].push(on[1]);
         rec.record(
             &robot,
             &mut kin,
             &body,
             plan,
             &support,
-            k,
+            (k, on),
             &state,
             controller.qdd().as_slice(),
         )?;
@@ -416,8 +449,10 @@ pub fn retarget_keypoints(
         times,
         trajectory,
         contacts,
+        stance,
         quality: rec.finish(&robot),
         fallback_ticks: controller.fallback_ticks(),
+        stance_gf_ticks: controller.stance_gf_ticks(),
         tick_median_us: percentile(&tick_us, 0.5),
     })
 }
@@ -458,7 +493,7 @@ pub fn joint_route_quality(
             &setup.body,
             plan,
             &setup.support,
-            k,
+            (k, [plan.contact[0][k], plan.contact[1][k]]),
             &state,
             ctl.qdd().as_slice(),
         )?;

@@ -20,7 +20,7 @@
 use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, UnitQuaternion, Vector3, Vector6};
 
 use super::body::RobotBody;
-use super::contacts::{detect, hold, remove_short};
+use super::contacts::{detect, hold, quintic, remove_short, runs};
 use super::scale::ScaledClip;
 use super::{KeypointSettings, SupportArea};
 use crate::error::{Error, Result};
@@ -88,6 +88,11 @@ pub(crate) struct Plan {
     pub feet: [Vec<PoseRef>; 2],
     /// Feet on the ground per tick (left, right).
     pub contact: [Vec<bool>; 2],
+    /// Per foot and tick, the weight of the offset latched at the foot's last touch-down
+    /// (the tracker's closed-loop hold) and its first and second time derivatives \[–\],
+    /// \[1/s\], \[1/s²\]: 1 in stance, `1 − s(τ)` over the swing to the next stance (the
+    /// swing's progress `τ`, [`quintic`]), 1 after the last stance, 0 before the first.
+    pub latch_weight: [Vec<[f64; 3]>; 2],
     pub com: Vec<ComReference>,
     pub pelvis: Vec<PoseRef>,
     pub torso: Vec<PoseRef>,
@@ -506,10 +511,15 @@ pub(crate) fn plan(
                 .collect()
         })
         .collect();
+    let latch_weight = [
+        latch_weights(&contact[0], s.dt),
+        latch_weights(&contact[1], s.dt),
+    ];
     Ok(Plan {
         ticks,
         feet,
         contact,
+        latch_weight,
         com,
         pelvis,
         torso,
@@ -528,6 +538,32 @@ pub(crate) const TRACKED: [BodyPoint; 4] = [
     BodyPoint::LeftElbow,
     BodyPoint::RightElbow,
 ];
+
+/// [`Plan::latch_weight`] of one foot: `1 − s(τ)` and its derivatives `−s'(τ)/T`,
+/// `−s''(τ)/T²` over a swing of `T` \[s\] (`s' = 30τ²(1 − τ)²`, `s'' = 60τ(1 − τ)(1 − 2τ)`).
+fn latch_weights(contact: &[bool], dt: f64) -> Vec<[f64; 3]> {
+    let n = contact.len();
+    let stances = runs(contact);
+    let mut w = vec![[0.0; 3]; n];
+    for (i, &(s, e)) in stances.iter().enumerate() {
+        w[s..e].iter_mut().for_each(|x| *x = [1.0, 0.0, 0.0]);
+        let a = e - 1;
+        match stances.get(i + 1) {
+            Some(&(b, _)) => {
+                let span = (b - a) as f64;
+                let t = span * dt;
+                for (k, x) in w.iter_mut().enumerate().take(b).skip(e) {
+                    let tau = (k - a) as f64 / span;
+                    let d1 = 30.0 * tau * tau * (1.0 - tau) * (1.0 - tau);
+                    let d2 = 60.0 * tau * (1.0 - tau) * (1.0 - 2.0 * tau);
+                    *x = [1.0 - quintic(tau), -d1 / t, -d2 / (t * t)];
+                }
+            }
+            None => w[e..].iter_mut().for_each(|x| *x = [1.0, 0.0, 0.0]),
+        }
+    }
+    w
+}
 
 fn unwrap(mut a: Vec<f64>) -> Vec<f64> {
     for k in 1..a.len() {

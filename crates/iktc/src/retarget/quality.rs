@@ -6,8 +6,10 @@
 //!   pelvis (the aligned clip `a`, [`super::scale`]); mean and max per point, reported in cm;
 //! * orientation error of the pelvis and the torso frames against the references built from the
 //!   points ([`super::plan`]): the angle of `R_ref R_robotᵀ` \[rad\], mean and max, in degrees;
-//! * stance-foot slip: for each stance run of a foot (contacts of the clip), the largest
-//!   horizontal distance of the sole centre from where it was at the run's first tick \[m\], in mm;
+//! * stance-foot slip: for each stance run of a foot (on the keypoint route the robot's stance,
+//!   from the foot's landing to the clip's lift-off; on the joint route the clip's contacts), the
+//!   largest horizontal distance of the sole centre from where it was at the run's first tick
+//!   \[m\], in mm;
 //! * foot below the ground: the largest depth below z = 0 of any sole corner \[m\], in mm;
 //! * joint jerk `(q̈_k − q̈_{k−1}) / Δt` of the active joints \[rad/s³\]: RMS over joints and
 //!   ticks, and max ([`DofSmoothness`]);
@@ -115,7 +117,8 @@ impl QualityRecorder {
         }
     }
 
-    /// Records tick `k` of `plan`: the state at its start and the q̈ applied over it.
+    /// Records tick `k` of `plan`: the state at its start and the q̈ applied over it; `stance`
+    /// says which feet are held on the ground (for the slip).
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn record(
         &mut self,
@@ -124,7 +127,7 @@ impl QualityRecorder {
         body: &RobotBody,
         plan: &Plan,
         support: &SupportSettings,
-        k: usize,
+        (k, stance): (usize, [bool; 2]),
         state: &State,
         qdd: &[f64],
     ) -> Result<()> {
@@ -149,8 +152,8 @@ impl QualityRecorder {
             self.orient[1] = (self.orient[1].0 + e, self.orient[1].1.max(e));
         }
         let mut any = false;
-        for i in 0..2 {
-            let foot = kin.frame_pose(robot, body.feet[i])?;
+        for (i, (held, f)) in stance.iter().zip(body.feet).enumerate() {
+            let foot = kin.frame_pose(robot, f)?;
             let (hl, hw) = (0.5 * support.sole_length, 0.5 * support.sole_width);
             for (sx, sy) in [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)] {
                 let c = foot
@@ -163,7 +166,7 @@ impl QualityRecorder {
             }
             let centre =
                 (foot * Point3::new(support.sole_offset_x, 0.0, -support.ankle_height)).coords;
-            if plan.contact[i][k] {
+            if *held {
                 any = true;
                 let start = *self.stance_start[i].get_or_insert(centre);
                 let d = (centre - start).xy().norm();
