@@ -85,10 +85,10 @@ pub(crate) fn runs(c: &[bool]) -> Vec<(usize, usize)> {
     out
 }
 
-/// The quintic blend `s(τ) = 10τ³ − 15τ⁴ + 6τ⁵` on `τ ∈ [0, 1]`.
+/// The quintic blend `s(τ) = 10τ³ − 15τ⁴ + 6τ⁵` on `τ ∈ [0, 1]` (clamped outside): the
+/// position of [`smoothstep`](crate::walk::smoothstep) over a unit interval.
 pub(crate) fn quintic(tau: f64) -> f64 {
-    let t = tau.clamp(0.0, 1.0);
-    t * t * t * (10.0 - 15.0 * t + 6.0 * t * t)
+    crate::walk::smoothstep(0.0, 1.0, tau).0
 }
 
 /// Fraction of a swing over which the captured foot's own motion is faded in (and out) \[–\]
