@@ -383,7 +383,16 @@ fn walking_settings_come_from_the_profile_and_the_default_push_scales_with_the_m
     ))
     .unwrap();
     let robot = p.robot().unwrap();
-    let cfg = p.walk_config(&robot, base.clone()).unwrap();
+    // From a base whose imitation knows no robot: the profile's feet and pelvis come in.
+    let blank = WalkImitateConfig {
+        imitate: ImitateConfig {
+            feet: Vec::new(),
+            pelvis: String::new(),
+            ..ImitateConfig::default()
+        },
+        ..base.clone()
+    };
+    let cfg = p.walk_config(&robot, blank).unwrap();
     assert_eq!(cfg.step_length, 0.07);
     assert_eq!(cfg.walk.swing_height, 0.03);
     assert_eq!(cfg.walk.ssp_duration, 0.5);
@@ -426,6 +435,10 @@ fn walking_settings_come_from_the_profile_and_the_default_push_scales_with_the_m
             "{name}: Δv {dv} m/s"
         );
         assert_eq!(push.impulse[1], 0.0);
+        if name == "jvrc1" {
+            // Without its key, JVRC-1 still gets the paper's push: 5 N·s on its 62.4 kg.
+            assert!((push.impulse[0] - 5.0).abs() < 1e-3, "{}", push.impulse[0]);
+        }
     }
     // The built-in JVRC-1 profile states the paper's 5 N·s.
     let p = RobotProfile::builtin("jvrc1").unwrap();
