@@ -57,15 +57,7 @@ impl NpyArray {
         let count: usize = self.shape.iter().product();
         let (descr, len) = match &self.data {
             NpyData::F64(v) => ("<f8".to_string(), v.len()),
-            NpyData::Str(v) => {
-                let width = v
-                    .iter()
-                    .map(|s| s.chars().count())
-                    .max()
-                    .unwrap_or(0)
-                    .max(1);
-                (format!("<U{width}"), v.len())
-            }
+            NpyData::Str(v) => (format!("<U{}", str_width(v)), v.len()),
         };
         if len != count {
             return Err(Error::DimensionMismatch {
@@ -107,12 +99,7 @@ impl NpyArray {
                 .iter()
                 .for_each(|x| out.extend_from_slice(&x.to_le_bytes())),
             NpyData::Str(v) => {
-                let width = v
-                    .iter()
-                    .map(|s| s.chars().count())
-                    .max()
-                    .unwrap_or(0)
-                    .max(1);
+                let width = str_width(v);
                 for s in v {
                     let n = s.chars().count();
                     for c in s.chars() {
@@ -124,6 +111,15 @@ impl NpyArray {
         }
         Ok(out)
     }
+}
+
+/// Characters per string of a `'<UN'` array: the longest string's, at least 1.
+fn str_width(v: &[String]) -> usize {
+    v.iter()
+        .map(|s| s.chars().count())
+        .max()
+        .unwrap_or(0)
+        .max(1)
 }
 
 /// The CRC-32 table of the reflected IEEE polynomial.
