@@ -125,6 +125,7 @@ fn base_profile(spec: &str) -> Result<(RobotProfile, String)> {
             posture: Default::default(),
             narrow: Default::default(),
             acceleration: Default::default(),
+            jerk: Default::default(),
             imitate: Default::default(),
             walk: Default::default(),
             origin: ProfileOrigin::Directory(PathBuf::new()),

@@ -16,6 +16,7 @@ fn bench_compute_box(c: &mut Criterion) {
             position_max: q_min + rng.random_range(0.5..4.0),
             velocity_max: rng.random_range(2.0..10.0),
             acceleration_max: rng.random_range(10.0..100.0),
+            jerk_max: f64::INFINITY,
         });
     }
     let limits = match JointLimits::new(dofs.clone()) {

@@ -28,6 +28,7 @@ fn limits() -> JointLimits {
         position_max: Q_MAX,
         velocity_max: V_MAX,
         acceleration_max: A_MAX,
+        jerk_max: f64::INFINITY,
     }])
     .unwrap()
 }

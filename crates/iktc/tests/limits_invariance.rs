@@ -147,6 +147,7 @@ fn case() -> impl Strategy<Value = Case> {
                 position_max: q_min + width,
                 velocity_max: v_max,
                 acceleration_max: ratio * v_max,
+                jerk_max: f64::INFINITY,
             },
             fraction,
             dt,
@@ -287,6 +288,7 @@ fn multi_dof_box_under_a_pushing_policy() {
                 position_max: q_min + rng.random_range(0.0..3.0),
                 velocity_max: v_max,
                 acceleration_max: v_max * 10f64.powf(rng.random_range(0.0..5.0)),
+                jerk_max: f64::INFINITY,
             }
         })
         .collect();

@@ -18,6 +18,7 @@ fn knee() -> DofLimits {
         position_max: 0.95,
         velocity_max: 4.0,
         acceleration_max: 40.0,
+        jerk_max: f64::INFINITY,
     }
 }
 

@@ -115,6 +115,7 @@ fn case() -> impl Strategy<Value = Case> {
                     position_max: centre + 0.5 * range,
                     velocity_max: 10f64.powf(log_v),
                     acceleration_max: 10f64.powf(log_a),
+                    jerk_max: f64::INFINITY,
                 },
                 fraction,
                 dt,
@@ -234,6 +235,7 @@ fn pushing_at_the_bound_arrives_within_the_profile_time() {
                 position_max: rng.random_range(-0.9..1.0),
                 velocity_max: rng.random_range(0.2..5.0),
                 acceleration_max: rng.random_range(5.0..200.0),
+                jerk_max: f64::INFINITY,
             },
             fraction: rng.random_range(0.2..=1.0),
             dt,
@@ -304,6 +306,7 @@ fn iktc_drives_a_joint_onto_its_limit_and_it_rests_there() {
             position_max: 0.5,
             velocity_max: rng.random_range(1.0..4.0),
             acceleration_max: rng.random_range(20.0..80.0),
+            jerk_max: f64::INFINITY,
         };
         let limits = JointLimits::new(vec![dof; nv]).unwrap();
         let method = BoundMethod::quiet();

@@ -17,6 +17,7 @@ fn joint(range: f64, v_max: f64, a_max: f64) -> DofLimits {
         position_max: range,
         velocity_max: v_max,
         acceleration_max: a_max,
+        jerk_max: f64::INFINITY,
     }
 }
 
@@ -345,6 +346,7 @@ fn sources(lower: [f64; 4], upper: [f64; 4]) -> DofBoundSources {
         velocity: v[1],
         position: v[2],
         viability: v[3],
+        jerk: f64::INFINITY.copysign(v[0]),
     };
     DofBoundSources {
         lower: side(lower),
@@ -612,6 +614,7 @@ fn braking_curve_regime_by_hand() {
         position_max: 0.95,
         velocity_max: 4.0,
         acceleration_max: 40.0,
+        jerk_max: f64::INFINITY,
     };
     assert!(viable::braking_curve_is_invariant(&k, 20.0, 0.01));
     assert!(viable::braking_curve_is_invariant(&k, 20.0, 0.1)); // 2 ≤ 4, 0.2 ≤ 0.4

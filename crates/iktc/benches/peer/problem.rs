@@ -21,7 +21,7 @@
 use std::f64::consts::{PI, TAU};
 
 use iktc::controller::{ControllerSettings, JointsHandle};
-use iktc::limits::{BoundMethod, JointLimits};
+use iktc::limits::{AccelerationBox, BoundMethod, JointLimits};
 use iktc::model::{jvrc1, ModelOptions, Robot, State};
 use iktc::solver::{Method, SolveReport, SolverSettings};
 use iktc::task::{Axes, Gains};
@@ -113,7 +113,18 @@ impl PeerProblem {
         settings: SolverSettings,
         bounds: BoundMethod,
     ) -> iktc::Result<Self> {
-        let robot = jvrc1(&ModelOptions::default())?;
+        Self::with_model(method, settings, bounds, &ModelOptions::default())
+    }
+
+    /// The problem at t = 0 on JVRC-1 built with `options` (e.g. jerk limits), with `bounds`,
+    /// solved by `method` with `settings`.
+    pub fn with_model(
+        method: Method,
+        settings: SolverSettings,
+        bounds: BoundMethod,
+        options: &ModelOptions,
+    ) -> iktc::Result<Self> {
+        let robot = jvrc1(options)?;
         let mut state = State::neutral(&robot);
         for (name, v) in INITIAL_POSE {
             state.set_joint(&robot, name, v)?;
@@ -159,6 +170,11 @@ impl PeerProblem {
     /// Its joint limits.
     pub fn limits(&self) -> &JointLimits {
         self.ctl.limits()
+    }
+
+    /// The acceleration box of the last step \[rad/s²\].
+    pub fn bounds(&self) -> &AccelerationBox {
+        self.ctl.bounds()
     }
 
     /// The q̈ of the last solve \[rad/s² or m/s²\].

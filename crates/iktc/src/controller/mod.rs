@@ -11,7 +11,8 @@
 //! 1. kinematics at (q, q̇): frame poses and Jacobians, drifts J̇q̇, the COM (eqs. 2–3);
 //! 2. each level linearised to `J_i q̈ = h_i` with
 //!    `h_i = ẍ_d + k_v (ẋ_d − ẋ) + k_p (x_d − x) − J̇_i q̇` (eqs. 3, 11);
-//! 3. the joint limits turned into the box `b_l ≤ q̈ ≤ b_u` (eq. 14 or the viable bounds);
+//! 3. the joint limits turned into the box `b_l ≤ q̈ ≤ b_u` (eq. 14 or the viable bounds), with
+//!    the optional jerk limits around the previous tick's q̈ ([`limit_jerk`]);
 //! 4. the solve: the prioritized solution (eqs. 5–10), corrected by IKTC (eqs. 19–25), or GF,
 //!    or clamping ([`ControllerSettings::method`]);
 //! 5. the constant-acceleration integration q⁺ = q + Δt q̇ + ½Δt² q̈, q̇⁺ = q̇ + Δt q̈.
@@ -39,7 +40,7 @@ use std::sync::Arc;
 use nalgebra::DVector;
 
 use crate::error::{Error, Result};
-use crate::limits::{compute_box, AccelerationBox, JointLimits};
+use crate::limits::{compute_box, limit_jerk, AccelerationBox, JointLimits};
 use crate::model::{Kinematics, Robot, State};
 use crate::solver::{SolveReport, Solver};
 use crate::task::{TaskEquation, TaskStack};
@@ -111,6 +112,10 @@ impl Controller {
             dt,
             &mut self.bounds,
         )?;
+        if self.limits.has_jerk_limits() {
+            // The previous command: the last solved q̈ (zero before the first solve).
+            limit_jerk(&self.limits, self.qdd.as_slice(), dt, &mut self.bounds)?;
+        }
         self.stage = Stage::Prepared { dt };
         Ok(())
     }

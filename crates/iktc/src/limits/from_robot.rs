@@ -6,7 +6,8 @@ use crate::model::Robot;
 
 impl JointLimits {
     /// One [`DofLimits`] per velocity coordinate of `robot`: unlimited for the floating base,
-    /// then each active joint's position range \[rad or m\], velocity and acceleration limits;
+    /// then each active joint's position range \[rad or m\], velocity, acceleration and jerk
+    /// limits;
     /// the dofs are named as in [`Robot::dof_names`].
     pub fn from_robot(robot: &Robot) -> Result<JointLimits> {
         let limits = JointLimits::new(
@@ -18,6 +19,7 @@ impl JointLimits {
                     position_max: l.upper,
                     velocity_max: l.velocity,
                     acceleration_max: l.acceleration,
+                    jerk_max: l.jerk,
                 })
                 .collect(),
         )?;

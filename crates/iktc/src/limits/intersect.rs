@@ -115,6 +115,7 @@ fn negate(side: &SourceBounds) -> SourceBounds {
         velocity: -side.velocity,
         position: -side.position,
         viability: -side.viability,
+        jerk: -side.jerk,
     }
 }
 

@@ -21,10 +21,14 @@ pub struct DofLimits {
     /// Largest acceleration in either direction, `a_max > 0` \[rad/s²\] or \[m/s²\]; `+inf` for
     /// none.
     pub acceleration_max: f64,
+    /// Largest change of the commanded acceleration per second, `j_max > 0` \[rad/s³\] or
+    /// \[m/s³\]; `+inf` for none (the default: URDF has none; a robot profile's `jerk` key
+    /// sets it). See [`limit_jerk`](super::limit_jerk).
+    pub jerk_max: f64,
 }
 
 impl DofLimits {
-    /// A degree of freedom without any limit (all four entries infinite), e.g. a floating-base
+    /// A degree of freedom without any limit (all five entries infinite), e.g. a floating-base
     /// dof.
     pub fn unlimited() -> Self {
         Self {
@@ -32,6 +36,7 @@ impl DofLimits {
             position_max: f64::INFINITY,
             velocity_max: f64::INFINITY,
             acceleration_max: f64::INFINITY,
+            jerk_max: f64::INFINITY,
         }
     }
 
@@ -39,13 +44,14 @@ impl DofLimits {
     ///
     /// Rules: no NaN ([`Error::NonFinite`]); `position_min ≤ position_max`, `position_min < +inf`
     /// and `position_max > -inf` ([`Error::InvalidLimit`]); `velocity_max > 0` and
-    /// `acceleration_max > 0`, `+inf` allowed ([`Error::InvalidSetting`]).
+    /// `acceleration_max > 0` and `jerk_max > 0`, `+inf` allowed ([`Error::InvalidSetting`]).
     pub fn validate(&self, what: &str) -> Result<()> {
         let fields = [
             ("position_min", self.position_min),
             ("position_max", self.position_max),
             ("velocity_max", self.velocity_max),
             ("acceleration_max", self.acceleration_max),
+            ("jerk_max", self.jerk_max),
         ];
         for (name, value) in fields {
             if value.is_nan() {
@@ -68,6 +74,7 @@ impl DofLimits {
         for (name, value, unit) in [
             ("velocity_max", self.velocity_max, "[rad/s]"),
             ("acceleration_max", self.acceleration_max, "[rad/s²]"),
+            ("jerk_max", self.jerk_max, "[rad/s³]"),
         ] {
             // NaN was rejected above: this catches zero and negative values.
             if value <= 0.0 {

@@ -10,7 +10,8 @@
 //! | [`BoundMethod::Quiet`] | as `Viable`, with a discrete braking profile that ends at rest at a tick ([`quiet`]) | yes, from a quietly viable state; the box never empties and a joint pushed into a limit rests on it with `q̈ = 0` |
 //!
 //! Each source of bound (acceleration, velocity, position, viability) is computed separately,
-//! as in TSID, then intersected ([`intersect`]). From a viable state the sources of `Viable`
+//! as in TSID, then intersected ([`intersect`]). Optional jerk limits are a fourth source,
+//! applied last with the lowest precedence ([`limit_jerk`], [`jerk`]). From a viable state the sources of `Viable`
 //! never conflict (beyond rounding); from any other state the acceleration limit is dropped
 //! first (exceeded by the least amount), then viability; position and velocity are kept, and
 //! if they conflict the box is reported empty. A run checks its start state
@@ -30,7 +31,7 @@
 //!     position_min: -1.0,
 //!     position_max: 1.0,
 //!     velocity_max: std::f64::consts::PI,
-//!     acceleration_max: 10.0 * std::f64::consts::PI,
+//!     acceleration_max: 10.0 * std::f64::consts::PI, jerk_max: f64::INFINITY,
 //! };
 //! let limits = JointLimits::new(vec![DofLimits::unlimited(), joint])?;
 //! let mut bounds = AccelerationBox::new(limits.nv());
@@ -46,6 +47,7 @@ mod compute;
 mod from_robot;
 mod integrator;
 mod intersect;
+pub mod jerk;
 mod joint_limits;
 mod method;
 mod narrow;
@@ -59,6 +61,7 @@ pub use acceleration_box::AccelerationBox;
 pub use compute::{compute_box, compute_dof};
 pub use integrator::{integrate_constant_acceleration, peak_in_step, StepExtremes};
 pub use intersect::{intersect, DofBounds};
+pub use jerk::limit_jerk;
 pub use joint_limits::{DofLimits, JointLimits};
 pub use method::{BoundMethod, OutsideLimits, ViableSettings};
 pub use narrow::NarrowedJoint;

@@ -95,6 +95,7 @@ mod tests {
             position_max: hi,
             velocity_max: 2.0,
             acceleration_max: 20.0,
+            jerk_max: f64::INFINITY,
         };
         JointLimits::new(vec![dof(-1.0, 1.0), dof(0.0, 2.0)])
             .unwrap()

@@ -77,12 +77,14 @@ pub fn paper_sources(limits: &DofLimits, q: f64, qd: f64, dt: f64) -> DofBoundSo
             velocity: velocity_lower(qd, limits.velocity_max, dt),
             position: position_term_lower(q, qd, limits.position_min, a_max, dt),
             viability: f64::NEG_INFINITY,
+            jerk: f64::NEG_INFINITY,
         },
         upper: SourceBounds {
             acceleration: a_max,
             velocity: velocity_upper(qd, limits.velocity_max, dt),
             position: position_term_upper(q, qd, limits.position_max, a_max, dt),
             viability: f64::INFINITY,
+            jerk: f64::INFINITY,
         },
     }
 }

@@ -181,6 +181,7 @@ mod tests {
             position_max: 0.5,
             velocity_max: 2.0,
             acceleration_max: 40.0,
+            jerk_max: f64::INFINITY,
         };
         let settings = ViableSettings {
             braking_fraction: 0.25,

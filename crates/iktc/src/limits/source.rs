@@ -23,6 +23,9 @@ pub enum BoundSource {
     /// ([`OutsideLimits::Recover`](super::OutsideLimits)): both sides are the recovery
     /// acceleration of [`recovery_acceleration`](super::viable::recovery_acceleration).
     Recovery,
+    /// The jerk limit: `q̈` within `j_max Δt` of the previous tick's `q̈`
+    /// ([`limit_jerk`](super::limit_jerk)).
+    Jerk,
 }
 
 /// Which sources conflict resolution removed for one dof (both sides).
@@ -36,12 +39,16 @@ pub struct DroppedSources {
     /// The viability bound was dropped as well: the next state may be unable to stop inside
     /// the range.
     pub viability: bool,
+    /// The jerk limit was relaxed ([`limit_jerk`](super::limit_jerk)): the interval of the other
+    /// sources lies outside `q̈₋ ± j_max Δt`, and the point of it nearest to that interval is
+    /// taken.
+    pub jerk: bool,
 }
 
 impl DroppedSources {
     /// Whether any source was dropped.
     pub fn any(&self) -> bool {
-        self.acceleration || self.viability
+        self.acceleration || self.viability || self.jerk
     }
 }
 
@@ -61,6 +68,9 @@ pub struct SourceBounds {
     pub position: f64,
     /// From viability (`Viable` only; infinite for `Paper`).
     pub viability: f64,
+    /// From the jerk limit: `q̈₋ ± j_max Δt` ([`limit_jerk`](super::limit_jerk)); infinite
+    /// when the dof has no jerk limit or the box was computed without one.
+    pub jerk: f64,
 }
 
 impl SourceBounds {
@@ -75,6 +85,7 @@ impl SourceBounds {
             velocity: value,
             position: value,
             viability: value,
+            jerk: value,
         }
     }
 }

@@ -79,6 +79,7 @@ fn intersect_follows_its_rule_on_every_combination() {
             velocity: pick(&mut rng, sign),
             position: pick(&mut rng, sign),
             viability: pick(&mut rng, sign),
+            jerk: f64::INFINITY * sign,
         };
         let s = DofBoundSources {
             lower: side(-1.0),
@@ -111,7 +112,7 @@ fn intersect_follows_its_rule_on_every_combination() {
                 BoundSource::Velocity => side.velocity,
                 BoundSource::Position | BoundSource::PaperPosition => side.position,
                 BoundSource::Viability => side.viability,
-                BoundSource::Recovery => f64::NAN,
+                BoundSource::Recovery | BoundSource::Jerk => f64::NAN,
             };
             // After conflict resolution a side may take the other side's value and source.
             let other = if lower { &s.upper } else { &s.lower };
@@ -151,6 +152,7 @@ fn ties_name_position_then_viability_then_velocity_then_acceleration() {
         velocity: v,
         position: v,
         viability: v,
+        jerk: v,
     };
     let s = DofBoundSources {
         lower: side(-1.0),
@@ -185,7 +187,13 @@ fn ties_name_position_then_viability_then_velocity_then_acceleration() {
     assert!(!b.dropped.any());
     assert!(DroppedSources {
         acceleration: false,
-        viability: true
+        viability: true,
+        jerk: false,
+    }
+    .any());
+    assert!(DroppedSources {
+        jerk: true,
+        ..DroppedSources::default()
     }
     .any());
 }
@@ -213,6 +221,7 @@ fn paper_terms_equal_the_printed_formula() {
         position_max: 1.0,
         velocity_max: 2.0,
         acceleration_max: a,
+        jerk_max: f64::INFINITY,
     };
     let s = paper_sources(&lim, q, qd, dt);
     assert_eq!((s.lower.acceleration, s.upper.acceleration), (-a, a));
@@ -275,6 +284,7 @@ fn velocity_terms_and_the_integrator_match_their_closed_forms() {
         position_max: 1.0,
         velocity_max: 1.0,
         acceleration_max: 1.0,
+        jerk_max: f64::INFINITY,
     };
     assert_eq!(
         lim.excursion(StepExtremes {
@@ -305,6 +315,7 @@ fn dof(lo: f64, hi: f64, v: f64, a: f64) -> DofLimits {
         position_max: hi,
         velocity_max: v,
         acceleration_max: a,
+        jerk_max: f64::INFINITY,
     }
 }
 

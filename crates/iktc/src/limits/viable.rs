@@ -343,12 +343,14 @@ pub fn viable_sources(
             velocity: velocity_lower(qd, limits.velocity_max, dt),
             position: position_lower(q, qd, limits.position_min, dt),
             viability: lower,
+            jerk: f64::NEG_INFINITY,
         },
         upper: SourceBounds {
             acceleration: a_max,
             velocity: velocity_upper(qd, limits.velocity_max, dt),
             position: position_upper(q, qd, limits.position_max, dt),
             viability: upper,
+            jerk: f64::INFINITY,
         },
     }
 }

@@ -268,6 +268,7 @@ fn the_braking_curve_regime_has_inclusive_ends() {
         position_max: 0.5,
         velocity_max: 2.0,
         acceleration_max: 100.0,
+        jerk_max: f64::INFINITY,
     };
     // aΔt = v_max exactly, aΔt² = 0.2 ≤ 1: invariant; a hair above either: not.
     assert!(braking_curve_is_invariant(&lim, 20.0, 0.1));
@@ -293,6 +294,7 @@ fn viable_sources_pick_the_regime_and_the_braking_fraction() {
         position_max: 0.5,
         velocity_max: 2.0,
         acceleration_max: 40.0,
+        jerk_max: f64::INFINITY,
     };
     let s = viable_sources(&lim, &settings, q, qd, dt);
     let a_stop = 10.0;
@@ -330,6 +332,7 @@ fn recovery_returns_at_rest_within_the_limits() {
         position_max: 0.5,
         velocity_max: 1.0,
         acceleration_max: 10.0,
+        jerk_max: f64::INFINITY,
     };
     let dt = 0.005;
     for start in [0.9, -0.9, 0.5 + 2e-9, -0.5 - 2e-9] {

@@ -82,6 +82,7 @@ pub fn planar3r() -> Robot {
                 upper: hi * deg,
                 velocity: 180.0 * deg,
                 acceleration: 1800.0 * deg,
+                jerk: f64::INFINITY,
                 effort: f64::INFINITY,
             },
             mimic: None,

@@ -60,6 +60,9 @@ pub struct JointLimit {
     /// Largest acceleration \[rad/s²\] or \[m/s²\]; URDF has none: it comes from
     /// [`ModelOptions`](crate::model::ModelOptions).
     pub acceleration: f64,
+    /// Largest jerk (rate of change of the acceleration) \[rad/s³\] or \[m/s³\]; URDF has
+    /// none: it comes from [`ModelOptions`](crate::model::ModelOptions), +∞ by default.
+    pub jerk: f64,
     /// Largest effort \[N·m\] or \[N\]; informative only (the IK is kinematic).
     pub effort: f64,
 }
@@ -71,6 +74,7 @@ impl JointLimit {
         upper: f64::INFINITY,
         velocity: f64::INFINITY,
         acceleration: f64::INFINITY,
+        jerk: f64::INFINITY,
         effort: f64::INFINITY,
     };
 }

@@ -84,6 +84,13 @@ pub struct ModelOptions {
     /// Acceleration limit \[rad/s²\] for joints that have neither an acceleration nor a velocity
     /// limit. Default +∞ (no limit).
     pub fallback_acceleration: f64,
+    /// Jerk limits \[rad/s³\] or \[m/s³\] by joint name (URDF has none); see
+    /// [`limit_jerk`](crate::limits::limit_jerk).
+    pub jerk_limits: Vec<(String, f64)>,
+    /// Default jerk limit as a multiple of the joint's acceleration limit \[1/s\]: the joint
+    /// reaches its full acceleration from zero in 1/this seconds. Default +∞: no jerk limit
+    /// for joints without an explicit one.
+    pub jerk_per_acceleration: f64,
     /// What to do with mimic joints.
     pub mimic: MimicPolicy,
 }
@@ -96,6 +103,8 @@ impl Default for ModelOptions {
             acceleration_limits: Vec::new(),
             acceleration_per_velocity: 10.0,
             fallback_acceleration: f64::INFINITY,
+            jerk_limits: Vec::new(),
+            jerk_per_acceleration: f64::INFINITY,
             mimic: MimicPolicy::Follow,
         }
     }
@@ -223,6 +232,13 @@ impl Robot {
                 name: "acceleration_per_velocity".into(),
                 value: options.acceleration_per_velocity.to_string(),
                 expected: "a positive number [1/s]".into(),
+            });
+        }
+        if options.jerk_per_acceleration.is_nan() || options.jerk_per_acceleration <= 0.0 {
+            return Err(Error::InvalidSetting {
+                name: "jerk_per_acceleration".into(),
+                value: options.jerk_per_acceleration.to_string(),
+                expected: "a positive number [1/s], or +inf for no default jerk limit".into(),
             });
         }
         if b.links.is_empty() {
@@ -394,6 +410,18 @@ impl Robot {
             }
             accel.insert(j, *value);
         }
+        let mut jerk: HashMap<usize, f64> = HashMap::new();
+        for (name, value) in &options.jerk_limits {
+            let j = find_joint("joint", name)?;
+            if value.is_nan() || *value <= 0.0 {
+                return Err(Error::InvalidSetting {
+                    name: format!("jerk limit of joint `{name}`"),
+                    value: value.to_string(),
+                    expected: "a positive number [rad/s³] or +inf".into(),
+                });
+            }
+            jerk.insert(j, *value);
+        }
         // Roles. First pass: active / locked / fixed; mimics resolved after.
         let nbase_v = if options.base == BaseKind::Floating {
             6
@@ -429,6 +457,12 @@ impl Robot {
                 } else {
                     options.fallback_acceleration
                 };
+            }
+            if let Some(value) = jerk.get(&j) {
+                limit.jerk = *value;
+            } else if !matches!(s.kind, JointKind::Fixed) {
+                // inf · a: +inf unless both are finite (0 · inf cannot occur: a > 0).
+                limit.jerk = options.jerk_per_acceleration * limit.acceleration;
             }
             joints.push(Joint {
                 name: s.name.clone(),

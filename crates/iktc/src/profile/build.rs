@@ -103,6 +103,17 @@ impl RobotProfile {
                 "a limit > 0 [rad/s² or m/s²]",
             )?;
         }
+        if let Some(r) = self.jerk.per_acceleration {
+            check_number("jerk.per_acceleration", r, r > 0.0, "a ratio > 0 [1/s]")?;
+        }
+        for (j, v) in &self.jerk.limits {
+            check_number(
+                &format!("jerk.limits.{j}"),
+                *v,
+                *v > 0.0,
+                "a limit > 0 [rad/s³ or m/s³]",
+            )?;
+        }
         self.check_walk()
     }
 
@@ -151,10 +162,16 @@ impl RobotProfile {
             .filter(|j| !matches!(j.kind, JointKind::Fixed))
             .map(|j| j.name.clone())
             .collect();
-        for j in self.acceleration.limits.keys() {
+        let limited = self
+            .acceleration
+            .limits
+            .keys()
+            .map(|j| ("acceleration", j))
+            .chain(self.jerk.limits.keys().map(|j| ("jerk", j)));
+        for (key, j) in limited {
             if !movable.contains(j) {
                 return Err(profile_error(
-                    &format!("acceleration.limits.{j}"),
+                    &format!("{key}.limits.{j}"),
                     j,
                     format!("no such movable joint; joints are {}", list(&movable)),
                 ));
@@ -170,6 +187,13 @@ impl RobotProfile {
                 .map(|(k, v)| (k.clone(), *v))
                 .collect(),
             acceleration_per_velocity: self.acceleration.per_velocity,
+            jerk_limits: self
+                .jerk
+                .limits
+                .iter()
+                .map(|(k, v)| (k.clone(), *v))
+                .collect(),
+            jerk_per_acceleration: self.jerk.per_acceleration.unwrap_or(f64::INFINITY),
             ..ModelOptions::default()
         };
         let robot = Robot::from_urdf_str(&text, &options)

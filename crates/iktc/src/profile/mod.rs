@@ -36,6 +36,10 @@
 //! per_velocity = 10.0                            # default limit / velocity limit [1/s]
 //! limits = { left_knee_joint = 200.0 }           # [rad/s²]
 //!
+//! [jerk]                                         # optional; none by default
+//! per_acceleration = 20.0                        # default limit / acceleration limit [1/s]
+//! limits = { left_knee_joint = 3000.0 }          # [rad/s³]
+//!
 //! [walk]                                         # all optional (iktc walk)
 //! step_length = 0.1                              # [m]
 //! swing_height = 0.04                            # [m]
@@ -49,7 +53,7 @@
 //!
 //! [`RobotProfile::load`] reads a file, [`RobotProfile::builtin`] a built-in profile (`jvrc1`,
 //! `g1`), [`RobotProfile::robot`] builds the [`Robot`](crate::model::Robot) with the locks and
-//! acceleration limits and checks every name the profile uses;
+//! acceleration and jerk limits and checks every name the profile uses;
 //! [`RobotProfile::imitate_config`] gives the imitation its feet, pelvis, posture, narrowed
 //! ranges and soles. Every error names the key that holds the wrong value
 //! ([`Error::Profile`](crate::Error::Profile)), e.g. ``profile key `feet.left.frame` = `X`: no
@@ -78,7 +82,7 @@ pub use glob::glob_match;
 pub use init::init_profile_toml;
 pub use load::{builtin_profile_text, BUILTIN_PROFILES};
 pub use schema::{
-    AccelerationProfile, BodyFrames, Feet, Foot, ImitateProfile, LockRule, ProfileOrigin,
-    PushProfile, RobotProfile, Sole, WalkProfile, DEFAULT_ACCELERATION_PER_VELOCITY,
+    AccelerationProfile, BodyFrames, Feet, Foot, ImitateProfile, JerkProfile, LockRule,
+    ProfileOrigin, PushProfile, RobotProfile, Sole, WalkProfile, DEFAULT_ACCELERATION_PER_VELOCITY,
 };
 pub use walk::DEFAULT_PUSH_VELOCITY_CHANGE;

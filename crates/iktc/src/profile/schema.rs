@@ -39,6 +39,9 @@ pub struct RobotProfile {
     /// Acceleration limits (key `acceleration`).
     #[serde(default)]
     pub acceleration: AccelerationProfile,
+    /// Jerk limits (key `jerk`; none by default).
+    #[serde(default, skip_serializing_if = "JerkProfile::is_empty")]
+    pub jerk: JerkProfile,
     /// Imitation settings (key `imitate`).
     #[serde(default)]
     pub imitate: ImitateProfile,
@@ -167,6 +170,28 @@ impl Default for AccelerationProfile {
             per_velocity: DEFAULT_ACCELERATION_PER_VELOCITY,
             limits: BTreeMap::new(),
         }
+    }
+}
+
+/// Jerk limits (key `jerk`): how fast a joint's commanded acceleration may change
+/// ([`limit_jerk`](crate::limits::limit_jerk)). None unless stated.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JerkProfile {
+    /// Jerk limit of joints not listed in `limits`, as a multiple of their acceleration limit
+    /// \[1/s\], `> 0` (key `jerk.per_acceleration`): the acceleration can go from zero to its
+    /// limit in 1/this seconds. Absent: no jerk limit on those joints.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub per_acceleration: Option<f64>,
+    /// Jerk limits by joint name \[rad/s³\] or \[m/s³\] (key `jerk.limits`).
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub limits: BTreeMap<String, f64>,
+}
+
+impl JerkProfile {
+    /// Whether the profile states no jerk limit.
+    pub fn is_empty(&self) -> bool {
+        self.per_acceleration.is_none() && self.limits.is_empty()
     }
 }
 

@@ -37,6 +37,7 @@ pub fn held_limit(d: &DofLimits, effort: f64) -> JointLimit {
         upper: d.position_max,
         velocity: d.velocity_max,
         acceleration: d.acceleration_max,
+        jerk: d.jerk_max,
         effort,
     }
 }

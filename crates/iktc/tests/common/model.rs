@@ -55,6 +55,7 @@ pub fn random_tree(r: &mut ChaCha8Rng, n: usize, base: BaseKind) -> Robot {
                     upper: 2.0,
                     velocity: 5.0,
                     acceleration: 50.0,
+                    jerk: f64::INFINITY,
                     effort: 10.0,
                 },
                 mimic: None,
