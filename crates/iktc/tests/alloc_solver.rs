@@ -47,3 +47,41 @@ fn solvers_allocate_nothing() {
         }
     }
 }
+
+/// IKTC with the continuity term, and a box with jerk limits, allocate nothing either.
+#[test]
+fn continuity_and_jerk_limits_allocate_nothing() {
+    use iktc::limits::{limit_jerk, AccelerationBox, DofLimits, JointLimits};
+    let dims = [12, 2, 3, 1, 20];
+    let mut r = rng(42);
+    let levels = random_levels(&mut r, 38, &dims);
+    let settings = SolverSettings {
+        continuity: 1.0,
+        ..SolverSettings::default()
+    };
+    let mut s = Solver::new(38, &dims, settings).unwrap();
+    let mut q0 = DVector::zeros(38);
+    s.solve(Method::Prioritized, &levels, &wide_box(38), &mut q0)
+        .unwrap();
+    let bx = box_violated_by(&mut r, &q0, 5.0, 3, 0.5);
+    let mut q = DVector::zeros(38);
+    s.solve(Method::Iktc, &levels, &bx, &mut q).unwrap();
+    let before = count();
+    let rep = s.solve(Method::Iktc, &levels, &bx, &mut q).unwrap();
+    let qps = rep.qp_solves;
+    assert_eq!(count() - before, 0);
+    assert!(qps >= 1, "the box must force a correction");
+    let limits = JointLimits::new(vec![
+        DofLimits {
+            jerk_max: 100.0,
+            ..DofLimits::unlimited()
+        };
+        38
+    ])
+    .unwrap();
+    let mut jerked = AccelerationBox::new(38);
+    let prev = vec![0.5; 38];
+    let before = count();
+    limit_jerk(&limits, &prev, 0.005, &mut jerked).unwrap();
+    assert_eq!(count() - before, 0);
+}

@@ -48,9 +48,10 @@ struct Figures {
 }
 
 /// Runs one variant on JVRC-1 built with `options`.
-fn run(bounds: BoundMethod, level_hold: usize, options: &ModelOptions) -> Figures {
+fn run(bounds: BoundMethod, level_hold: usize, continuity: f64, options: &ModelOptions) -> Figures {
     let settings = SolverSettings {
         level_hold,
+        continuity,
         ..SolverSettings::default()
     };
     let mut p = PeerProblem::with_model(Method::Iktc, settings, bounds, options).expect("problem");
@@ -118,15 +119,29 @@ fn every_bound_method_keeps_the_limits_on_the_peer_problem_and_its_smoothness_is
         jerk_per_acceleration: JERK_PER_ACCELERATION,
         ..ModelOptions::default()
     };
-    for (name, bounds, hold, options) in [
-        ("viable", BoundMethod::viable(), 1, &plain),
-        ("quiet", BoundMethod::quiet(), 1, &plain),
-        ("quiet + hold 3", BoundMethod::quiet(), 3, &plain),
-        ("viable + hold 3", BoundMethod::viable(), 3, &plain),
-        ("viable + jerk", BoundMethod::viable(), 1, &jerk),
-        ("quiet + jerk", BoundMethod::quiet(), 1, &jerk),
+    for (name, bounds, hold, mu, options) in [
+        ("viable", BoundMethod::viable(), 1, 0.0, &plain),
+        ("quiet", BoundMethod::quiet(), 1, 0.0, &plain),
+        ("quiet + hold 3", BoundMethod::quiet(), 3, 0.0, &plain),
+        ("viable + hold 3", BoundMethod::viable(), 3, 0.0, &plain),
+        (
+            "viable + continuity 10",
+            BoundMethod::viable(),
+            1,
+            10.0,
+            &plain,
+        ),
+        (
+            "quiet + continuity 10",
+            BoundMethod::quiet(),
+            1,
+            10.0,
+            &plain,
+        ),
+        ("viable + jerk", BoundMethod::viable(), 1, 0.0, &jerk),
+        ("quiet + jerk", BoundMethod::quiet(), 1, 0.0, &jerk),
     ] {
-        let f = run(bounds, hold, options);
+        let f = run(bounds, hold, mu, options);
         println!(
             "peer problem, {name}: reversals {:.1} % of ticks (mean over the 20 joints), \
              RMS jerk {:.0} rad/s³, max {:.0} rad/s³, level changes undone at the next \

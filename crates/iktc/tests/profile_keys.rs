@@ -165,6 +165,12 @@ fn every_joint_key_names_itself() {
             "L_KNEES",
             "no such movable joint",
         ),
+        (
+            "[jerk]\nlimits = { L_KNEES = 10.0 }",
+            "jerk.limits.L_KNEES",
+            "L_KNEES",
+            "no such movable joint",
+        ),
     ] {
         let head = "[[lock]]\njoints = \"*THUMB\"";
         let e = build_error(&jvrc1_with(head, toml));
@@ -201,6 +207,8 @@ fn every_number_key_names_itself() {
             "[acceleration]\nper_velocity = 0.0",
             "acceleration.per_velocity",
         ),
+        ("[jerk]\nper_acceleration = -2.0", "jerk.per_acceleration"),
+        ("[jerk]\nlimits = { L_KNEE = 0.0 }", "jerk.limits.L_KNEE"),
         ("[narrow]\nL_KNEE = [0.9, 0.5]", "narrow.L_KNEE"),
         ("[posture]\nL_KNEE = nan", "posture.L_KNEE"),
         ("[walk]\nssp_duration = 0.0", "walk.ssp_duration"),
@@ -444,4 +452,33 @@ fn walking_settings_come_from_the_profile_and_the_default_push_scales_with_the_m
     let p = RobotProfile::builtin("jvrc1").unwrap();
     let cfg = p.walk_config(&p.robot().unwrap(), base).unwrap();
     assert_eq!(cfg.push.unwrap().impulse, [5.0, 0.0]);
+}
+
+/// `jerk.per_acceleration` scales every joint's acceleration limit; `jerk.limits` overrides
+/// one joint; without the key no joint has a jerk limit. Checked against the robot's own
+/// acceleration limits.
+#[test]
+fn jerk_limits_come_from_the_profile() {
+    let plain = parse(&jvrc1_with("", "")).unwrap().robot().unwrap();
+    let limits = iktc::limits::JointLimits::from_robot(&plain).unwrap();
+    assert!(!limits.has_jerk_limits());
+    let text = jvrc1_with(
+        "",
+        "[jerk]\nper_acceleration = 20.0\nlimits = { L_KNEE = 3000.0 }",
+    );
+    let robot = parse(&text).unwrap().robot().unwrap();
+    let limits = iktc::limits::JointLimits::from_robot(&robot).unwrap();
+    let knee = robot.joint_v_index("L_KNEE").unwrap();
+    for (i, d) in limits.dofs().iter().enumerate() {
+        if i < robot.base_nv() {
+            assert_eq!(d.jerk_max, f64::INFINITY);
+        } else if i == knee {
+            assert_eq!(d.jerk_max, 3000.0);
+        } else {
+            assert_eq!(d.jerk_max, 20.0 * d.acceleration_max, "dof {i}");
+        }
+    }
+    // Printed and read back, the key survives.
+    let p = parse(&text).unwrap();
+    assert_eq!(parse(&p.to_toml_string().unwrap()).unwrap().jerk, p.jerk);
 }

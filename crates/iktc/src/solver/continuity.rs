@@ -21,6 +21,24 @@
 //! above `c_k` are untouched (strict priority); what the hold trades is that the levels
 //! `c_k..f_k − 1` are corrected for up to `H − 1` ticks longer than Algorithm 2 would. Ticks
 //! without any correction count as ticks where a lower level sufficed.
+//!
+//! **Continuity of the correction itself.** The hold keeps the level; the correction can still
+//! jump when the level changes, because the least-norm correction of levels `c..n_T` need not be
+//! near the least-norm correction of levels `c'..n_T`. With
+//! [`SolverSettings::continuity`](super::SolverSettings::continuity) `μ > 0` the correction QP
+//! of eq. (23) becomes
+//!
+//! ```text
+//! min ½‖Δh‖² + ½μ‖q̈₀ + G Δh − q̈₋‖²   s.t.   b_l ≤ q̈₀ + G Δh ≤ b_u,
+//! H = I + μ GᵀG,   c = μ Gᵀ(q̈₀ − q̈₋),
+//! ```
+//!
+//! with `q̈₀` the prioritized solution, `G` the columns of the corrected levels and `q̈₋` the
+//! previous solve's q̈. The constraints are those of eq. (23), so the feasibility of each level,
+//! hence Algorithm 2's choice, the box and the strict priority of the levels above the corrected
+//! one, are unchanged; `H` is positive definite for every `G` (`I` plus a positive
+//! semi-definite term). Only which feasible correction is taken changes: the one whose q̈ is
+//! nearer the last command.
 
 /// The hold's state between ticks. Plain data; `H ≤ 1` makes it Algorithm 2 exactly.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]

@@ -86,6 +86,16 @@ pub struct SolverSettings {
     /// the QP runs as before. Same answer up to rounding and the QP's feasibility tolerance,
     /// fewer QP iterations when the same level is corrected tick after tick. Default true.
     pub warm_start: bool,
+    /// Weight `μ` of the continuity term of IKTC's correction QP \[–\] (the `continuity`
+    /// module notes in the solver): `min ½‖Δh‖² + ½μ‖q̈ − q̈₋‖²` over the corrections of the
+    /// levels Algorithm 2 chose, `q̈₋` the previous solve's q̈. The level chosen is unchanged
+    /// (feasibility does not depend on the objective), the box and the levels above it stay
+    /// exact; among the corrections that make q̈ fit the box, the one nearer the last command
+    /// is preferred, so q̈ does not jump when the corrected level changes. The two norms mix
+    /// task units (m/s², rad/s²) with joint units (rad/s²); `μ` weighs one against the other.
+    /// 0 is IKTC as printed. The warm start is not used when `μ > 0` (it assumes `min ½‖Δh‖²`).
+    /// Default 0.
+    pub continuity: f64,
     /// Settings of the QPs.
     pub qp: QpSettings,
 }
@@ -102,6 +112,7 @@ impl Default for SolverSettings {
             level_hold: 1,
             rebase_release: 1.0,
             warm_start: true,
+            continuity: 0.0,
             qp: QpSettings::default(),
         }
     }
@@ -137,6 +148,7 @@ impl SolverSettings {
         positive("rank_threshold", self.rank_threshold, false)?;
         positive("box_tolerance", self.box_tolerance, true)?;
         positive("cascade_regularization", self.cascade_regularization, false)?;
+        positive("continuity", self.continuity, true)?;
         if !(self.rebase_release > 0.0 && self.rebase_release <= 1.0) {
             return Err(Error::InvalidSetting {
                 name: "rebase_release".into(),

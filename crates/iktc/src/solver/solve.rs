@@ -47,6 +47,13 @@ pub struct Solver {
     rebase: Rebase,
     /// The active sets of the last optima, tried before each correction QP.
     warm: WarmStart,
+    /// The previous solve's q̈ \[rad/s²\] ([`SolverSettings::continuity`]; zero before the first).
+    previous: DVector<f64>,
+    /// q̈₀ − q̈₋ of the current solve \[rad/s²\].
+    step_change: Vec<f64>,
+    /// The continuity QP's Hessian `I + μ GᵀG` (top-left block used) and linear term.
+    continuity_h: DMatrix<f64>,
+    continuity_c: Vec<f64>,
     // Cascade buffers.
     h: DMatrix<f64>,
     c: Vec<f64>,
@@ -83,6 +90,10 @@ impl Solver {
             hold: LevelHold::default(),
             rebase: Rebase::new(nv, dims),
             warm: WarmStart::new(dims.len(), total, nv),
+            previous: DVector::zeros(nv),
+            step_change: vec![0.0; nv],
+            continuity_h: DMatrix::zeros(total, total),
+            continuity_c: vec![0.0; total],
             h: DMatrix::zeros(nv, nv),
             c: vec![0.0; nv],
             a_eq: DMatrix::zeros(total.max(1), nv),
@@ -163,6 +174,7 @@ impl Solver {
             }
             self.report.task_error_norms[i] = e.norm();
         }
+        self.previous.copy_from(qdd);
         Ok(&self.report)
     }
 
@@ -254,6 +266,7 @@ impl Solver {
         for d in 0..n {
             self.qp_lo[d] = self.lo[d] - self.q0[d];
             self.qp_hi[d] = self.hi[d] - self.q0[d];
+            self.step_change[d] = self.q0[d] - self.previous[d];
         }
         let start = match self.settings.climb {
             Climb::FromBottom => nt - 1,
@@ -344,7 +357,9 @@ impl Solver {
             return Ok(false);
         }
         let g = self.hierarchy.g().columns(off, ma);
-        if self.settings.warm_start
+        let mu = self.settings.continuity;
+        if mu == 0.0
+            && self.settings.warm_start
             && self.warm.solve(
                 i,
                 &g,
@@ -370,9 +385,33 @@ impl Solver {
             self.report.screened_infeasible += 1;
             return Ok(false);
         }
+        if mu > 0.0 {
+            // H = I + μ GᵀG, c = μ Gᵀ(q̈₀ − q̈₋) (the `continuity` module notes).
+            for a in 0..ma {
+                let ga = g.column(a);
+                for b in 0..=a {
+                    let v = mu * ga.dot(&g.column(b)) + if a == b { 1.0 } else { 0.0 };
+                    self.continuity_h[(a, b)] = v;
+                    self.continuity_h[(b, a)] = v;
+                }
+                let mut s = 0.0;
+                for (x, d) in ga.iter().zip(&self.step_change) {
+                    s += x * d;
+                }
+                self.continuity_c[a] = mu * s;
+            }
+        }
         let problem = QpProblem {
-            hessian: Hessian::Identity,
-            c: &self.zeros[..ma],
+            hessian: if mu > 0.0 {
+                Hessian::Dense(self.continuity_h.view((0, 0), (ma, ma)))
+            } else {
+                Hessian::Identity
+            },
+            c: if mu > 0.0 {
+                &self.continuity_c[..ma]
+            } else {
+                &self.zeros[..ma]
+            },
             a_eq: self.a_eq.rows(0, 0),
             b_eq: &[],
             a_in: g,
@@ -385,7 +424,9 @@ impl Solver {
         self.report.qp_solves += 1;
         self.report.qp_iterations += rep.iterations;
         if rep.status == QpStatus::Optimal {
-            self.warm.remember(i, self.qp.active_set());
+            if mu == 0.0 {
+                self.warm.remember(i, self.qp.active_set());
+            }
             Ok(true)
         } else {
             self.warm.forget(i);
