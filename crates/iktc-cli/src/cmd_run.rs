@@ -71,7 +71,7 @@ pub struct Args {
     #[arg(long, value_enum, default_value = "iktc")]
     pub solver: SolverArg,
     /// Joint bounds.
-    #[arg(long, value_enum, default_value = "viable")]
+    #[arg(long, value_enum, default_value = "quiet")]
     pub bounds: BoundsArg,
     /// Control period \[s\].
     #[arg(long, default_value_t = 0.005)]

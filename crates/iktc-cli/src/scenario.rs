@@ -40,7 +40,7 @@ pub struct ScenarioArgs {
     #[arg(long, value_enum, default_value = "iktc")]
     pub solver: SolverArg,
     /// Joint bounds.
-    #[arg(long, value_enum, default_value = "viable")]
+    #[arg(long, value_enum, default_value = "quiet")]
     pub bounds: BoundsArg,
     /// Start even if a joint is outside its (narrowed) range, and bring it back at the
     /// acceleration limit (viable or quiet bounds); without it such a start is an error.

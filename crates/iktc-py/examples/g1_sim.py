@@ -7,7 +7,7 @@ position servos ``τ = KP (q_cmd − q) − KV q̇`` [N·m] (clipped to each joi
 ``actuatorfrcrange``), the ``implicitfast`` integrator at ``PHYSICS_STEP``, and a 6-axis
 force/torque sensor at each ankle roll joint (a site at the joint, ``force`` and ``torque``).
 
-The controller: ``iktc.Imitation`` on the built-in ``g1`` profile (Table 1 stack, IKTC, viable
+The controller: ``iktc.Imitation`` on the built-in ``g1`` profile (Table 1 stack, IKTC, quiet
 bounds) integrates its own kinematic state at ``CONTROL_PERIOD``; every tick its joint angles
 are the servos' set points (position control, as on the paper's Hubo). The ZMP is measured from
 the two ankle sensors by eqs. 29–30 (``iktc.measure_zmp``); the damping controller (Section 4)

@@ -16,7 +16,8 @@ sweep of Section 4.2, places the poles, and pushes the standing robot at the pel
 without the damping controller, printing the fit and the damping ratios. `walking` walks
 while imitating the clip (damping controller off) and prints whether the robot stayed up, the
 standing feet's errors and the ZMP against the pattern's support polygon. `causes` prints the
-figures behind the expected failures: the standing run with the knees narrowed, quiet bounds,
+figures behind the expected failures: the standing run with the knees narrowed, the viable
+bounds and Algorithm 2's level as printed,
 the pelvis held, the clip slower, the arms frozen in the plan; the walking plan's ZMP and knees
 with and without narrowed knees; the walk in MuJoCo with stiffer servos. See ``g1_sim.py``.
 """
@@ -72,7 +73,7 @@ def causes(a) -> dict:
         "arms_frozen_in_the_plan": {"frozen": upper},
         "knees_narrowed": {"narrow": g1_sim.G1_KNEES},
         "knees_narrowed_accel_1x_velocity_limit": {"narrow": g1_sim.G1_KNEES, "robot": slow},
-        "quiet_bounds_level_hold_5": {"bounds": "quiet", "level_hold": 5},
+        "viable_bounds_algorithm2": {"bounds": "viable", "level_hold": 1},
         "pelvis_held": {"map": held},
         "clip_4x_slower": {"time_scale": 4.0},
     }

@@ -3,7 +3,7 @@
     python crates/iktc-py/examples/tick_overhead.py
     cargo bench -p iktc --bench humanoid_tick -- humanoid_tick/iktc
 
-Both run JVRC-1 imitating humanoid3d_dance_b (Table 1 stack, IKTC, viable bounds, L_KNEE and
+Both run JVRC-1 imitating humanoid3d_dance_b (Table 1 stack, IKTC, quiet bounds, level hold 3, continuity 0.3, L_KNEE and
 L_HIP_R narrowed, Δt = 5 ms): the bench times `tick` + `integrate` in Rust, this script times
 `Imitation.tick()` (the same two calls plus the Python call, the GIL release and the report
 turned into Python objects) with timeit, over passes of the whole clip.

@@ -139,9 +139,9 @@ impl PyControllerBuilder {
 impl PyControllerBuilder {
     /// `robot`, the state (q, v = 0 by default) the tasks hold at, CLIK gains k_p [s⁻²] and
     /// k_v [s⁻¹] (default critical damping 2√k_p), the solver method (iktc, gf, clamp) and the
-    /// bound method (viable, paper).
+    /// bound method (quiet, the default; viable; paper).
     #[new]
-    #[pyo3(signature = (robot, q, v=None, *, kp=100.0, kv=None, method="iktc", bounds="viable"))]
+    #[pyo3(signature = (robot, q, v=None, *, kp=100.0, kv=None, method="iktc", bounds="quiet"))]
     fn new(
         robot: &PyRobot,
         q: &Bound<'_, PyAny>,

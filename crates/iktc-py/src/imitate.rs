@@ -116,17 +116,18 @@ fn pose_of(m: &PyReadonlyArray2<'_, f64>) -> PyResult<Isometry3<f64>> {
 impl PyImitation {
     /// `robot` must have a profile (feet, pelvis, posture, narrowed ranges, soles); `motion` a
     /// skeleton. `map`: a built-in map or TOML file (default: the profile's); `dt` the control
-    /// period [s]; `method` iktc, gf, clamp or prioritized; `bounds` viable, paper or quiet
-    /// (viable bounds that come to rest on a limit without chatter); `level_hold` [ticks] and
-    /// `rebase_release` [–] the solver's hold on IKTC's corrected level and the release rate of
-    /// its corrected levels' demands (`iktc::solver::SolverSettings`; 1 and 1.0 are Algorithm 2
-    /// as printed); `narrow` a list of (joint, lower, upper) [rad] replacing the profile's
+    /// period [s]; `method` iktc, gf, clamp or prioritized; `bounds` quiet (the default), viable or paper
+    /// (quiet: viable bounds that come to rest on a limit without chatter); `level_hold` [ticks],
+    /// `rebase_release` [–] and `continuity` [–] the solver's hold on IKTC's corrected level
+    /// (default `iktc::sim::IMITATE_LEVEL_HOLD`, 4), the release rate of its corrected levels'
+    /// demands and the weight of the continuity term of its correction
+    /// (`iktc::solver::SolverSettings`; 1, 1.0 and 0.0 are Algorithm 2 as printed); `narrow` a list of (joint, lower, upper) [rad] replacing the profile's
     /// narrowed ranges (the tasks below the level a narrowed joint blocks are corrected);
     /// `duration` [s] keeps the clip's frames up to the first at or past it (default: all);
     /// `time_scale` [–] plays the clip that many times slower (its frame times multiplied:
     /// rates divided by it, accelerations by its square), before the cut.
     #[new]
-    #[pyo3(signature = (robot, motion, *, map=None, dt=0.005, method="iktc", bounds="viable", duration=None, time_scale=1.0, level_hold=1, rebase_release=1.0, narrow=None))]
+    #[pyo3(signature = (robot, motion, *, map=None, dt=0.005, method="iktc", bounds="quiet", duration=None, time_scale=1.0, level_hold=None, rebase_release=1.0, continuity=0.0, narrow=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -138,8 +139,9 @@ impl PyImitation {
         bounds: &str,
         duration: Option<f64>,
         time_scale: f64,
-        level_hold: usize,
+        level_hold: Option<usize>,
         rebase_release: f64,
+        continuity: f64,
         narrow: Option<Vec<(String, f64, f64)>>,
     ) -> PyResult<Self> {
         let profile = robot.required_profile("the imitation", "feet, pelvis and posture")?;
@@ -151,8 +153,9 @@ impl PyImitation {
         };
         let base = ImitateConfig {
             solver: SolverSettings {
-                level_hold,
+                level_hold: level_hold.unwrap_or(base.solver.level_hold),
                 rebase_release,
+                continuity,
                 ..base.solver
             },
             ..base

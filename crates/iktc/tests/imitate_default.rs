@@ -248,8 +248,8 @@ fn bad_settings_are_errors() {
         .contains("NOPE"));
 }
 
-/// Issue 13, the smooth settings (quiet bounds, level hold 3) against the defaults (viable
-/// bounds, Algorithm 2's level as printed), one run each: on the narrowed joints the RMS jerk of
+/// The default settings (quiet bounds, level hold `IMITATE_LEVEL_HOLD`) against Algorithm 2 as printed with the
+/// viable bounds, one run each: on the narrowed joints the RMS jerk of
 /// q̈ is at least 1.5× lower and q̈'s change reverses its sign on at most 30 % of the ticks (from
 /// about 40 %; the issue's goal, 3× and 10 %, is not reached: what remains comes from the
 /// correction of the levels above as other joints' bounds come and go, not from resting on a
@@ -260,17 +260,17 @@ fn default_run_is_smooth_at_the_limits() {
     use iktc::limits::BoundMethod;
     use iktc::solver::SolverSettings;
     let (robot, refs) = setup();
-    let old = ImitateConfig::default();
-    let new = ImitateConfig {
-        bounds: BoundMethod::quiet(),
+    let new = ImitateConfig::default();
+    let old = ImitateConfig {
+        bounds: BoundMethod::viable(),
         solver: SolverSettings {
-            level_hold: 3,
-            ..old.solver
+            level_hold: 1,
+            ..new.solver
         },
         ..ImitateConfig::default()
     };
-    assert_eq!(old.bounds, BoundMethod::viable());
-    assert_eq!(old.solver.level_hold, 1);
+    assert_eq!(new.bounds, BoundMethod::quiet());
+    assert_eq!(new.solver.level_hold, iktc::sim::IMITATE_LEVEL_HOLD);
     let before = run_imitate(&robot, &refs, &old).unwrap();
     let after = run_imitate(&robot, &refs, &new).unwrap();
     let (b, a) = (&before.summary, &after.summary);

@@ -20,7 +20,7 @@ impl Default for ControllerSettings {
     fn default() -> Self {
         Self {
             method: Method::Iktc,
-            bounds: BoundMethod::viable(),
+            bounds: BoundMethod::quiet(),
             solver: SolverSettings::default(),
         }
     }

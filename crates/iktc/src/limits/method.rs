@@ -24,11 +24,10 @@ pub enum BoundMethod {
 }
 
 impl Default for BoundMethod {
-    /// [`BoundMethod::Viable`] with default settings: safe in discrete time. The quiet bounds
-    /// ([`BoundMethod::quiet`]) are selectable; they are not the default because the imitation
-    /// tests at coarse `Δt` and with a huge knee acceleration limit lose the feet task with them.
+    /// [`BoundMethod::Quiet`] with default settings: safe in discrete time, and a joint pushed
+    /// into a limit comes to rest on it with `q̈ = 0` instead of chattering.
     fn default() -> Self {
-        Self::Viable(ViableSettings::default())
+        Self::Quiet(ViableSettings::default())
     }
 }
 

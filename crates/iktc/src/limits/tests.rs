@@ -378,7 +378,7 @@ fn every_validation_rule_has_its_error() {
     assert_eq!(BoundMethod::Paper.name(), "paper");
     assert_eq!(BoundMethod::viable().name(), "viable");
     assert_eq!(BoundMethod::quiet().name(), "quiet");
-    assert_eq!(BoundMethod::default(), BoundMethod::viable());
+    assert_eq!(BoundMethod::default(), BoundMethod::quiet());
     let recover = ViableSettings {
         braking_fraction: 0.5,
         outside: OutsideLimits::Recover,

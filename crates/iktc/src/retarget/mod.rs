@@ -147,12 +147,13 @@ impl Default for KeypointSettings {
                 kv: 20.0,
             },
             method: Method::Iktc,
-            bounds: BoundMethod::viable(),
+            bounds: BoundMethod::quiet(),
             solver: SolverSettings {
                 damping: Damping::Adaptive {
                     max: DEFAULT_DAMPING,
                     threshold: DEFAULT_DAMPING_REGION,
                 },
+                level_hold: crate::sim::IMITATE_LEVEL_HOLD,
                 ..SolverSettings::default()
             },
             settle_time: 1.5,

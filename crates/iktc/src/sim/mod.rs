@@ -24,7 +24,7 @@ pub use health::{HealthCheck, HealthIssue, HealthMonitor, HealthReport, HealthSe
 #[cfg(all(feature = "urdf", feature = "json", feature = "toml"))]
 pub use imitate::{
     imitation_references, run_imitate, ImitateConfig, ImitateRun, ImitateStep, ImitateSummary,
-    ImitationController, ImitationTasks,
+    ImitationController, ImitationTasks, IMITATE_LEVEL_HOLD,
 };
 pub use margins::{dof_margins, held_limit, median, percentile, DofMargins, JointMargin};
 pub use planar3r::{

@@ -76,7 +76,7 @@ impl Default for Planar3rConfig {
     fn default() -> Self {
         Self {
             method: Method::Iktc,
-            bounds: BoundMethod::viable(),
+            bounds: BoundMethod::quiet(),
             dt: 0.005,
             duration: 2.0,
             run_limits: RunLimits::default(),

@@ -1,0 +1,74 @@
+//! Smoothness of the paper's imitation run (JVRC-1, the default clip, L_KNEE and L_HIP_R
+//! narrowed) under Algorithm 2 as printed with the viable bounds, and under the smoothing
+//! settings one at a time: the quiet bounds, the level hold (the defaults), the continuity term.
+//!
+//! ```sh
+//! cargo run --release -p iktc --example imitate_smoothness
+//! ```
+//!
+//! Per variant: level changes (and those undone at the next tick), RMS commanded jerk
+//! `(q̈ₖ − q̈ₖ₋₁)/Δt` over all joints, and per narrowed joint its RMS jerk and the share of ticks
+//! where the change of q̈ reverses its sign; and the largest excursion beyond a limit.
+
+use iktc::limits::BoundMethod;
+use iktc::sim::{Experiment, ImitateConfig};
+use iktc::solver::SolverSettings;
+
+fn main() -> iktc::Result<()> {
+    let (e, defaults) = Experiment::jvrc1()?;
+    let printed = SolverSettings {
+        level_hold: 1,
+        continuity: 0.0,
+        ..defaults.solver
+    };
+    let hold = format!(
+        "quiet bounds, hold {} (the defaults)",
+        defaults.solver.level_hold
+    );
+    let variants = [
+        ("Algorithm 2, viable bounds", BoundMethod::viable(), printed),
+        ("quiet bounds", BoundMethod::quiet(), printed),
+        (hold.as_str(), defaults.bounds, defaults.solver),
+        (
+            "the defaults with the continuity term, μ = 0.3",
+            defaults.bounds,
+            SolverSettings {
+                continuity: 0.3,
+                ..defaults.solver
+            },
+        ),
+    ];
+    for (name, bounds, solver) in variants {
+        let mut cfg = ImitateConfig {
+            bounds,
+            solver,
+            ..defaults.clone()
+        };
+        cfg.health.keep_going = true;
+        let s = e.imitate(&cfg)?.summary;
+        let all = (s
+            .smoothness
+            .iter()
+            .map(|j| j.smoothness.rms_jerk.powi(2))
+            .sum::<f64>()
+            / s.smoothness.len() as f64)
+            .sqrt();
+        print!(
+            "{name}: level changes {} ({} undone), RMS jerk {all:.0} rad/s³",
+            s.level_switches.switches, s.level_switches.flips
+        );
+        for j in &s.narrowed_smoothness {
+            print!(
+                "; {} {:.0} rad/s³, reversals {:.1} %",
+                j.joint,
+                j.smoothness.rms_jerk,
+                100.0 * j.smoothness.reversal_share
+            );
+        }
+        println!(
+            "; worst excursion {:.1e} rad",
+            s.worst_position_margin.max(0.0)
+        );
+    }
+    Ok(())
+}
