@@ -84,3 +84,103 @@ impl ViewerData {
             .collect())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::{unpack, LinkMesh, QuantizedMesh, TriMesh};
+    use crate::model::planar3r;
+    use crate::sim::viewer::{robot_figure, Figure3d};
+    use nalgebra::{UnitQuaternion, Vector3};
+
+    fn data(robot: &Robot, rotations: Vec<Vec<[f32; 4]>>) -> ViewerData {
+        let mut figure = robot_figure(robot);
+        figure.frames = vec![vec![[0.0; 3]; robot.links().len()]; rotations.len()];
+        ViewerData {
+            title: "t".into(),
+            dt: 0.02,
+            robot: figure,
+            skeleton: Figure3d {
+                name: "s".into(),
+                segments: Vec::new(),
+                frames: Vec::new(),
+            },
+            com: Vec::new(),
+            support: Vec::new(),
+            on_limit: Vec::new(),
+            on_limit_names: Vec::new(),
+            support_frames: Vec::new(),
+            footsteps: Vec::new(),
+            phases: Vec::new(),
+            robot_rotations: rotations,
+            meshes: None,
+        }
+    }
+
+    fn mesh(link: &str) -> LinkMesh {
+        let m = TriMesh {
+            vertices: vec![[0.0, 0.0, 0.0], [0.1, 0.0, 0.0], [0.0, 0.2, 0.0]],
+            triangles: vec![[0, 1, 2]],
+        };
+        LinkMesh {
+            link: link.into(),
+            color: [1, 2, 3],
+            mesh: QuantizedMesh::new(&m).unwrap(),
+        }
+    }
+
+    #[test]
+    fn orientations_round_trip_within_half_a_step_and_unknown_links_are_warned() {
+        let robot = planar3r();
+        let nl = robot.links().len();
+        // Turns about a tilted axis, one per link and frame.
+        let axis = nalgebra::Unit::new_normalize(Vector3::new(0.3, -0.5, 0.8));
+        let rotations: Vec<Vec<[f32; 4]>> = (0..3)
+            .map(|f| {
+                (0..nl)
+                    .map(|l| {
+                        let q = UnitQuaternion::from_axis_angle(&axis, 0.4 * (f * nl + l) as f64);
+                        q.coords.map(|x| x as f32).into()
+                    })
+                    .collect()
+            })
+            .collect();
+        let mut d = data(&robot, rotations.clone());
+        let set = MeshSet {
+            meshes: vec![mesh("link2"), mesh("no_such_link")],
+        };
+        let warnings = d.attach_meshes(&robot, &set).unwrap();
+        assert_eq!(warnings.len(), 1);
+        assert!(warnings[0].contains("no_such_link"), "{}", warnings[0]);
+        let m = d.meshes.as_ref().unwrap();
+        assert_eq!(m.triangles, 1);
+        assert_eq!(m.links.len(), nl);
+        let packed = unpack(&base64::decode(&m.packed).unwrap()).unwrap();
+        assert_eq!(packed.meshes, vec![mesh("link2")]);
+        let bytes = base64::decode(&m.rotations).unwrap();
+        assert_eq!(bytes.len(), 3 * nl * 4 * 2);
+        let read: Vec<f32> = bytes
+            .chunks(2)
+            .map(|b| f32::from(i16::from_le_bytes([b[0], b[1]])) / QUAT_SCALE)
+            .collect();
+        let want: Vec<f32> = rotations.iter().flatten().flatten().copied().collect();
+        for (a, b) in read.iter().zip(&want) {
+            // Half a step of 1/32767, plus the f32 rounding of the division.
+            assert!((a - b).abs() <= 0.5 / QUAT_SCALE + 1e-7, "{a} vs {b}");
+        }
+    }
+
+    #[test]
+    fn orientations_of_the_wrong_size_are_an_error() {
+        let robot = planar3r();
+        let mut d = data(&robot, vec![vec![[0.0, 0.0, 0.0, 1.0]; 2]]);
+        let e = d
+            .attach_meshes(&robot, &MeshSet::default())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("link orientations"), "{e}");
+        let mut d = data(&robot, Vec::new());
+        d.robot.frames.push(Vec::new());
+        assert!(d.attach_meshes(&robot, &MeshSet::default()).is_err());
+    }
+}
