@@ -217,8 +217,10 @@ function drawMeshes(R, hot) {
   });
   const order = M.order.subarray(0, nt);
   order.sort((i, j) => M.td[j] - M.td[i]);
-  // Far to near; consecutive triangles of one colour filled as one path.
+  // Far to near; consecutive triangles of one colour filled as one path, and outlined in it
+  // (half a pixel each side) so that no background shows between neighbours.
   let cur = null;
+  ctx.lineWidth = 1; ctx.lineJoin = "round";
   ctx.beginPath();
   for (const k of order) {
     const pi = M.part[k], level = M.shade[k], key = pi * 32 + level;
@@ -229,13 +231,13 @@ function drawMeshes(R, hot) {
       M.styles.set(key, st);
     }
     if (st !== cur) {
-      if (cur !== null) { ctx.fillStyle = cur; ctx.fill(); ctx.beginPath(); }
+      if (cur !== null) { ctx.fillStyle = cur; ctx.strokeStyle = cur; ctx.fill(); ctx.stroke(); ctx.beginPath(); }
       cur = st;
     }
     const a = M.tris[3 * k], b = M.tris[3 * k + 1], c = M.tris[3 * k + 2];
     ctx.moveTo(M.sx[a], M.sy[a]); ctx.lineTo(M.sx[b], M.sy[b]); ctx.lineTo(M.sx[c], M.sy[c]); ctx.closePath();
   }
-  if (cur !== null) { ctx.fillStyle = cur; ctx.fill(); }
+  if (cur !== null) { ctx.fillStyle = cur; ctx.strokeStyle = cur; ctx.fill(); ctx.stroke(); }
   // The robot's box on the page (CSS pixels), for tests and tools.
   const off = cv.getBoundingClientRect();
   document.body.dataset.robotBox = [x0 + off.left, y0 + off.top, x1 + off.left, y1 + off.top].map(Math.round).join(",");
