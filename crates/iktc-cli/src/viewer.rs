@@ -61,8 +61,16 @@ if (D.meshes) {
     const nv = dv.getUint32(o, true), nt = dv.getUint32(o + 4, true); o += 8;
     const v = new Float32Array(nv * 3);
     for (let i = 0; i < nv * 3; i++) { const k = i % 3; v[i] = lo[k] + dv.getUint16(o, true) * (hi[k] - lo[k]) / 65535; o += 2; }
-    const t = new Uint32Array(nt * 3);
-    for (let i = 0; i < nt * 3; i++) { t[i] = NV + dv.getUint16(o, true); o += 2; }
+    // Indices: LEB128 varints against the high-water mark hw (0: the next new vertex).
+    const bytes = dv.getUint32(o, true); o += 4;
+    const t = new Uint32Array(nt * 3), end = o + bytes;
+    let hw = 0;
+    for (let i = 0; i < nt * 3; i++) {
+      let d = 0, shift = 0, byte;
+      do { byte = u[o++]; d |= (byte & 127) << shift; shift += 7; } while (byte & 128);
+      t[i] = NV + (d === 0 ? hw++ : hw - d);
+    }
+    o = end;
     const li = linkIndex.get(name);
     if (li !== undefined) parts.push({ link: li, color, v, t, v0: NV, t0: NT });
     NV += nv; NT += nt;

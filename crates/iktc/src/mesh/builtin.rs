@@ -74,8 +74,8 @@ mod tests {
             (lowest - sole).abs() < 2.0 * crate::mesh::VIEWER_CELL,
             "lowest mesh point {lowest} m, sole {sole} m"
         );
-        // A few hundred KB at most.
-        assert!(G1_MESHES.len() < 400_000, "{} bytes", G1_MESHES.len());
+        // Well under the 1 MB the crate may grow by (160 KB when made).
+        assert!(G1_MESHES.len() < 250_000, "{} bytes", G1_MESHES.len());
     }
 
     /// The lowest point of the collision spheres of `link` in the G1 URDF \[m\], world.

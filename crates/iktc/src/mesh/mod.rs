@@ -12,7 +12,8 @@
 //! * [`quantize`] stores each coordinate as a 16-bit integer across the mesh's bounding box:
 //!   `u = round((x − min) / (max − min) · 65535)`, so the round trip `x' = min + u·step` with
 //!   `step = (max − min) / 65535` is within `step / 2` of `x`; it also packs a set of meshes into
-//!   the little-endian binary the viewer page reads (format in [`quantize::pack`]).
+//!   the little-endian binary the viewer page reads, triangle indices as varints against a
+//!   high-water mark (format in [`quantize::pack`]).
 //! * [`urdf`] (feature `urdf`) finds the `<visual>` meshes of a URDF, resolves their paths,
 //!   applies the visual's `<origin>` and `scale`, and runs the steps above; [`builtin`] holds the
 //!   built-in G1's meshes, prepared that way from Unitree's STL files.
@@ -30,7 +31,7 @@ pub use quantize::{pack, unpack, LinkMesh, MeshSet, QuantizedMesh};
 pub use stl::{read_stl, StlMesh};
 
 /// The cube side of the vertex clustering used for robot meshes in the viewer \[m\]: 12 mm
-/// keeps the links' shapes readable at a whole-robot view and the built-in G1 at a few hundred
+/// keeps the links' shapes readable at a whole-robot view and the built-in G1 at 160
 /// KB.
 pub const VIEWER_CELL: f64 = 0.012;
 

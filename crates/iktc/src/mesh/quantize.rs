@@ -4,6 +4,12 @@
 //! Coordinate `x` in `[min, max]` is stored as `u = round((x − min) / step)` with
 //! `step = (max − min) / 65535` (a zero-width axis has step 0 and stores 0); it reads back as
 //! `min + u · step`, within `step / 2` of `x` (plus `f32` rounding).
+//!
+//! Triangle indices are packed against a high-water mark: vertices are numbered in the order
+//! the triangles first use them, so an index is either the next new vertex (`hw`, written as
+//! 0, then `hw ← hw + 1`) or an earlier one `i < hw` (written as `hw − i`), each a LEB128
+//! varint (7 bits a byte, low first); neighbouring triangles share recent vertices, so most
+//! indices take one byte instead of two.
 
 use super::TriMesh;
 use crate::error::{Error, Result};
@@ -11,7 +17,7 @@ use crate::error::{Error, Result};
 /// The largest quantized coordinate (16 bits).
 const LEVELS: f64 = 65535.0;
 /// First bytes of a packed mesh set.
-pub const MAGIC: &[u8; 8] = b"IKTCMSH1";
+pub const MAGIC: &[u8; 8] = b"IKTCMSH2";
 
 /// A mesh with 16-bit coordinates and indices.
 #[derive(Debug, Clone, PartialEq)]
@@ -114,7 +120,9 @@ fn step(min: &[f32; 3], max: &[f32; 3]) -> [f64; 3] {
 
 /// Packs `set` (little endian): [`MAGIC`], `u32` mesh count; per mesh `u16` name length, the
 /// link name (UTF-8), colour `u8 ×3`, `min`, `max` (`f32 ×3` each), `u32` vertex count, `u32`
-/// triangle count, the positions (`u16 ×3` each) and the triangles (`u16 ×3` each).
+/// triangle count, the positions (`u16 ×3` each, in the order of first use), `u32` byte length
+/// of the index stream, and the index stream (module docs). Vertices no triangle uses, and
+/// triangles with an index past the vertices, are left out.
 pub fn pack(set: &MeshSet) -> Vec<u8> {
     let mut b = MAGIC.to_vec();
     b.extend((set.meshes.len() as u32).to_le_bytes());
@@ -126,11 +134,44 @@ pub fn pack(set: &MeshSet) -> Vec<u8> {
         for x in m.mesh.min.iter().chain(&m.mesh.max) {
             b.extend(x.to_le_bytes());
         }
-        b.extend((m.mesh.positions.len() as u32).to_le_bytes());
-        b.extend((m.mesh.triangles.len() as u32).to_le_bytes());
-        for x in m.mesh.positions.iter().chain(&m.mesh.triangles).flatten() {
-            b.extend(x.to_le_bytes());
+        let nv = m.mesh.positions.len();
+        let tris: Vec<&[u16; 3]> = m
+            .mesh
+            .triangles
+            .iter()
+            .filter(|t| t.iter().all(|&i| usize::from(i) < nv))
+            .collect();
+        // New numbers in the order of first use, and the index stream.
+        let mut new_of = vec![u32::MAX; nv];
+        let mut order: Vec<usize> = Vec::new();
+        let mut stream = Vec::new();
+        for &i in tris.iter().copied().flatten() {
+            let hw = order.len() as u32;
+            let n = &mut new_of[usize::from(i)];
+            if *n == u32::MAX {
+                *n = hw;
+                order.push(usize::from(i));
+            }
+            let mut d = hw - *n;
+            loop {
+                let byte = (d & 0x7f) as u8;
+                d >>= 7;
+                if d == 0 {
+                    stream.push(byte);
+                    break;
+                }
+                stream.push(byte | 0x80);
+            }
         }
+        b.extend((order.len() as u32).to_le_bytes());
+        b.extend((tris.len() as u32).to_le_bytes());
+        for &i in &order {
+            for x in m.mesh.positions[i] {
+                b.extend(x.to_le_bytes());
+            }
+        }
+        b.extend((stream.len() as u32).to_le_bytes());
+        b.extend(stream);
     }
     b
 }
@@ -166,6 +207,57 @@ impl Reader<'_> {
     fn f32(&mut self, what: &str) -> Result<f32> {
         let s = self.take(4, what)?;
         Ok(f32::from_le_bytes([s[0], s[1], s[2], s[3]]))
+    }
+    /// `nt` triangles from an index stream of `len` bytes over `nv` vertices (module docs).
+    fn triangles(&mut self, nt: u32, nv: u32, len: u32) -> Result<Vec<[u16; 3]>> {
+        let stream = self.take(len as usize, "the index stream")?;
+        let bad = |message: String| Error::Parse {
+            source_name: "packed meshes".into(),
+            line: 0,
+            message,
+        };
+        if (nt as usize).saturating_mul(3) > stream.len() {
+            return Err(bad(format!(
+                "{nt} triangles do not fit in {len} index bytes"
+            )));
+        }
+        let (mut hw, mut at) = (0u32, 0usize);
+        let mut next = || -> Result<u16> {
+            let mut d = 0u32;
+            for shift in (0..32).step_by(7) {
+                let byte = *stream
+                    .get(at)
+                    .ok_or_else(|| bad("the index stream ends inside a triangle".into()))?;
+                at += 1;
+                d |= u32::from(byte & 0x7f) << shift;
+                if byte & 0x80 == 0 {
+                    let i = if d == 0 {
+                        hw += 1;
+                        hw - 1
+                    } else {
+                        hw.checked_sub(d).ok_or_else(|| {
+                            bad(format!("an index {d} back, past the {hw} vertices seen"))
+                        })?
+                    };
+                    return if i < nv {
+                        Ok(i as u16)
+                    } else {
+                        Err(bad(format!("index {i} past its {nv} vertices")))
+                    };
+                }
+            }
+            Err(bad("an index of more than 32 bits".into()))
+        };
+        let tris = (0..nt)
+            .map(|_| Ok([next()?, next()?, next()?]))
+            .collect::<Result<Vec<_>>>()?;
+        if at != stream.len() {
+            return Err(bad(format!(
+                "{} bytes left in the index stream after {nt} triangles",
+                stream.len() - at
+            )));
+        }
+        Ok(tris)
     }
     fn u16x3(&mut self, n: u32, what: &str) -> Result<Vec<[u16; 3]>> {
         // Checked against the bytes left before allocating.
@@ -215,13 +307,16 @@ pub fn unpack(bytes: &[u8]) -> Result<MeshSet> {
         }
         let nv = r.u32("a vertex count")?;
         let nt = r.u32("a triangle count")?;
-        let positions = r.u16x3(nv, "vertices")?;
-        let triangles = r.u16x3(nt, "triangles")?;
-        if let Some(t) = triangles.iter().flatten().find(|&&k| u32::from(k) >= nv) {
+        if nv > u32::from(u16::MAX) + 1 {
             return Err(bad(format!(
-                "mesh {i} ({link}): triangle index {t} past its {nv} vertices"
+                "mesh {i} ({link}): {nv} vertices, at most 65536"
             )));
         }
+        let positions = r.u16x3(nv, "vertices")?;
+        let len = r.u32("the index stream's length")?;
+        let triangles = r
+            .triangles(nt, nv, len)
+            .map_err(|e| bad(format!("mesh {i} ({link}): {e}")))?;
         set.meshes.push(LinkMesh {
             link,
             color,
@@ -305,11 +400,50 @@ mod tests {
         let mut wrong = b.clone();
         wrong[0] = b'X';
         assert!(unpack(&wrong).unwrap_err().to_string().contains("magic"));
-        // A triangle index past the vertices: the last u16 of the first... last mesh.
+        // The last index (one byte: 1 or 2 back) made to point before the first vertex.
         let mut past = b;
         let n = past.len();
-        past[n - 2..].copy_from_slice(&1000u16.to_le_bytes());
-        assert!(unpack(&past).unwrap_err().to_string().contains("past its"));
+        past[n - 1] = 0x7f;
+        let e = unpack(&past).unwrap_err().to_string();
+        assert!(e.contains("past the") && e.contains("link_2"), "{e}");
+    }
+
+    #[test]
+    fn packing_renumbers_vertices_by_first_use_and_drops_unused_ones() {
+        let m = TriMesh {
+            vertices: vec![
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [9.0, 9.0, 9.0],
+                [1.0, 1.0, 0.5],
+            ],
+            // Vertex 3 unused; first use order 2, 1, 0, 4.
+            triangles: vec![[2, 1, 0], [0, 4, 2], [4, 1, 2]],
+        };
+        let mut q = QuantizedMesh::new(&m).unwrap();
+        // A triangle past the vertices is dropped too.
+        q.triangles.push([0, 1, 7]);
+        let set = MeshSet {
+            meshes: vec![LinkMesh {
+                link: "l".into(),
+                color: [0; 3],
+                mesh: q.clone(),
+            }],
+        };
+        let back = unpack(&pack(&set)).unwrap();
+        let r = &back.meshes[0].mesh;
+        assert_eq!(r.positions.len(), 4);
+        assert_eq!(r.triangles, vec![[0, 1, 2], [2, 3, 0], [3, 1, 0]]);
+        // The same corners, corner by corner.
+        for (a, b) in q.triangles.iter().zip(&r.triangles) {
+            for k in 0..3 {
+                assert_eq!(
+                    q.positions[usize::from(a[k])],
+                    r.positions[usize::from(b[k])]
+                );
+            }
+        }
     }
 
     #[test]
