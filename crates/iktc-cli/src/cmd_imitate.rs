@@ -47,9 +47,10 @@ pub fn run(a: &Args) -> Result<()> {
         let sc = &a.scenario;
         return crate::cmd_keypoints::run(profile, &sc.motion, &sc.motion_options, &cfg, &a.out);
     }
-    let (e, cfg, _) = prepare(&a.scenario)?;
+    let (e, cfg, profile) = prepare(&a.scenario)?;
     let r = e.imitate(&cfg)?;
-    let files = write_imitate(&r, &e, &a.out)?;
+    let meshes = crate::viewer::robot_meshes(&profile);
+    let files = write_imitate(&r, &e, meshes.as_ref(), &a.out)?;
     print_summary(&r)?;
     crate::outln!(
         "wrote {} figures, trajectory.csv, summary.json and viewer.html to {}",
@@ -89,7 +90,12 @@ fn print_summary(r: &ImitateRun) -> std::io::Result<()> {
 
 /// Writes trajectory.csv, summary.json, the figures and viewer.html; returns the figures
 /// (path relative to `dir`, caption).
-pub fn write_imitate(r: &ImitateRun, e: &Experiment, dir: &Path) -> Result<Vec<(String, String)>> {
+pub fn write_imitate(
+    r: &ImitateRun,
+    e: &Experiment,
+    meshes: Option<&iktc::mesh::MeshSet>,
+    dir: &Path,
+) -> Result<Vec<(String, String)>> {
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     let s = &r.summary;
     let narrowed: Vec<(String, usize)> = s
@@ -334,7 +340,9 @@ pub fn write_imitate(r: &ImitateRun, e: &Experiment, dir: &Path) -> Result<Vec<(
         "corrections.svg".into(),
         format!("Which level was corrected, when, and by how much ({tag})"),
     ));
-    write_viewer(&dir.join("viewer.html"), &imitation_viewer(r, e)?)?;
+    let mut viewer = imitation_viewer(r, e)?;
+    crate::viewer::attach(&mut viewer, &e.robot, meshes)?;
+    write_viewer(&dir.join("viewer.html"), &viewer)?;
     Ok(figs)
 }
 
@@ -455,7 +463,8 @@ pub fn imitate_section(out: &Path) -> Result<Section> {
         // paper's bound, 58 ticks of the default clip) is shown with its health report.
         cfg.health.keep_going = true;
         let r = e.imitate(&cfg)?;
-        let figs = write_imitate(&r, &e, &base.join(name))?;
+        // JVRC-1: no meshes, the stick figure.
+        let figs = write_imitate(&r, &e, None, &base.join(name))?;
         table = table.row(summary_row(name, &r));
         if name == "iktc" {
             for (f, c) in figs {

@@ -119,7 +119,9 @@ pub fn run(
     }
     let path = out.join("keypoints_trajectory.csv");
     std::fs::write(&path, csv).with_context(|| format!("writing {}", path.display()))?;
-    let viewer = iktc::retarget::keypoint_viewer(&robot, &kp, &run, cfg.dt)?;
+    let mut viewer = iktc::retarget::keypoint_viewer(&robot, &kp, &run, cfg.dt)?;
+    let meshes = crate::viewer::robot_meshes(profile);
+    crate::viewer::attach(&mut viewer, &robot, meshes.as_ref())?;
     crate::viewer::write_viewer(&out.join("viewer.html"), &viewer)?;
     crate::outln!(
         "wrote keypoints_summary.json, keypoints_trajectory.csv and viewer.html to {}",

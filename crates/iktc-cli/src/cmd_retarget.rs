@@ -13,6 +13,7 @@ use std::time::{Instant, SystemTime};
 
 use anyhow::{Context, Result};
 use iktc::batch::{run_parallel, BatchRetarget, ClipOutcome, DEFAULT_RETARGET_METHOD};
+use iktc::mesh::MeshSet;
 use iktc::profile::glob_match;
 use iktc::sim::viewer::imitation_viewer;
 use serde::Serialize;
@@ -144,13 +145,20 @@ pub fn run(a: &Args) -> Result<()> {
             figures: read_figures(&a.out.join(&c.name)),
         });
     }
+    // The robot's meshes, read once for every clip's viewer.
+    let meshes = if a.no_viewer || todo.is_empty() {
+        None
+    } else {
+        crate::viewer::robot_meshes(&batch.profile)
+    };
+    let viewer = (!a.no_viewer).then_some(meshes.as_ref());
     let mut progress = Progress::new(&todo, skipped.len());
     run_parallel(
         &todo,
         jobs,
         |_, c| {
             let start = Instant::now();
-            let r = retarget_one(&batch, c, &a.out.join(&c.name), &hash, !a.no_viewer);
+            let r = retarget_one(&batch, c, &a.out.join(&c.name), &hash, viewer);
             (r, start.elapsed().as_secs_f64())
         },
         |i, r| {
@@ -229,7 +237,7 @@ fn retarget_one(
     c: &ClipInput,
     dir: &Path,
     hash: &str,
-    viewer: bool,
+    viewer: Option<Option<&MeshSet>>,
 ) -> Result<(usize, serde_json::Value)> {
     // A stale marker must not vouch for files being replaced, nor for a clip that now fails.
     let marker = dir.join(SETTINGS_FILE);
@@ -261,8 +269,10 @@ fn retarget_one(
         &dir.join(OUTPUTS[2]),
         crate::finite::to_json("quality.json", &doc)?.as_bytes(),
     )?;
-    if viewer {
-        let html = crate::viewer::render_viewer(&imitation_viewer(&run, &experiment)?)?;
+    if let Some(meshes) = viewer {
+        let mut data = imitation_viewer(&run, &experiment)?;
+        crate::viewer::attach(&mut data, &experiment.robot, meshes)?;
+        let html = crate::viewer::render_viewer(&data)?;
         write_atomic(&dir.join("viewer.html"), html.as_bytes())?;
     }
     write_atomic(&marker, format!("{hash}\n").as_bytes())?;

@@ -111,7 +111,8 @@ fn run_walk(
     dir: &Path,
 ) -> Result<(Figures, WalkRun, WalkRun)> {
     let (with, without) = e.walk_with_and_without_damping(&config(e, profile, imitate, w)?)?;
-    let figs = write_walk(&with, &without, e, imitate, dir)?;
+    let meshes = crate::viewer::robot_meshes(profile);
+    let figs = write_walk(&with, &without, e, imitate, meshes.as_ref(), dir)?;
     Ok((figs, with, without))
 }
 
@@ -196,6 +197,7 @@ pub fn write_walk(
     without: &WalkRun,
     e: &Experiment,
     imitate: &ImitateConfig,
+    meshes: Option<&iktc::mesh::MeshSet>,
     dir: &Path,
 ) -> Result<Vec<(String, String)>> {
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
@@ -450,15 +452,14 @@ pub fn write_walk(
         "Phase timeline, ankle heights, the damping controller's COM offset and IKTC's corrections"
             .into(),
     ));
-    write_viewer(
-        &dir.join("walk_viewer.html"),
-        &walking_viewer(
-            with,
-            e,
-            imitate.dt,
-            [imitate.support.sole_length, imitate.support.sole_width],
-        )?,
+    let mut viewer = walking_viewer(
+        with,
+        e,
+        imitate.dt,
+        [imitate.support.sole_length, imitate.support.sole_width],
     )?;
+    crate::viewer::attach(&mut viewer, &e.robot, meshes)?;
+    write_viewer(&dir.join("walk_viewer.html"), &viewer)?;
     Ok(figs)
 }
 

@@ -9,7 +9,7 @@ use iktc_report::escape_html;
 use crate::cmd_retarget::ClipStatus;
 
 /// The figures shown: key in `quality.json`'s `figures`, column label with its unit.
-const COLUMNS: [(&str, &str); 12] = [
+const COLUMNS: [(&str, &str); 14] = [
     ("duration", "duration [s]"),
     ("rms_error_upper_body", "upper-body RMS error [rad]"),
     ("max_error_upper_body", "upper-body max error [rad]"),
@@ -20,6 +20,11 @@ const COLUMNS: [(&str, &str); 12] = [
     ("rms_error_pelvis_height", "pelvis height RMS error [m]"),
     ("rms_error_com", "COM RMS error [m]"),
     ("foot_slip", "foot slip [m]"),
+    ("penetration", "sole penetration [m]"),
+    (
+        "penetration_share",
+        "share of ticks with a sole below the ground [–]",
+    ),
     ("worst_position_margin", "worst position margin [rad]"),
     ("worst_velocity_margin", "worst velocity margin [rad/s]"),
     ("max_rms_jerk", "max RMS jerk [rad/s³]"),

@@ -56,6 +56,7 @@ mod buffer;
 pub mod controller;
 pub mod error;
 pub mod limits;
+pub mod mesh;
 pub mod model;
 #[cfg(all(feature = "urdf", feature = "json", feature = "toml"))]
 pub mod motion;

@@ -71,6 +71,34 @@ fn inside(poly: &[[f32; 3]], p: [f64; 2]) -> bool {
     })
 }
 
+/// The link orientations of the viewer agree with its link positions: a revolute or fixed
+/// joint's child link sits at `p_parent + R_parent · t_origin`, whatever the joint's angle.
+fn orientations_agree_with_positions(
+    v: &iktc::sim::viewer::ViewerData,
+    robot: &iktc::model::Robot,
+) {
+    use iktc::model::JointKind;
+    use nalgebra::{Quaternion, UnitQuaternion, Vector3};
+    assert_eq!(v.robot_rotations.len(), v.robot.frames.len());
+    let mut checked = 0;
+    for (pos, rot) in v.robot.frames.iter().zip(&v.robot_rotations) {
+        assert_eq!(rot.len(), robot.links().len());
+        for j in robot.joints() {
+            if matches!(j.kind, JointKind::Prismatic { .. }) {
+                continue;
+            }
+            let r = rot[j.parent].map(f64::from);
+            let q = UnitQuaternion::from_quaternion(Quaternion::new(r[3], r[0], r[1], r[2]));
+            let p = |i: usize| Vector3::from(pos[i].map(f64::from));
+            let want = p(j.parent) + q * j.origin.translation.vector;
+            // f32 storage: positions of a few metres to ~1e-6 m, quaternions to ~1e-7.
+            assert!((p(j.child) - want).norm() < 1e-5, "joint {}", j.name);
+            checked += 1;
+        }
+    }
+    assert!(checked > 0);
+}
+
 #[test]
 fn the_standing_viewer_pins_the_skeleton_beside_the_robot() {
     let (e, cfg) = Experiment::jvrc1().unwrap();
@@ -95,6 +123,7 @@ fn the_standing_viewer_pins_the_skeleton_beside_the_robot() {
     for (c, st) in v.com.iter().zip(run.steps.iter().step_by(stride)) {
         assert!((c[0] as f64 - st.com[0]).abs() < 1e-5);
     }
+    orientations_agree_with_positions(&v, &e.robot);
 }
 
 #[test]
@@ -112,6 +141,7 @@ fn the_walking_viewer_draws_the_soles_that_carry_the_robot() {
         cfg.imitate.support.sole_width,
     ];
     let v = walking_viewer(&run, &e, cfg.imitate.dt, sole).unwrap();
+    orientations_agree_with_positions(&v, &e.robot);
     let stride = (0.02 / cfg.imitate.dt).round() as usize;
     assert_eq!(v.support_frames.len(), v.robot.frames.len());
     assert_eq!(v.phases.len(), v.robot.frames.len());

@@ -12,7 +12,9 @@ pub mod training;
 
 pub use npz::{crc32, npz_bytes, zip_stored, NpyArray, NpyData};
 pub use pool::run_parallel;
-pub use quality::ClipQuality;
+pub use quality::{
+    run_penetration, sole_penetration, ClipQuality, Penetration, PENETRATION_TOLERANCE,
+};
 pub use retarget::{
     BatchRetarget, ClipOutcome, RetargetMethod, DEFAULT_RETARGET_METHOD, MIN_CLIP_FRAMES,
 };

@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-use super::quality::ClipQuality;
+use super::quality::{run_penetration, ClipQuality};
 use super::training::TrainingTrajectory;
 use crate::error::{Error, Result};
 use crate::model::Robot;
@@ -169,7 +169,11 @@ impl BatchRetarget {
             &self.body_frames(),
             self.output_rate(),
         )?;
-        let quality = ClipQuality::from_summary(&run.summary);
+        let mut quality = ClipQuality::from_summary(&run.summary);
+        if let Some(feet) = &self.profile.feet {
+            let p = run_penetration(&self.robot, &run, &[&feet.left, &feet.right])?;
+            quality = quality.with_penetration(p);
+        }
         Ok(ClipOutcome {
             experiment,
             run,

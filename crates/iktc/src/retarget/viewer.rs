@@ -8,7 +8,9 @@ use crate::error::Result;
 use crate::limits::JointLimits;
 use crate::model::{Kinematics, Robot, State};
 use crate::motion::{BodyPoint, Keypoints};
-use crate::sim::viewer::{point, robot_figure, stride, Figure3d, ViewerData, SKELETON_OFFSET};
+use crate::sim::viewer::{
+    point, quat, robot_figure, stride, Figure3d, ViewerData, SKELETON_OFFSET,
+};
 
 use super::KeypointRun;
 
@@ -63,8 +65,8 @@ pub fn keypoint_viewer(
     let mut state = State::neutral(robot);
     let mut kin = Kinematics::new(robot, &state)?;
     let mut figure = robot_figure(robot);
-    let (mut com, mut on_limit, mut on_limit_names, mut times) =
-        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let (mut com, mut on_limit, mut on_limit_names, mut times, mut rotations) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for (t, q) in run.times.iter().zip(&run.trajectory).step_by(stride) {
         state.q.copy_from_slice(q);
         kin.update(robot, &state)?;
@@ -72,6 +74,12 @@ pub fn keypoint_viewer(
             kin.link_poses()
                 .iter()
                 .map(|p| point(&p.translation.vector.into()))
+                .collect(),
+        );
+        rotations.push(
+            kin.link_poses()
+                .iter()
+                .map(|p| quat(&p.rotation.coords.into()))
                 .collect(),
         );
         com.push(point(&kin.com().into()));
@@ -109,6 +117,8 @@ pub fn keypoint_viewer(
         support_frames: Vec::new(),
         footsteps: Vec::new(),
         phases: Vec::new(),
+        robot_rotations: rotations,
+        meshes: None,
     })
 }
 

@@ -14,6 +14,8 @@ pub mod switches;
 #[cfg(all(feature = "urdf", feature = "json", feature = "toml"))]
 pub mod viewer;
 #[cfg(all(feature = "urdf", feature = "json", feature = "toml"))]
+pub mod viewer_mesh;
+#[cfg(all(feature = "urdf", feature = "json", feature = "toml"))]
 pub mod walk_imitate;
 #[cfg(all(feature = "urdf", feature = "json", feature = "toml"))]
 pub mod walk_plants;

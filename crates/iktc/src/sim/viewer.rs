@@ -58,6 +58,14 @@ pub struct ViewerData {
     /// Walking: the support phase of every frame.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub phases: Vec<String>,
+    /// Orientation of every robot link at every frame, unit quaternion (x, y, z, w); put in
+    /// the page with the meshes ([`ViewerData::attach_meshes`]).
+    #[serde(skip)]
+    pub robot_rotations: Vec<Vec<[f32; 4]>>,
+    /// The robot's meshes and link orientations; without them the page draws the stick
+    /// figure.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub meshes: Option<crate::sim::viewer_mesh::ViewerMeshes>,
 }
 
 /// How the skeleton's root moves in the viewer.
@@ -72,6 +80,10 @@ enum RootMotion {
 
 pub(crate) fn point(p: &[f64; 3]) -> [f32; 3] {
     [p[0] as f32, p[1] as f32, p[2] as f32]
+}
+
+pub(crate) fn quat(q: &[f64; 4]) -> [f32; 4] {
+    q.map(|x| x as f32)
 }
 
 /// Ticks between viewer frames for a control period `dt` \[s\].
@@ -145,10 +157,11 @@ pub fn imitation_viewer(r: &ImitateRun, e: &Experiment) -> Result<ViewerData> {
         })
         .collect();
     let mut figure = robot_figure(&e.robot);
-    let (mut com, mut on_limit, mut on_limit_names, mut times) =
-        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let (mut com, mut on_limit, mut on_limit_names, mut times, mut rotations) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for st in r.steps.iter().step_by(stride) {
         figure.frames.push(st.links.iter().map(point).collect());
+        rotations.push(st.link_rotations.iter().map(quat).collect());
         com.push(point(&st.com));
         on_limit.push(
             st.on_limit
@@ -182,6 +195,8 @@ pub fn imitation_viewer(r: &ImitateRun, e: &Experiment) -> Result<ViewerData> {
         support_frames: Vec::new(),
         footsteps: Vec::new(),
         phases: Vec::new(),
+        robot_rotations: rotations,
+        meshes: None,
     })
 }
 
@@ -207,10 +222,11 @@ pub fn walking_viewer(
     let stride = stride(dt);
     let [length, width] = sole_size;
     let mut figure = robot_figure(&e.robot);
-    let (mut com, mut support_frames, mut phases, mut times) =
-        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let (mut com, mut support_frames, mut phases, mut times, mut rotations) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for st in r.steps.iter().step_by(stride) {
         figure.frames.push(st.links.iter().map(point).collect());
+        rotations.push(st.link_rotations.iter().map(quat).collect());
         com.push(point(&st.com));
         times.push(st.t);
         let poly: Vec<[f32; 3]> = st
@@ -252,5 +268,7 @@ pub fn walking_viewer(
             .map(|(_, p)| sole_outline(p, length, width))
             .collect(),
         phases,
+        robot_rotations: rotations,
+        meshes: None,
     })
 }

@@ -159,6 +159,10 @@ pub struct WalkStep {
     /// World positions of every link \[m\] (for the viewer).
     #[serde(skip)]
     pub links: Vec<[f64; 3]>,
+    /// Orientation of every link in the world, unit quaternion (x, y, z, w) (for the viewer's
+    /// meshes).
+    #[serde(skip)]
+    pub link_rotations: Vec<[f64; 4]>,
     /// Dof positions (joint angles; 0 for the base) \[rad\].
     #[serde(skip)]
     pub q: Vec<f64>,
@@ -674,6 +678,11 @@ pub fn run_walk_imitate(
                 .link_poses()
                 .iter()
                 .map(|p| [p.translation.x, p.translation.y, p.translation.z])
+                .collect(),
+            link_rotations: kin
+                .link_poses()
+                .iter()
+                .map(|p| p.rotation.coords.into())
                 .collect(),
             q: ctl.dof_positions().to_vec(),
             qd: state.qd.as_slice().to_vec(),

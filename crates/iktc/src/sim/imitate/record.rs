@@ -69,6 +69,10 @@ pub struct ImitateStep {
     pub pelvis_rpy: [f64; 3],
     /// World positions of every link origin \[m\] (for the viewer).
     pub links: Vec<[f64; 3]>,
+    /// Orientation of every link in the world, unit quaternion (x, y, z, w) (for the viewer's
+    /// meshes).
+    #[serde(skip)]
+    pub link_rotations: Vec<[f64; 4]>,
     /// Dofs sitting on a position, velocity or acceleration limit.
     pub on_limit: Vec<usize>,
     /// QPs solved this tick.
@@ -368,6 +372,11 @@ pub fn run_imitate(
                 .link_poses()
                 .iter()
                 .map(|p| [p.translation.x, p.translation.y, p.translation.z])
+                .collect(),
+            link_rotations: kin
+                .link_poses()
+                .iter()
+                .map(|p| p.rotation.coords.into())
                 .collect(),
             on_limit,
             qp_solves: rep.qp_solves,
