@@ -4,7 +4,7 @@
 //!
 //! * [`stl`] reads binary and ASCII STL into a triangle soup, then welds it into an indexed
 //!   [`TriMesh`] (vertices at bit-identical positions become one).
-//! * [`decimate`] simplifies a mesh by vertex clustering: space is cut into cubes of side `c`
+//! * [`decimate()`] simplifies a mesh by vertex clustering: space is cut into cubes of side `c`
 //!   \[m\]; every vertex is replaced by the mean of the vertices in its cube, and triangles whose
 //!   corners fall into fewer than three distinct cubes are dropped (Rossignac & Borrel, 1993).
 //!   Every kept vertex moves by less than the cube's diagonal `√3·c`, so the bounding box moves

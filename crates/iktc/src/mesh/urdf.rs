@@ -4,7 +4,7 @@
 //! (`package://PKG/REST` is looked up as `REST` and `PKG/REST` in the URDF's folder and its
 //! ancestors, `file://` is stripped, a relative path is taken from the URDF's folder), read as
 //! STL, each vertex mapped into the link frame by `p_link = R·(s ⊙ p) + t` (`s` the scale,
-//! `R, t` the visual's `<origin>`, rpy as `Rz·Ry·Rx`), decimated ([`super::decimate`]) and
+//! `R, t` the visual's `<origin>`, rpy as `Rz·Ry·Rx`), decimated ([`super::decimate()`]) and
 //! quantized ([`super::QuantizedMesh`]). A mesh that cannot be used (missing file, Collada or
 //! another format, a malformed STL) is left out with a warning naming the file and the link.
 
