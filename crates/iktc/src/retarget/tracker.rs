@@ -611,6 +611,12 @@ impl KeypointController {
         self.stance_gf_ticks
     }
 
+    /// Ticks so far with a swing foot's floor engaged in the `swing_floor` level (landing feet
+    /// not counted).
+    pub fn floor_ticks(&self) -> usize {
+        self.floor_ticks
+    }
+
     /// Applies the last q̈ over Δt (constant acceleration). Errors: no tick solved since the
     /// last integration.
     pub fn integrate(&mut self) -> Result<()> {
