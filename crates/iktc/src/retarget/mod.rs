@@ -13,8 +13,10 @@
 //! 4. The stack of [`KEYPOINT_LEVELS`] is tracked ([`KeypointController`]): after a settling
 //!    phase at rest on the first frame's references, one tick per control period; IKTC under
 //!    the viable box of the robot's own limits, nothing clipped after the solve. Only the feet
-//!    that have landed are in the first level (one stack per contact state), held where the
-//!    robot's foot landed.
+//!    that have landed are in the first level, held where the robot's foot landed; a foot
+//!    lands low, slow and flat, brought down in the second level, where a swing foot near the
+//!    ground also meets its floor (module `floor`: its soles kept above the ground). One
+//!    stack per pair of foot modes is built once.
 //! 5. The same quality figures ([`RetargetQuality`]) measure this run and, for comparison, the
 //!    joint-angle route ([`joint_route_quality`]).
 //!
