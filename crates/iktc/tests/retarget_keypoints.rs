@@ -20,13 +20,15 @@ const CMU_MAX_PELVIS_DEG: f64 = 90.0;
 const CMU_MAX_SLIP_MM: f64 = 150.0;
 
 /// Largest stance slip on every shared clip and both robots \[mm\] (0.2.0 with the floor and
-/// the landing rule: at most 2.3 mm, G1 dance_a; up to 60 mm before, landings forced at speed).
-const MAX_SLIP_MM: f64 = 3.0;
+/// the landing rule: at most 3.5 mm, JVRC-1 dance_a; up to 60 mm before, landings forced at
+/// speed).
+const MAX_SLIP_MM: f64 = 4.0;
 
 /// Deepest sole corner below the ground on every shared clip and both robots \[mm\] (0.2.0 with
-/// the swing feet's floor: at most 14 mm, G1 CMU 131_01, where IKTC corrects the floor's level
-/// on a kick, and under 0.6 mm elsewhere; up to 233 mm before).
-const MAX_BELOW_MM: f64 = 20.0;
+/// the swing feet's floor: at most 0.8 mm; up to 233 mm before). The floor asks the foot
+/// frame's vertical acceleration from its lowest corner's motion, so a foot turning while it
+/// lands dips by a fraction of a millimetre.
+const MAX_BELOW_MM: f64 = 2.0;
 
 /// The targets for every clip and robot: stance slip at most this \[mm\] ...
 const TARGET_SLIP_MM: f64 = 2.0;
@@ -189,12 +191,11 @@ fn every_shared_clip_onto_g1() {
 }
 
 /// The targets: stance feet slip at most [`TARGET_SLIP_MM`] and never go below the
-/// ground, on every shared clip and both robots. Not met in 0.2.0: slip up to 2.3 mm (G1,
-/// dance_a), soles up to 14 mm below the ground (G1, CMU 131_01, a kick where IKTC corrects
-/// the swing foot's floor) and up to 0.6 mm elsewhere (the floor bounds the foot frame's
-/// acceleration, not each corner's).
+/// ground, on every shared clip and both robots. Not met in 0.2.0: slip up to 3.2 mm (G1,
+/// CMU 131_01; above 2 mm on four of the twelve runs) and soles up to 0.8 mm below the ground
+/// (the floor bounds the foot frame's acceleration, not each corner's).
 #[test]
-#[ignore = "target not met in 0.2.0: slip up to 2.3 mm, soles up to 14 mm below the ground"]
+#[ignore = "target not met in 0.2.0: slip up to 3.2 mm, soles up to 0.8 mm below the ground"]
 fn stance_feet_hold_and_stay_above_ground() {
     let mut failures = Vec::new();
     for name in ["jvrc1", "g1"] {
