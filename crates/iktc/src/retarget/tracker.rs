@@ -3,26 +3,31 @@
 //!
 //! Levels, in priority order ([`KEYPOINT_LEVELS`]):
 //! 1. `stance_feet`: the feet on the ground, 6D each, held where they touched down;
-//! 2. `com_xy`: the COM over the support polygon, horizontal;
-//! 3. `pelvis`: the pelvis pose, 6D;
-//! 4. `hands_swing_feet`: the hand frames' positions and the feet in the air, 6D;
-//! 5. `elbows_head_torso`: the elbows' and the head's positions and the torso's orientation;
-//! 6. `posture`: every active joint at its posture reference (a regulariser).
+//! 2. `swing_floor`: the feet the clip puts on the ground that have not landed yet, 6D towards
+//!    the plan's hold, and the height, roll and pitch of a swing foot near the ground: the
+//!    floor ([`super::floor`]) keeps their soles above the ground;
+//! 3. `com_xy`: the COM over the support polygon, horizontal;
+//! 4. `pelvis`: the pelvis pose, 6D;
+//! 5. `hands_swing_feet`: the hand frames' positions and the feet in the air, 6D;
+//! 6. `elbows_head_torso`: the elbows' and the head's positions and the torso's orientation;
+//! 7. `posture`: every active joint at its posture reference (a regulariser).
 //!
-//! A foot is in the first level only while the clip has it on the ground: one stack per
-//! contact state (both feet, left, right, none; the last without the first level) is built
-//! once, and each tick is solved by the stack of its contacts. A swing foot that the robot
-//! cannot follow (a kick faster than its joint limits allow) then costs the hands' level
-//! accuracy, never the stance foot's hold.
+//! A foot is in the first level only once it has landed, and in the second only while it
+//! lands or its floor is engaged: one stack per pair of foot modes ([`FootMode`]: stance,
+//! swing, swing with its floor, landing; 16 stacks) is built once, and each tick is solved by
+//! the stack of its modes. A swing foot that the robot cannot follow (a kick faster than its
+//! joint limits allow) then costs the hands' level accuracy, never the stance foot's hold.
 //!
 //! The hold is closed-loop. A foot the clip puts on the ground is first brought to the plan's
-//! hold in the swing levels; it lands (moves to the first level) once its ankle is within
-//! `land_height` of the hold's height and slower than `land_speed`, or after
-//! `max_landing_delay` ([`KeypointSettings`]). At landing the offset `δ = (x, y, ψ)_robot −
-//! (x, y, ψ)_plan` of the robot's foot from the plan's hold (horizontal position \[m\] and yaw
-//! \[rad\]) is latched and added to the foot's reference with the weight
-//! [`Plan::latch_weight`] (1 in stance, fading to 0 over the next swing): the foot is held
-//! where it landed, at rest, not pulled to where the plan wanted it.
+//! hold in the second level (its height under the floor); it lands (moves to the first level)
+//! once its lowest sole corner is within `land_height` of the ground, its ankle slower than
+//! `land_speed` ([`KeypointSettings`]) and its sole tilted less than [`LAND_TILT`]; a foot
+//! that does not get there is not held (landing it at speed, or in the air, would make it
+//! slide or stamp). At landing the offset `δ = (x, y, ψ)_robot − (x, y, ψ)_plan` of the
+//! robot's foot from the plan's hold (horizontal position \[m\] and yaw \[rad\]) is latched and
+//! added to the foot's reference with the weight [`Plan::latch_weight`] (1 in stance, fading
+//! to 0 over the next swing): the foot is held where it landed, at rest, not pulled to where
+//! the plan wanted it.
 //!
 //! Each level is linearised as in the controller (`J_i q̈ = ẍ_d + k_v(ẋ_d − ẋ) + k_p(x_d − x)
 //! − J̇_i q̇`, eqs. 3, 11) and solved under the viable box of the robot's own joint limits with
@@ -33,6 +38,7 @@ use std::sync::Arc;
 use nalgebra::{DVector, UnitQuaternion, Vector3};
 
 use super::body::RobotBody;
+use super::floor::{engaged, floor_acceleration, lowest_corner, sole_corners};
 use super::plan::Plan;
 use super::KeypointSettings;
 use crate::controller::{
@@ -41,15 +47,17 @@ use crate::controller::{
 use crate::error::Result;
 use crate::model::{FrameId, Kinematics, Robot, State};
 use crate::motion::BodyPoint;
+use crate::sim::imitate::SupportSettings;
 use crate::solver::{Method, SolveReport};
-use crate::task::{Axes, ComReference, FrameReference};
+use crate::task::{Axes, ComReference, FrameReference, Gains};
 
 /// Joint names and their (position, rate, acceleration) references per tick.
 pub(crate) type PostureTracks = (Vec<String>, Vec<[Vec<f64>; 3]>);
 
 /// Names of the levels of the keypoint stack, in priority order.
-pub const KEYPOINT_LEVELS: [&str; 6] = [
+pub const KEYPOINT_LEVELS: [&str; 7] = [
     "stance_feet",
+    "swing_floor",
     "com_xy",
     "pelvis",
     "hands_swing_feet",
@@ -60,8 +68,8 @@ pub const KEYPOINT_LEVELS: [&str; 6] = [
 /// The keypoint stack on a robot, its references and its state (see the module docs).
 #[derive(Debug, Clone)]
 pub struct KeypointController {
-    /// One stack per contact state, indexed by `left + 2 right` (feet on the ground).
-    stacks: Box<[Stack; 4]>,
+    /// One stack per pair of [`FootMode`]s, indexed by `left + 4 right`.
+    stacks: Vec<Stack>,
     /// The stack of the last tick.
     active: usize,
     /// Whether the last tick was solved by the active stack's GF fallback.
@@ -79,12 +87,18 @@ pub struct KeypointController {
     latch: [(Vector3<f64>, f64); 2],
     /// Whether each foot has landed (is in the first level).
     stance: [bool; 2],
-    /// Ticks each foot has waited to land since the clip put it on the ground.
-    waiting: [usize; 2],
-    /// Landing thresholds: height \[m\], speed \[m/s\], largest wait \[ticks\].
-    landing: (f64, f64, usize),
-    /// Kinematics of the state, updated while a foot waits to land.
+    /// Landing thresholds: height \[m\], speed \[m/s\].
+    landing: (f64, f64),
+    /// Kinematics of the state, updated while a foot is in the air.
     kin: Kinematics,
+    /// The floor of each swing foot at the current tick ([`super::floor`]).
+    floor: [Floor; 2],
+    /// The sole's corners in the foot frame \[m\].
+    corners: [Vector3<f64>; 4],
+    /// The tasks' gains (the floor's approach uses them too).
+    gains: Gains,
+    /// Ticks with a swing foot's floor engaged so far.
+    floor_ticks: usize,
     robot: Arc<Robot>,
     posture_track: Vec<[Vec<f64>; 3]>,
     posture_ref: [Vec<f64>; 3],
@@ -104,11 +118,72 @@ struct Stack {
 struct Tasks {
     /// Foot index (left 0, right 1) and handle, stance feet first.
     feet: Vec<(usize, FrameHandle)>,
+    /// Foot index and handle of the swing feet whose floor is engaged ([`super::floor`]).
+    floor: Vec<(usize, FrameHandle)>,
     com: ComHandle,
     pelvis: FrameHandle,
     torso: Option<FrameHandle>,
     points: Vec<(FrameHandle, usize)>,
     posture: JointsHandle,
+}
+
+/// The roll, pitch and height of a swing foot while its floor is engaged ([`super::floor`]).
+const FLOOR_AXES: Axes = Axes([false, false, true, true, true, false]);
+
+/// A foot lands only while its sole is tilted less than this from the ground \[rad\] (about
+/// 1.7°): the first level holds it flat, and flattening a foot tilted by `θ` moves its sole's
+/// centre by about `ankle_height · sin θ` (1 mm at G1's 0.035 m and this angle).
+pub const LAND_TILT: f64 = 0.03;
+
+/// Gains of the held feet's level (k_p \[1/s²\], k_v \[1/s\]; critically damped, ω = 20 rad/s),
+/// stiffer than the other tasks': the held foot's level is solved exactly, yet the foot
+/// drifted by up to 6.6 mm over a stance at the default 100 / 20 (G1, dance_a), the
+/// integration's error over a tick (constant q̈ over Δt on a whirling floating base) acting
+/// as a disturbance that the feedback pulls back in proportion to `1/k_p`. At 900 / 60 a run
+/// diverged (G1, punch).
+const STANCE_GAINS: Gains = Gains {
+    kp: 400.0,
+    kv: 40.0,
+};
+
+/// What the stack does with a foot.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum FootMode {
+    /// Held where it landed, 6D, in the first level.
+    Stance,
+    /// In the air, tracked with the hands (position) and the torso (orientation).
+    Swing,
+    /// In the air near the ground: as `Swing`, and its floor ([`super::floor`]) with its roll
+    /// and pitch in the second level.
+    Floor,
+    /// The clip has it on the ground, it has not landed yet and its floor is engaged: 6D, its
+    /// height under the floor, its horizontal motion damped out, in the second level (higher
+    /// up it is brought down to the hold as a swing).
+    Landing,
+}
+
+impl FootMode {
+    /// Every mode, in the order of their index.
+    const ALL: [FootMode; 4] = [Self::Stance, Self::Swing, Self::Floor, Self::Landing];
+
+    /// The mode's index in [`FootMode::ALL`].
+    fn index(self) -> usize {
+        self as usize
+    }
+}
+
+/// The floor's state of one swing foot at the current tick.
+#[derive(Debug, Clone, Copy, Default)]
+struct Floor {
+    /// Height of the foot frame \[m\].
+    z: f64,
+    /// Its vertical speed \[m/s\].
+    z_dot: f64,
+    /// The vertical acceleration asked of it, `max(a_ref, a_min)` \[m/s²\].
+    acceleration: f64,
+    /// While landing, its horizontal position \[m\]: its horizontal motion is damped out there
+    /// rather than carried on to the plan's hold (where the foot lands is latched anyway).
+    stop: Option<[f64; 2]>,
 }
 
 /// The reference of foot `i` at tick `k` with the latched offset `(d, yaw)` (see the module
@@ -150,6 +225,7 @@ fn set_references(
     t: &Tasks,
     p: &Plan,
     latch: &[(Vector3<f64>, f64); 2],
+    floor: &[Floor; 2],
     posture_track: &[[Vec<f64>; 3]],
     posture_ref: &mut [Vec<f64>; 3],
     k: usize,
@@ -157,6 +233,25 @@ fn set_references(
 ) -> Result<()> {
     for (i, h) in &t.feet {
         ctl.set_frame_reference(*h, foot_reference(p, *i, k, hold, latch[*i]))?;
+    }
+    for (i, h) in &t.floor {
+        let mut r = foot_reference(p, *i, k, hold, latch[*i]);
+        let f = &floor[*i];
+        // z̈ = max(a_ref, a_min) as the reference's feed-forward at the current height and
+        // speed (the row's feedback terms vanish).
+        r.pose.translation.vector.z = f.z;
+        r.velocity[2] = f.z_dot;
+        r.acceleration[2] = f.acceleration;
+        if let Some([x, y]) = f.stop {
+            // Landing: the horizontal motion is damped out where the foot is (ẍ = −k_v ẋ).
+            r.pose.translation.vector.x = x;
+            r.pose.translation.vector.y = y;
+            for a in 0..2 {
+                r.velocity[a] = 0.0;
+                r.acceleration[a] = 0.0;
+            }
+        }
+        ctl.set_frame_reference(*h, r)?;
     }
     let c = p.com[k];
     let c = if hold {
@@ -189,8 +284,10 @@ fn build_stack(
     plan: &Plan,
     posture: &[String],
     s: &KeypointSettings,
-    stance: [bool; 2],
+    modes: [FootMode; 2],
 ) -> Result<Stack> {
+    let stance = modes.map(|m| m == FootMode::Stance);
+    let swing = modes.map(|m| matches!(m, FootMode::Swing | FootMode::Floor));
     let mut b = ControllerBuilder::new(robot.clone(), state)?;
     b.gains(s.gains).settings(ControllerSettings {
         method: s.method,
@@ -207,41 +304,58 @@ fn build_stack(
     let mut feet = Vec::with_capacity(2);
     if stance.iter().any(|on| *on) {
         b.level(KEYPOINT_LEVELS[0]);
+        b.gains(STANCE_GAINS);
         for i in (0..2).filter(|i| stance[*i]) {
             feet.push((i, b.frame(&name(body.feet[i]), Axes::ALL)?));
         }
+        b.gains(s.gains);
     }
-    let com = b.level(KEYPOINT_LEVELS[1]).com([true, true, false])?;
+    let mut floor = Vec::with_capacity(2);
+    if modes
+        .iter()
+        .any(|m| matches!(m, FootMode::Floor | FootMode::Landing))
+    {
+        b.level(KEYPOINT_LEVELS[1]);
+        for (i, m) in modes.iter().enumerate() {
+            let axes = match m {
+                FootMode::Floor => FLOOR_AXES,
+                FootMode::Landing => Axes::ALL,
+                _ => continue,
+            };
+            floor.push((i, b.frame(&name(body.feet[i]), axes)?));
+        }
+    }
+    let com = b.level(KEYPOINT_LEVELS[2]).com([true, true, false])?;
     let pelvis = b
-        .level(KEYPOINT_LEVELS[2])
+        .level(KEYPOINT_LEVELS[3])
         .frame(&name(body.pelvis), Axes::ALL)?;
     let mut points = Vec::new();
-    b.level(KEYPOINT_LEVELS[3]);
-    for i in (0..2).filter(|i| !stance[*i]) {
+    b.level(KEYPOINT_LEVELS[4]);
+    for i in (0..2).filter(|i| swing[*i]) {
         feet.push((i, b.frame(&name(body.feet[i]), Axes::POSITION)?));
     }
-    let mut level = 3;
+    let mut level = 4;
     for (i, (p, _)) in plan.points.iter().enumerate() {
-        if level == 3 && !matches!(p, BodyPoint::LeftWrist | BodyPoint::RightWrist) {
-            b.level(KEYPOINT_LEVELS[4]);
-            level = 4;
+        if level == 4 && !matches!(p, BodyPoint::LeftWrist | BodyPoint::RightWrist) {
+            b.level(KEYPOINT_LEVELS[5]);
+            level = 5;
         }
         if let Some(f) = body.frame_of(*p) {
             points.push((b.frame(&name(f), Axes::POSITION)?, i));
         }
     }
-    if level == 3 {
-        b.level(KEYPOINT_LEVELS[4]);
+    if level == 4 {
+        b.level(KEYPOINT_LEVELS[5]);
     }
     let torso = match body.torso {
         Some(f) => Some(b.frame(&name(f), Axes::ORIENTATION)?),
         None => None,
     };
-    for i in (0..2).filter(|i| !stance[*i]) {
+    for i in (0..2).filter(|i| swing[*i]) {
         feet.push((i, b.frame(&name(body.feet[i]), Axes::ORIENTATION)?));
     }
     let names: Vec<&str> = posture.iter().map(String::as_str).collect();
-    let posture = b.level(KEYPOINT_LEVELS[5]).joints(&names)?;
+    let posture = b.level(KEYPOINT_LEVELS[6]).joints(&names)?;
     // The clone keeps the builder's identity: the handles address both controllers.
     let mut gf = b.clone();
     gf.settings(ControllerSettings {
@@ -254,6 +368,7 @@ fn build_stack(
         fallback: gf.build()?,
         tasks: Tasks {
             feet,
+            floor,
             com,
             pelvis,
             torso,
@@ -270,20 +385,23 @@ impl KeypointController {
         body: &RobotBody,
         plan: Plan,
         posture: PostureTracks,
+        support: &SupportSettings,
         s: &KeypointSettings,
     ) -> Result<Self> {
-        let build = |stance| build_stack(&robot, &state, body, &plan, &posture.0, s, stance);
         let kin = Kinematics::new(&robot, &state)?;
-        let stacks = Box::new([
-            build([false, false])?,
-            build([true, false])?,
-            build([false, true])?,
-            build([true, true])?,
-        ]);
+        let mut stacks = Vec::with_capacity(16);
+        for right in FootMode::ALL {
+            for left in FootMode::ALL {
+                let modes = [left, right];
+                stacks.push(build_stack(
+                    &robot, &state, body, &plan, &posture.0, s, modes,
+                )?);
+            }
+        }
         let m = posture.0.len();
         Ok(Self {
             stacks,
-            active: 3,
+            active: 0,
             used_fallback: false,
             fallback_ticks: 0,
             stance_gf_ticks: 0,
@@ -293,14 +411,13 @@ impl KeypointController {
             feet: body.feet,
             latch: [(Vector3::zeros(), 0.0); 2],
             kin,
+            floor: [Floor::default(); 2],
+            corners: sole_corners(support),
+            gains: s.gains,
+            floor_ticks: 0,
             robot: robot.clone(),
             stance: [true; 2],
-            waiting: [0; 2],
-            landing: (
-                s.land_height,
-                s.land_speed,
-                (s.max_landing_delay / s.dt).round() as usize,
-            ),
+            landing: (s.land_height, s.land_speed),
             posture_track: posture.1,
             posture_ref: [vec![0.0; m], vec![0.0; m], vec![0.0; m]],
         })
@@ -331,45 +448,75 @@ impl KeypointController {
         for i in 0..2 {
             if hold || !on[i] {
                 self.stance[i] = on[i];
-                self.waiting[i] = 0;
             } else if !self.stance[i] && (k == 0 || !c[i][k - 1]) {
                 // The clip's touch-down: the foot goes to the plan's hold, then lands.
                 self.latch[i] = (Vector3::zeros(), 0.0);
-                self.waiting[i] = 0;
             }
         }
-        if (0..2).any(|i| on[i] && !self.stance[i]) {
+        let mut modes = [FootMode::Stance; 2];
+        if self.stance != [true; 2] {
             // The robot's feet where they are now.
             self.kin.update(&self.robot, &self.state)?;
             let (kin, robot) = (&self.kin, &*self.robot);
-            let (height, speed, max_wait) = self.landing;
-            let waiting = [on[0] && !self.stance[0], on[1] && !self.stance[1]];
-            for i in (0..2).filter(|i| waiting[*i]) {
+            let (height, speed) = self.landing;
+            for i in 0..2 {
+                if self.stance[i] {
+                    continue;
+                }
                 let pose = kin.frame_pose(robot, self.feet[i])?;
                 let v = kin.frame_velocity(robot, self.feet[i])?;
-                let plan = &self.plan.feet[i][k];
-                let mut d = pose.translation.vector - plan.position.position;
-                let low = d.z <= height;
-                let slow = v.fixed_rows::<3>(0).norm() <= speed;
-                if (low && slow) || self.waiting[i] >= max_wait {
-                    d.z = 0.0;
-                    let x = (pose.rotation * plan.rotation.inverse()) * Vector3::x();
-                    self.latch[i] = (d, x.y.atan2(x.x));
-                    self.stance[i] = true;
-                } else {
-                    self.waiting[i] += 1;
+                let (e, e_dot) = lowest_corner(&pose, &v, &self.corners);
+                if on[i] {
+                    let plan = &self.plan.feet[i][k];
+                    let low = e <= height;
+                    let slow = v.fixed_rows::<3>(0).norm() <= speed;
+                    let flat = (pose.rotation * Vector3::z()).z >= LAND_TILT.cos();
+                    if low && slow && flat {
+                        let mut d = pose.translation.vector - plan.position.position;
+                        d.z = 0.0;
+                        let x = (pose.rotation * plan.rotation.inverse()) * Vector3::x();
+                        self.latch[i] = (d, x.y.atan2(x.x));
+                        self.stance[i] = true;
+                        continue;
+                    }
+                }
+                let a_min = floor_acceleration(e, e_dot, &self.gains);
+                modes[i] = match (on[i], engaged(a_min)) {
+                    (true, true) => FootMode::Landing,
+                    (false, true) => FootMode::Floor,
+                    // Far above the ground a foot is brought down to its hold as in a swing.
+                    (_, false) => FootMode::Swing,
+                };
+                if modes[i] != FootMode::Swing {
+                    let r = foot_reference(&self.plan, i, k, hold, self.latch[i]);
+                    let (z, z_dot) = (pose.translation.vector.z, v[2]);
+                    let a_ref = r.acceleration[2]
+                        + self.gains.kv * (r.velocity[2] - z_dot)
+                        + self.gains.kp * (r.pose.translation.vector.z - z);
+                    let p = pose.translation.vector;
+                    self.floor[i] = Floor {
+                        z,
+                        z_dot,
+                        acceleration: a_ref.max(a_min),
+                        stop: (modes[i] == FootMode::Landing).then_some([p.x, p.y]),
+                    };
                 }
             }
         }
-        self.active = usize::from(self.stance[0]) + 2 * usize::from(self.stance[1]);
-        let stack = &mut self.stacks[self.active & 3];
+        if modes.contains(&FootMode::Floor) {
+            self.floor_ticks += 1;
+        }
+        let stance = usize::from(self.stance[0]) + 2 * usize::from(self.stance[1]);
+        self.active = modes[0].index() + 4 * modes[1].index();
+        let stack = &mut self.stacks[self.active & 15];
         let tolerance = stack.ctl.settings().solver.box_tolerance;
-        let (p, l, pt) = (&self.plan, &self.latch, &self.posture_track);
+        let (p, l, fl, pt) = (&self.plan, &self.latch, &self.floor, &self.posture_track);
         set_references(
             &mut stack.ctl,
             &stack.tasks,
             p,
             l,
+            fl,
             pt,
             &mut self.posture_ref,
             k,
@@ -378,14 +525,24 @@ impl KeypointController {
         stack.ctl.prepare(&self.state, self.dt)?;
         let iktc = stack.ctl.settings().method == Method::Iktc;
         let r = stack.ctl.solve()?;
-        let held = self.active != 0 && r.corrected_from == Some(0);
+        let held = stance != 0 && r.corrected_from == Some(0);
         let stance_error = r.task_error_norms.first().copied().unwrap_or(0.0);
         let violation = r.violation;
         if (violation <= tolerance && !held) || !iktc {
             return Ok(stack.ctl.report());
         }
         let f = &mut stack.fallback;
-        set_references(f, &stack.tasks, p, l, pt, &mut self.posture_ref, k, hold)?;
+        set_references(
+            f,
+            &stack.tasks,
+            p,
+            l,
+            fl,
+            pt,
+            &mut self.posture_ref,
+            k,
+            hold,
+        )?;
         f.prepare(&self.state, self.dt)?;
         let g = f.solve()?;
         let gf_error = g.task_error_norms.first().copied().unwrap_or(0.0);
@@ -454,10 +611,16 @@ impl KeypointController {
         self.stance_gf_ticks
     }
 
+    /// Ticks so far with a swing foot's floor engaged in the `swing_floor` level (landing feet
+    /// not counted).
+    pub fn floor_ticks(&self) -> usize {
+        self.floor_ticks
+    }
+
     /// Applies the last q̈ over Δt (constant acceleration). Errors: no tick solved since the
     /// last integration.
     pub fn integrate(&mut self) -> Result<()> {
-        let s = &mut self.stacks[self.active & 3];
+        let s = &mut self.stacks[self.active & 15];
         if self.used_fallback {
             s.fallback.integrate(&mut self.state)
         } else {
@@ -472,7 +635,7 @@ impl KeypointController {
 
     /// q̈ of the last tick \[rad/s²\] (base: \[m/s²\], \[rad/s²\]).
     pub fn qdd(&self) -> &DVector<f64> {
-        let s = &self.stacks[self.active & 3];
+        let s = &self.stacks[self.active & 15];
         if self.used_fallback {
             s.fallback.qdd()
         } else {
@@ -486,6 +649,6 @@ impl KeypointController {
 
     /// The controller of the last tick's contact state (IKTC).
     pub fn controller(&self) -> &Controller {
-        &self.stacks[self.active & 3].ctl
+        &self.stacks[self.active & 15].ctl
     }
 }

@@ -1,0 +1,169 @@
+//! The floor under a swing foot: the lowest sole corner kept at or above the ground (z = 0).
+//!
+//! Per swing foot and tick, from the robot's state: the sole's lowest corner height `e` \[m\]
+//! above the ground and its vertical speed `ė` \[m/s\] (`ė = v_z + (ω × R c)_z`, corner `c` in
+//! the foot frame). The floor bounds the corner's vertical acceleration from below by the
+//! slowest approach that never passes the ground:
+//!
+//! * `a_PD = −k_p e − k_v ė`, a critically damped approach (`k_v = 2√k_p`, `ω = √k_p`): from
+//!   `e₀ ≥ 0` it stays at or above the ground iff `ė₀ ≥ −ω e₀` (the solution
+//!   `e(t) = (e₀ + (ė₀ + ω e₀) t) e^{−ωt}`); below the ground it returns without overshoot;
+//! * `a_brake = ė² / 2e`, the constant deceleration that stops the corner exactly at the
+//!   ground, for the case `ė₀ < −ω e₀` above the ground.
+//!
+//! `a_min = a_PD` where the approach is viable (`ė ≥ −ω e`, or at or below the ground), else
+//! `max(a_PD, a_brake)`: any acceleration above `a_min` keeps the corner at or above the
+//! comparison solution, which never passes the ground (the two branches meet at `ė = −ω e`,
+//! where `a_PD = ω² e > a_brake = ω² e / 2`, so the bound is continuous). The
+//! floor joins the stack ([`super::tracker`]) once `a_min ≥ −`[`FLOOR_ENGAGE`] (the foot is
+//! low, or descends fast enough that the floor will soon have to brake it): the foot's height
+//! is then asked `z̈ = max(a_ref, a_min)`, `a_ref` the acceleration its own reference asks
+//! (`z̈_d + k_v(ż_d − ż) + k_p(z_d − z)`), so the floor only ever pushes up, and the foot's
+//! roll and pitch are asked to follow the reference (flat) in the same level.
+
+use nalgebra::{Isometry3, Point3, Vector3, Vector6};
+
+use crate::task::Gains;
+
+/// The floor joins the stack once it bounds the lowest corner's downward acceleration to less
+/// than this \[m/s²\] (see the module documentation): larger values engage it earlier (higher
+/// above the ground), smaller ones later, with harder braking.
+pub const FLOOR_ENGAGE: f64 = 2.0;
+
+/// The corners of a sole in the foot frame \[m\]: `sole_offset_x ± l/2`, `± w/2`, `−ankle_height`.
+pub(crate) fn sole_corners(support: &crate::sim::imitate::SupportSettings) -> [Vector3<f64>; 4] {
+    let (hl, hw) = (0.5 * support.sole_length, 0.5 * support.sole_width);
+    [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)].map(|(sx, sy)| {
+        Vector3::new(
+            support.sole_offset_x + sx * hl,
+            sy * hw,
+            -support.ankle_height,
+        )
+    })
+}
+
+/// The lowest corner's height \[m\] and vertical speed \[m/s\] of a foot at `pose` moving with
+/// the twist `velocity` (linear velocity of the frame's origin \[m/s\], angular velocity
+/// \[rad/s\], world axes).
+pub(crate) fn lowest_corner(
+    pose: &Isometry3<f64>,
+    velocity: &Vector6<f64>,
+    corners: &[Vector3<f64>; 4],
+) -> (f64, f64) {
+    let (v, w) = (
+        velocity.fixed_rows::<3>(0).into_owned(),
+        velocity.fixed_rows::<3>(3).into_owned(),
+    );
+    let mut best = (f64::INFINITY, 0.0);
+    for c in corners {
+        let r = pose.rotation * c;
+        let z = (pose * Point3::from(*c)).z;
+        if z < best.0 {
+            best = (z, v.z + w.cross(&r).z);
+        }
+    }
+    best
+}
+
+/// The floor's lower bound on the lowest corner's vertical acceleration `a_min` \[m/s²\] at
+/// height `e` \[m\] and vertical speed `ė` \[m/s\] (see the module documentation).
+pub(crate) fn floor_acceleration(e: f64, e_dot: f64, gains: &Gains) -> f64 {
+    let pd = -gains.kp * e - gains.kv * e_dot;
+    if e > 0.0 && e_dot < -gains.kp.sqrt() * e {
+        pd.max(e_dot * e_dot / (2.0 * e))
+    } else {
+        pd
+    }
+}
+
+/// Whether the floor joins the stack at `a_min` \[m/s²\] ([`FLOOR_ENGAGE`]).
+pub(crate) fn engaged(a_min: f64) -> bool {
+    a_min >= -FLOOR_ENGAGE
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const GAINS: Gains = Gains {
+        kp: 100.0,
+        kv: 20.0,
+    };
+
+    /// Integrates a point under `z̈ = a_min(z, ż)` (the floor binding all the way), constant
+    /// acceleration over each step \[s\]; returns the lowest height reached \[m\].
+    fn lowest_under_floor(z0: f64, v0: f64, dt: f64, steps: usize) -> f64 {
+        let (mut z, mut v, mut low) = (z0, v0, z0);
+        for _ in 0..steps {
+            let a = floor_acceleration(z, v, &GAINS);
+            z += v * dt + 0.5 * a * dt * dt;
+            v += a * dt;
+            low = low.min(z);
+        }
+        low
+    }
+
+    #[test]
+    fn a_falling_foot_stops_at_the_ground_not_below() {
+        // From 0.2 m at up to 3 m/s down, and from 5 mm at 1 m/s (the braking branch), at the
+        // control rate: the corner never passes the ground by more than the step's rounding
+        // of the braking parabola (a micrometre).
+        for (z0, v0) in [
+            (0.2, 0.0),
+            (0.2, -1.0),
+            (0.2, -3.0),
+            (0.005, -1.0),
+            (0.05, -0.2),
+        ] {
+            let low = lowest_under_floor(z0, v0, 0.005, 400);
+            assert!(low >= -1e-6, "from {z0} m at {v0} m/s: {low} m");
+        }
+    }
+
+    #[test]
+    fn the_braking_branch_is_the_constant_deceleration_to_rest_at_the_ground() {
+        // 0.01 m above, 2 m/s down (ė < −ω e, and a_PD = −1 + 40 = 39 < a_brake): a = ė²/2e
+        // = 200 m/s², and under it the corner reaches rest after ė/a = 0.01 s at exactly the
+        // ground.
+        let a = floor_acceleration(0.01, -2.0, &GAINS);
+        assert!((a - 200.0).abs() < 1e-9, "{a}");
+        let (t, z) = (
+            2.0 / a,
+            0.01 - 2.0 * (2.0 / a) + 0.5 * a * (2.0 / a).powi(2),
+        );
+        assert!((t - 0.01).abs() < 1e-12 && z.abs() < 1e-12, "{t} {z}");
+        // A slow descent high above is not braked: the bound is the PD's, below zero.
+        let slow = floor_acceleration(0.25, -0.17, &GAINS);
+        assert!((slow - (-25.0 + 3.4)).abs() < 1e-12, "{slow}");
+        // Below the ground it pushes up; at rest high above it does not engage.
+        assert!(floor_acceleration(-0.01, 0.0, &GAINS) > 0.0);
+        assert!(!engaged(floor_acceleration(0.5, 0.0, &GAINS)));
+        assert!(engaged(floor_acceleration(0.01, 0.0, &GAINS)));
+        assert!(engaged(floor_acceleration(0.3, -2.0, &GAINS)));
+    }
+
+    #[test]
+    fn the_lowest_corner_of_a_tilted_foot_moves_with_the_rotation() {
+        // A foot pitched 0.1 rad nose down (about +y), its ankle 0.1 m up, turning at 1 rad/s
+        // about +y: the front corners are lowest, at 0.1 − 0.1 sin θ − 0.05 cos θ, and drop
+        // at (ω × R c)_z, compared with the finite difference of the height.
+        let s = crate::sim::imitate::SupportSettings {
+            sole_length: 0.2,
+            sole_width: 0.1,
+            sole_offset_x: 0.0,
+            ankle_height: 0.05,
+        };
+        let corners = sole_corners(&s);
+        let pose =
+            |th: f64| Isometry3::new(Vector3::new(0.0, 0.0, 0.1), Vector3::new(0.0, th, 0.0));
+        let twist = Vector6::new(0.0, 0.0, 0.0, 0.0, 1.0, 0.0);
+        let (h, hd) = lowest_corner(&pose(0.1), &twist, &corners);
+        let expected = 0.1 - 0.1 * 0.1_f64.sin() - 0.05 * 0.1_f64.cos();
+        assert!((h - expected).abs() < 1e-12, "{h} {expected}");
+        let d = 1e-6;
+        let fd = (lowest_corner(&pose(0.1 + d), &twist, &corners).0
+            - lowest_corner(&pose(0.1 - d), &twist, &corners).0)
+            / (2.0 * d);
+        assert!((hd - fd).abs() < 1e-6, "{hd} {fd}");
+    }
+}
