@@ -45,7 +45,24 @@ pub fn run(a: &Args) -> Result<()> {
             .as_ref()
             .context("`planar3r` has no profile and cannot imitate a motion")?;
         let sc = &a.scenario;
-        return crate::cmd_keypoints::run(profile, &sc.motion, &sc.motion_options, &cfg, &a.out);
+        // Keypoint retargeting has its own default bounds; --recover applies to them too.
+        let mut bounds = sc.bounds.map_or_else(
+            || iktc::retarget::KeypointSettings::default().bounds,
+            crate::cmd_run::BoundsArg::method,
+        );
+        if sc.recover {
+            if let BoundMethod::Viable(s) | BoundMethod::Quiet(s) = &mut bounds {
+                s.outside = iktc::limits::OutsideLimits::Recover;
+            }
+        }
+        return crate::cmd_keypoints::run(
+            profile,
+            &sc.motion,
+            &sc.motion_options,
+            &cfg,
+            bounds,
+            &a.out,
+        );
     }
     let (e, cfg, profile) = prepare(&a.scenario)?;
     let r = e.imitate(&cfg)?;

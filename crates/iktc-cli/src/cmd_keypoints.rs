@@ -40,8 +40,8 @@ fn load(
     Ok((kp, clip))
 }
 
-/// Runs the keypoint retargeting of `spec` on `profile` with the imitation's solver, bounds,
-/// period and tick limit from `cfg`, compares it with the joint route where the profile has a
+/// Runs the keypoint retargeting of `spec` on `profile` with the imitation's solver, period and
+/// tick limit from `cfg` and `bounds`, compares it with the joint route where the profile has a
 /// map for the clip's format, prints both and writes `keypoints_summary.json` and
 /// `keypoints_trajectory.csv` to `out`.
 pub fn run(
@@ -49,13 +49,14 @@ pub fn run(
     spec: &str,
     options: &crate::cmd_map::MotionArgs,
     cfg: &ImitateConfig,
+    bounds: iktc::limits::BoundMethod,
     out: &Path,
 ) -> Result<()> {
     let (kp, clip) = load(spec, options)?;
     crate::outln!("{}", kp.summary())?;
     let settings = KeypointSettings {
         method: cfg.method,
-        bounds: cfg.bounds,
+        bounds,
         dt: cfg.dt,
         run_limits: cfg.run_limits,
         ..KeypointSettings::default()

@@ -39,9 +39,9 @@ pub struct ScenarioArgs {
     /// Solver.
     #[arg(long, value_enum, default_value = "iktc")]
     pub solver: SolverArg,
-    /// Joint bounds.
-    #[arg(long, value_enum, default_value = "quiet")]
-    pub bounds: BoundsArg,
+    /// Joint bounds (default: quiet; viable for keypoint retargeting).
+    #[arg(long, value_enum)]
+    pub bounds: Option<BoundsArg>,
     /// Start even if a joint is outside its (narrowed) range, and bring it back at the
     /// acceleration limit (viable or quiet bounds); without it such a start is an error.
     #[arg(long)]
@@ -98,7 +98,9 @@ pub fn prepare_config(a: &ScenarioArgs) -> Result<(ResolvedRobot, ImitateConfig)
     let mut cfg = profile
         .imitate_config(ImitateConfig {
             method: a.solver.method(),
-            bounds: a.bounds.method(),
+            bounds: a
+                .bounds
+                .map_or_else(|| ImitateConfig::default().bounds, BoundsArg::method),
             dt: a.dt,
             run_limits: RunLimits {
                 max_ticks: a.max_ticks,
