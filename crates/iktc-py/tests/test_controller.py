@@ -136,14 +136,37 @@ def gil_round(robot, n):
     return (time.perf_counter() - t0) / serial
 
 
+def keypoint_round(robot, motion):
+    def run():
+        iktc.retarget_keypoints(motion, robot)
+
+    t0 = time.perf_counter()
+    run()
+    run()
+    serial = time.perf_counter() - t0
+    threads = [threading.Thread(target=run) for _ in range(2)]
+    t0 = time.perf_counter()
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    return (time.perf_counter() - t0) / serial
+
+
 def test_the_gil_is_released_while_rust_runs():
     robot = iktc.Robot("jvrc1")
-    # Two threads stepping two controllers, against the same two run one after the other.
-    # With the GIL held the ratio is ≈ 1; released, the threads overlap on two cores
-    # (≈ 0.5–0.7 on a quiet 2-core machine). The best of three rounds filters out a busy
-    # neighbour on a shared machine.
-    ratios = [gil_round(robot, 400) for _ in range(3)]
-    assert min(ratios) < 0.85, ratios
+    # Two threads stepping two controllers, and two threads each retargeting a clip (one call
+    # of ≈ 0.1 s in Rust), against the same two run one after the other. With the GIL held the
+    # ratio is ≈ 1; released, the threads overlap on two cores (≈ 0.55 for the clips). A
+    # controller step is ≈ 11 µs, of which the Python call and the array conversions (GIL
+    # held) are a large part, so its ratio is higher and noisier. On this shared machine a
+    # round sometimes gets one core only (ratio ≈ 0.95 even for the clips): the best of five
+    # rounds is taken.
+    motion = iktc.load_motion("humanoid3d_walk")
+    clips = [keypoint_round(robot, motion) for _ in range(5)]
+    assert min(clips) < 0.8, clips
+    steps = [gil_round(robot, 400) for _ in range(5)]
+    assert min(steps) < 0.9, steps
 
 
 def iktc_binary():

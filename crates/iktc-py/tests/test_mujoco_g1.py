@@ -255,8 +255,11 @@ def test_the_replay_holds_both_runs_tick_by_tick(tmp_path):
 
 def test_the_walking_plan_straightens_a_knee_unless_the_knees_are_narrowed():
     # The cause recorded for the walking failure: the pelvis height reference drives a knee to
-    # its lower limit (the leg straight); narrowed, the knees stay off it and the plan's ZMP
-    # (MuJoCo's inverse dynamics) leaves the single-support polygon on fewer ticks.
+    # its lower limit (the leg straight); narrowed, the knees stay off it. With the viable
+    # bounds the straight knee chattered at ±200 rad/s² and the plan's ZMP (MuJoCo's inverse
+    # dynamics) left the single-support polygon on 459 of 480 ticks (49 narrowed); with the
+    # quiet bounds and the level hold (the defaults) the knee rests on its limit and the plan's
+    # ZMP is outside on 50 (71 narrowed).
     plain = g1_sim.walking_plan_figures("humanoid3d_walk")
     narrowed = g1_sim.walking_plan_figures("humanoid3d_walk", g1_sim.G1_KNEES)
     assert plain["right_knee_straight_from_s"] is not None, plain
@@ -264,6 +267,7 @@ def test_the_walking_plan_straightens_a_knee_unless_the_knees_are_narrowed():
     assert min(narrowed["left_knee_min_rad"], narrowed["right_knee_min_rad"]) >= 0.3 - 1e-6
 
     def outside(f):
-        return int(f["plan_zmp_outside_single"].split(" of ")[0])
+        n_out, n = f["plan_zmp_outside_single"].split(" of ")
+        return int(n_out) / int(n)
 
-    assert outside(narrowed) < outside(plain) / 2, (plain, narrowed)
+    assert outside(plain) < 0.25, plain
