@@ -116,6 +116,22 @@ def step_many(ctrl, q, v, n):
         ctrl.step(q, v, DT)
 
 
+def parallel_ratio(serial, parallel):
+    """Wall time of the two calls `parallel` in two threads over that of the two calls
+    `serial` one after the other."""
+    t0 = time.perf_counter()
+    for f in serial:
+        f()
+    alone = time.perf_counter() - t0
+    threads = [threading.Thread(target=f) for f in parallel]
+    t0 = time.perf_counter()
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    return (time.perf_counter() - t0) / alone
+
+
 def gil_round(robot, n):
     runs = []
     for _ in range(4):
@@ -123,34 +139,15 @@ def gil_round(robot, n):
         ctrl, _, com = feet_and_com(robot, q)
         ctrl.set_com_reference(com, robot.com(q) + [0.02, 0.0, 0.0])
         runs.append((ctrl, q, v))
-    t0 = time.perf_counter()
-    step_many(*runs[0], n)
-    step_many(*runs[1], n)
-    serial = time.perf_counter() - t0
-    threads = [threading.Thread(target=step_many, args=(*r, n)) for r in runs[2:]]
-    t0 = time.perf_counter()
-    for t in threads:
-        t.start()
-    for t in threads:
-        t.join()
-    return (time.perf_counter() - t0) / serial
+    steps = [lambda r=r: step_many(*r, n) for r in runs]
+    return parallel_ratio(steps[:2], steps[2:])
 
 
 def keypoint_round(robot, motion):
     def run():
         iktc.retarget_keypoints(motion, robot)
 
-    t0 = time.perf_counter()
-    run()
-    run()
-    serial = time.perf_counter() - t0
-    threads = [threading.Thread(target=run) for _ in range(2)]
-    t0 = time.perf_counter()
-    for t in threads:
-        t.start()
-    for t in threads:
-        t.join()
-    return (time.perf_counter() - t0) / serial
+    return parallel_ratio([run, run], [run, run])
 
 
 def test_the_gil_is_released_while_rust_runs():

@@ -165,3 +165,30 @@ fn bad_acceleration_option() {
     let r = Robot::from_urdf_str(GOOD, &o).unwrap();
     assert_eq!(r.active_joints().next().unwrap().limit.acceleration, 7.0);
 }
+
+/// A per-joint acceleration or jerk limit that is not positive names its joint, its kind and
+/// its unit.
+#[test]
+fn bad_per_joint_acceleration_and_jerk_limits_are_named() {
+    for (options, says) in [
+        (
+            ModelOptions {
+                acceleration_limits: vec![("L_KNEE".into(), 0.0)],
+                ..ModelOptions::default()
+            },
+            ["acceleration limit of joint `L_KNEE`", "rad/s²"],
+        ),
+        (
+            ModelOptions {
+                jerk_limits: vec![("L_KNEE".into(), f64::NAN)],
+                ..ModelOptions::default()
+            },
+            ["jerk limit of joint `L_KNEE`", "rad/s³"],
+        ),
+    ] {
+        let e = jvrc1(&options).unwrap_err().to_string();
+        for s in says {
+            assert!(e.contains(s), "`{s}` not in {e}");
+        }
+    }
+}

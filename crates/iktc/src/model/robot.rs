@@ -398,30 +398,24 @@ impl Robot {
             }
             locked.insert(j, *value);
         }
-        let mut accel: HashMap<usize, f64> = HashMap::new();
-        for (name, value) in &options.acceleration_limits {
-            let j = find_joint("joint", name)?;
-            if value.is_nan() || *value <= 0.0 {
-                return Err(Error::InvalidSetting {
-                    name: format!("acceleration limit of joint `{name}`"),
-                    value: value.to_string(),
-                    expected: "a positive number [rad/s²] or +inf".into(),
-                });
+        // Per-joint limits by name: positive or +inf, named in the error.
+        let by_joint = |list: &[(String, f64)], what: &str, unit: &str| {
+            let mut out: HashMap<usize, f64> = HashMap::new();
+            for (name, value) in list {
+                let j = find_joint("joint", name)?;
+                if value.is_nan() || *value <= 0.0 {
+                    return Err(Error::InvalidSetting {
+                        name: format!("{what} limit of joint `{name}`"),
+                        value: value.to_string(),
+                        expected: format!("a positive number [{unit}] or +inf"),
+                    });
+                }
+                out.insert(j, *value);
             }
-            accel.insert(j, *value);
-        }
-        let mut jerk: HashMap<usize, f64> = HashMap::new();
-        for (name, value) in &options.jerk_limits {
-            let j = find_joint("joint", name)?;
-            if value.is_nan() || *value <= 0.0 {
-                return Err(Error::InvalidSetting {
-                    name: format!("jerk limit of joint `{name}`"),
-                    value: value.to_string(),
-                    expected: "a positive number [rad/s³] or +inf".into(),
-                });
-            }
-            jerk.insert(j, *value);
-        }
+            Ok(out)
+        };
+        let accel = by_joint(&options.acceleration_limits, "acceleration", "rad/s²")?;
+        let jerk = by_joint(&options.jerk_limits, "jerk", "rad/s³")?;
         // Roles. First pass: active / locked / fixed; mimics resolved after.
         let nbase_v = if options.base == BaseKind::Floating {
             6
