@@ -45,16 +45,7 @@ pub fn run(a: &Args) -> Result<()> {
             .as_ref()
             .context("`planar3r` has no profile and cannot imitate a motion")?;
         let sc = &a.scenario;
-        // Keypoint retargeting has its own default bounds; --recover applies to them too.
-        let mut bounds = sc.bounds.map_or_else(
-            || iktc::retarget::KeypointSettings::default().bounds,
-            crate::cmd_run::BoundsArg::method,
-        );
-        if sc.recover {
-            if let BoundMethod::Viable(s) | BoundMethod::Quiet(s) = &mut bounds {
-                s.outside = iktc::limits::OutsideLimits::Recover;
-            }
-        }
+        let bounds = crate::scenario::keypoint_bounds(sc);
         return crate::cmd_keypoints::run(
             profile,
             &sc.motion,

@@ -1,6 +1,7 @@
 //! `iktc retarget`: retarget whole datasets. Inputs are files, folders (searched recursively
 //! for motion files) or glob patterns; every clip runs on a pool of threads
-//! ([`iktc::batch::run_parallel`]) through [`BatchRetarget::retarget`] and gets its own folder
+//! ([`iktc::batch::run_parallel`]) through [`BatchRetarget::retarget`] (keypoint retargeting
+//! by default, `--retarget joints` for the joint-angle route) and gets its own folder
 //! `OUT/<clip>/` with `motion.csv`, `motion.npz`, `quality.json` and `viewer.html`; a clip that
 //! fails is listed with its error and the batch goes on. Every file is written to a temporary
 //! name and renamed, and `.settings` (the settings hash) is written last: a clip is skipped on a
@@ -12,7 +13,7 @@ use std::path::{Path, PathBuf};
 use std::time::{Instant, SystemTime};
 
 use anyhow::{Context, Result};
-use iktc::batch::{run_parallel, BatchRetarget, ClipOutcome, DEFAULT_RETARGET_METHOD};
+use iktc::batch::{run_parallel, BatchRetarget, ClipOutcome, ClipRun, RetargetMethod};
 use iktc::mesh::MeshSet;
 use iktc::profile::glob_match;
 use iktc::sim::viewer::imitation_viewer;
@@ -23,12 +24,16 @@ use crate::scenario::{prepare_config, ScenarioArgs};
 /// Arguments of `iktc retarget`.
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// Motion files, folders (searched recursively for .bvh, .amc, .txt and .json files) or
+    /// Motion files, folders (searched recursively for .bvh, .amc, .c3d, .txt and .json files) or
     /// glob patterns (`*` and `?`, quoted so the shell leaves them; `*` also crosses folders).
     #[arg(required = true, value_name = "INPUT")]
     pub inputs: Vec<String>,
     #[command(flatten)]
     pub scenario: ScenarioArgs,
+    /// Retargeting: body keypoints tracked by a task stack, or the paper's joint-angle route
+    /// (captured rotations decomposed onto the robot's joints through a map).
+    #[arg(long, value_enum, default_value = "keypoints")]
+    pub retarget: crate::cmd_keypoints::RetargetArg,
     /// Output directory: one folder per clip, index.html and batch.json.
     #[arg(long, default_value = "out/retarget")]
     pub out: PathBuf,
@@ -47,7 +52,9 @@ pub struct Args {
 }
 
 /// Motion file extensions taken from folders.
-pub const MOTION_EXTENSIONS: [&str; 4] = ["bvh", "amc", "txt", "json"];
+/// (CSV files of named points are read when named, not taken from folders, where CSV files of
+/// other kinds are common.)
+pub const MOTION_EXTENSIONS: [&str; 5] = ["bvh", "amc", "c3d", "txt", "json"];
 
 /// Files of one clip, in the order they are written (`.settings` last).
 const OUTPUTS: [&str; 3] = ["motion.csv", "motion.npz", "quality.json"];
@@ -122,10 +129,20 @@ pub fn run(a: &Args) -> Result<()> {
         robot: resolved.robot.clone(),
         profile,
         map,
+        keypoints: iktc::retarget::KeypointSettings {
+            method: config.method,
+            bounds: crate::scenario::keypoint_bounds(&a.scenario),
+            dt: config.dt,
+            run_limits: config.run_limits,
+            ..iktc::retarget::KeypointSettings::default()
+        },
         config,
         motion_options: a.scenario.motion_options.options()?,
         rate: a.rate,
-        method: DEFAULT_RETARGET_METHOD,
+        method: match a.retarget {
+            crate::cmd_keypoints::RetargetArg::Keypoints => RetargetMethod::Keypoints,
+            crate::cmd_keypoints::RetargetArg::Joints => RetargetMethod::Joints,
+        },
     };
     let (clips, mut statuses) = discover(&a.inputs);
     std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
@@ -244,17 +261,17 @@ fn retarget_one(
     if marker.exists() {
         std::fs::remove_file(&marker).with_context(|| format!("removing {}", marker.display()))?;
     }
+    let outcome = batch.retarget(&c.path)?;
     let ClipOutcome {
-        experiment,
         run,
         trajectory,
         quality,
-    } = batch.retarget(&c.path)?;
+    } = &outcome;
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     remove_temporaries(dir)?;
     write_atomic(&dir.join(OUTPUTS[0]), trajectory.csv().as_bytes())?;
     write_atomic(&dir.join(OUTPUTS[1]), &trajectory.npz()?)?;
-    let figures = serde_json::to_value(&quality)?;
+    let figures = serde_json::to_value(quality)?;
     let doc = serde_json::json!({
         "clip": c.name,
         "input": c.path.display().to_string(),
@@ -262,16 +279,28 @@ fn retarget_one(
         "output_rate_hz": trajectory.fps,
         "frames": trajectory.len(),
         "quaternion_order": "x, y, z, w",
+        "route": match run {
+            ClipRun::Keypoints { .. } => "keypoints",
+            ClipRun::Joints { .. } => "joints",
+        },
         "figures": figures,
-        "summary": run.summary,
+        "summary": outcome.summary()?,
     });
     write_atomic(
         &dir.join(OUTPUTS[2]),
         crate::finite::to_json("quality.json", &doc)?.as_bytes(),
     )?;
     if let Some(meshes) = viewer {
-        let mut data = imitation_viewer(&run, &experiment)?;
-        crate::viewer::attach(&mut data, &experiment.robot, meshes)?;
+        let mut data = match run {
+            ClipRun::Keypoints { keypoints, run } => iktc::retarget::keypoint_viewer(
+                &batch.robot,
+                keypoints,
+                run,
+                batch.control_period(),
+            )?,
+            ClipRun::Joints { experiment, run } => imitation_viewer(run, experiment)?,
+        };
+        crate::viewer::attach(&mut data, &batch.robot, meshes)?;
         let html = crate::viewer::render_viewer(&data)?;
         write_atomic(&dir.join("viewer.html"), html.as_bytes())?;
     }

@@ -8,9 +8,17 @@ use iktc_report::escape_html;
 
 use crate::cmd_retarget::ClipStatus;
 
-/// The figures shown: key in `quality.json`'s `figures`, column label with its unit.
-const COLUMNS: [(&str, &str); 14] = [
+/// The figures shown: key in `quality.json`'s `figures`, column label with its unit. A column
+/// appears when some clip has its figure (the keypoint and joint routes measure different
+/// things).
+const COLUMNS: [(&str, &str); 22] = [
     ("duration", "duration [s]"),
+    ("mean_keypoint_error", "mean keypoint error [m]"),
+    ("max_keypoint_error", "max keypoint error [m]"),
+    (
+        "max_orientation_error",
+        "max pelvis/torso orientation error [rad]",
+    ),
     ("rms_error_upper_body", "upper-body RMS error [rad]"),
     ("max_error_upper_body", "upper-body max error [rad]"),
     (
@@ -27,10 +35,31 @@ const COLUMNS: [(&str, &str); 14] = [
     ),
     ("worst_position_margin", "worst position margin [rad]"),
     ("worst_velocity_margin", "worst velocity margin [rad/s]"),
+    (
+        "worst_acceleration_margin",
+        "worst acceleration margin [rad/s²]",
+    ),
+    ("rms_jerk", "RMS jerk [rad/s³]"),
+    ("max_jerk", "max jerk [rad/s³]"),
     ("max_rms_jerk", "max RMS jerk [rad/s³]"),
     ("com_min_margin", "COM min margin [m]"),
     ("fallback_share", "fallback share [–]"),
+    (
+        "stance_gf_share",
+        "share of ticks solved by GF for the feet [–]",
+    ),
+    ("leg_ratio", "leg ratio robot/person [–]"),
 ];
+
+/// The figure rows are sorted by, worst first: the first of these a clip has.
+const SORT_KEYS: [&str; 2] = ["mean_keypoint_error", "rms_error_upper_body"];
+
+fn sort_key(c: &ClipStatus) -> f64 {
+    SORT_KEYS
+        .iter()
+        .find_map(|k| figure(c, k))
+        .unwrap_or(f64::INFINITY)
+}
 
 /// Bins of each histogram.
 const BINS: usize = 12;
@@ -100,14 +129,16 @@ fn histogram(label: &str, values: &[f64]) -> String {
 pub fn render(clips: &[ClipStatus], robot: &str, viewer: bool) -> String {
     let mut ok: Vec<&ClipStatus> = clips.iter().filter(|c| c.status != "failed").collect();
     let failed: Vec<&ClipStatus> = clips.iter().filter(|c| c.status == "failed").collect();
-    // Worst first: failed run checks, then the largest upper-body RMS error.
+    // Worst first: failed checks, then the largest keypoint (or upper-body) error.
     ok.sort_by(|a, b| {
-        healthy(a).cmp(&healthy(b)).then(
-            figure(b, "rms_error_upper_body")
-                .unwrap_or(f64::INFINITY)
-                .total_cmp(&figure(a, "rms_error_upper_body").unwrap_or(f64::INFINITY)),
-        )
+        healthy(a)
+            .cmp(&healthy(b))
+            .then(sort_key(b).total_cmp(&sort_key(a)))
     });
+    let columns: Vec<(&str, &str)> = COLUMNS
+        .into_iter()
+        .filter(|(key, _)| ok.iter().any(|c| figure(c, key).is_some()))
+        .collect();
     let mut s = String::from(
         "<!DOCTYPE html><html lang=\"en\"><head><meta charset=\"utf-8\"><title>iktc retarget: dataset report</title><style>\
          body{font:13px sans-serif;margin:16px;color:#222}table{border-collapse:collapse}\
@@ -118,7 +149,8 @@ pub fn render(clips: &[ClipStatus], robot: &str, viewer: bool) -> String {
     );
     s.push_str(&format!(
         "<h1>Dataset report</h1><p>Robot: {}. {} clips: {} retargeted, {} up to date (skipped), {} failed. \
-         Rows are sorted worst first (run checks failed, then the largest upper-body RMS error); click a header to sort by it. \
+         Rows are sorted worst first (checks failed, then the largest mean keypoint error, or upper-body RMS error on the joint route); click a header to sort by it. \
+         Checks: on the keypoint route every joint limit kept, on the joint route the run checks (feet held, finite state, COM over the support). \
          Margins are signed: positive means a limit was exceeded.</p>",
         escape_html(robot),
         clips.len(),
@@ -127,7 +159,7 @@ pub fn render(clips: &[ClipStatus], robot: &str, viewer: bool) -> String {
         failed.len()
     ));
     s.push_str("<h2>Clips</h2><table id=\"clips\"><thead><tr><th>clip</th><th>checks</th>");
-    for (_, label) in COLUMNS {
+    for (_, label) in &columns {
         s.push_str(&format!("<th>{}</th>", escape_html(label)));
     }
     s.push_str("<th>files</th></tr></thead><tbody>");
@@ -140,7 +172,7 @@ pub fn render(clips: &[ClipStatus], robot: &str, viewer: bool) -> String {
             u8::from(h),
             if h { "passed" } else { "FAILED" }
         ));
-        for (key, _) in COLUMNS {
+        for (key, _) in &columns {
             match figure(c, key) {
                 Some(v) => s.push_str(&format!("<td data-v=\"{v:e}\">{}</td>", cell(v))),
                 None => s.push_str("<td data-v=\"\">–</td>"),
@@ -156,7 +188,7 @@ pub fn render(clips: &[ClipStatus], robot: &str, viewer: bool) -> String {
         s.push_str(&format!("<td>{links}</td></tr>"));
     }
     s.push_str("</tbody></table><h2>Distributions across the dataset</h2>");
-    for (key, label) in COLUMNS {
+    for (key, label) in &columns {
         let v: Vec<f64> = ok.iter().filter_map(|c| figure(c, key)).collect();
         if !v.is_empty() {
             s.push_str(&histogram(label, &v));

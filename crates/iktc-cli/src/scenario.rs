@@ -80,6 +80,21 @@ fn choose_map(spec: Option<&str>, format: MotionFormat, r: &ResolvedRobot) -> Re
 
 /// The robot and the run configuration the arguments describe (robot flags, profile, solver,
 /// bounds, control period, recovery, run checks).
+/// The joint bounds of keypoint retargeting: `--bounds`, else its own default (viable, unlike
+/// the rest of the command line); `--recover` applies to them too.
+pub fn keypoint_bounds(a: &ScenarioArgs) -> BoundMethod {
+    let mut bounds = a.bounds.map_or_else(
+        || iktc::retarget::KeypointSettings::default().bounds,
+        BoundsArg::method,
+    );
+    if a.recover {
+        if let BoundMethod::Viable(s) | BoundMethod::Quiet(s) = &mut bounds {
+            s.outside = OutsideLimits::Recover;
+        }
+    }
+    bounds
+}
+
 pub fn prepare_config(a: &ScenarioArgs) -> Result<(ResolvedRobot, ImitateConfig)> {
     let mut ro = a.robot_options.clone();
     let path = std::path::Path::new(&a.robot);

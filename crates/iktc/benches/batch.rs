@@ -37,7 +37,8 @@ fn batch(b: &BatchRetarget, clips: &[PathBuf], jobs: usize, out: &Path) -> usize
             std::fs::create_dir_all(&dir).expect("dir");
             std::fs::write(dir.join("motion.csv"), o.trajectory.csv()).expect("csv");
             std::fs::write(dir.join("motion.npz"), o.trajectory.npz().expect("npz")).expect("npz");
-            let q = serde_json::to_string(&(&o.quality, &o.run.summary)).expect("json");
+            let q =
+                serde_json::to_string(&(&o.quality, o.summary().expect("summary"))).expect("json");
             std::fs::write(dir.join("quality.json"), q).expect("json");
             o.trajectory.len()
         },

@@ -1,4 +1,5 @@
-//! Retargeting whole datasets: one clip end to end in memory ([`BatchRetarget::retarget`]),
+//! Retargeting whole datasets: one clip end to end in memory ([`BatchRetarget::retarget`], by
+//! keypoints or joint angles),
 //! its outputs for training code ([`TrainingTrajectory`] as CSV and NPZ, written by
 //! [`npz`] without a dependency), its quality figures ([`ClipQuality`]), and a pool of worker
 //! threads over the clips ([`run_parallel`]). Files, progress and the dataset report are the
@@ -13,9 +14,10 @@ pub mod training;
 pub use npz::{crc32, npz_bytes, zip_stored, NpyArray, NpyData};
 pub use pool::run_parallel;
 pub use quality::{
-    run_penetration, sole_penetration, ClipQuality, Penetration, PENETRATION_TOLERANCE,
+    run_penetration, sole_penetration, trajectory_penetration, ClipQuality, JointFigures,
+    KeypointFigures, Penetration, MARGIN_ROUNDING, PENETRATION_TOLERANCE,
 };
 pub use retarget::{
-    BatchRetarget, ClipOutcome, RetargetMethod, DEFAULT_RETARGET_METHOD, MIN_CLIP_FRAMES,
+    BatchRetarget, ClipOutcome, ClipRun, RetargetMethod, DEFAULT_RETARGET_METHOD, MIN_CLIP_FRAMES,
 };
 pub use training::TrainingTrajectory;

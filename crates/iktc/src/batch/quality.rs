@@ -1,6 +1,8 @@
-//! The quality figures of one retargeted clip, a flat record for the dataset report: what the
-//! imitation run already measures ([`ImitateSummary`]), one number per quality, and the soles'
-//! penetration of the ground ([`sole_penetration`]).
+//! The quality figures of one retargeted clip, a flat record for the dataset report
+//! ([`ClipQuality`]): on the keypoint route what [`RetargetQuality`] measures (keypoint errors,
+//! foot slip, jerk, limit margins), on the joint route what the imitation run measures
+//! ([`ImitateSummary`]); one number per quality, and on both the soles' penetration of the
+//! ground ([`sole_penetration`]).
 //!
 //! Penetration: a sole is the rectangle `length × width` of its profile, centred `offset_x`
 //! ahead of the foot frame and `ankle_height` below it (foot frame axes); its corner `c` (foot
@@ -15,6 +17,7 @@ use serde::Serialize;
 use crate::error::{Error, Result};
 use crate::model::Robot;
 use crate::profile::Foot;
+use crate::retarget::{KeypointRun, RetargetQuality};
 use crate::sim::{ImitateRun, ImitateSummary};
 
 /// A sole corner deeper than this below the ground counts as penetrating in the share of frames
@@ -102,9 +105,172 @@ pub fn run_penetration(robot: &Robot, run: &ImitateRun, feet: &[&Foot]) -> Resul
     Ok(sole_penetration(poses.chunks(feet.len().max(1)), feet))
 }
 
-/// One clip's quality figures (the `figures` of its `quality.json`).
+/// A limit margin up to this counts as the limit kept \[rad, rad/s, rad/s²\]: the rounding of
+/// the margins' own arithmetic (the in-step peak of a joint resting on its limit).
+pub const MARGIN_ROUNDING: f64 = 1e-9;
+
+/// The penetration of `feet`'s soles over recorded configurations `qs` of `robot` (each of
+/// length `nq`), by the forward kinematics of each.
+///
+/// # Errors
+/// [`Error::UnknownName`] for a foot frame the robot does not have; [`Error::DimensionMismatch`]
+/// for a configuration whose length is not `nq`; those of the kinematics (a non-finite
+/// configuration).
+pub fn trajectory_penetration(
+    robot: &Robot,
+    qs: &[Vec<f64>],
+    feet: &[&Foot],
+) -> Result<Penetration> {
+    let ids = feet
+        .iter()
+        .map(|f| robot.frame_id(&f.frame))
+        .collect::<Result<Vec<_>>>()?;
+    let mut state = crate::model::State::neutral(robot);
+    let mut kin = crate::model::Kinematics::new(robot, &state)?;
+    let mut poses = Vec::with_capacity(qs.len() * feet.len());
+    for q in qs {
+        if q.len() != robot.nq() {
+            return Err(Error::DimensionMismatch {
+                what: "a recorded configuration".into(),
+                expected: robot.nq(),
+                got: q.len(),
+            });
+        }
+        state.q.copy_from_slice(q);
+        kin.update(robot, &state)?;
+        for id in &ids {
+            poses.push(kin.frame_pose(robot, *id)?);
+        }
+    }
+    Ok(sole_penetration(poses.chunks(feet.len().max(1)), feet))
+}
+
+/// One clip's quality figures (the `figures` of its `quality.json`), by route.
 #[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct ClipQuality {
+#[serde(untagged)]
+pub enum ClipQuality {
+    /// Keypoint retargeting ([`crate::retarget::retarget_keypoints`]).
+    Keypoints(KeypointFigures),
+    /// The joint-angle route ([`crate::sim::Experiment::imitate`]).
+    Joints(JointFigures),
+}
+
+impl ClipQuality {
+    /// The soles' penetration these figures hold.
+    pub fn penetration(&self) -> Penetration {
+        match self {
+            Self::Keypoints(f) => Penetration {
+                depth: f.penetration,
+                share: f.penetration_share,
+            },
+            Self::Joints(f) => Penetration {
+                depth: f.penetration,
+                share: f.penetration_share,
+            },
+        }
+    }
+
+    /// Whether the clip passed its checks (see each route's `healthy`).
+    pub fn healthy(&self) -> bool {
+        match self {
+            Self::Keypoints(f) => f.healthy,
+            Self::Joints(f) => f.healthy,
+        }
+    }
+}
+
+/// The quality figures of a keypoint retargeting, flat, in SI units.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct KeypointFigures {
+    /// `keypoints`.
+    pub route: &'static str,
+    /// Duration of the recorded run \[s\].
+    pub duration: f64,
+    /// Control ticks recorded.
+    pub ticks: usize,
+    /// Every joint limit kept: position, velocity and acceleration margins at most
+    /// [`MARGIN_ROUNDING`].
+    pub healthy: bool,
+    /// Mean over the body points of each point's mean position error \[m\].
+    pub mean_keypoint_error: f64,
+    /// Largest position error of any body point \[m\].
+    pub max_keypoint_error: f64,
+    /// The body point with the largest mean error.
+    pub worst_keypoint: String,
+    /// Largest orientation error of the pelvis or torso \[rad\].
+    pub max_orientation_error: f64,
+    /// Largest stance-foot slip \[m\].
+    pub foot_slip: f64,
+    /// Worst signed position margin over the joints \[rad\] (positive: a limit exceeded).
+    pub worst_position_margin: f64,
+    /// Worst signed velocity margin \[rad/s\].
+    pub worst_velocity_margin: f64,
+    /// Worst signed acceleration margin \[rad/s²\].
+    pub worst_acceleration_margin: f64,
+    /// RMS joint jerk over joints and ticks \[rad/s³\].
+    pub rms_jerk: f64,
+    /// Largest joint jerk \[rad/s³\].
+    pub max_jerk: f64,
+    /// Share of the ticks solved by GF because IKTC's answer left the box \[–\].
+    pub fallback_share: f64,
+    /// Share of the ticks solved by GF to keep the stance feet more exactly \[–\].
+    pub stance_gf_share: f64,
+    /// Ratio of the robot's leg length to the captured person's \[–\].
+    pub leg_ratio: f64,
+    /// Median tick time \[µs\] (wall clock, noisy).
+    pub tick_median_us: f64,
+    /// Deepest sole corner below the ground \[m\] ([`sole_penetration`]).
+    pub penetration: f64,
+    /// Share of the ticks with a sole corner deeper than [`PENETRATION_TOLERANCE`] \[–\].
+    pub penetration_share: f64,
+}
+
+impl KeypointFigures {
+    /// The figures of a keypoint run recorded every `dt` \[s\], with the soles' penetration
+    /// `p`.
+    pub fn from_run(run: &KeypointRun, dt: f64, p: Penetration) -> Self {
+        let q: &RetargetQuality = &run.quality;
+        let ticks = q.ticks.max(1) as f64;
+        let worst = q
+            .points
+            .iter()
+            .max_by(|a, b| a.mean_cm.total_cmp(&b.mean_cm));
+        let margins = [q.position_margin, q.velocity_margin, q.acceleration_margin];
+        Self {
+            route: "keypoints",
+            duration: run.times.len() as f64 * dt,
+            ticks: q.ticks,
+            healthy: margins.iter().all(|m| *m <= MARGIN_ROUNDING),
+            mean_keypoint_error: q.mean_cm / 100.0,
+            max_keypoint_error: q.points.iter().map(|e| e.max_cm).fold(0.0, f64::max) / 100.0,
+            worst_keypoint: worst.map_or_else(String::new, |e| e.point.clone()),
+            max_orientation_error: q
+                .orientations
+                .iter()
+                .map(|o| o.max_deg)
+                .fold(0.0, f64::max)
+                .to_radians(),
+            foot_slip: q.slip_mm / 1000.0,
+            worst_position_margin: q.position_margin,
+            worst_velocity_margin: q.velocity_margin,
+            worst_acceleration_margin: q.acceleration_margin,
+            rms_jerk: q.jerk_rms,
+            max_jerk: q.jerk_max,
+            fallback_share: run.fallback_ticks as f64 / ticks,
+            stance_gf_share: run.stance_gf_ticks as f64 / ticks,
+            leg_ratio: run.scaling.leg,
+            tick_median_us: run.tick_median_us,
+            penetration: p.depth,
+            penetration_share: p.share,
+        }
+    }
+}
+
+/// The quality figures of a joint-route imitation, flat.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct JointFigures {
+    /// `joints`.
+    pub route: &'static str,
     /// Duration of the run \[s\].
     pub duration: f64,
     /// Control ticks run.
@@ -148,13 +314,13 @@ pub struct ClipQuality {
     /// Median tick time \[µs\] (wall clock, noisy).
     pub tick_median_us: f64,
     /// Deepest sole corner below the ground \[m\] ([`sole_penetration`]; 0 until
-    /// [`ClipQuality::with_penetration`]).
+    /// [`JointFigures::with_penetration`]).
     pub penetration: f64,
     /// Share of the ticks with a sole corner deeper than [`PENETRATION_TOLERANCE`] \[–\].
     pub penetration_share: f64,
 }
 
-impl ClipQuality {
+impl JointFigures {
     /// The figures of a run's summary.
     pub fn from_summary(s: &ImitateSummary) -> Self {
         let rms = |i: usize| s.levels.get(i).map_or(0.0, |l| l.rms_error);
@@ -164,6 +330,7 @@ impl ClipQuality {
             .iter()
             .max_by(|a, b| a.smoothness.rms_jerk.total_cmp(&b.smoothness.rms_jerk));
         Self {
+            route: "joints",
             duration: s.duration,
             ticks: s.steps,
             healthy: s.health.healthy,
@@ -257,14 +424,18 @@ mod tests {
     #[test]
     fn a_run_penetration_matches_the_kinematics_of_its_configurations() {
         let profile = RobotProfile::builtin("jvrc1").unwrap();
-        let b = BatchRetarget::from_profile(profile, ImitateConfig::default()).unwrap();
+        let mut b = BatchRetarget::from_profile(profile, ImitateConfig::default()).unwrap();
+        b.method = crate::batch::RetargetMethod::Joints;
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("data/motions/deepmimic/humanoid3d_walk.txt");
         let o = b.retarget(&path).unwrap();
+        let crate::batch::ClipRun::Joints { run, .. } = &o.run else {
+            panic!("joint run")
+        };
         let feet = b.profile.feet.as_ref().unwrap();
         let feet = [&feet.left, &feet.right];
-        let got = run_penetration(&b.robot, &o.run, &feet).unwrap();
-        assert_eq!(o.quality.penetration, got.depth);
+        let got = run_penetration(&b.robot, run, &feet).unwrap();
+        assert_eq!(o.quality.penetration().depth, got.depth);
         // Second method: the foot frames' poses from each tick's configuration.
         let robot = &b.robot;
         let ids: Vec<_> = feet
@@ -275,9 +446,11 @@ mod tests {
         let mut kin = Kinematics::new(robot, &state).unwrap();
         let (bq, bv) = (robot.base_nq(), robot.base_nv());
         let mut poses = Vec::new();
-        for st in &o.run.steps {
+        let mut qs = Vec::new();
+        for st in &run.steps {
             state.q.as_mut_slice()[..bq].copy_from_slice(&st.base[..bq]);
             state.q.as_mut_slice()[bq..].copy_from_slice(&st.q[bv..]);
+            qs.push(state.q.as_slice().to_vec());
             kin.update(robot, &state).unwrap();
             poses.push(
                 ids.iter()
@@ -288,6 +461,13 @@ mod tests {
         let want = sole_penetration(poses.iter().map(|p| &p[..]), &feet);
         assert!((got.depth - want.depth).abs() < 1e-9, "{got:?} vs {want:?}");
         assert_eq!(got.share, want.share);
+        // The configurations' own function gives the same.
+        let from_q = trajectory_penetration(robot, &qs, &feet).unwrap();
+        assert!((from_q.depth - want.depth).abs() < 1e-9, "{from_q:?}");
+        assert_eq!(from_q.share, want.share);
+        qs[1].pop();
+        let e = trajectory_penetration(robot, &qs, &feet).unwrap_err();
+        assert!(matches!(e, Error::DimensionMismatch { .. }), "{e}");
         // Standing on held feet: the soles stay within a millimetre of the ground.
         assert!(got.depth < 1e-3, "{got:?}");
     }

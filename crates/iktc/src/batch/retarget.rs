@@ -1,27 +1,43 @@
 //! One clip of a batch, end to end in memory: read the motion file, retarget it onto the
-//! robot, run the imitation, resample it for training and measure its quality
+//! robot, resample the run for training and measure its quality
 //! ([`BatchRetarget::retarget`]); and the fingerprint of the settings a re-run compares
 //! ([`BatchRetarget::settings_hash`]).
+//!
+//! Two routes ([`RetargetMethod`]): keypoint retargeting (the default, as `iktc imitate`),
+//! where the clip's body points are scaled to the robot and tracked
+//! ([`retarget_keypoints`]) with the joint route's angles, where the profile has a map for
+//! the clip's format, as the posture level's references; and the paper's joint-angle route
+//! ([`Experiment::imitate`]).
 
 use std::path::Path;
 
-use super::quality::{run_penetration, ClipQuality};
+use super::quality::{
+    run_penetration, trajectory_penetration, ClipQuality, JointFigures, KeypointFigures,
+    Penetration,
+};
 use super::training::TrainingTrajectory;
 use crate::error::{Error, Result};
 use crate::model::Robot;
-use crate::motion::{MotionFormat, MotionOptions, RetargetMap};
+use crate::motion::{
+    load_motion, Clip, Keypoints, MotionFormat, MotionOptions, RetargetMap, DEFAULT_MAX_GAP,
+};
 use crate::profile::RobotProfile;
-use crate::sim::{load_clip, Experiment, ImitateConfig, ImitateRun};
+use crate::retarget::{retarget_keypoints, KeypointRun, KeypointSettings};
+use crate::sim::{imitation_references, load_clip, Experiment, ImitateConfig, ImitateRun};
 
 /// How a clip becomes robot references.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum RetargetMethod {
-    /// Joint angles through a [`RetargetMap`] ([`Experiment::references`]), as `iktc imitate`.
+    /// Body keypoints scaled to the robot and tracked by the keypoint stack
+    /// ([`retarget_keypoints`]), as `iktc imitate` does by default.
+    Keypoints,
+    /// Joint angles through a [`RetargetMap`] ([`Experiment::references`]), as
+    /// `iktc imitate --retarget joints`.
     Joints,
 }
 
 /// The method a batch uses unless told otherwise: the one place to switch the default.
-pub const DEFAULT_RETARGET_METHOD: RetargetMethod = RetargetMethod::Joints;
+pub const DEFAULT_RETARGET_METHOD: RetargetMethod = RetargetMethod::Keypoints;
 
 /// The fewest frames a clip needs: resampling it at the control period interpolates between
 /// samples, so one frame (no interval) is too short.
@@ -36,8 +52,11 @@ pub struct BatchRetarget {
     pub profile: RobotProfile,
     /// A map for every clip; `None`: the profile's map for each clip's format.
     pub map: Option<RetargetMap>,
-    /// The imitation settings (from the profile, with the command's options).
+    /// The imitation settings (from the profile, with the command's options); the joint
+    /// route runs them, and the keypoint route takes its period from them.
     pub config: ImitateConfig,
+    /// The keypoint route's settings.
+    pub keypoints: KeypointSettings,
     /// How motion files are read.
     pub motion_options: MotionOptions,
     /// Output rate \[Hz\]; `None`: the control rate `1 / config.dt`.
@@ -46,29 +65,81 @@ pub struct BatchRetarget {
     pub method: RetargetMethod,
 }
 
+/// The run of one clip, by route.
+#[derive(Debug, Clone)]
+pub enum ClipRun {
+    /// A keypoint retargeting: the clip's body points and the run.
+    Keypoints {
+        /// The clip's body points (metres, Z up).
+        keypoints: Keypoints,
+        /// The recorded run (boxed: the variants stay of similar size).
+        run: Box<KeypointRun>,
+    },
+    /// A joint-route imitation.
+    Joints {
+        /// The robot, clip and map of the run (boxed: the variants stay of similar size).
+        experiment: Box<Experiment>,
+        /// The recorded run (boxed, as above).
+        run: Box<ImitateRun>,
+    },
+}
+
 /// One retargeted clip.
 #[derive(Debug, Clone)]
 pub struct ClipOutcome {
-    /// The robot, clip and map of the run.
-    pub experiment: Experiment,
-    /// The recorded run.
-    pub run: ImitateRun,
+    /// The run.
+    pub run: ClipRun,
     /// The training trajectory at the output rate.
     pub trajectory: TrainingTrajectory,
     /// Its quality figures.
     pub quality: ClipQuality,
 }
 
+impl ClipOutcome {
+    /// The run's own summary as JSON (the `summary` of `quality.json`): the keypoint route's
+    /// [`crate::retarget::RetargetQuality`] with its scaling and GF ticks, or the imitation's
+    /// [`crate::sim::ImitateSummary`].
+    ///
+    /// Errors: [`Error::InvalidSetting`] if a figure cannot be written as JSON.
+    pub fn summary(&self) -> Result<serde_json::Value> {
+        let v = match &self.run {
+            ClipRun::Keypoints { keypoints, run } => serde_json::json!({
+                "source": keypoints.source,
+                "leg_ratio": run.scaling.leg,
+                "gf_ticks": run.fallback_ticks,
+                "stance_gf_ticks": run.stance_gf_ticks,
+                "keypoints": run.quality,
+            }),
+            ClipRun::Joints { run, .. } => {
+                serde_json::to_value(&run.summary).map_err(|e| Error::InvalidSetting {
+                    name: "summary".into(),
+                    value: e.to_string(),
+                    expected: "figures that JSON can hold".into(),
+                })?
+            }
+        };
+        Ok(v)
+    }
+}
+
 impl BatchRetarget {
     /// A batch of `profile`'s robot ([`RobotProfile::robot`]) with the imitation settings
-    /// [`RobotProfile::imitate_config`] makes of `base`, the profile's map for each clip's
-    /// format, default motion options and the control rate as output rate.
+    /// [`RobotProfile::imitate_config`] makes of `base`, the keypoint settings' defaults with
+    /// `base`'s solver, period and tick limit, the profile's map for each clip's format,
+    /// default motion options, the control rate as output rate and the default method.
     ///
     /// Errors: those of building the robot and the settings.
     pub fn from_profile(profile: RobotProfile, base: ImitateConfig) -> Result<Self> {
+        let config = profile.imitate_config(base)?;
         Ok(Self {
             robot: profile.robot()?,
-            config: profile.imitate_config(base)?,
+            keypoints: KeypointSettings {
+                method: config.method,
+                dt: config.dt,
+                run_limits: config.run_limits,
+                ..KeypointSettings::default()
+            },
+            config,
             profile,
             map: None,
             motion_options: MotionOptions::default(),
@@ -79,7 +150,15 @@ impl BatchRetarget {
 
     /// The output rate \[Hz\].
     pub fn output_rate(&self) -> f64 {
-        self.rate.unwrap_or(1.0 / self.config.dt)
+        self.rate.unwrap_or(1.0 / self.control_period())
+    }
+
+    /// The control period of the method's run \[s\].
+    pub fn control_period(&self) -> f64 {
+        match self.method {
+            RetargetMethod::Keypoints => self.keypoints.dt,
+            RetargetMethod::Joints => self.config.dt,
+        }
     }
 
     /// The body frames whose world positions are written: the profile's named frames (pelvis,
@@ -100,15 +179,17 @@ impl BatchRetarget {
     }
 
     /// A text that changes whenever an output could: the crate version, the method, the
-    /// profile, the map, the imitation settings, the motion options and the output rate.
+    /// profile, the map, the imitation and keypoint settings, the motion options and the
+    /// output rate.
     pub fn settings_text(&self) -> String {
         format!(
-            "iktc {}\nmethod {:?}\nprofile {:?}\nmap {:?}\nconfig {:?}\nmotion {:?}\nrate {}\nbodies {:?}\n",
+            "iktc {}\nmethod {:?}\nprofile {:?}\nmap {:?}\nconfig {:?}\nkeypoints {:?}\nmotion {:?}\nrate {}\nbodies {:?}\n",
             env!("CARGO_PKG_VERSION"),
             self.method,
             self.profile,
             self.map,
             self.config,
+            self.keypoints,
             self.motion_options,
             self.output_rate(),
             self.body_frames()
@@ -126,16 +207,40 @@ impl BatchRetarget {
         format!("{h:016x}")
     }
 
-    /// Retargets the motion file `path`: [`load_clip`], the map ([`Self::map`] or the
-    /// profile's for the file's format), [`Experiment::imitate`] with [`Self::config`],
-    /// [`TrainingTrajectory::from_run`] at [`Self::output_rate`] and [`ClipQuality`].
+    /// The retargeting map of a clip in `format`: [`Self::map`] or the profile's.
+    fn map_for(&self, format: MotionFormat) -> Result<RetargetMap> {
+        match &self.map {
+            Some(m) => Ok(m.clone()),
+            None => {
+                let key = if format == MotionFormat::DeepMimic {
+                    "deepmimic"
+                } else {
+                    "bvh"
+                };
+                self.profile.retarget_map(key, &self.robot)
+            }
+        }
+    }
+
+    /// Retargets the motion file `path` by [`Self::method`], resamples the run at
+    /// [`Self::output_rate`] ([`TrainingTrajectory`]) and measures its [`ClipQuality`].
+    ///
+    /// Keypoint route: [`load_motion`], the clip's body points, the joint route's references
+    /// as posture (when the profile, or [`Self::map`], maps the clip; a profile without a map
+    /// for the format leaves the posture at the start pose, a given map that fails is an
+    /// error), [`retarget_keypoints`]. Joint route: [`load_clip`], the map,
+    /// [`Experiment::imitate`] with [`Self::config`].
     ///
     /// Errors: [`Error::InsufficientData`] for a clip of fewer than [`MIN_CLIP_FRAMES`]
     /// frames; whatever reading, mapping, the run or the resampling give.
     pub fn retarget(&self, path: &Path) -> Result<ClipOutcome> {
-        let spec = path.to_string_lossy();
-        let loaded = load_clip(&spec, &self.motion_options)?;
-        let frames = loaded.clip.frame_count();
+        match self.method {
+            RetargetMethod::Keypoints => self.retarget_keypoints(path),
+            RetargetMethod::Joints => self.retarget_joints(path),
+        }
+    }
+
+    fn check_frames(spec: &str, frames: usize) -> Result<()> {
         if frames < MIN_CLIP_FRAMES {
             return Err(Error::InsufficientData {
                 what: format!("resampling clip `{spec}`"),
@@ -144,41 +249,99 @@ impl BatchRetarget {
                 ),
             });
         }
-        let map = match &self.map {
-            Some(m) => m.clone(),
-            None => {
-                let format = if loaded.format == MotionFormat::DeepMimic {
-                    "deepmimic"
-                } else {
-                    "bvh"
-                };
-                self.profile.retarget_map(format, &self.robot)?
-            }
+        Ok(())
+    }
+
+    fn feet_penetration(&self, qs: &[Vec<f64>]) -> Result<Penetration> {
+        match &self.profile.feet {
+            Some(feet) => trajectory_penetration(&self.robot, qs, &[&feet.left, &feet.right]),
+            None => Ok(Penetration {
+                depth: 0.0,
+                share: 0.0,
+            }),
+        }
+    }
+
+    fn retarget_keypoints(&self, path: &Path) -> Result<ClipOutcome> {
+        let spec = path.to_string_lossy();
+        let motion = load_motion(path, &self.motion_options)?;
+        let keypoints = motion.keypoints(DEFAULT_MAX_GAP)?;
+        Self::check_frames(&spec, keypoints.times.len())?;
+        let s = &self.keypoints;
+        let posture = match motion.clip().transpose()? {
+            Some(clip) => self.posture(&clip, motion.format)?,
+            None => None,
         };
+        let run = retarget_keypoints(&self.profile, &keypoints, posture.as_ref(), s)?;
+        let trajectory = TrainingTrajectory::from_keypoint_run(
+            &self.robot,
+            &run,
+            s.dt,
+            &self.body_frames(),
+            self.output_rate(),
+        )?;
+        let p = self.feet_penetration(&run.trajectory)?;
+        let quality = ClipQuality::Keypoints(KeypointFigures::from_run(&run, s.dt, p));
+        Ok(ClipOutcome {
+            run: ClipRun::Keypoints {
+                keypoints,
+                run: Box::new(run),
+            },
+            trajectory,
+            quality,
+        })
+    }
+
+    /// The joint route's references of `clip` at the keypoint period, the posture level's
+    /// references: `None` when the profile has no map for the clip's format (and none was
+    /// given).
+    fn posture(
+        &self,
+        clip: &Clip,
+        format: MotionFormat,
+    ) -> Result<Option<crate::motion::RobotReferences>> {
+        let map = match self.map_for(format) {
+            Ok(m) => m,
+            Err(e) if self.map.is_some() => return Err(e),
+            Err(_) => return Ok(None),
+        };
+        let cfg = ImitateConfig {
+            narrow: Vec::new(),
+            dt: self.keypoints.dt,
+            ..self.config.clone()
+        };
+        imitation_references(&self.robot, clip, &map, &cfg).map(Some)
+    }
+
+    fn retarget_joints(&self, path: &Path) -> Result<ClipOutcome> {
+        let spec = path.to_string_lossy();
+        let loaded = load_clip(&spec, &self.motion_options)?;
+        Self::check_frames(&spec, loaded.clip.frame_count())?;
+        let map = self.map_for(loaded.format)?;
         let experiment = Experiment {
             robot: self.robot.clone(),
             clip: loaded.clip,
             map,
         };
-        let run = match self.method {
-            RetargetMethod::Joints => experiment.imitate(&self.config)?,
-        };
+        let run = experiment.imitate(&self.config)?;
         let trajectory = TrainingTrajectory::from_run(
             &self.robot,
             &run,
             &self.body_frames(),
             self.output_rate(),
         )?;
-        let mut quality = ClipQuality::from_summary(&run.summary);
+        let mut figures = JointFigures::from_summary(&run.summary);
         if let Some(feet) = &self.profile.feet {
             let p = run_penetration(&self.robot, &run, &[&feet.left, &feet.right])?;
-            quality = quality.with_penetration(p);
+            figures = figures.with_penetration(p);
         }
         Ok(ClipOutcome {
-            experiment,
-            run,
+            run: ClipRun::Joints {
+                experiment: Box::new(experiment),
+                run: Box::new(run),
+            },
             trajectory,
-            quality,
+            quality: ClipQuality::Joints(figures),
         })
     }
 }
@@ -193,6 +356,11 @@ mod tests {
         BatchRetarget::from_profile(profile, ImitateConfig::default()).unwrap()
     }
 
+    fn walk() -> std::path::PathBuf {
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("data/motions/deepmimic/humanoid3d_walk.txt")
+    }
+
     #[test]
     fn settings_hash_follows_every_setting() {
         let b = batch();
@@ -205,26 +373,123 @@ mod tests {
         let mut c = batch();
         c.config.dt = 0.01;
         assert_ne!(c.settings_hash(), h);
+        let mut m = batch();
+        m.method = RetargetMethod::Joints;
+        assert_ne!(m.settings_hash(), h);
+        let mut k = batch();
+        k.keypoints.land_height = 0.03;
+        assert_ne!(k.settings_hash(), h);
+    }
+
+    #[test]
+    fn the_default_route_is_keypoints_at_the_imitation_period() {
+        let b = batch();
+        assert_eq!(b.method, RetargetMethod::Keypoints);
+        assert_eq!(b.keypoints.dt, b.config.dt);
+        assert_eq!(b.keypoints.method, b.config.method);
+        assert_eq!(b.output_rate(), 1.0 / b.keypoints.dt);
     }
 
     #[test]
     fn bad_rates_and_unknown_bodies_are_errors() {
-        let b = batch();
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("data/motions/deepmimic/humanoid3d_walk.txt");
-        let o = b.retarget(&path).unwrap();
+        let mut b = batch();
+        b.method = RetargetMethod::Joints;
+        let o = b.retarget(&walk()).unwrap();
+        let ClipRun::Joints { run, .. } = &o.run else {
+            panic!("the joint route gives a joint run")
+        };
+        assert!(matches!(o.quality, ClipQuality::Joints(_)));
         let bodies = b.body_frames();
-        assert_eq!(o.trajectory.len(), o.run.steps.len());
+        assert_eq!(o.trajectory.len(), run.steps.len());
         for rate in [0.0, -5.0, f64::NAN, f64::INFINITY] {
-            let e = TrainingTrajectory::from_run(&b.robot, &o.run, &bodies, rate).unwrap_err();
+            let e = TrainingTrajectory::from_run(&b.robot, run, &bodies, rate).unwrap_err();
             assert!(e.to_string().contains("output rate"), "{rate}: {e}");
         }
-        let e = TrainingTrajectory::from_run(&b.robot, &o.run, &["no_such_frame".into()], 100.0)
+        let e = TrainingTrajectory::from_run(&b.robot, run, &["no_such_frame".into()], 100.0)
             .unwrap_err();
         assert!(e.to_string().contains("no_such_frame"), "{e}");
-        let mut empty = o.run.clone();
+        let mut empty = run.clone();
         empty.steps.clear();
         let e = TrainingTrajectory::from_run(&b.robot, &empty, &bodies, 100.0).unwrap_err();
+        assert!(matches!(e, Error::InsufficientData { .. }), "{e}");
+    }
+
+    /// At the control rate the keypoint route's training trajectory is the recorded run itself:
+    /// every configuration and velocity copied, in the robot's order; its figures are the run's.
+    #[test]
+    fn keypoint_route_writes_the_run_at_the_control_rate() {
+        let b = batch();
+        let o = b.retarget(&walk()).unwrap();
+        let ClipRun::Keypoints { run, keypoints } = &o.run else {
+            panic!("the default route gives a keypoint run")
+        };
+        let ClipQuality::Keypoints(f) = &o.quality else {
+            panic!("keypoint figures")
+        };
+        let t = &o.trajectory;
+        let (nqb, nb) = (b.robot.base_nq(), b.robot.base_nv());
+        assert_eq!(nqb, 7);
+        assert_eq!(t.len(), run.trajectory.len());
+        assert_eq!(t.joint_names, b.robot.dof_names()[nb..].to_vec());
+        // Frame times j / rate against ticks t0 + k Δt: equal to rounding [s].
+        const TIME_ROUNDING: f64 = 1e-12;
+        for k in 0..t.len() {
+            let (q, qd) = (&run.trajectory[k], &run.velocities[k]);
+            assert!((t.time[k] - run.times[k]).abs() < TIME_ROUNDING, "{k}");
+            assert_eq!(t.base_pos[k][..], q[..3]);
+            assert_eq!(t.base_quat_xyzw[k][..], q[3..7]);
+            assert_eq!(t.joint_pos[k][..], q[nqb..]);
+            assert_eq!(t.base_lin_vel[k][..], qd[..3]);
+            assert_eq!(t.base_ang_vel[k][..], qd[3..6]);
+            assert_eq!(t.joint_vel[k][..], qd[nb..]);
+        }
+        assert_eq!(f.ticks, run.quality.ticks);
+        assert_eq!(f.mean_keypoint_error, run.quality.mean_cm / 100.0);
+        assert_eq!(f.foot_slip, run.quality.slip_mm / 1000.0);
+        assert_eq!(f.leg_ratio, run.scaling.leg);
+        assert!(f.healthy, "{f:?}");
+        let feet = b.profile.feet.as_ref().unwrap();
+        let p =
+            trajectory_penetration(&b.robot, &run.trajectory, &[&feet.left, &feet.right]).unwrap();
+        assert_eq!(o.quality.penetration(), p);
+        let summary = o.summary().unwrap();
+        assert_eq!(summary["source"], keypoints.source.as_str());
+        assert_eq!(
+            summary["keypoints"]["ticks"].as_u64(),
+            Some(run.quality.ticks as u64)
+        );
+    }
+
+    #[test]
+    fn a_keypoint_run_of_the_wrong_shape_is_an_error() {
+        let b = batch();
+        let o = b.retarget(&walk()).unwrap();
+        let ClipRun::Keypoints { run, .. } = o.run else {
+            panic!("keypoint run")
+        };
+        let bodies = b.body_frames();
+        let dt = b.keypoints.dt;
+        let mut short = run.clone();
+        short.velocities.pop();
+        let e = TrainingTrajectory::from_keypoint_run(&b.robot, &short, dt, &bodies, 100.0)
+            .unwrap_err();
+        assert!(matches!(e, Error::DimensionMismatch { .. }), "{e}");
+        let mut narrow = run.clone();
+        narrow.trajectory[3].pop();
+        let e = TrainingTrajectory::from_keypoint_run(&b.robot, &narrow, dt, &bodies, 100.0)
+            .unwrap_err();
+        assert!(e.to_string().contains("configuration"), "{e}");
+        for bad in [0.0, f64::NAN] {
+            let e = TrainingTrajectory::from_keypoint_run(&b.robot, &run, bad, &bodies, 100.0)
+                .unwrap_err();
+            assert!(e.to_string().contains("control period"), "{bad}: {e}");
+        }
+        let mut empty = run;
+        empty.trajectory.clear();
+        empty.velocities.clear();
+        empty.times.clear();
+        let e = TrainingTrajectory::from_keypoint_run(&b.robot, &empty, dt, &bodies, 100.0)
+            .unwrap_err();
         assert!(matches!(e, Error::InsufficientData { .. }), "{e}");
     }
 }

@@ -15,11 +15,17 @@ use nalgebra::{DVector, Quaternion, UnitQuaternion};
 use super::npz::{npz_bytes, NpyArray};
 use crate::error::{check_finite, Error, Result};
 use crate::model::{Kinematics, Robot, State};
+use crate::retarget::KeypointRun;
 use crate::sim::ImitateRun;
 
 /// The output rate's tolerance on the last frame \[s·Hz\]: a frame at most this fraction of an
 /// output period past the last tick (rounding of `j / rate`) is still written.
 pub const LAST_FRAME_SLACK: f64 = 1e-9;
+
+/// A frame time within this many control periods of a recorded tick is taken as that tick
+/// \[–\]: `j / rate` and `k Δt` differ by rounding where the output rate divides the control
+/// rate, and the tick is then copied exactly.
+pub const TICK_ROUNDING: f64 = 1e-9;
 
 /// One clip resampled for training.
 #[derive(Debug, Clone, PartialEq)]
@@ -52,6 +58,40 @@ fn lerp(a: f64, b: f64, s: f64) -> f64 {
     a + s * (b - a)
 }
 
+/// One recorded tick, as resampling reads it.
+struct Tick<'a> {
+    /// Time \[s\].
+    t: f64,
+    /// Base position \[m\] and unit quaternion (x, y, z, w).
+    base: [f64; 7],
+    /// Active joint positions \[rad\] (or \[m\]), the robot's order.
+    joints: &'a [f64],
+    /// Velocity, length `nv` (base twist in the base's axes, then joint rates).
+    qd: &'a [f64],
+}
+
+/// The base pose a fixed-base robot records: at the origin, not rotated.
+const FIXED_BASE: [f64; 7] = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0];
+
+fn check_rate(rate: f64) -> Result<()> {
+    check_finite(|| "output rate [Hz]".to_string(), rate)?;
+    if rate <= 0.0 {
+        return Err(Error::InvalidSetting {
+            name: "output rate [Hz]".into(),
+            value: rate.to_string(),
+            expected: "a rate > 0".into(),
+        });
+    }
+    Ok(())
+}
+
+fn no_tick() -> Error {
+    Error::InsufficientData {
+        what: "training trajectory".into(),
+        message: "the run recorded no tick".into(),
+    }
+}
+
 impl TrainingTrajectory {
     /// Resamples `run` (of `robot`) at `rate` \[Hz\] and computes the world positions of
     /// `bodies` (frame names of `robot`).
@@ -60,22 +100,116 @@ impl TrainingTrajectory {
     /// [`Error::InsufficientData`] for a run without ticks, [`Error::UnknownName`] for a body
     /// frame the robot lacks.
     pub fn from_run(robot: &Robot, run: &ImitateRun, bodies: &[String], rate: f64) -> Result<Self> {
-        check_finite(|| "output rate [Hz]".to_string(), rate)?;
-        if rate <= 0.0 {
-            return Err(Error::InvalidSetting {
-                name: "output rate [Hz]".into(),
-                value: rate.to_string(),
-                expected: "a rate > 0".into(),
+        check_rate(rate)?;
+        if run.steps.is_empty() {
+            return Err(no_tick());
+        }
+        let nb = robot.base_nv();
+        let ticks: Vec<Tick> = run
+            .steps
+            .iter()
+            .map(|st| Tick {
+                t: st.t,
+                base: st.base,
+                joints: &st.q[nb..],
+                qd: &st.qd,
+            })
+            .collect();
+        Self::resample(
+            robot,
+            &ticks,
+            run.summary.dt,
+            &run.dof_names[nb..],
+            bodies,
+            rate,
+        )
+    }
+
+    /// Resamples a keypoint retargeting `run` of `robot` recorded every `dt` \[s\], as
+    /// [`Self::from_run`] does an imitation run.
+    ///
+    /// Errors: those of [`Self::from_run`], and [`Error::DimensionMismatch`] for a recorded
+    /// configuration or velocity whose length is not the robot's `nq` or `nv`.
+    pub fn from_keypoint_run(
+        robot: &Robot,
+        run: &KeypointRun,
+        dt: f64,
+        bodies: &[String],
+        rate: f64,
+    ) -> Result<Self> {
+        check_rate(rate)?;
+        if run.trajectory.is_empty() {
+            return Err(no_tick());
+        }
+        let (nqb, nq, nv) = (robot.base_nq(), robot.nq(), robot.nv());
+        for (what, expected, got) in [
+            (
+                "recorded ticks' velocities",
+                run.trajectory.len(),
+                run.velocities.len(),
+            ),
+            (
+                "recorded ticks' times",
+                run.trajectory.len(),
+                run.times.len(),
+            ),
+        ] {
+            if got != expected {
+                return Err(Error::DimensionMismatch {
+                    what: what.into(),
+                    expected,
+                    got,
+                });
+            }
+        }
+        let mut ticks = Vec::with_capacity(run.trajectory.len());
+        for ((t, q), qd) in run.times.iter().zip(&run.trajectory).zip(&run.velocities) {
+            for (what, expected, got) in [
+                ("a recorded configuration", nq, q.len()),
+                ("a recorded velocity", nv, qd.len()),
+            ] {
+                if got != expected {
+                    return Err(Error::DimensionMismatch {
+                        what: what.into(),
+                        expected,
+                        got,
+                    });
+                }
+            }
+            let mut base = FIXED_BASE;
+            if nqb == 7 {
+                base.copy_from_slice(&q[..7]);
+            }
+            ticks.push(Tick {
+                t: *t,
+                base,
+                joints: &q[nqb..],
+                qd,
             });
         }
-        let steps = &run.steps;
+        let names = robot.dof_names();
+        Self::resample(robot, &ticks, dt, &names[robot.base_nv()..], bodies, rate)
+    }
+
+    fn resample(
+        robot: &Robot,
+        steps: &[Tick],
+        dt: f64,
+        joint_names: &[String],
+        bodies: &[String],
+        rate: f64,
+    ) -> Result<Self> {
         let (Some(first), Some(last)) = (steps.first(), steps.last()) else {
-            return Err(Error::InsufficientData {
-                what: "training trajectory".into(),
-                message: "the run recorded no tick".into(),
-            });
+            return Err(no_tick());
         };
-        let dt = run.summary.dt;
+        check_finite(|| "control period [s]".to_string(), dt)?;
+        if dt <= 0.0 {
+            return Err(Error::InvalidSetting {
+                name: "control period [s]".into(),
+                value: dt.to_string(),
+                expected: "a period > 0".into(),
+            });
+        }
         let frame_ids = bodies
             .iter()
             .map(|b| robot.frame_id(b))
@@ -86,7 +220,7 @@ impl TrainingTrajectory {
         let frames = (span * rate + LAST_FRAME_SLACK).floor() as usize + 1;
         let mut out = Self {
             fps: rate,
-            joint_names: run.dof_names[nb..].to_vec(),
+            joint_names: joint_names.to_vec(),
             body_names: bodies.to_vec(),
             time: Vec::with_capacity(frames),
             base_pos: Vec::with_capacity(frames),
@@ -101,7 +235,11 @@ impl TrainingTrajectory {
         let mut kin = Kinematics::new(robot, &state)?;
         for j in 0..frames {
             let t = first.t + j as f64 / rate;
-            let x = ((t - first.t) / dt).max(0.0);
+            let mut x = ((t - first.t) / dt).max(0.0);
+            // A frame within rounding of a tick is that tick (copied, not interpolated).
+            if (x - x.round()).abs() <= TICK_ROUNDING {
+                x = x.round();
+            }
             let k = (x.floor() as usize).min(steps.len() - 1);
             let (a, b) = (&steps[k], &steps[(k + 1).min(steps.len() - 1)]);
             let s = if k + 1 < steps.len() {
@@ -117,14 +255,19 @@ impl TrainingTrajectory {
             // Exactly the recorded tick at s = 0; a slerp renormalised against round-off
             // otherwise (and the nearer end for opposite orientations, where it is undefined).
             let r = if s == 0.0 {
-                ra
+                // The recorded quaternion itself, not renormalised.
+                UnitQuaternion::new_unchecked(Quaternion::new(
+                    a.base[6], a.base[3], a.base[4], a.base[5],
+                ))
             } else {
                 let r = ra
                     .try_slerp(&rb, s, 0.0)
                     .unwrap_or(if s < 0.5 { ra } else { rb });
                 UnitQuaternion::new_normalize(r.into_inner())
             };
-            let q: Vec<f64> = (nb..nv).map(|d| lerp(a.q[d], b.q[d], s)).collect();
+            let q: Vec<f64> = (0..nv - nb)
+                .map(|d| lerp(a.joints[d], b.joints[d], s))
+                .collect();
             let qd: Vec<f64> = (0..nv).map(|d| lerp(a.qd[d], b.qd[d], s)).collect();
             // Forward kinematics of the resampled configuration.
             if nqb == 7 {

@@ -222,6 +222,9 @@ pub struct KeypointRun {
     /// The robot's configuration q at every recorded tick (base position \[m\] and quaternion,
     /// then joints \[rad\]).
     pub trajectory: Vec<Vec<f64>>,
+    /// The robot's velocity at every recorded tick (base twist in the base's axes \[m/s,
+    /// rad/s\], then joint rates \[rad/s\]).
+    pub velocities: Vec<Vec<f64>>,
     /// The clip's contacts per tick, left and right foot.
     pub contacts: [Vec<bool>; 2],
     /// The robot's stance per tick, left and right foot: the foot landed and held by the first
@@ -415,6 +418,7 @@ pub fn retarget_keypoints(
     let mut rec = QualityRecorder::new("keypoints", &body, s.dt);
     let mut kin = Kinematics::new(&robot, controller.state())?;
     let mut trajectory = Vec::with_capacity(ticks);
+    let mut velocities = Vec::with_capacity(ticks);
     let mut times = Vec::with_capacity(ticks);
     let mut tick_us = Vec::with_capacity(ticks);
     let mut stance = [Vec::with_capacity(ticks), Vec::with_capacity(ticks)];
@@ -444,6 +448,7 @@ pub fn retarget_keypoints(
             *last += start.elapsed().as_secs_f64() * 1e6;
         }
         trajectory.push(state.q.as_slice().to_vec());
+        velocities.push(state.qd.as_slice().to_vec());
         times.push(t0 + k as f64 * s.dt);
     }
     let contacts = controller.plan().contact.clone();
@@ -451,6 +456,7 @@ pub fn retarget_keypoints(
         scaling,
         times,
         trajectory,
+        velocities,
         contacts,
         stance,
         quality: rec.finish(&robot),
