@@ -5,7 +5,7 @@
 //!
 //! Two routes ([`RetargetMethod`]): keypoint retargeting (the default, as `iktc imitate`),
 //! where the clip's body points are scaled to the robot and tracked
-//! ([`retarget_keypoints`]) with the joint route's angles, where the profile has a map for
+//! ([`retarget_keypoints`](crate::retarget::retarget_keypoints)) with the joint route's angles, where the profile has a map for
 //! the clip's format, as the posture level's references; and the paper's joint-angle route
 //! ([`Experiment::imitate`]).
 
@@ -22,14 +22,14 @@ use crate::motion::{
     load_motion, Clip, Keypoints, MotionFormat, MotionOptions, RetargetMap, DEFAULT_MAX_GAP,
 };
 use crate::profile::RobotProfile;
-use crate::retarget::{retarget_keypoints, KeypointRun, KeypointSettings};
+use crate::retarget::{retarget_keypoints_on, KeypointRun, KeypointSettings};
 use crate::sim::{imitation_references, load_clip, Experiment, ImitateConfig, ImitateRun};
 
 /// How a clip becomes robot references.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum RetargetMethod {
     /// Body keypoints scaled to the robot and tracked by the keypoint stack
-    /// ([`retarget_keypoints`]), as `iktc imitate` does by default.
+    /// ([`retarget_keypoints`](crate::retarget::retarget_keypoints)), as `iktc imitate` does by default.
     Keypoints,
     /// Joint angles through a [`RetargetMap`] ([`Experiment::references`]), as
     /// `iktc imitate --retarget joints`.
@@ -228,7 +228,7 @@ impl BatchRetarget {
     /// Keypoint route: [`load_motion`], the clip's body points, the joint route's references
     /// as posture (when the profile, or [`Self::map`], maps the clip; a profile without a map
     /// for the format leaves the posture at the start pose, a given map that fails is an
-    /// error), [`retarget_keypoints`]. Joint route: [`load_clip`], the map,
+    /// error), [`retarget_keypoints`](crate::retarget::retarget_keypoints). Joint route: [`load_clip`], the map,
     /// [`Experiment::imitate`] with [`Self::config`].
     ///
     /// Errors: [`Error::InsufficientData`] for a clip of fewer than [`MIN_CLIP_FRAMES`]
@@ -272,7 +272,8 @@ impl BatchRetarget {
             Some(clip) => self.posture(&clip, motion.format)?,
             None => None,
         };
-        let run = retarget_keypoints(&self.profile, &keypoints, posture.as_ref(), s)?;
+        let robot = std::sync::Arc::new(self.robot.clone());
+        let run = retarget_keypoints_on(robot, &self.profile, &keypoints, posture.as_ref(), s)?;
         let trajectory = TrainingTrajectory::from_keypoint_run(
             &self.robot,
             &run,

@@ -295,13 +295,13 @@ fn frame_names(profile: &RobotProfile, cfg: &ImitateConfig) -> Result<BodyFrameN
 }
 
 fn setup(
+    robot: Arc<Robot>,
     profile: &RobotProfile,
     kp: &Keypoints,
     posture: Option<&RobotReferences>,
     s: &KeypointSettings,
 ) -> Result<Setup> {
     s.validate()?;
-    let robot = Arc::new(profile.robot()?);
     let cfg = profile.imitate_config(ImitateConfig::default())?;
     let names = frame_names(profile, &cfg)?;
     let state0 = State::neutral(&robot);
@@ -386,7 +386,7 @@ pub fn keypoint_controller(
     posture: Option<&RobotReferences>,
     s: &KeypointSettings,
 ) -> Result<KeypointController> {
-    Ok(setup(profile, kp, posture, s)?.controller)
+    Ok(setup(Arc::new(profile.robot()?), profile, kp, posture, s)?.controller)
 }
 
 /// Retargets `kp` onto the robot of `profile` (see the module documentation); `posture`, the
@@ -402,13 +402,27 @@ pub fn retarget_keypoints(
     posture: Option<&RobotReferences>,
     s: &KeypointSettings,
 ) -> Result<KeypointRun> {
+    retarget_keypoints_on(Arc::new(profile.robot()?), profile, kp, posture, s)
+}
+
+/// [`retarget_keypoints`] on `robot`, the robot of `profile` already built
+/// ([`RobotProfile::robot`]): a batch builds it once for every clip instead of reading the
+/// URDF again per clip. A robot that is not the profile's gives the errors of a profile whose
+/// frames or joints it lacks, or a retargeting of that other robot.
+pub fn retarget_keypoints_on(
+    robot: Arc<Robot>,
+    profile: &RobotProfile,
+    kp: &Keypoints,
+    posture: Option<&RobotReferences>,
+    s: &KeypointSettings,
+) -> Result<KeypointRun> {
     let Setup {
         robot,
         body,
         support,
         mut controller,
         scaling,
-    } = setup(profile, kp, posture, s)?;
+    } = setup(robot, profile, kp, posture, s)?;
     let settle = (s.settle_time / s.dt).round() as usize;
     for _ in 0..settle {
         controller.tick(0, true)?;
@@ -477,7 +491,7 @@ pub fn joint_route_quality(
     refs: &RobotReferences,
     s: &KeypointSettings,
 ) -> Result<RetargetQuality> {
-    let setup = setup(profile, kp, None, s)?;
+    let setup = setup(Arc::new(profile.robot()?), profile, kp, None, s)?;
     let cfg = ImitateConfig {
         method: s.method,
         bounds: s.bounds,
