@@ -1,6 +1,7 @@
 //! The 3D viewer of `iktc imitate`, `iktc retarget` and `iktc walk` (Fig. 21): one self-contained HTML file
 //! (inline script, plain 2D canvas, no network, no library) showing the captured skeleton and the
-//! robot side by side. Drag to orbit, wheel to zoom; `viewer.html#t=1.5` opens paused at 1.5 s.
+//! robot side by side. Drag to orbit, wheel to zoom, "follow" keeps a travelling clip in the
+//! centre; `viewer.html#t=1.5` opens paused at 1.5 s.
 //!
 //! A robot with meshes (the built-in G1, or a URDF whose STL meshes are on disk) is drawn with
 //! them: every link's mesh placed by the link's pose of the frame, its triangles sorted far to
@@ -29,7 +30,8 @@ canvas{display:block;width:100%;height:calc(100vh - 40px);cursor:grab}
 </style></head><body>
 <div id="bar"><button id="play">pause</button><input id="slider" type="range" min="0" value="0" step="1">
 <span id="time">0.00 s</span><label>speed <select id="speed"><option>0.25</option><option>0.5</option>
-<option selected>1</option><option>2</option></select></label></div>
+<option selected>1</option><option>2</option></select></label>
+<label title="keep the robot and the skeleton in the centre of the view"><input id="follow" type="checkbox" checked> follow</label></div>
 <canvas id="c"></canvas>
 <script id="data" type="application/json">__DATA__</script>
 <script>
@@ -87,14 +89,23 @@ if (D.meshes) {
 slider.max = String(Math.max(0, n - 1));
 let frame = 0, playing = true, last = null, az = -1.25, el = 0.25, dist = 7.0, acc = 0;
 let drag = null;
-// Centre of the scene: between the robot and the skeleton at frame 0.
+// Centre of the scene: between the robot and the skeleton (at frame 0, or at every frame
+// with "follow" checked, so a clip that travels stays in view).
 // Distance: the scene's size at frame 0 fills about two thirds of the canvas.
+const followBox = document.getElementById("follow");
 let cx = 0, cy = 0, cz = 0.7;
+function sceneCentre(f) {
+  const ks = Math.min(f, D.skeleton.frames.length - 1);
+  const pts = D.robot.frames[f].concat(ks >= 0 ? D.skeleton.frames[ks] : []);
+  let x = 0, y = 0;
+  for (const p of pts) { x += p[0]; y += p[1]; }
+  return [x / Math.max(1, pts.length), y / Math.max(1, pts.length)];
+}
 {
   const pts = D.robot.frames[0].concat(D.skeleton.frames.length ? D.skeleton.frames[0] : []);
   const lo = [Infinity, Infinity, 0], hi = [-Infinity, -Infinity, 0];
-  for (const p of pts) { cx += p[0]; cy += p[1]; for (let k = 0; k < 3; k++) { lo[k] = Math.min(lo[k], p[k]); hi[k] = Math.max(hi[k], p[k]); } }
-  cx /= Math.max(1, pts.length); cy /= Math.max(1, pts.length);
+  for (const p of pts) { for (let k = 0; k < 3; k++) { lo[k] = Math.min(lo[k], p[k]); hi[k] = Math.max(hi[k], p[k]); } }
+  [cx, cy] = sceneCentre(0);
   const size = Math.max(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
   if (size > 0 && isFinite(size)) { dist = Math.max(2, Math.min(20, 2.3 * size)); cz = hi[2] / 2; }
 }
@@ -116,12 +127,14 @@ function draw() {
   shown = frame;
   const w = cv.clientWidth, h = cv.clientHeight;
   if (cv.width !== w || cv.height !== h) { cv.width = w; cv.height = h; }
+  if (followBox.checked) [cx, cy] = sceneCentre(frame);
   ctx.fillStyle = "#fbfbfb"; ctx.fillRect(0, 0, cv.width, cv.height);
-  // Ground grid.
+  // Ground grid, fixed in the world (0.25 m cells around the centre): it shows the travel.
+  const gx = Math.round(cx / 0.25) * 0.25, gy = Math.round(cy / 0.25) * 0.25;
   for (let i = -10; i <= 10; i++) {
     const g = i * 0.25;
-    line([cx + g, cy - 2.5, 0], [cx + g, cy + 2.5, 0], "#e2e2e2", 1);
-    line([cx - 2.5, cy + g, 0], [cx + 2.5, cy + g, 0], "#e2e2e2", 1);
+    line([gx + g, gy - 2.5, 0], [gx + g, gy + 2.5, 0], "#e2e2e2", 1);
+    line([gx - 2.5, gy + g, 0], [gx + 2.5, gy + g, 0], "#e2e2e2", 1);
   }
   // Footsteps (walking).
   for (const f of (D.footsteps || [])) {
@@ -263,6 +276,7 @@ function step(ts) {
 }
 playBtn.onclick = () => { playing = !playing; playBtn.textContent = playing ? "pause" : "play"; };
 slider.oninput = () => { frame = parseInt(slider.value, 10) || 0; draw(); };
+followBox.onchange = () => draw();
 cv.onmousedown = e => { drag = [e.clientX, e.clientY]; };
 window.onmouseup = () => { drag = null; };
 window.onmousemove = e => {
