@@ -1,6 +1,7 @@
 //! The viewer written by `iktc imitate` loads in headless Chromium without a script error and
 //! draws a non-blank picture; the G1 viewer of `iktc retarget` draws the robot's meshes (its
-//! screen box is mostly filled). Needs Debian's `chromium` on PATH: the test fails (it does not
+//! screen box is mostly filled); a clip that travels 2 m stays in view at its end ("follow"),
+//! and leaves the centre without it. Needs Debian's `chromium` on PATH: the test fails (it does not
 //! skip) when it is missing.
 
 use std::path::{Path, PathBuf};
@@ -211,22 +212,7 @@ fn g1_mesh_viewer_draws_the_robot() {
 
     // Paused at the first frame; the page writes the robot's screen box.
     let url = format!("file://{}#t=0", page.display());
-    let dom = Command::new(&browser)
-        .args(chromium_args(&dir.join("profile_mesh_dom")))
-        .arg("--dump-dom")
-        .arg(&url)
-        .output()
-        .unwrap();
-    let dom = String::from_utf8_lossy(&dom.stdout);
-    let at = dom
-        .find("data-robot-box=\"")
-        .unwrap_or_else(|| panic!("no robot box in the page: {}", &dom[..dom.len().min(300)]));
-    let rest = &dom[at + "data-robot-box=\"".len()..];
-    let bx: Vec<i64> = rest[..rest.find('"').unwrap()]
-        .split(',')
-        .map(|x| x.parse().unwrap())
-        .collect();
-    assert_eq!(bx.len(), 4, "the robot box is x0,y0,x1,y1");
+    let bx = robot_box(&browser, &dir, &url, "mesh");
     let (x0, y0, x1, y1) = (bx[0], bx[1], bx[2], bx[3]);
     assert!(
         x1 - x0 > 30 && y1 - y0 > 80,
@@ -250,6 +236,101 @@ fn g1_mesh_viewer_draws_the_robot() {
     assert!(
         stick < MIN_MESH_COVER && cover > 2.0 * stick,
         "the stick figure covers {stick:.2} of the box, the meshes {cover:.2}: no difference"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The robot's screen box (x0, y0, x1, y1, page pixels) the page at `url` reports.
+fn robot_box(browser: &Path, dir: &Path, url: &str, tag: &str) -> Vec<i64> {
+    let dom = Command::new(browser)
+        .args(chromium_args(&dir.join(format!("profile_{tag}_dom"))))
+        .arg("--dump-dom")
+        .arg(url)
+        .output()
+        .unwrap();
+    let dom = String::from_utf8_lossy(&dom.stdout);
+    let at = dom
+        .find("data-robot-box=\"")
+        .unwrap_or_else(|| panic!("no robot box in the page: {}", &dom[..dom.len().min(300)]));
+    let rest = &dom[at + "data-robot-box=\"".len()..];
+    let bx: Vec<i64> = rest[..rest.find('"').unwrap()]
+        .split(',')
+        .map(|x| x.parse().unwrap())
+        .collect();
+    assert_eq!(bx.len(), 4, "the robot box is x0,y0,x1,y1");
+    bx
+}
+
+/// The window of [`chromium_args`] [CSS px].
+const WINDOW: (i64, i64) = (800, 600);
+
+#[test]
+fn a_travelling_clip_stays_in_view() {
+    let browser = chromium();
+    let dir = std::env::temp_dir().join(format!("iktc_follow_test_{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("run");
+    // CMU 131_01: the subject walks about 2 m.
+    let clip =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../iktc/tests/data/motions/cmu/131_01.bvh");
+    let run = Command::new(env!("CARGO_BIN_EXE_iktc"))
+        .arg("retarget")
+        .arg(&clip)
+        .args(["--robot", "g1", "--jobs", "1", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "iktc retarget failed: {}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let page = out.join("131_01").join("viewer.html");
+    let html = std::fs::read_to_string(&page).unwrap();
+    // The last second of the clip (8.3 s).
+    let end = "#t=8";
+    let centre = |bx: &[i64]| ((bx[0] + bx[2]) / 2, (bx[1] + bx[3]) / 2);
+    let start = robot_box(
+        &browser,
+        &dir,
+        &format!("file://{}#t=0", page.display()),
+        "s",
+    );
+    let followed = robot_box(
+        &browser,
+        &dir,
+        &format!("file://{}{end}", page.display()),
+        "f",
+    );
+    let fixed_page = dir.join("fixed.html");
+    let unchecked = html.replace(
+        "id=\"follow\" type=\"checkbox\" checked",
+        "id=\"follow\" type=\"checkbox\"",
+    );
+    assert_ne!(unchecked, html, "the follow box is in the page");
+    std::fs::write(&fixed_page, unchecked).unwrap();
+    let fixed = robot_box(
+        &browser,
+        &dir,
+        &format!("file://{}{end}", fixed_page.display()),
+        "x",
+    );
+    let (cs, cf, cx) = (centre(&start), centre(&followed), centre(&fixed));
+    eprintln!("robot box centre: start {cs:?}, end followed {cf:?}, end fixed {cx:?}");
+    // Followed: the robot's centre stays within the middle half of the window's width and
+    // inside its height.
+    assert!(
+        (WINDOW.0 / 4..3 * WINDOW.0 / 4).contains(&cf.0) && (0..WINDOW.1).contains(&cf.1),
+        "followed robot at {cf:?} in a {WINDOW:?} window"
+    );
+    // The control: with the camera left where frame 0 put it, the robot has moved far from
+    // where it started on the screen (more than a quarter of the width).
+    let moved = ((cx.0 - cs.0).pow(2) + (cx.1 - cs.1).pow(2)) as f64;
+    assert!(
+        moved.sqrt() > WINDOW.0 as f64 / 4.0,
+        "without follow the robot moved {:.0} px only",
+        moved.sqrt()
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
