@@ -1,5 +1,6 @@
-//! Throughput of dataset retargeting, end to end: read each shared DeepMimic clip, retarget it
-//! onto JVRC-1 at the 200 Hz control rate ([`BatchRetarget::retarget`]), and write its CSV, NPZ
+//! Throughput of dataset retargeting, end to end: read each shared clip (the four DeepMimic
+//! clips and the two CMU BVH files), retarget it onto G1 and onto JVRC-1 at the 200 Hz control
+//! rate by the default route, keypoints ([`BatchRetarget::retarget`]), and write its CSV, NPZ
 //! and quality JSON (the viewer page, which the command line adds, is not included). Criterion
 //! reports the time of the whole batch with 1 and 2 worker threads; the throughput element is
 //! one 200 Hz frame. Then, in the same process, the 1 → 2 job scaling: five alternating
@@ -14,12 +15,19 @@ use iktc::profile::RobotProfile;
 use iktc::sim::ImitateConfig;
 
 fn clips() -> Vec<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/motions/deepmimic");
-    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
-        .expect("clip folder")
-        .map(|e| e.expect("entry").path())
-        .filter(|p| p.extension().is_some_and(|e| e == "txt"))
-        .collect();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut v = Vec::new();
+    for (dir, ext) in [
+        ("data/motions/deepmimic", "txt"),
+        ("tests/data/motions/cmu", "bvh"),
+    ] {
+        v.extend(
+            std::fs::read_dir(root.join(dir))
+                .expect("clip folder")
+                .map(|e| e.expect("entry").path())
+                .filter(|p| p.extension().is_some_and(|e| e == ext)),
+        );
+    }
     v.sort();
     v
 }
@@ -48,13 +56,19 @@ fn batch(b: &BatchRetarget, clips: &[PathBuf], jobs: usize, out: &Path) -> usize
 }
 
 fn bench(c: &mut Criterion) {
-    let profile = RobotProfile::builtin("jvrc1").expect("profile");
+    for robot in ["g1", "jvrc1"] {
+        bench_robot(c, robot);
+    }
+}
+
+fn bench_robot(c: &mut Criterion, robot: &str) {
+    let profile = RobotProfile::builtin(robot).expect("profile");
     let b = BatchRetarget::from_profile(profile, ImitateConfig::default()).expect("batch");
     let clips = clips();
     let out = std::env::temp_dir().join(format!("iktc-bench-batch-{}", std::process::id()));
     let frames = batch(&b, &clips, 1, &out);
-    let seconds = frames as f64 * b.config.dt;
-    let mut g = c.benchmark_group("batch_retarget_shared_clips");
+    let seconds = frames as f64 * b.control_period();
+    let mut g = c.benchmark_group(format!("batch_retarget_shared_clips_{robot}"));
     g.sample_size(10);
     g.throughput(Throughput::Elements(frames as u64));
     for jobs in [1, 2] {
@@ -77,7 +91,7 @@ fn bench(c: &mut Criterion) {
     }
     let (one, two) = (t[0][2], t[1][2]);
     println!(
-        "batch: {} clips, {frames} frames ({seconds:.2} s of motion at 200 Hz); 1 job {one:.3} s = {:.0} frames/s = {:.0}x real time per core; 2 jobs {two:.3} s; scaling 1 -> 2 jobs {:.2}x",
+        "batch {robot}: {} clips, {frames} frames ({seconds:.2} s of motion at 200 Hz); 1 job {one:.3} s = {:.0} frames/s = {:.0}x real time per core; 2 jobs {two:.3} s; scaling 1 -> 2 jobs {:.2}x",
         clips.len(),
         frames as f64 / one,
         seconds / one,
