@@ -461,6 +461,24 @@ mod tests {
         );
     }
 
+    /// The posture level's references: the profile's map for the clip's format, none where
+    /// the profile has no map for it (JVRC-1 maps DeepMimic and BVH, G1 DeepMimic only).
+    #[test]
+    fn posture_references_come_from_the_profiles_map_for_the_format() {
+        let clip = crate::motion::builtin_clip("humanoid3d_walk").unwrap();
+        let g1 = RobotProfile::builtin("g1").unwrap();
+        let b = BatchRetarget::from_profile(g1, ImitateConfig::default()).unwrap();
+        let refs = b.posture(&clip, MotionFormat::DeepMimic).unwrap().unwrap();
+        let dt = b.keypoints.dt;
+        assert!(refs.len() > 1);
+        assert!(((refs.len() - 1) as f64 * dt - clip.duration()).abs() <= dt);
+        assert!(!refs.joint_names.is_empty());
+        for n in &refs.joint_names {
+            assert!(b.robot.joints().iter().any(|j| &j.name == n), "{n}");
+        }
+        assert!(b.posture(&clip, MotionFormat::Bvh).unwrap().is_none());
+    }
+
     #[test]
     fn a_keypoint_run_of_the_wrong_shape_is_an_error() {
         let b = batch();
