@@ -17,10 +17,15 @@
 //!   one). A `<node>`'s transform is the product `T = T₁·T₂·…·Tₙ` of its `<matrix>` (16 numbers,
 //!   row-major), `<translate>` (x y z), `<rotate>` (axis x y z, angle in degrees, right-handed)
 //!   and `<scale>` (x y z) children in document order; a nested node's world transform is
-//!   `W = W_parent·T`, and each `<instance_geometry url="#id">` places geometry `id` at `W`.
-//!   Without a visual scene every geometry is taken once, untransformed. `<instance_node>`,
-//!   `<instance_controller>`, external URLs, `<lookat>`, `<skew>` and `<ph>` (polygons with holes)
-//!   are left out with a warning.
+//!   `W = W_parent·T`, and each `<instance_geometry url="#id">` places geometry `id` at `W`; an
+//!   `<instance_node url="#id">` walks node `id` (of `<library_nodes>` or a visual scene) as a
+//!   child. Without a visual scene every geometry is taken once, untransformed.
+//!   `<instance_controller>` (skinned meshes), external URLs, `<lookat>`, `<skew>` and `<ph>`
+//!   (polygons with holes) are left out with a warning; `<lines>` and `<linestrips>` (no
+//!   surface) are ignored, as normals and texture coordinates are.
+//! * Bounds: at most [`MAX_DEPTH`] nested elements and nested nodes (`<instance_node>` hops
+//!   counted, so a node that instances itself is an error, not a stack overflow), at most
+//!   [`MAX_NODES`] nodes entered and [`MAX_TRIANGLES`] triangles placed.
 //! * `<asset>`: a point `p` of the file becomes `p' = U·(m·p)` with `m` the `<unit meter>` (1
 //!   without one) and `U` the rotation that takes the file's `<up_axis>` to z up. After the
 //!   COLLADA specification's axes (right, up, toward the viewer): `Y_UP` is (+x, +y, +z), `Z_UP`
@@ -46,6 +51,14 @@ use crate::error::{Error, Result};
 /// The deepest element nesting read \[elements\]; deeper files are refused (nodes are walked
 /// recursively, and real scenes nest a few dozen levels at most).
 pub const MAX_DEPTH: usize = 256;
+
+/// The most nodes a scene walk enters \[nodes\], each `<instance_node>` hop counted anew:
+/// bounds the walk of a file whose nodes instance each other many times over.
+pub const MAX_NODES: usize = 1_000_000;
+
+/// The most triangles a file may place \[triangles\]: 4 M triangles are 144 MB as `f32`
+/// corners, far above a robot link's visual mesh (a UR5e upper arm: 40 124).
+pub const MAX_TRIANGLES: usize = 4_000_000;
 
 /// A Collada file read into one mesh.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -576,9 +589,6 @@ fn read_geometry(
                     ));
                 }
             }
-            "lines" | "linestrips" => {
-                warnings.push(format!("{what}: lines have no surface; left out"))
-            }
             _ => {}
         }
     }
@@ -627,43 +637,106 @@ fn node_transform(node: &Element, name: &str, warnings: &mut Vec<String>) -> Res
     Ok(t)
 }
 
-/// Collects the geometry instances under `node` with their world transforms.
-fn walk(
-    node: &Element,
-    parent: &Matrix4<f64>,
-    geometries: &[&Element],
-    name: &str,
-    out: &mut Vec<(Matrix4<f64>, usize)>,
-    warnings: &mut Vec<String>,
-) -> Result<()> {
-    let world = parent * node_transform(node, name, warnings)?;
-    for c in &node.children {
-        match c.tag.as_str() {
-            "node" => walk(c, &world, geometries, name, out, warnings)?,
-            "instance_geometry" => {
-                let url = c.attr("url").unwrap_or("");
-                let id = url.strip_prefix('#');
-                match geometries
+/// The walk over a visual scene's nodes: what it can reach and what it has collected.
+struct Walk<'a> {
+    name: &'a str,
+    geometries: &'a [&'a Element],
+    /// The nodes an `<instance_node>` may name: those of `<library_nodes>` and of the visual
+    /// scenes, by id.
+    nodes: HashMap<&'a str, &'a Element>,
+    /// Nodes entered so far (counted against [`MAX_NODES`]).
+    visited: usize,
+    /// The geometry instances: world transform and index into `geometries`.
+    instances: Vec<(Matrix4<f64>, usize)>,
+    warnings: Vec<String>,
+}
+
+impl<'a> Walk<'a> {
+    fn new(root: &'a Element, name: &'a str, geometries: &'a [&'a Element]) -> Walk<'a> {
+        let mut nodes = HashMap::new();
+        let mut todo: Vec<&Element> = root
+            .all("library_nodes")
+            .chain(root.all("library_visual_scenes"))
+            .flat_map(|l| l.children.iter())
+            .collect();
+        while let Some(e) = todo.pop() {
+            if e.tag == "node" {
+                if let Some(id) = e.attr("id") {
+                    nodes.entry(id).or_insert(e);
+                }
+            }
+            todo.extend(e.all("node"));
+        }
+        Walk {
+            name,
+            geometries,
+            nodes,
+            visited: 0,
+            instances: Vec::new(),
+            warnings: Vec::new(),
+        }
+    }
+
+    /// Collects the geometry instances under `node` placed at `parent`·(its transform);
+    /// `depth` counts the nodes above it, `<instance_node>` hops included.
+    fn node(&mut self, node: &'a Element, parent: &Matrix4<f64>, depth: usize) -> Result<()> {
+        let name = self.name;
+        self.visited += 1;
+        if self.visited > MAX_NODES {
+            return Err(bad(
+                name,
+                node.line,
+                format!(
+                    "the scene enters more than {MAX_NODES} nodes (counting each \
+                     <instance_node> anew); expected at most that"
+                ),
+            ));
+        }
+        if depth > MAX_DEPTH {
+            return Err(bad(
+                name,
+                node.line,
+                format!(
+                    "{}: nodes nest deeper than {MAX_DEPTH} (through <instance_node>: a node \
+                     that instances itself?)",
+                    node.describe()
+                ),
+            ));
+        }
+        let world = parent * node_transform(node, name, &mut self.warnings)?;
+        for c in &node.children {
+            let url = c.attr("url").unwrap_or("");
+            let id = url.strip_prefix('#');
+            match c.tag.as_str() {
+                "node" => self.node(c, &world, depth + 1)?,
+                "instance_node" => match id.and_then(|id| self.nodes.get(id).copied()) {
+                    Some(target) => self.node(target, &world, depth + 1)?,
+                    None => self.warnings.push(format!(
+                        "{}: <instance_node url=\"{url}\"> names no <node> of this file; left out",
+                        node.describe()
+                    )),
+                },
+                "instance_geometry" => match self
+                    .geometries
                     .iter()
                     .position(|g| id.is_some() && g.attr("id") == id)
                 {
-                    Some(g) => out.push((world, g)),
-                    None => warnings.push(format!(
-                        "{}: <instance_geometry url=\"{url}\"> names no <geometry> of this file; \
-                         left out",
+                    Some(g) => self.instances.push((world, g)),
+                    None => self.warnings.push(format!(
+                        "{}: <instance_geometry url=\"{url}\"> names no <geometry> of this \
+                         file; left out",
                         node.describe()
                     )),
-                }
+                },
+                "instance_controller" => self.warnings.push(format!(
+                    "{}: <instance_controller> (a skinned mesh) is not read; left out",
+                    node.describe()
+                )),
+                _ => {}
             }
-            "instance_node" | "instance_controller" => warnings.push(format!(
-                "{}: <{}> is not read; left out",
-                node.describe(),
-                c.tag
-            )),
-            _ => {}
         }
+        Ok(())
     }
-    Ok(())
 }
 
 /// The map `p ↦ U·(m·p)` of the file's `<asset>`: unit `m` \[m per file unit\], up axis `U`.
@@ -767,23 +840,22 @@ pub fn read_collada(bytes: &[u8], name: &str) -> Result<ColladaMesh> {
         }
         None => scenes.first().copied(),
     };
-    let mut warnings = Vec::new();
-    let mut instances = Vec::new();
+    let mut walk = Walk::new(&root, name, &geometries);
     match scene {
         Some(s) => {
             for node in s.all("node") {
-                walk(
-                    node,
-                    &Matrix4::identity(),
-                    &geometries,
-                    name,
-                    &mut instances,
-                    &mut warnings,
-                )?;
+                walk.node(node, &Matrix4::identity(), 1)?;
             }
         }
-        None => instances.extend((0..geometries.len()).map(|g| (Matrix4::identity(), g))),
+        None => walk
+            .instances
+            .extend((0..geometries.len()).map(|g| (Matrix4::identity(), g))),
     }
+    let Walk {
+        instances,
+        mut warnings,
+        ..
+    } = walk;
     // Each geometry is read once, however often it is instanced.
     let mut read: HashMap<usize, Option<Geometry>> = HashMap::new();
     let mut soup = Vec::new();
@@ -812,6 +884,17 @@ pub fn read_collada(bytes: &[u8], name: &str) -> Result<ColladaMesh> {
                 g.line,
                 format!(
                     "{} placed by its node reaches {q:?}, expected finite coordinates in metres",
+                    g.describe()
+                ),
+            ));
+        }
+        if soup.len() + geometry.triangles.len() > MAX_TRIANGLES {
+            return Err(bad(
+                name,
+                g.line,
+                format!(
+                    "the scene places more than {MAX_TRIANGLES} triangles (at {}); expected at \
+                     most that",
                     g.describe()
                 ),
             ));
@@ -1101,13 +1184,87 @@ mod tests {
         assert_box(&m.mesh, [0.0; 3], [6.0, 1.0, 1.0]);
         assert!((volume(&m.mesh) - 2.0).abs() < TOL);
         assert_eq!(m.warnings.len(), 2, "{:?}", m.warnings);
-        assert!(m.warnings[0].contains("<instance_node>"));
+        assert!(m.warnings[0].contains("<instance_node url=\"#elsewhere\"> names no <node>"));
         assert!(m.warnings[1].contains("#missing"));
         let holes =
             per_face("polygons").replace("</polygons>", "<ph><p>0 1 2</p><h>3</h></ph></polygons>");
         let h = read(&dae("", &holes, ""));
         assert_eq!(h.mesh.triangles.len(), 12);
         assert!(h.warnings[0].contains("<ph>"), "{:?}", h.warnings);
+    }
+
+    /// The cube geometry, `<library_nodes>` of `library`, and a visual scene of `body`.
+    fn with_library(prims: &str, library: &str, body: &str) -> String {
+        dae("", prims, &scene(body)).replace(
+            "<library_visual_scenes>",
+            &format!("<library_nodes>{library}</library_nodes><library_visual_scenes>"),
+        )
+    }
+
+    #[test]
+    fn instance_node_places_a_library_node_under_the_instancing_node() {
+        // part = translate (0, 0, 5) · cube; placed twice, at x = 10 and turned 90° about z.
+        let library = format!(r#"<node id="part"><translate>0 0 5</translate>{INSTANCE}</node>"#);
+        let body = r##"<translate>10 0 0</translate><instance_node url="#part"/>
+            <node id="turned"><rotate>0 0 1 90</rotate><instance_node url="#part"/></node>"##;
+        let m = read(&with_library(&triangles(), &library, body));
+        assert!(m.warnings.is_empty(), "{:?}", m.warnings);
+        assert_eq!(m.mesh.triangles.len(), 24);
+        // First at [10,11]×[0,1]×[5,6]; the second, under the node at x = 10 turned 90°,
+        // at [9,10]×[0,1]×[5,6]: together [9,11]×[0,1]×[5,6].
+        assert_box(&m.mesh, [9.0, 0.0, 5.0], [11.0, 1.0, 6.0]);
+        assert!((volume(&m.mesh) - 2.0).abs() < TOL);
+    }
+
+    #[test]
+    fn runaway_node_instancing_is_an_error() {
+        // A node that instances itself.
+        let library = r##"<node id="loop"><instance_node url="#loop"/></node>"##;
+        let e = error(&with_library(
+            &triangles(),
+            library,
+            r##"<instance_node url="#loop"/>"##,
+        ));
+        assert!(
+            e.contains("<node id=\"loop\">") && e.contains("deeper than"),
+            "{e}"
+        );
+        // 25 levels each instancing the next twice: 2²⁵ nodes.
+        let mut library = String::from(r#"<node id="n0"/>"#);
+        for k in 1..=25 {
+            let j = k - 1;
+            library.push_str(&format!(
+                r##"<node id="n{k}"><instance_node url="#n{j}"/><instance_node url="#n{j}"/></node>"##
+            ));
+        }
+        let e = error(&with_library(
+            &triangles(),
+            &library,
+            r##"<instance_node url="#n25"/>"##,
+        ));
+        assert!(e.contains(&format!("more than {MAX_NODES} nodes")), "{e}");
+        // 2¹² instances of a 1000-corner polygon (998 triangles): 4 087 808 triangles.
+        let p = joined((0..1000).map(|i| (i % 8).to_string()));
+        let big = format!(
+            r##"<polylist count="1"><input semantic="VERTEX" source="#verts" offset="0"/>
+            <vcount>1000</vcount><p>{p}</p></polylist>"##
+        );
+        let mut library = format!(r#"<node id="n0">{INSTANCE}</node>"#);
+        for k in 1..=12 {
+            let j = k - 1;
+            library.push_str(&format!(
+                r##"<node id="n{k}"><instance_node url="#n{j}"/><instance_node url="#n{j}"/></node>"##
+            ));
+        }
+        let e = error(&with_library(
+            &big,
+            &library,
+            r##"<instance_node url="#n12"/>"##,
+        ));
+        assert!(
+            e.contains(&format!("more than {MAX_TRIANGLES} triangles")),
+            "{e}"
+        );
     }
 
     #[test]

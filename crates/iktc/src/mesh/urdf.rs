@@ -10,8 +10,8 @@
 //! triangles clockwise, so two corners of each are swapped back), decimated
 //! ([`super::decimate()`]) and quantized ([`super::QuantizedMesh`]). A mesh that cannot be used
 //! (missing file, another format, a malformed STL or Collada file) is left out with a warning
-//! naming the file and the link; the parts of a Collada file left out (an `<instance_node>`, …)
-//! are warned about the same way.
+//! naming the file and the link; the parts of a Collada file left out (an
+//! `<instance_controller>`, …) are warned about the same way.
 
 use std::path::{Path, PathBuf};
 
@@ -261,7 +261,7 @@ mod tests {
 
     /// A Collada file of one counter-clockwise triangle (0,0,0), (1,0,0), (0,1,0) in
     /// millimetres, y up, placed by a node moved by 1000 mm along the file's x, and an
-    /// `<instance_node>` the reader leaves out.
+    /// `<instance_node>` naming no node, which the reader leaves out with a warning.
     const TRIANGLE_DAE: &str = r##"<?xml version="1.0"?>
 <COLLADA version="1.4.1"><asset><unit meter="0.001"/><up_axis>Y_UP</up_axis></asset>
 <library_geometries><geometry id="g"><mesh>
@@ -302,7 +302,8 @@ mod tests {
         // The only warning is the reader's, about the <instance_node>: no "not supported".
         assert_eq!(m.warnings.len(), 1, "{:?}", m.warnings);
         assert!(
-            m.warnings[0].contains("link `base`") && m.warnings[0].contains("<instance_node>"),
+            m.warnings[0].contains("link `base`")
+                && m.warnings[0].contains("<instance_node url=\"#other\"> names no <node>"),
             "{:?}",
             m.warnings
         );
