@@ -371,7 +371,8 @@ fn positions(source: &Element, name: &str) -> Result<Vec<[f64; 3]>> {
         .checked_sub(1)
         .map_or(Some(0), |last| {
             last.checked_mul(stride)
-                .and_then(|s| s.checked_add(offset + 3))
+                .and_then(|s| s.checked_add(offset))
+                .and_then(|s| s.checked_add(3))
         })
         .unwrap_or(usize::MAX);
     if needed > data.len() {
@@ -426,7 +427,7 @@ fn layout(prim: &Element, what: &str, name: &str) -> Result<(usize, usize)> {
     let mut vertex = None;
     for input in prim.all("input") {
         let offset = count_attr(input, "offset", Some(0), name)?;
-        stride = stride.max(offset + 1);
+        stride = stride.max(offset.saturating_add(1));
         if input.attr("semantic") == Some("VERTEX") {
             vertex = Some(offset);
         }
@@ -640,7 +641,8 @@ fn node_transform(node: &Element, name: &str, warnings: &mut Vec<String>) -> Res
 /// The walk over a visual scene's nodes: what it can reach and what it has collected.
 struct Walk<'a> {
     name: &'a str,
-    geometries: &'a [&'a Element],
+    /// The index among the file's geometries of each geometry id.
+    geometry_ids: HashMap<&'a str, usize>,
     /// The nodes an `<instance_node>` may name: those of `<library_nodes>` and of the visual
     /// scenes, by id.
     nodes: HashMap<&'a str, &'a Element>,
@@ -667,9 +669,15 @@ impl<'a> Walk<'a> {
             }
             todo.extend(e.all("node"));
         }
+        let mut geometry_ids = HashMap::new();
+        for (i, g) in geometries.iter().enumerate() {
+            if let Some(id) = g.attr("id") {
+                geometry_ids.entry(id).or_insert(i);
+            }
+        }
         Walk {
             name,
-            geometries,
+            geometry_ids,
             nodes,
             visited: 0,
             instances: Vec::new(),
@@ -716,12 +724,8 @@ impl<'a> Walk<'a> {
                         node.describe()
                     )),
                 },
-                "instance_geometry" => match self
-                    .geometries
-                    .iter()
-                    .position(|g| id.is_some() && g.attr("id") == id)
-                {
-                    Some(g) => self.instances.push((world, g)),
+                "instance_geometry" => match id.and_then(|id| self.geometry_ids.get(id)) {
+                    Some(&g) => self.instances.push((world, g)),
                     None => self.warnings.push(format!(
                         "{}: <instance_geometry url=\"{url}\"> names no <geometry> of this \
                          file; left out",
