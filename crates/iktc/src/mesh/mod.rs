@@ -1,9 +1,14 @@
-//! Robot meshes for the viewer: reading STL, decimating, quantizing and packing them.
+//! Robot meshes for the viewer: reading STL and Collada, decimating, quantizing and packing
+//! them.
 //!
 //! The pipeline, one file a step:
 //!
 //! * [`stl`] reads binary and ASCII STL into a triangle soup, then welds it into an indexed
-//!   [`TriMesh`] (vertices at bit-identical positions become one).
+//!   [`TriMesh`] (vertices at bit-identical positions become one, [`TriMesh::weld`]).
+//! * [`collada`] (feature `urdf`) reads a Collada (`.dae`) file's triangles, polygons, fans and
+//!   strips, places them by the `<visual_scene>`'s node transforms, converts them to metres and
+//!   z up after the file's `<asset>`, keeps the triangles counter-clockwise under mirroring
+//!   transforms, and welds the result the same way.
 //! * [`decimate()`] simplifies a mesh by vertex clustering: space is cut into cubes of side `c`
 //!   \[m\]; every vertex is replaced by the mean of the vertices in its cube, and triangles whose
 //!   corners fall into fewer than three distinct cubes are dropped (Rossignac & Borrel, 1993).
@@ -18,14 +23,20 @@
 //!   applies the visual's `<origin>` and `scale`, and runs the steps above; [`builtin`] holds the
 //!   built-in G1's meshes, prepared that way from Unitree's STL files.
 
+use std::collections::HashMap;
+
 pub mod base64;
 pub mod builtin;
+#[cfg(feature = "urdf")]
+pub mod collada;
 pub mod decimate;
 pub mod quantize;
 pub mod stl;
 #[cfg(feature = "urdf")]
 pub mod urdf;
 
+#[cfg(feature = "urdf")]
+pub use collada::{read_collada, ColladaMesh};
 pub use decimate::decimate;
 pub use quantize::{pack, unpack, LinkMesh, MeshSet, QuantizedMesh};
 pub use stl::{read_stl, StlMesh};
@@ -45,6 +56,25 @@ pub struct TriMesh {
 }
 
 impl TriMesh {
+    /// The indexed mesh of a triangle soup: corners at bit-identical positions become one
+    /// vertex; triangles keep their order and their corners' order.
+    pub fn weld(soup: &[[[f32; 3]; 3]]) -> TriMesh {
+        let mut index: HashMap<[u32; 3], u32> = HashMap::new();
+        let mut mesh = TriMesh::default();
+        for t in soup {
+            let mut tri = [0u32; 3];
+            for (k, p) in t.iter().enumerate() {
+                let key = p.map(f32::to_bits);
+                tri[k] = *index.entry(key).or_insert_with(|| {
+                    mesh.vertices.push(*p);
+                    (mesh.vertices.len() - 1) as u32
+                });
+            }
+            mesh.triangles.push(tri);
+        }
+        mesh
+    }
+
     /// The axis-aligned bounding box `(min, max)` of the vertices used by a triangle; `None`
     /// for a mesh without triangles.
     pub fn bounding_box(&self) -> Option<([f32; 3], [f32; 3])> {

@@ -6,8 +6,6 @@
 //! start binary headers with `solid`); otherwise as ASCII (`solid … facet normal nx ny nz /
 //! outer loop / vertex x y z ×3 / endloop / endfacet … endsolid`).
 
-use std::collections::HashMap;
-
 use super::TriMesh;
 use crate::error::{Error, Result};
 
@@ -169,22 +167,10 @@ fn read_ascii(text: &str, name: &str) -> Result<StlMesh> {
 }
 
 impl StlMesh {
-    /// The indexed mesh: corners at bit-identical positions become one vertex.
+    /// The indexed mesh: corners at bit-identical positions become one vertex
+    /// ([`TriMesh::weld`]).
     pub fn weld(&self) -> TriMesh {
-        let mut index: HashMap<[u32; 3], u32> = HashMap::new();
-        let mut mesh = TriMesh::default();
-        for t in &self.triangles {
-            let mut tri = [0u32; 3];
-            for (k, p) in t.iter().enumerate() {
-                let key = p.map(f32::to_bits);
-                tri[k] = *index.entry(key).or_insert_with(|| {
-                    mesh.vertices.push(*p);
-                    (mesh.vertices.len() - 1) as u32
-                });
-            }
-            mesh.triangles.push(tri);
-        }
-        mesh
+        TriMesh::weld(&self.triangles)
     }
 }
 
