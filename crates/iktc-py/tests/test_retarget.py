@@ -1,5 +1,6 @@
-"""`iktc retarget`'s NPZ and CSV read by numpy and the csv module, against the Python imitation
-of the same clip (an independent path through the bindings)."""
+"""`iktc retarget`'s NPZ and CSV read by numpy and the csv module, against the Python retargeting
+of the same clip (an independent path through the bindings): the keypoint route (the default)
+against `iktc.retarget_keypoints`, the joint route against `iktc.Imitation`."""
 import csv
 import os
 import subprocess
@@ -13,10 +14,12 @@ from test_controller import REPO, iktc_binary
 CLIP = REPO / "crates" / "iktc" / "data" / "motions" / "deepmimic" / "humanoid3d_walk.txt"
 
 
-def test_retarget_npz_and_csv_equal_the_python_imitation():
+def batch_outputs(*route):
+    """Runs `iktc retarget` on the walk clip for G1 and returns its NPZ, after checking the NPZ's
+    shapes and that the CSV holds the same numbers by its named columns."""
     out = tempfile.mkdtemp()
     subprocess.run([iktc_binary(), "retarget", str(CLIP), "--robot", "g1", "--no-viewer",
-                    "--out", out], check=True, stdout=subprocess.DEVNULL,
+                    *route, "--out", out], check=True, stdout=subprocess.DEVNULL,
                    stderr=subprocess.DEVNULL)
     d = np.load(os.path.join(out, "humanoid3d_walk", "motion.npz"))
     robot = iktc.Robot("g1")
@@ -35,14 +38,39 @@ def test_retarget_npz_and_csv_equal_the_python_imitation():
         assert [float(row[c]) for c in ("base_qx", "base_qy", "base_qz", "base_qw")] == \
             list(d["base_quat_xyzw"][k])
         assert [float(row[c]) for c in names] == list(d["joint_pos"][k])
-    # The Python imitation of the same clip: q = (base position, quaternion x y z w, joints).
-    sim = iktc.Imitation(robot, iktc.load_motion(str(CLIP)))
-    assert sim.ticks == n
+    return d, robot
+
+
+def worst_difference(d, qs, vs):
+    """The largest difference between the NPZ's frames and configurations `qs` (base position,
+    quaternion x y z w, joints) and velocities `vs` (base twist, joint rates)."""
     worst = 0.0
-    for k in range(n):
-        q = sim.q
+    for k, (q, v) in enumerate(zip(qs, vs)):
         worst = max(worst, np.abs(q[7:] - d["joint_pos"][k]).max(),
                     np.abs(q[:3] - d["base_pos"][k]).max(),
-                    np.abs(q[3:7] / np.linalg.norm(q[3:7]) - d["base_quat_xyzw"][k]).max())
+                    np.abs(q[3:7] / np.linalg.norm(q[3:7]) - d["base_quat_xyzw"][k]).max(),
+                    np.abs(v[6:] - d["joint_vel"][k]).max(),
+                    np.abs(v[:3] - d["base_lin_vel"][k]).max(),
+                    np.abs(v[3:6] - d["base_ang_vel"][k]).max())
+    return worst
+
+
+def test_retarget_npz_and_csv_equal_the_python_keypoint_retargeting():
+    d, robot = batch_outputs()
+    run = iktc.retarget_keypoints(iktc.load_motion(str(CLIP)), robot)
+    assert len(run) == d["joint_pos"].shape[0]
+    assert np.allclose(run.times, d["time"], rtol=0, atol=1e-12)
+    assert worst_difference(d, run.q, run.v) < 1e-9
+
+
+def test_retarget_joints_npz_equals_the_python_imitation():
+    d, robot = batch_outputs("--retarget", "joints")
+    sim = iktc.Imitation(robot, iktc.load_motion(str(CLIP)))
+    n = d["joint_pos"].shape[0]
+    assert sim.ticks == n
+    qs, vs = [], []
+    for _ in range(n):
+        qs.append(sim.q.copy())
+        vs.append(sim.v.copy())
         sim.tick()
-    assert worst < 1e-9, worst
+    assert worst_difference(d, qs, vs) < 1e-9
