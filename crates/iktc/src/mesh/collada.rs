@@ -1089,6 +1089,53 @@ mod tests {
     }
 
     #[test]
+    fn fans_and_strips_follow_the_collada_corner_rules() {
+        // Fan (v₀, vᵢ, vᵢ₊₁); strip (vᵢ, vᵢ₊₁, vᵢ₊₂) for even i, (vᵢ₊₁, vᵢ, vᵢ₊₂) for odd i.
+        let mut fan = Vec::new();
+        triangulate(&[7, 8, 9, 10, 11], Shape::Fan, &mut fan);
+        assert_eq!(fan, vec![[7, 8, 9], [7, 9, 10], [7, 10, 11]]);
+        let mut strip = Vec::new();
+        triangulate(&[7, 8, 9, 10, 11], Shape::Strip, &mut strip);
+        assert_eq!(strip, vec![[7, 8, 9], [9, 8, 10], [9, 10, 11]]);
+        let mut none = Vec::new();
+        triangulate(&[7, 8], Shape::Strip, &mut none);
+        assert!(none.is_empty());
+    }
+
+    #[test]
+    fn triangles_without_a_count_take_their_count_from_p() {
+        let m = read(&dae("", &triangles().replace(" count=\"12\"", ""), "")).mesh;
+        assert_eq!(m.triangles.len(), 12);
+        assert!((volume(&m) - 1.0).abs() < TOL);
+    }
+
+    #[test]
+    fn numbers_in_cdata_read_as_text() {
+        let cdata = dae("", &triangles(), "")
+            .replace("count=\"24\">", "count=\"24\"><![CDATA[")
+            .replace("</float_array>", "]]></float_array>");
+        assert!(cdata.contains("<![CDATA[0 0 0 1 0 0"), "{cdata}");
+        let m = read(&cdata).mesh;
+        assert_eq!(m.triangles.len(), 12);
+        assert_box(&m, [0.0; 3], [1.0; 3]);
+    }
+
+    #[test]
+    fn lines_are_counted_from_one() {
+        let text = "a\nb\nc";
+        assert_eq!(
+            [0, 1, 2, 3, 4, 99].map(|p| line_at(text, p)),
+            [1, 1, 2, 2, 3, 3]
+        );
+        // A mismatched end tag on line 3 is reported there.
+        let e = error("<COLLADA>\n<asset>\n</COLLADA>\n");
+        assert!(
+            e.starts_with("bad.dae:3:") && e.contains("not well-formed"),
+            "{e}"
+        );
+    }
+
+    #[test]
     fn node_transforms_compose_in_document_order_and_parent_first() {
         // p' = T·R·S·p with S = diag(2, 1, 1), R = 90° about z, T = (1, 2, 3): the box
         // [0,2]×[0,1]×[0,1] turned to [−1,0]×[0,2]×[0,1], then moved.
