@@ -5,13 +5,14 @@
 use std::path::Path;
 
 use anyhow::{Context, Result};
+use iktc::batch::{posture_references, Posture};
 use iktc::motion::{Keypoints, MotionFormat, BUILTIN_CLIP_NAMES, DEFAULT_MAX_GAP};
 use iktc::profile::RobotProfile;
 use iktc::retarget::{
     builtin_motion, joint_route_quality, retarget_keypoints, KeypointRun, KeypointSettings,
     RetargetQuality,
 };
-use iktc::sim::{imitation_references, ImitateConfig};
+use iktc::sim::ImitateConfig;
 
 /// Which retargeting `iktc imitate` runs.
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -62,31 +63,19 @@ pub fn run(
         ..KeypointSettings::default()
     };
     let robot = profile.robot()?;
-    let refs = match &clip {
-        Some((clip, format)) => {
-            let key = if *format == MotionFormat::DeepMimic {
-                "deepmimic"
-            } else {
-                "bvh"
-            };
-            match profile.retarget_map(key, &robot) {
-                Ok(map) => {
-                    let joints_cfg = ImitateConfig {
-                        narrow: Vec::new(),
-                        ..cfg.clone()
-                    };
-                    Some(imitation_references(&robot, clip, &map, &joints_cfg)?)
-                }
-                Err(e) => {
-                    crate::outln!("joint route: not run ({e})")?;
-                    None
-                }
-            }
-        }
-        None => None,
+    let posture = match &clip {
+        Some((clip, format)) => posture_references(&robot, profile, clip, *format, None, cfg)?,
+        None => Posture::Start("the motion has no skeleton".into()),
     };
-    let run = retarget_keypoints(profile, &kp, refs.as_ref(), &settings)?;
-    let joints = match &refs {
+    if let Posture::Start(_) = &posture {
+        crate::outln!(
+            "joint route: not run; posture level: {}",
+            posture.describe()
+        )?;
+    }
+    let refs = posture.references();
+    let run = retarget_keypoints(profile, &kp, refs, &settings)?;
+    let joints = match refs {
         Some(r) => Some(joint_route_quality(profile, &kp, r, &settings)?),
         None => None,
     };

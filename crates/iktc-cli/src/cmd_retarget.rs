@@ -292,7 +292,7 @@ fn retarget_one(
     )?;
     if let Some(meshes) = viewer {
         let mut data = match run {
-            ClipRun::Keypoints { keypoints, run } => iktc::retarget::keypoint_viewer(
+            ClipRun::Keypoints { keypoints, run, .. } => iktc::retarget::keypoint_viewer(
                 &batch.robot,
                 keypoints,
                 run,

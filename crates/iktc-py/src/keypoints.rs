@@ -2,9 +2,10 @@
 //! `iktc imitate`) run from Python, its state recorded tick by tick (q, v, q̈) as numpy arrays,
 //! e.g. as the set points of a simulated robot's servos.
 
-use iktc::motion::{MotionFormat, DEFAULT_MAX_GAP};
+use iktc::batch::{posture_references, Posture};
+use iktc::motion::DEFAULT_MAX_GAP;
 use iktc::retarget::{keypoint_controller, KeypointSettings};
-use iktc::sim::{imitation_references, ImitateConfig};
+use iktc::sim::ImitateConfig;
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
 
@@ -61,16 +62,18 @@ pub fn py_retarget_keypoints(
             narrow: Vec::new(),
             ..profile.imitate_config(ImitateConfig::default())?
         };
-        let key = if motion.motion.format == MotionFormat::DeepMimic {
-            "deepmimic"
-        } else {
-            "bvh"
+        let posture = match &motion.clip {
+            Some(clip) => posture_references(
+                &robot.robot,
+                profile,
+                clip,
+                motion.motion.format,
+                None,
+                &cfg,
+            )?,
+            None => Posture::Start("the motion has no skeleton".into()),
         };
-        let refs = match (&motion.clip, profile.retarget_map(key, &robot.robot)) {
-            (Some(clip), Ok(map)) => Some(imitation_references(&robot.robot, clip, &map, &cfg)?),
-            _ => None,
-        };
-        let mut ctl = keypoint_controller(profile, &kp, refs.as_ref(), &settings)?;
+        let mut ctl = keypoint_controller(profile, &kp, posture.references(), &settings)?;
         for _ in 0..(settings.settle_time / dt).round() as usize {
             ctl.tick(0, true)?;
             ctl.integrate()?;

@@ -50,10 +50,16 @@ fn a_points_csv_is_retargeted_from_the_start_posture() {
     let b = BatchRetarget::from_profile(profile.clone(), ImitateConfig::default()).unwrap();
     let path = walk_as_points_csv();
     let o = b.retarget(&path).unwrap();
-    let ClipRun::Keypoints { keypoints, run } = &o.run else {
+    let ClipRun::Keypoints {
+        keypoints,
+        run,
+        posture,
+    } = &o.run
+    else {
         panic!("keypoint route")
     };
     assert!(keypoints.points.contains(&BodyPoint::LeftWrist));
+    assert!(posture.contains("start posture"), "{posture}");
     // The same file through the library's own entry point, no posture references.
     let kp = load_motion(&path, &MotionOptions::default())
         .unwrap()
@@ -84,4 +90,23 @@ fn a_map_given_for_every_clip_that_does_not_fit_the_robot_is_an_error() {
     );
     let e = b.retarget(&clip).unwrap_err().to_string();
     assert!(e.contains("WAIST") || e.contains("joint"), "{e}");
+}
+
+/// JVRC-1's built-in BVH map names a `Spine` joint that CMU's rig lacks: the keypoint route
+/// still runs, from the start posture, and says why.
+#[test]
+fn a_profile_map_that_does_not_fit_the_rig_leaves_the_start_posture() {
+    let profile = RobotProfile::builtin("jvrc1").unwrap();
+    let b = BatchRetarget::from_profile(profile, ImitateConfig::default()).unwrap();
+    let clip = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/motions/cmu/scaled_131_02.bvh");
+    let o = b.retarget(&clip).unwrap();
+    let ClipRun::Keypoints { posture, .. } = &o.run else {
+        panic!("keypoint route")
+    };
+    assert!(
+        posture.contains("start posture") && posture.contains("Spine"),
+        "{posture}"
+    );
+    assert!(o.quality.healthy());
 }

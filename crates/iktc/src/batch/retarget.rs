@@ -19,7 +19,8 @@ use super::training::TrainingTrajectory;
 use crate::error::{Error, Result};
 use crate::model::Robot;
 use crate::motion::{
-    load_motion, Clip, Keypoints, MotionFormat, MotionOptions, RetargetMap, DEFAULT_MAX_GAP,
+    load_motion, Clip, Keypoints, MotionFormat, MotionOptions, RetargetMap, RobotReferences,
+    DEFAULT_MAX_GAP,
 };
 use crate::profile::RobotProfile;
 use crate::retarget::{retarget_keypoints_on, KeypointRun, KeypointSettings};
@@ -70,10 +71,12 @@ pub struct BatchRetarget {
 pub enum ClipRun {
     /// A keypoint retargeting: the clip's body points and the run.
     Keypoints {
-        /// The clip's body points (metres, Z up).
-        keypoints: Keypoints,
+        /// The clip's body points (metres, Z up; boxed, as the run).
+        keypoints: Box<Keypoints>,
         /// The recorded run (boxed: the variants stay of similar size).
         run: Box<KeypointRun>,
+        /// Where the posture level's references came from ([`Posture::describe`]).
+        posture: String,
     },
     /// A joint-route imitation.
     Joints {
@@ -103,8 +106,13 @@ impl ClipOutcome {
     /// Errors: [`Error::InvalidSetting`] if a figure cannot be written as JSON.
     pub fn summary(&self) -> Result<serde_json::Value> {
         let v = match &self.run {
-            ClipRun::Keypoints { keypoints, run } => serde_json::json!({
+            ClipRun::Keypoints {
+                keypoints,
+                run,
+                posture,
+            } => serde_json::json!({
                 "source": keypoints.source,
+                "posture": posture,
                 "leg_ratio": run.scaling.leg,
                 "gf_ticks": run.fallback_ticks,
                 "stance_gf_ticks": run.stance_gf_ticks,
@@ -120,6 +128,77 @@ impl ClipOutcome {
         };
         Ok(v)
     }
+}
+
+/// The posture level's references of a keypoint run.
+#[derive(Debug, Clone)]
+pub enum Posture {
+    /// The joint route's references of the clip (its angles decomposed through a map; boxed:
+    /// the variants stay of similar size).
+    JointRoute(Box<RobotReferences>),
+    /// None: the posture level holds the start posture, for the reason given.
+    Start(String),
+}
+
+impl Posture {
+    /// The references to pass to [`crate::retarget::retarget_keypoints`].
+    pub fn references(&self) -> Option<&RobotReferences> {
+        match self {
+            Self::JointRoute(r) => Some(r),
+            Self::Start(_) => None,
+        }
+    }
+
+    /// One line saying where the posture references came from.
+    pub fn describe(&self) -> String {
+        match self {
+            Self::JointRoute(_) => "the joint route's angles".into(),
+            Self::Start(why) => format!("the start posture ({why})"),
+        }
+    }
+}
+
+/// The keypoint route's posture references for a skeleton `clip` in `format` on `profile`'s
+/// robot `robot`: the joint route's references ([`imitation_references`] with `cfg`, the
+/// narrowed ranges left out) through `map`, else the profile's map for the format. The posture
+/// is a regulariser below every keypoint task, so a profile map that does not fit the clip
+/// (a built-in BVH map naming joints another rig lacks) leaves the start posture, with the
+/// reason; a `map` the caller gave that does not fit is an error.
+///
+/// Errors: those of `map` (given) on the robot or the clip.
+pub fn posture_references(
+    robot: &Robot,
+    profile: &RobotProfile,
+    clip: &Clip,
+    format: MotionFormat,
+    map: Option<&RetargetMap>,
+    cfg: &ImitateConfig,
+) -> Result<Posture> {
+    let cfg = ImitateConfig {
+        narrow: Vec::new(),
+        ..cfg.clone()
+    };
+    let map = match map {
+        Some(m) => {
+            return imitation_references(robot, clip, m, &cfg)
+                .map(|r| Posture::JointRoute(r.into()))
+        }
+        None => {
+            let key = if format == MotionFormat::DeepMimic {
+                "deepmimic"
+            } else {
+                "bvh"
+            };
+            match profile.retarget_map(key, robot) {
+                Ok(m) => m,
+                Err(e) => return Ok(Posture::Start(format!("no joint route: {e}"))),
+            }
+        }
+    };
+    Ok(match imitation_references(robot, clip, &map, &cfg) {
+        Ok(r) => Posture::JointRoute(r.into()),
+        Err(e) => Posture::Start(format!("the profile's map does not fit the clip: {e}")),
+    })
 }
 
 impl BatchRetarget {
@@ -270,10 +349,10 @@ impl BatchRetarget {
         let s = &self.keypoints;
         let posture = match motion.clip().transpose()? {
             Some(clip) => self.posture(&clip, motion.format)?,
-            None => None,
+            None => Posture::Start("the motion has no skeleton".into()),
         };
         let robot = std::sync::Arc::new(self.robot.clone());
-        let run = retarget_keypoints_on(robot, &self.profile, &keypoints, posture.as_ref(), s)?;
+        let run = retarget_keypoints_on(robot, &self.profile, &keypoints, posture.references(), s)?;
         let trajectory = TrainingTrajectory::from_keypoint_run(
             &self.robot,
             &run,
@@ -285,8 +364,9 @@ impl BatchRetarget {
         let quality = ClipQuality::Keypoints(KeypointFigures::from_run(&run, s.dt, p));
         Ok(ClipOutcome {
             run: ClipRun::Keypoints {
-                keypoints,
+                keypoints: Box::new(keypoints),
                 run: Box::new(run),
+                posture: posture.describe(),
             },
             trajectory,
             quality,
@@ -294,24 +374,20 @@ impl BatchRetarget {
     }
 
     /// The joint route's references of `clip` at the keypoint period, the posture level's
-    /// references: `None` when the profile has no map for the clip's format (and none was
-    /// given).
-    fn posture(
-        &self,
-        clip: &Clip,
-        format: MotionFormat,
-    ) -> Result<Option<crate::motion::RobotReferences>> {
-        let map = match self.map_for(format) {
-            Ok(m) => m,
-            Err(e) if self.map.is_some() => return Err(e),
-            Err(_) => return Ok(None),
-        };
+    /// references ([`posture_references`] with [`Self::map`]).
+    fn posture(&self, clip: &Clip, format: MotionFormat) -> Result<Posture> {
         let cfg = ImitateConfig {
-            narrow: Vec::new(),
             dt: self.keypoints.dt,
             ..self.config.clone()
         };
-        imitation_references(&self.robot, clip, &map, &cfg).map(Some)
+        posture_references(
+            &self.robot,
+            &self.profile,
+            clip,
+            format,
+            self.map.as_ref(),
+            &cfg,
+        )
     }
 
     fn retarget_joints(&self, path: &Path) -> Result<ClipOutcome> {
@@ -421,7 +497,12 @@ mod tests {
     fn keypoint_route_writes_the_run_at_the_control_rate() {
         let b = batch();
         let o = b.retarget(&walk()).unwrap();
-        let ClipRun::Keypoints { run, keypoints } = &o.run else {
+        let ClipRun::Keypoints {
+            run,
+            keypoints,
+            posture,
+        } = &o.run
+        else {
             panic!("the default route gives a keypoint run")
         };
         let ClipQuality::Keypoints(f) = &o.quality else {
@@ -455,6 +536,8 @@ mod tests {
         assert_eq!(o.quality.penetration(), p);
         let summary = o.summary().unwrap();
         assert_eq!(summary["source"], keypoints.source.as_str());
+        assert_eq!(summary["posture"], posture.as_str());
+        assert_eq!(posture, "the joint route's angles");
         assert_eq!(
             summary["keypoints"]["ticks"].as_u64(),
             Some(run.quality.ticks as u64)
@@ -468,7 +551,8 @@ mod tests {
         let clip = crate::motion::builtin_clip("humanoid3d_walk").unwrap();
         let g1 = RobotProfile::builtin("g1").unwrap();
         let b = BatchRetarget::from_profile(g1, ImitateConfig::default()).unwrap();
-        let refs = b.posture(&clip, MotionFormat::DeepMimic).unwrap().unwrap();
+        let refs = b.posture(&clip, MotionFormat::DeepMimic).unwrap();
+        let refs = refs.references().unwrap();
         let dt = b.keypoints.dt;
         assert!(refs.len() > 1);
         assert!(((refs.len() - 1) as f64 * dt - clip.duration()).abs() <= dt);
@@ -476,7 +560,13 @@ mod tests {
         for n in &refs.joint_names {
             assert!(b.robot.joints().iter().any(|j| &j.name == n), "{n}");
         }
-        assert!(b.posture(&clip, MotionFormat::Bvh).unwrap().is_none());
+        let none = b.posture(&clip, MotionFormat::Bvh).unwrap();
+        assert!(none.references().is_none());
+        assert!(
+            none.describe().contains("no joint route"),
+            "{}",
+            none.describe()
+        );
     }
 
     #[test]
