@@ -46,12 +46,19 @@ pub fn run(a: &Args) -> Result<()> {
             .context("`planar3r` has no profile and cannot imitate a motion")?;
         let sc = &a.scenario;
         let bounds = crate::scenario::keypoint_bounds(sc);
+        let map = match &sc.map {
+            Some(spec) => Some(
+                iktc::sim::load_map(spec, &resolved.robot)
+                    .with_context(|| format!("--map `{spec}`"))?,
+            ),
+            None => None,
+        };
         return crate::cmd_keypoints::run(
             profile,
             &sc.motion,
             &sc.motion_options,
             &cfg,
-            bounds,
+            (bounds, map.as_ref()),
             &a.out,
         );
     }

@@ -42,15 +42,19 @@ fn load(
 }
 
 /// Runs the keypoint retargeting of `spec` on `profile` with the imitation's solver, period and
-/// tick limit from `cfg` and `bounds`, compares it with the joint route where the profile has a
-/// map for the clip's format, prints both and writes `keypoints_summary.json` and
+/// tick limit from `cfg` and `bounds`, compares it with the joint route where `map` (`--map`),
+/// else the profile's map for the clip's format, fits the clip (its angles are then the
+/// posture level's references too), prints both and writes `keypoints_summary.json` and
 /// `keypoints_trajectory.csv` to `out`.
 pub fn run(
     profile: &RobotProfile,
     spec: &str,
     options: &crate::cmd_map::MotionArgs,
     cfg: &ImitateConfig,
-    bounds: iktc::limits::BoundMethod,
+    (bounds, map): (
+        iktc::limits::BoundMethod,
+        Option<&iktc::motion::RetargetMap>,
+    ),
     out: &Path,
 ) -> Result<()> {
     let (kp, clip) = load(spec, options)?;
@@ -64,7 +68,7 @@ pub fn run(
     };
     let robot = profile.robot()?;
     let posture = match &clip {
-        Some((clip, format)) => posture_references(&robot, profile, clip, *format, None, cfg)?,
+        Some((clip, format)) => posture_references(&robot, profile, clip, *format, map, cfg)?,
         None => Posture::Start("the motion has no skeleton".into()),
     };
     if let Posture::Start(_) = &posture {

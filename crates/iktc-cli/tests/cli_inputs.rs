@@ -177,3 +177,48 @@ fn bad_files_are_errors() {
         "the model summary lists the warning: {text}"
     );
 }
+
+/// JVRC-1's built-in BVH map names a `Spine` joint CMU's rig lacks: keypoint retargeting runs
+/// from the start posture and says so; the same map given with `--map` is an error naming the
+/// joint.
+#[test]
+fn keypoints_on_a_rig_the_profile_map_does_not_fit() {
+    let clip = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../iktc/tests/data/motions/cmu/131_01.bvh"
+    );
+    let out = tmp("rig");
+    let o = run(&[
+        "imitate",
+        "--robot",
+        "jvrc1",
+        "--motion",
+        clip,
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success(),
+        "{text}{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(
+        text.contains("posture level: the start posture") && text.contains("Spine"),
+        "{text}"
+    );
+    assert_error(
+        &[
+            "imitate",
+            "--robot",
+            "jvrc1",
+            "--motion",
+            clip,
+            "--map",
+            "bvh_jvrc1",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        &["Spine"],
+    );
+}
