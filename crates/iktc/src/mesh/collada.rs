@@ -43,10 +43,10 @@ use std::collections::hash_map::Entry;
 use std::collections::HashMap;
 
 use nalgebra::{Matrix3, Matrix4, Rotation3, Unit, Vector3, Vector4};
-use quick_xml::events::{BytesStart, Event};
 
+use super::xml::{bad, by_url, count_attr, floats, indices, parse_tree, Element};
 use super::TriMesh;
-use crate::error::{Error, Result};
+use crate::error::Result;
 
 /// The deepest element nesting read \[elements\]; deeper files are refused (nodes are walked
 /// recursively, and real scenes nest a few dozen levels at most).
@@ -67,267 +67,6 @@ pub struct ColladaMesh {
     pub mesh: TriMesh,
     /// One line per part of the file left out (an `<instance_node>`, a `<ph>`, …).
     pub warnings: Vec<String>,
-}
-
-fn bad(name: &str, line: usize, message: impl Into<String>) -> Error {
-    Error::Parse {
-        source_name: name.into(),
-        line,
-        message: message.into(),
-    }
-}
-
-/// One XML element, with the 1-based line its start tag is on.
-#[derive(Debug, Default)]
-struct Element {
-    tag: String,
-    attrs: Vec<(String, String)>,
-    text: String,
-    children: Vec<Element>,
-    line: usize,
-}
-
-impl Element {
-    fn attr(&self, key: &str) -> Option<&str> {
-        self.attrs
-            .iter()
-            .find(|(k, _)| k == key)
-            .map(|(_, v)| v.as_str())
-    }
-
-    fn child(&self, tag: &str) -> Option<&Element> {
-        self.children.iter().find(|c| c.tag == tag)
-    }
-
-    fn all<'a>(&'a self, tag: &'a str) -> impl Iterator<Item = &'a Element> + 'a {
-        self.children.iter().filter(move |c| c.tag == tag)
-    }
-
-    /// `<tag id="…">` (or `<tag>`) for messages.
-    fn describe(&self) -> String {
-        match self.attr("id") {
-            Some(id) => format!("<{} id=\"{id}\">", self.tag),
-            None => format!("<{}>", self.tag),
-        }
-    }
-}
-
-/// The 1-based line of byte `pos` of `text`.
-fn line_at(text: &str, pos: usize) -> usize {
-    let end = pos.min(text.len());
-    text.as_bytes()[..end]
-        .iter()
-        .filter(|&&b| b == b'\n')
-        .count()
-        + 1
-}
-
-fn start_element(e: &BytesStart<'_>, line: usize, name: &str) -> Result<Element> {
-    let tag = String::from_utf8_lossy(e.local_name().as_ref()).into_owned();
-    let mut attrs = Vec::new();
-    for a in e.attributes() {
-        let a = a.map_err(|err| bad(name, line, format!("not well-formed XML: <{tag}>: {err}")))?;
-        let key = String::from_utf8_lossy(a.key.local_name().as_ref()).into_owned();
-        let value = a
-            .unescape_value()
-            .map_err(|err| {
-                bad(
-                    name,
-                    line,
-                    format!("not well-formed XML: <{tag} {key}>: {err}"),
-                )
-            })?
-            .into_owned();
-        attrs.push((key, value));
-    }
-    Ok(Element {
-        tag,
-        attrs,
-        line,
-        ..Element::default()
-    })
-}
-
-/// The element tree of `text` (without a loop of recursion: the depth is checked first).
-fn parse_tree(text: &str, name: &str) -> Result<Element> {
-    let mut reader = quick_xml::Reader::from_str(text);
-    let mut stack: Vec<Element> = Vec::new();
-    let mut root: Option<Element> = None;
-    let (mut line, mut counted) = (1usize, 0usize);
-    loop {
-        let pos = (reader.buffer_position() as usize).min(text.len());
-        let event = reader.read_event().map_err(|e| {
-            let at = line_at(text, reader.error_position() as usize);
-            bad(
-                name,
-                at,
-                format!("not a Collada file: not well-formed XML: {e}"),
-            )
-        })?;
-        let (start, empty) = match &event {
-            Event::Start(e) => (e, false),
-            Event::Empty(e) => (e, true),
-            Event::Text(t) => {
-                if let Some(top) = stack.last_mut() {
-                    let s = t.decode().map_err(|e| bad(name, line, e.to_string()))?;
-                    top.text.push_str(&s);
-                }
-                continue;
-            }
-            Event::CData(t) => {
-                if let Some(top) = stack.last_mut() {
-                    let s = t.decode().map_err(|e| bad(name, line, e.to_string()))?;
-                    top.text.push_str(&s);
-                }
-                continue;
-            }
-            Event::End(_) => {
-                if let Some(done) = stack.pop() {
-                    attach(&mut stack, &mut root, done, name)?;
-                }
-                continue;
-            }
-            Event::Eof => break,
-            _ => continue,
-        };
-        line += text.as_bytes()[counted..pos]
-            .iter()
-            .filter(|&&b| b == b'\n')
-            .count();
-        counted = pos;
-        let el = start_element(start, line, name)?;
-        if stack.len() >= MAX_DEPTH {
-            return Err(bad(
-                name,
-                line,
-                format!(
-                    "<{}> is nested {} elements deep; at most {MAX_DEPTH} are read",
-                    el.tag,
-                    stack.len() + 1
-                ),
-            ));
-        }
-        if empty {
-            attach(&mut stack, &mut root, el, name)?;
-        } else {
-            stack.push(el);
-        }
-    }
-    if let Some(open) = stack.last() {
-        return Err(bad(
-            name,
-            open.line,
-            format!(
-                "not a Collada file: <{}> is never closed (truncated?)",
-                open.tag
-            ),
-        ));
-    }
-    root.ok_or_else(|| bad(name, 0, "not a Collada file: no XML element at all"))
-}
-
-fn attach(
-    stack: &mut [Element],
-    root: &mut Option<Element>,
-    el: Element,
-    name: &str,
-) -> Result<()> {
-    if let Some(parent) = stack.last_mut() {
-        parent.children.push(el);
-    } else if root.is_none() {
-        *root = Some(el);
-    } else {
-        return Err(bad(
-            name,
-            el.line,
-            format!(
-                "not a Collada file: a second root element <{}> after the first",
-                el.tag
-            ),
-        ));
-    }
-    Ok(())
-}
-
-/// The finite numbers of `el`'s text, exactly `want` of them when given.
-fn floats(el: &Element, want: Option<usize>, name: &str) -> Result<Vec<f64>> {
-    let mut out = Vec::new();
-    for (k, w) in el.text.split_whitespace().enumerate() {
-        let x = w
-            .parse::<f64>()
-            .ok()
-            .filter(|x| x.is_finite())
-            .ok_or_else(|| {
-                bad(
-                    name,
-                    el.line,
-                    format!(
-                        "{}: number {k} is `{w}`, expected a finite number",
-                        el.describe()
-                    ),
-                )
-            })?;
-        out.push(x);
-    }
-    if let Some(n) = want.filter(|&n| n != out.len()) {
-        return Err(bad(
-            name,
-            el.line,
-            format!(
-                "{} holds {} numbers, expected {n}",
-                el.describe(),
-                out.len()
-            ),
-        ));
-    }
-    Ok(out)
-}
-
-/// The non-negative integers of `el`'s text.
-fn indices(el: &Element, name: &str) -> Result<Vec<usize>> {
-    el.text
-        .split_whitespace()
-        .map(|w| {
-            w.parse::<usize>().map_err(|_| {
-                bad(
-                    name,
-                    el.line,
-                    format!("<{}>: `{w}` is not a non-negative integer index", el.tag),
-                )
-            })
-        })
-        .collect()
-}
-
-/// Attribute `key` of `el` as a non-negative integer, `default` when absent.
-fn count_attr(el: &Element, key: &str, default: Option<usize>, name: &str) -> Result<usize> {
-    match (el.attr(key), default) {
-        (Some(v), _) => v.trim().parse::<usize>().map_err(|_| {
-            bad(
-                name,
-                el.line,
-                format!(
-                    "{}: {key}=\"{v}\" is not a non-negative integer",
-                    el.describe()
-                ),
-            )
-        }),
-        (None, Some(d)) => Ok(d),
-        (None, None) => Err(bad(
-            name,
-            el.line,
-            format!("{} has no `{key}` attribute", el.describe()),
-        )),
-    }
-}
-
-/// The element `url` (`#id`) names among `candidates`.
-fn by_url<'a>(candidates: &[&'a Element], url: &str) -> Option<&'a Element> {
-    let id = url.strip_prefix('#')?;
-    candidates
-        .iter()
-        .copied()
-        .find(|e| e.attr("id") == Some(id))
 }
 
 /// The positions of `source` \[file unit\]: three numbers per accessor element.
@@ -786,7 +525,7 @@ fn asset_transform(root: &Element, name: &str) -> Result<Matrix4<f64>> {
 /// Reads a Collada file's bytes; `name` names the source in errors.
 ///
 /// # Errors
-/// [`Error::Parse`] (naming the file, the line and the element) for bytes that are not XML or
+/// [`Error::Parse`](crate::error::Error::Parse) (naming the file, the line and the element) for bytes that are not XML or
 /// not Collada, a file without `<geometry>` or without triangles, a `<float_array>` whose
 /// `count` is not its number of values, a number that is not finite, an accessor or a `<p>`
 /// index beyond the positions, a `<p>` or `<vcount>` that does not fit its primitive, a
@@ -925,6 +664,7 @@ pub fn read_collada(bytes: &[u8], name: &str) -> Result<ColladaMesh> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::mesh::xml::line_at;
 
     /// Tolerance on coordinates and volumes computed in `f32` \[m, m³\]: a few ulps of the
     /// unit-sized values the tests use.

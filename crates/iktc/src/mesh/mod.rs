@@ -34,6 +34,8 @@ pub mod quantize;
 pub mod stl;
 #[cfg(feature = "urdf")]
 pub mod urdf;
+#[cfg(feature = "urdf")]
+mod xml;
 
 #[cfg(feature = "urdf")]
 pub use collada::{read_collada, ColladaMesh};
