@@ -569,6 +569,66 @@ mod tests {
         );
     }
 
+    /// At another output rate every frame is the linear interpolation of the two recorded
+    /// ticks around its time (slerp for the base orientation), recomputed here from the run,
+    /// and the frame count covers the run.
+    #[test]
+    fn other_output_rates_interpolate_the_recorded_ticks() {
+        let b = batch();
+        let o = b.retarget(&walk()).unwrap();
+        let ClipRun::Keypoints { run, .. } = &o.run else {
+            panic!("keypoint run")
+        };
+        let dt = b.keypoints.dt;
+        let (nqb, nb) = (b.robot.base_nq(), b.robot.base_nv());
+        let bodies = b.body_frames();
+        // Interpolation against recomputation: rounding of a few operations [rad, m].
+        const SAME: f64 = 1e-12;
+        for rate in [50.0, 37.5, 130.0] {
+            let t =
+                TrainingTrajectory::from_keypoint_run(&b.robot, run, dt, &bodies, rate).unwrap();
+            let span = run.times[run.times.len() - 1] - run.times[0];
+            assert_eq!(t.len(), (span * rate + 1e-9).floor() as usize + 1, "{rate}");
+            for (j, tj) in t.time.iter().enumerate() {
+                assert!((tj - (run.times[0] + j as f64 / rate)).abs() < SAME);
+                let x = (tj - run.times[0]) / dt;
+                let k = (x.floor() as usize).min(run.trajectory.len() - 1);
+                let k1 = (k + 1).min(run.trajectory.len() - 1);
+                let s = if k1 > k { x - k as f64 } else { 0.0 };
+                let (a, c) = (&run.trajectory[k], &run.trajectory[k1]);
+                for (d, q) in t.joint_pos[j].iter().enumerate() {
+                    let want = a[nqb + d] * (1.0 - s) + c[nqb + d] * s;
+                    assert!((q - want).abs() < SAME, "{rate} Hz frame {j} joint {d}");
+                }
+                let (va, vc) = (&run.velocities[k], &run.velocities[k1]);
+                for (d, v) in t.joint_vel[j].iter().enumerate() {
+                    let want = va[nb + d] * (1.0 - s) + vc[nb + d] * s;
+                    assert!((v - want).abs() < SAME, "{rate} Hz frame {j} rate {d}");
+                }
+                for i in 0..3 {
+                    let want = a[i] * (1.0 - s) + c[i] * s;
+                    assert!((t.base_pos[j][i] - want).abs() < SAME);
+                }
+                let quat = |q: &[f64]| {
+                    nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(
+                        q[6], q[3], q[4], q[5],
+                    ))
+                };
+                let want = quat(a).slerp(&quat(c), s);
+                let got = quat(&[
+                    0.0,
+                    0.0,
+                    0.0,
+                    t.base_quat_xyzw[j][0],
+                    t.base_quat_xyzw[j][1],
+                    t.base_quat_xyzw[j][2],
+                    t.base_quat_xyzw[j][3],
+                ]);
+                assert!(want.angle_to(&got) < 1e-9, "{rate} Hz frame {j}");
+            }
+        }
+    }
+
     #[test]
     fn a_keypoint_run_of_the_wrong_shape_is_an_error() {
         let b = batch();
