@@ -189,18 +189,7 @@ fn g1_mesh_viewer_draws_the_robot() {
     let out = dir.join("run");
     let clip = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../iktc/data/motions/deepmimic/humanoid3d_walk.txt");
-    let run = Command::new(env!("CARGO_BIN_EXE_iktc"))
-        .arg("retarget")
-        .arg(&clip)
-        .args(["--robot", "g1", "--jobs", "1", "--out"])
-        .arg(&out)
-        .output()
-        .unwrap();
-    assert!(
-        run.status.success(),
-        "iktc retarget failed: {}",
-        String::from_utf8_lossy(&run.stderr)
-    );
+    retarget_g1(&clip, &out);
     let page = out.join("humanoid3d_walk").join("viewer.html");
     let html = std::fs::read_to_string(&page).unwrap();
     assert!(
@@ -240,6 +229,22 @@ fn g1_mesh_viewer_draws_the_robot() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// `iktc retarget CLIP --robot g1 --jobs 1 --out OUT`, which must succeed.
+fn retarget_g1(clip: &Path, out: &Path) {
+    let run = Command::new(env!("CARGO_BIN_EXE_iktc"))
+        .arg("retarget")
+        .arg(clip)
+        .args(["--robot", "g1", "--jobs", "1", "--out"])
+        .arg(out)
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "iktc retarget failed: {}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+}
+
 /// The robot's screen box (x0, y0, x1, y1, page pixels) the page at `url` reports.
 fn robot_box(browser: &Path, dir: &Path, url: &str, tag: &str) -> Vec<i64> {
     let dom = Command::new(browser)
@@ -274,18 +279,7 @@ fn a_travelling_clip_stays_in_view() {
     // CMU 131_01: the subject walks about 2 m.
     let clip =
         Path::new(env!("CARGO_MANIFEST_DIR")).join("../iktc/tests/data/motions/cmu/131_01.bvh");
-    let run = Command::new(env!("CARGO_BIN_EXE_iktc"))
-        .arg("retarget")
-        .arg(&clip)
-        .args(["--robot", "g1", "--jobs", "1", "--out"])
-        .arg(&out)
-        .output()
-        .unwrap();
-    assert!(
-        run.status.success(),
-        "iktc retarget failed: {}",
-        String::from_utf8_lossy(&run.stderr)
-    );
+    retarget_g1(&clip, &out);
     let page = out.join("131_01").join("viewer.html");
     let html = std::fs::read_to_string(&page).unwrap();
     // The last second of the clip (8.3 s).

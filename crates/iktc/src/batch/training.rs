@@ -73,16 +73,21 @@ struct Tick<'a> {
 /// The base pose a fixed-base robot records: at the origin, not rotated.
 const FIXED_BASE: [f64; 7] = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0];
 
-fn check_rate(rate: f64) -> Result<()> {
-    check_finite(|| "output rate [Hz]".to_string(), rate)?;
-    if rate <= 0.0 {
+/// `value` finite and positive, else an error naming `name` and saying `expected`.
+fn check_positive(name: &str, value: f64, expected: &str) -> Result<()> {
+    check_finite(|| name.to_string(), value)?;
+    if value <= 0.0 {
         return Err(Error::InvalidSetting {
-            name: "output rate [Hz]".into(),
-            value: rate.to_string(),
-            expected: "a rate > 0".into(),
+            name: name.into(),
+            value: value.to_string(),
+            expected: expected.into(),
         });
     }
     Ok(())
+}
+
+fn check_rate(rate: f64) -> Result<()> {
+    check_positive("output rate [Hz]", rate, "a rate > 0")
 }
 
 fn no_tick() -> Error {
@@ -101,9 +106,6 @@ impl TrainingTrajectory {
     /// frame the robot lacks.
     pub fn from_run(robot: &Robot, run: &ImitateRun, bodies: &[String], rate: f64) -> Result<Self> {
         check_rate(rate)?;
-        if run.steps.is_empty() {
-            return Err(no_tick());
-        }
         let nb = robot.base_nv();
         let ticks: Vec<Tick> = run
             .steps
@@ -138,9 +140,6 @@ impl TrainingTrajectory {
         rate: f64,
     ) -> Result<Self> {
         check_rate(rate)?;
-        if run.trajectory.is_empty() {
-            return Err(no_tick());
-        }
         let (nqb, nq, nv) = (robot.base_nq(), robot.nq(), robot.nv());
         for (what, expected, got) in [
             (
@@ -202,14 +201,7 @@ impl TrainingTrajectory {
         let (Some(first), Some(last)) = (steps.first(), steps.last()) else {
             return Err(no_tick());
         };
-        check_finite(|| "control period [s]".to_string(), dt)?;
-        if dt <= 0.0 {
-            return Err(Error::InvalidSetting {
-                name: "control period [s]".into(),
-                value: dt.to_string(),
-                expected: "a period > 0".into(),
-            });
-        }
+        check_positive("control period [s]", dt, "a period > 0")?;
         let frame_ids = bodies
             .iter()
             .map(|b| robot.frame_id(b))
