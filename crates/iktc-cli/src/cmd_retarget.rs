@@ -13,7 +13,9 @@ use std::path::{Path, PathBuf};
 use std::time::{Instant, SystemTime};
 
 use anyhow::{Context, Result};
-use iktc::batch::{run_parallel, BatchRetarget, ClipOutcome, ClipRun, RetargetMethod};
+use iktc::batch::{
+    longest_first, run_parallel_in, BatchRetarget, ClipOutcome, ClipRun, RetargetMethod,
+};
 use iktc::mesh::MeshSet;
 use iktc::profile::glob_match;
 use iktc::sim::viewer::imitation_viewer;
@@ -170,8 +172,13 @@ pub fn run(a: &Args) -> Result<()> {
     };
     let viewer = (!a.no_viewer).then_some(meshes.as_ref());
     let mut progress = Progress::new(&todo, skipped.len());
-    run_parallel(
+    // The longest clips first (by file size), so that a long clip does not run alone at the end.
+    let order = longest_first(&todo, |c| {
+        std::fs::metadata(&c.path).map(|m| m.len()).unwrap_or(0)
+    });
+    run_parallel_in(
         &todo,
+        &order,
         jobs,
         |_, c| {
             let start = Instant::now();

@@ -3,14 +3,15 @@
 //! rate by the default route, keypoints ([`BatchRetarget::retarget`]), and write its CSV, NPZ
 //! and quality JSON (the viewer page, which the command line adds, is not included). Criterion
 //! reports the time of the whole batch with 1 and 2 worker threads; the throughput element is
-//! one 200 Hz frame. Then, in the same process, the 1 → 2 job scaling: five alternating
+//! one 200 Hz frame. Clips are taken longest first ([`longest_first`], by file size), as the
+//! command line does. Then, in the same process, the 1 → 2 job scaling: five alternating
 //! timings of each, the ratio of their medians printed as `scaling`.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use iktc::batch::{run_parallel, BatchRetarget};
+use iktc::batch::{longest_first, run_parallel_in, BatchRetarget};
 use iktc::profile::RobotProfile;
 use iktc::sim::ImitateConfig;
 
@@ -36,8 +37,12 @@ fn clips() -> Vec<PathBuf> {
 /// frames written.
 fn batch(b: &BatchRetarget, clips: &[PathBuf], jobs: usize, out: &Path) -> usize {
     let mut frames = 0;
-    run_parallel(
+    let order = longest_first(clips, |p| {
+        std::fs::metadata(p).map(|m| m.len()).unwrap_or(0)
+    });
+    run_parallel_in(
         clips,
+        &order,
         jobs,
         |i, path| {
             let o = b.retarget(path).expect("retarget");

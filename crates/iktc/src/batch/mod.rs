@@ -2,7 +2,7 @@
 //! keypoints or joint angles),
 //! its outputs for training code ([`TrainingTrajectory`] as CSV and NPZ, written by
 //! [`npz`] without a dependency), its quality figures ([`ClipQuality`]), and a pool of worker
-//! threads over the clips ([`run_parallel`]). Files, progress and the dataset report are the
+//! threads over the clips ([`run_parallel`], the longest clips first with [`longest_first`]). Files, progress and the dataset report are the
 //! command line's (`iktc retarget`).
 
 pub mod npz;
@@ -12,7 +12,7 @@ pub mod retarget;
 pub mod training;
 
 pub use npz::{crc32, npz_bytes, zip_stored, NpyArray, NpyData};
-pub use pool::run_parallel;
+pub use pool::{longest_first, run_parallel, run_parallel_in};
 pub use quality::{
     run_penetration, sole_penetration, trajectory_penetration, ClipQuality, JointFigures,
     KeypointFigures, Penetration, MARGIN_ROUNDING, PENETRATION_TOLERANCE,
