@@ -52,19 +52,18 @@ where
         for _ in 0..workers {
             let tx = tx.clone();
             let (next, work) = (&next, &work);
-            scope.spawn(move || loop {
-                let Some(&i) = order.get(next.fetch_add(1, Ordering::Relaxed)) else {
-                    break;
-                };
-                let Some(item) = items.get(i) else { continue };
-                let r = catch_unwind(AssertUnwindSafe(|| work(i, item))).map_err(|p| {
-                    p.downcast_ref::<&str>()
-                        .map(|s| s.to_string())
-                        .or_else(|| p.downcast_ref::<String>().cloned())
-                        .unwrap_or_else(|| "a worker panicked".into())
-                });
-                if tx.send((i, r)).is_err() {
-                    break;
+            scope.spawn(move || {
+                while let Some(&i) = order.get(next.fetch_add(1, Ordering::Relaxed)) {
+                    let Some(item) = items.get(i) else { continue };
+                    let r = catch_unwind(AssertUnwindSafe(|| work(i, item))).map_err(|p| {
+                        p.downcast_ref::<&str>()
+                            .map(|s| s.to_string())
+                            .or_else(|| p.downcast_ref::<String>().cloned())
+                            .unwrap_or_else(|| "a worker panicked".into())
+                    });
+                    if tx.send((i, r)).is_err() {
+                        break;
+                    }
                 }
             });
         }
