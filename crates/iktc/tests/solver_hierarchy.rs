@@ -288,6 +288,58 @@ fn g_is_the_derivative_of_the_solution_with_respect_to_h() {
 }
 
 #[test]
+fn levels_with_no_coordinate_left_have_rank_zero_and_zero_columns_of_g() {
+    // n = 9 and the levels ask for 4 + 3 + 4 + 2 rows: the third keeps 2 of its 4 rows, the
+    // fourth gets none. The solution is the projector recursion's, and G is still the
+    // derivative of the solution with respect to every h (the fourth level's columns zero),
+    // built level by level, all at once, or over a range that starts at the empty level.
+    let mut r = rng(43);
+    let (n, dims) = (9, [4, 3, 4, 2]);
+    for case in 0..20 {
+        let mut levels = random_levels(&mut r, n, &dims);
+        let settings = SolverSettings::default();
+        let mut h = Hierarchy::new(n, &dims);
+        let mut q0 = DVector::zeros(n);
+        h.solve(&levels, &settings, &mut q0).unwrap();
+        assert_eq!(h.ranks(), &[4, 3, 2, 0], "case {case}");
+        let want = reference_solution(&levels, 0.0);
+        assert!(
+            (&q0 - &want).norm() < 1e-8 * (1.0 + want.norm()),
+            "case {case}"
+        );
+        // Poison G first: every column must be written.
+        h.build_g_levels(0, dims.len());
+        match case % 3 {
+            0 => (0..dims.len()).for_each(|i| h.build_g_level(i)),
+            1 => h.build_g_levels(0, dims.len()),
+            _ => {
+                h.build_g_levels(3, 4);
+                h.build_g_levels(0, 3);
+            }
+        }
+        let g = h.g().clone();
+        assert!(g.columns(11, 2).iter().all(|x| *x == 0.0), "case {case}");
+        let mut col = 0;
+        for i in 0..dims.len() {
+            for j in 0..dims[i] {
+                levels[i].rhs[j] += 1.0;
+                let mut q1 = DVector::zeros(n);
+                Hierarchy::new(n, &dims)
+                    .solve(&levels, &settings, &mut q1)
+                    .unwrap();
+                levels[i].rhs[j] -= 1.0;
+                let d = &q1 - &q0;
+                assert!(
+                    (&d - g.column(col)).norm() < 1e-9 * (1.0 + d.norm()),
+                    "case {case} level {i} row {j}"
+                );
+                col += 1;
+            }
+        }
+    }
+}
+
+#[test]
 fn pinv_is_the_pseudo_inverse_of_the_projected_jacobian() {
     // J̄_i⁺ = (J_i N_{i−1})⁺ with N_{i−1} = I − A⁺A from the stacked Jacobian A of the levels
     // above, by SVD (λ = 0), against the matrix the factorization forms on request.

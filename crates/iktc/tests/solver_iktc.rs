@@ -81,6 +81,58 @@ fn iktc_brings_the_solution_into_the_box_with_the_least_correction_from_the_bott
     );
 }
 
+/// Levels reached with no coordinate left (the levels above use all n) have rank 0: they move
+/// nothing, and IKTC's correction of them is zero. The solver then leaves them out of the
+/// correction QP and of G's product; the answer must equal that of the same problem without
+/// those levels, with their corrections zero and their task errors what the others leave.
+#[test]
+fn levels_with_no_coordinate_left_change_nothing() {
+    let mut r = rng(41);
+    let n = 12;
+    let dims = [6, 4, 3, 5];
+    let live = [6, 4, 3];
+    let mut corrected = [0usize; 3];
+    for case in 0..300 {
+        let levels = random_levels(&mut r, n, &dims);
+        let mut s = Solver::new(n, &dims, SolverSettings::default()).unwrap();
+        let mut s_live = Solver::new(n, &live, SolverSettings::default()).unwrap();
+        let mut q0 = DVector::zeros(n);
+        s.solve(Method::Prioritized, &levels, &wide_box(n), &mut q0)
+            .unwrap();
+        assert_eq!(
+            s.report().ranks[3],
+            0,
+            "case {case}: the last level has no coordinate"
+        );
+        let bx = box_violated_by(&mut r, &q0, 2.0, 1 + case % 5, 0.5);
+        // Twice, so that the second solve starts from the first one's level and active set.
+        for pass in 0..2 {
+            let mut q = DVector::zeros(n);
+            let rep = s.solve(Method::Iktc, &levels, &bx, &mut q).unwrap().clone();
+            let mut q_live = DVector::zeros(n);
+            let rep_live = s_live
+                .solve(Method::Iktc, &levels[..3], &bx, &mut q_live)
+                .unwrap()
+                .clone();
+            let scale = 1.0 + q_live.amax();
+            assert!(
+                (&q - &q_live).amax() < 1e-9 * scale,
+                "case {case} pass {pass}: {:e}",
+                (&q - &q_live).amax()
+            );
+            assert_eq!(rep.fallback, rep_live.fallback, "case {case} pass {pass}");
+            assert_eq!(rep.corrected_from, rep_live.corrected_from, "case {case}");
+            if let Some(from) = rep.corrected_from {
+                corrected[from] += 1;
+                assert!(rep.corrections[3].iter().all(|c| *c == 0.0), "case {case}");
+                assert!(bx.contains(q.as_slice(), 1e-8).unwrap(), "case {case}");
+            }
+        }
+    }
+    // Corrections from every live level were exercised.
+    assert!(corrected.iter().all(|c| *c > 10), "{corrected:?}");
+}
+
 /// Lexicographic comparison with a tolerance: GF's level errors are never worse than IKTC's at
 /// the first level where they differ (errata 3.2: IKTC's single QP is not lexicographic).
 #[test]
@@ -178,7 +230,8 @@ fn empty_box_and_infeasible_problems_take_a_reported_fallback() {
         q[2],
         q[5]
     );
-    // Rank loss: a zero Jacobian on the only level leaves G = 0: no level is feasible.
+    // Rank loss: a zero Jacobian on the only level leaves G = 0: no level is feasible, and a
+    // level of rank 0 is known to be without a QP (it moves nothing).
     let mut zero = random_levels(&mut r, 3, &[2]);
     zero[0].jacobian.fill(0.0);
     let mut s = Solver::new(3, &[2], SolverSettings::default()).unwrap();
@@ -188,7 +241,8 @@ fn empty_box_and_infeasible_problems_take_a_reported_fallback() {
     let mut q = DVector::zeros(3);
     let rep = s.solve(Method::Iktc, &zero, &bx, &mut q).unwrap();
     assert_eq!(rep.fallback, Some(Fallback::ClampedToBox));
-    assert_eq!(rep.qp_infeasible, 1);
+    assert_eq!(rep.ranks, vec![0]);
+    assert_eq!((rep.qp_solves, rep.qp_infeasible), (0, 0));
     assert_eq!(q[0], 1.0);
 }
 

@@ -31,6 +31,12 @@
 //! reached). At the end q̈ = Q u. Cost: one Householder reduction of the stacked Jacobian, O(n² Σm_i),
 //! instead of the O(n² Σm_i) products with an explicit basis on top of it; no SVD.
 //!
+//! A level reached with no coordinate left (p_i = n: the levels above use every degree of
+//! freedom, as the posture level of the keypoint stack on G1 does on every tick) has rank 0 and
+//! moves nothing: its rows are not reduced, its columns of G are zero and are not computed, and
+//! the solver leaves such levels at the bottom out of IKTC's correction QP (their corrections
+//! are zero at its optimum).
+//!
 //! Algorithm 1 builds G = \[g_1 … g_{n_T}\] with g_i = (Π_{k>i} (I − J̄_k^{λ+} J_k)) J̄_i^{λ+},
 //! which is ∂q̈/∂h_i: adding corrections Δh to the right-hand sides changes the solution by
 //! G Δh (eq. 20). In reduced coordinates it is the same forward substitution as the solution,
@@ -246,15 +252,18 @@ impl Hierarchy {
         let (n, m, p) = (self.n, self.dims[i], self.refl.len());
         let k = n - p;
         self.ranks[i] = 0;
+        if m == 0 || k == 0 {
+            // No coordinate left (the levels above took all n) or no row: rank 0, and W_i is
+            // never read (the residual, the reduced blocks and the propagation into lower
+            // levels all skip a level of rank 0), so its rows are not reduced.
+            return;
+        }
         let (off, wld) = (self.offsets[i], self.wld);
         // The rows of this level under the reflectors of the levels above:
         // W_i = J_i H_0 ⋯ H_{p−1}, applied when the level is reached (left-looking), in the
         // blocks of four of all levels above at once, to all the level's rows together.
         self.refl
             .apply_forward_rows(p, &mut self.w, wld, off, m, &mut self.qscratch);
-        if m == 0 || k == 0 {
-            return;
-        }
         let ar = self.a.nrows();
         {
             let asl = self.a.as_mut_slice();
@@ -424,33 +433,56 @@ impl Hierarchy {
 
     /// Builds the blocks g_i of the levels `from..to` together: each level's reduced block,
     /// then Q applied once to all their columns (one pass over the reflectors instead of one
-    /// per level). Allocates nothing.
+    /// per level). A level of rank 0 moves nothing (g_i = 0, nor does any level below it
+    /// respond): its columns are zeroed, not computed. Allocates nothing.
     pub fn build_g_levels(&mut self, from: usize, to: usize) {
         let n = self.n;
         let to = to.min(self.dims.len());
         if from >= to {
             return;
         }
-        let (c0, width) = (self.offsets[from], self.offsets[to - 1] + self.dims[to - 1]);
-        let w = width - c0;
+        // The columns of the levels of rank > 0, side by side in `yall` (w of them).
+        let mut w = 0;
+        for i in from..to {
+            if self.ranks[i] > 0 {
+                w += self.dims[i];
+            } else {
+                let (c, m) = (self.offsets[i], self.dims[i]);
+                self.g.as_mut_slice()[c * n..(c + m) * n].fill(0.0);
+            }
+        }
         if w == 0 {
             return;
         }
+        let mut co = 0;
         for i in from..to {
-            let (m, co) = (self.dims[i], self.offsets[i] - c0);
+            let m = self.dims[i];
+            if self.ranks[i] == 0 {
+                continue;
+            }
             self.reduced_block(i, true);
             for d in 0..n {
                 self.yall[d * w + co..d * w + co + m].copy_from_slice(&self.yb[d * m..(d + 1) * m]);
             }
+            co += m;
         }
         // G = Q Y on the rows of Y, then into the columns of G.
         self.refl
             .apply_q_rows(&mut self.yall[..n * w], w, &mut self.qscratch);
-        let gs = &mut self.g.as_mut_slice()[c0 * n..width * n];
-        for (c, col) in gs.chunks_exact_mut(n).enumerate() {
-            for (d, x) in col.iter_mut().enumerate() {
-                *x = self.yall[d * w + c];
+        let mut co = 0;
+        for i in from..to {
+            let m = self.dims[i];
+            if self.ranks[i] == 0 {
+                continue;
             }
+            let c0 = self.offsets[i];
+            let gs = &mut self.g.as_mut_slice()[c0 * n..(c0 + m) * n];
+            for (c, col) in gs.chunks_exact_mut(n).enumerate() {
+                for (d, x) in col.iter_mut().enumerate() {
+                    *x = self.yall[d * w + co + c];
+                }
+            }
+            co += m;
         }
     }
 }

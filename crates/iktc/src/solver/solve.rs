@@ -347,11 +347,21 @@ impl Solver {
     }
 
     /// Solves the correction QP of levels i..n_T into `xs[i]` (G blocks of those levels built);
-    /// true when it is feasible. Counts the QP in the report.
+    /// true when it is feasible. Counts the QP in the report. Levels of rank 0 at the bottom
+    /// (zero columns of G) are left out of the QP and get a zero correction, which is their
+    /// value at the QP's optimum; when only such levels remain, no QP is run and the level is
+    /// infeasible (q̈ is outside the box and they cannot move it).
     fn level_feasible(&mut self, i: usize) -> Result<bool> {
         let off = self.hierarchy.offset(i);
-        let total: usize = self.hierarchy.dims().iter().sum();
-        let ma = total - off;
+        // The corrections of levels of rank 0 below the last level of rank > 0 move nothing
+        // (their columns of G are zero) and are zero at the optimum: the QP is over the others.
+        let (dims, ranks) = (self.hierarchy.dims(), self.hierarchy.ranks());
+        let live_end = (i..dims.len())
+            .rev()
+            .find(|&k| ranks[k] > 0)
+            .map_or(off, |k| self.hierarchy.offset(k) + dims[k]);
+        let ma = live_end - off;
+        self.xs[i].fill(0.0);
         if ma == 0 {
             // Nothing to correct: feasible only if already inside, which it is not.
             return Ok(false);
@@ -366,7 +376,7 @@ impl Solver {
                 &self.qp_lo,
                 &self.qp_hi,
                 self.settings.qp.feasibility_tolerance,
-                self.xs[i].as_mut_slice(),
+                &mut self.xs[i].as_mut_slice()[..ma],
             )
         {
             self.report.qp_solves += 1;
@@ -418,9 +428,11 @@ impl Solver {
             lower: &self.qp_lo,
             upper: &self.qp_hi,
         };
-        let rep = self
-            .qp
-            .solve(&problem, &self.settings.qp, &mut self.xs[i])?;
+        let rep = self.qp.solve_into(
+            &problem,
+            &self.settings.qp,
+            &mut self.xs[i].as_mut_slice()[..ma],
+        )?;
         self.report.qp_solves += 1;
         self.report.qp_iterations += rep.iterations;
         if rep.status == QpStatus::Optimal {

@@ -192,6 +192,16 @@ impl QpWorkspace {
         settings: &QpSettings,
         x: &mut DVector<f64>,
     ) -> Result<QpReport> {
+        self.solve_into(problem, settings, x.as_mut_slice())
+    }
+
+    /// [`QpWorkspace::solve`] into a slice of length `n`.
+    pub fn solve_into(
+        &mut self,
+        problem: &QpProblem<'_>,
+        settings: &QpSettings,
+        x: &mut [f64],
+    ) -> Result<QpReport> {
         settings.validate()?;
         let dims = problem.check(self.capacity, settings)?;
         check_dim("length of x", dims.n, x.len())?;
@@ -214,7 +224,6 @@ impl QpWorkspace {
                 self.basis.reset_from_factor(self.chol.as_slice(), n);
             }
         }
-        let x = x.as_mut_slice();
         // Unconstrained minimum x₀ = −H⁻¹ c = −J Jᵀ c (J = L⁻ᵀ while nothing is active).
         self.basis.project(problem.c, self.d.as_mut_slice());
         self.basis.primal_direction(self.d.as_slice(), x);
