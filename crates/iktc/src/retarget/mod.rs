@@ -430,7 +430,6 @@ pub fn retarget_keypoints_on(
     }
     let ticks = controller.ticks();
     let mut rec = QualityRecorder::new("keypoints", &body, s.dt);
-    let mut kin = Kinematics::new(&robot, controller.state())?;
     let mut trajectory = Vec::with_capacity(ticks);
     let mut velocities = Vec::with_capacity(ticks);
     let mut times = Vec::with_capacity(ticks);
@@ -446,9 +445,10 @@ pub fn retarget_keypoints_on(
         let on = controller.stance();
         stance[0].push(on[0]);
         stance[1].push(on[1]);
+        // The tick's controller prepared its kinematics at `state`.
         rec.record(
             &robot,
-            &mut kin,
+            controller.controller().kinematics(),
             &body,
             plan,
             &support,
@@ -510,9 +510,10 @@ pub fn joint_route_quality(
     for k in 0..plan.ticks.min(refs.len()) {
         let state = ctl.state().clone();
         ctl.tick(robot, k)?;
+        kin.update(robot, &state)?;
         rec.record(
             robot,
-            &mut kin,
+            &kin,
             &setup.body,
             plan,
             &setup.support,

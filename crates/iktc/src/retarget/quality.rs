@@ -117,13 +117,13 @@ impl QualityRecorder {
         }
     }
 
-    /// Records tick `k` of `plan`: the state at its start and the q̈ applied over it; `stance`
-    /// says which feet are held on the ground (for the slip).
+    /// Records tick `k` of `plan`: the state at its start (`kin` updated at it) and the q̈ applied
+    /// over it; `stance` says which feet are held on the ground (for the slip).
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn record(
         &mut self,
         robot: &Robot,
-        kin: &mut Kinematics,
+        kin: &Kinematics,
         body: &RobotBody,
         plan: &Plan,
         support: &SupportSettings,
@@ -131,7 +131,6 @@ impl QualityRecorder {
         state: &State,
         qdd: &[f64],
     ) -> Result<()> {
-        kin.update(robot, state)?;
         let pelvis = kin.frame_pose(robot, body.pelvis)?;
         for ((p, sum, max), (f_p, f)) in self.sums.iter_mut().zip(&body.points) {
             debug_assert_eq!(p, f_p);
