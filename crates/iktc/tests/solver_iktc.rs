@@ -133,6 +133,105 @@ fn levels_with_no_coordinate_left_change_nothing() {
     assert!(corrected.iter().all(|c| *c > 10), "{corrected:?}");
 }
 
+/// Levels of lower rank than rows: IKTC's QP runs over the r_i corrections of each level that
+/// move q̈ (the correction map), not over all m_i. Its answer must be the least correction of
+/// eq. (23) over all m_i: checked against that QP solved directly on Algorithm 1's G
+/// (Hierarchy::build_g_levels, every column), at the level IKTC chose, which must also be the
+/// lowest feasible one. Damped and undamped; levels made rank-deficient by repeated rows and
+/// by running out of coordinates.
+#[test]
+fn the_correction_over_the_row_space_is_the_least_correction_over_all_rows() {
+    let mut r = rng(47);
+    let n = 14;
+    let dims = [5, 4, 6, 7];
+    let mut checked = [0usize; 4];
+    for case in 0..300 {
+        let mut levels = random_levels(&mut r, n, &dims);
+        // Level 2 repeats two rows of level 1 and two of its own: rank 2 of 6 (with 5 + 4 = 9
+        // above, 5 coordinates left); level 3 gets 3 of its 7.
+        let l0 = levels[0].jacobian.rows(0, 2).into_owned();
+        levels[2].jacobian.rows_mut(0, 2).copy_from(&l0);
+        let own = levels[2].jacobian.rows(2, 2).into_owned();
+        levels[2].jacobian.rows_mut(4, 2).copy_from(&own);
+        let settings = SolverSettings {
+            damping: if case % 2 == 0 {
+                Damping::None
+            } else {
+                Damping::Fixed(0.05)
+            },
+            ..Default::default()
+        };
+        let mut s = Solver::new(n, &dims, settings).unwrap();
+        let mut q0 = DVector::zeros(n);
+        s.solve(Method::Prioritized, &levels, &wide_box(n), &mut q0)
+            .unwrap();
+        let ranks = s.report().ranks.clone();
+        assert_eq!(ranks, vec![5, 4, 2, 3], "case {case}");
+        let bx = box_violated_by(&mut r, &q0, 2.0, 1 + case % 6, 0.5);
+        let mut q = DVector::zeros(n);
+        let rep = s.solve(Method::Iktc, &levels, &bx, &mut q).unwrap().clone();
+        let Some(from) = rep.corrected_from else {
+            continue;
+        };
+        // The oracle: G over all rows, the QP of eq. (23) over all m_i of levels i..n_T.
+        let mut h = Hierarchy::new(n, &dims);
+        let mut p = DVector::zeros(n);
+        h.solve(&levels, &settings, &mut p).unwrap();
+        h.build_g_levels(0, dims.len());
+        let lo: Vec<f64> = (0..n).map(|d| bx.lower[d] - p[d]).collect();
+        let hi: Vec<f64> = (0..n).map(|d| bx.upper[d] - p[d]).collect();
+        let oracle = |i: usize| {
+            let off: usize = dims[..i].iter().sum();
+            let m: usize = dims[i..].iter().sum();
+            let g = h.g().columns(off, m);
+            let zeros = vec![0.0; m];
+            let a_eq = nalgebra::DMatrix::<f64>::zeros(0, m);
+            let problem = QpProblem {
+                hessian: Hessian::Identity,
+                c: &zeros,
+                a_eq: a_eq.rows(0, 0),
+                b_eq: &[],
+                a_in: g,
+                lower: &lo,
+                upper: &hi,
+            };
+            let mut qp = QpWorkspace::new(m, 0, n);
+            let mut x = DVector::zeros(m);
+            let rep = qp.solve(&problem, &QpSettings::default(), &mut x).unwrap();
+            (rep.status == QpStatus::Optimal).then_some(x)
+        };
+        let x = oracle(from).unwrap_or_else(|| panic!("case {case}: level {from} infeasible"));
+        if from + 1 < dims.len() {
+            assert!(
+                oracle(from + 1).is_none(),
+                "case {case}: level {} was feasible",
+                from + 1
+            );
+        }
+        let off: usize = dims[..from].iter().sum();
+        let m: usize = dims[from..].iter().sum();
+        let want = &p + h.g().columns(off, m) * &x;
+        let scale = 1.0 + want.amax();
+        assert!(
+            (&q - &want).amax() < 1e-7 * scale,
+            "case {case}: {:e}",
+            (&q - &want).amax()
+        );
+        // The same corrections Δh, level by level.
+        let mut c = 0;
+        for k in from..dims.len() {
+            let d = (&rep.corrections[k] - x.rows(c, dims[k])).amax();
+            assert!(d < 1e-7 * (1.0 + x.amax()), "case {case} level {k}: {d:e}");
+            c += dims[k];
+        }
+        checked[from] += 1;
+    }
+    assert!(
+        checked[2] + checked[3] > 30,
+        "rank-deficient levels corrected: {checked:?}"
+    );
+}
+
 /// Lexicographic comparison with a tolerance: GF's level errors are never worse than IKTC's at
 /// the first level where they differ (errata 3.2: IKTC's single QP is not lexicographic).
 #[test]

@@ -34,8 +34,16 @@
 //! A level reached with no coordinate left (p_i = n: the levels above use every degree of
 //! freedom, as the posture level of the keypoint stack on G1 does on every tick) has rank 0 and
 //! moves nothing: its rows are not reduced, its columns of G are zero and are not computed, and
-//! the solver leaves such levels at the bottom out of IKTC's correction QP (their corrections
-//! are zero at its optimum).
+//! it has no column in IKTC's correction QP (its correction is zero at the optimum).
+//!
+//! IKTC's correction QP (eq. 23) needs G only through the changes of h that move q̈. Level i
+//! moves q̈ through J̄_i^{λ+} = Z Q_r S_i⁻¹ R_r Πᵀ, whose row space is that of R_r Πᵀ (S_i is
+//! invertible): r_i dimensions. With R_rᵀ = V T (Householder QR, V m_i × r_i orthonormal) and
+//! U_i = Π V, a correction Δh_i = U_i z_i + w with w ⊥ U_i moves q̈ by g_i U_i z_i and costs
+//! ‖z_i‖² + ‖w‖²: the least correction has w = 0. The correction map holds g_i U_i (r_i
+//! columns) for a level with r_i < m_i, g_i for a full-rank one and nothing at rank 0
+//! ([`Hierarchy::build_correction_map`]); it is built as G is, with U_i as the level's
+//! right-hand sides in place of the identity.
 //!
 //! Algorithm 1 builds G = \[g_1 … g_{n_T}\] with g_i = (Π_{k>i} (I − J̄_k^{λ+} J_k)) J̄_i^{λ+},
 //! which is ∂q̈/∂h_i: adding corrections Δh to the right-hand sides changes the solution by
@@ -95,6 +103,8 @@ pub struct Hierarchy {
     x: Vec<f64>,
     /// G, n × Σm_i, blocks in level order; columns of level i valid once built.
     g: DMatrix<f64>,
+    /// The correction map ([`Hierarchy::build_correction_map`]), n × Σ widths.
+    gc: DMatrix<f64>,
     /// J̄_i^{λ+} formed on request ([`Hierarchy::pinv`]); never in the tick.
     pinv: Vec<DMatrix<f64>>,
 }
@@ -131,6 +141,7 @@ impl Hierarchy {
             res: vec![0.0; mmax],
             x: vec![0.0; mmax],
             g: DMatrix::zeros(n, total.max(1)),
+            gc: DMatrix::zeros(n, total.max(1)),
             pinv: dims.iter().map(|&m| DMatrix::zeros(n, m)).collect(),
         }
     }
@@ -369,26 +380,45 @@ impl Hierarchy {
             col[top..rank].fill(0.0);
         }
         f.factor(rank, m, lambda2);
+        f.row_space(rank, m);
     }
 
     /// Writes into `yb` (row-major n × m_i, rows p_i.. written, the rows above zero) the
     /// reduced-coordinate change of q̈ caused by unit changes of the rows of h_i: level i's own
     /// step (J̄_i⁺ in reduced coordinates), then, if `propagate`, every lower level's response
     /// (g_i). All m_i columns at once: each step is a row operation on m_i-long rows.
-    fn reduced_block(&mut self, i: usize, propagate: bool) {
-        let (n, nc, r, p) = (self.n, self.dims[i], self.ranks[i], self.starts[i]);
+    ///
+    /// With `in_basis` and 0 < r_i < m_i the right-hand sides are instead the r_i columns of
+    /// U_i = Π V_i ([`LevelFactor::row_space`]): the changes of h_i that move q̈ at all, in an
+    /// orthonormal basis, so `yb` is n × r_i. Returns the number of columns written.
+    fn reduced_block(&mut self, i: usize, propagate: bool) -> usize {
+        self.reduced_block_in(i, propagate, false)
+    }
+
+    fn reduced_block_in(&mut self, i: usize, propagate: bool, in_basis: bool) -> usize {
+        let (n, m, r, p) = (self.n, self.dims[i], self.ranks[i], self.starts[i]);
+        let basis = in_basis && r > 0 && self.fac[i].reduced;
+        let nc = if basis { r } else { m };
         let yb = &mut self.yb[..n * nc];
         if r == 0 || nc == 0 {
             // Level i moves nothing, so nothing below it moves either.
             yb.fill(0.0);
-            return;
+            return nc;
         }
         // Rows p..p + r are written below (and the lower levels' rows, when propagating).
         yb[..p * nc].fill(0.0);
         yb[(p + r) * nc..].fill(0.0);
         let f = &self.fac[i];
-        let bb = &mut self.bb[..nc * nc];
-        if f.direct {
+        let bb = &mut self.bb[..m * nc];
+        if basis {
+            // B = Πᵀ U = V (pivoted order): row j is row j of V.
+            for j in 0..m {
+                for q in 0..nc {
+                    bb[j * nc + q] = f.basis[(j, q)];
+                }
+            }
+            f.apply_rows(r, m, nc, bb, &mut yb[p * nc..(p + r) * nc]);
+        } else if f.direct {
             f.inverse_rows(nc, bb, &mut yb[p * nc..(p + r) * nc]);
         } else {
             // B = Πᵀ I: row j is e_{perm[j]}.
@@ -399,7 +429,7 @@ impl Hierarchy {
             f.apply_rows(r, nc, nc, bb, &mut yb[p * nc..(p + r) * nc]);
         }
         if !propagate {
-            return;
+            return nc;
         }
         let (ws, wld) = (&self.w, self.wld);
         for k in i + 1..self.dims.len() {
@@ -423,6 +453,7 @@ impl Hierarchy {
             }
             f.apply_rows(rk, mk, nc, bb, &mut yb[pk * nc..(pk + rk) * nc]);
         }
+        nc
     }
 
     /// Builds the block g_i of G (Algorithm 1), using the factors of the last
@@ -485,6 +516,86 @@ impl Hierarchy {
             co += m;
         }
     }
+
+    /// Columns of level i in the correction map ([`Hierarchy::build_correction_map`]): 0 when
+    /// its rank is 0, r_i when 0 < r_i < m_i, m_i when it has full rank.
+    pub fn correction_width(&self, i: usize) -> usize {
+        let r = self.ranks[i];
+        if r == 0 {
+            0
+        } else if self.fac[i].reduced {
+            r
+        } else {
+            self.dims[i]
+        }
+    }
+
+    /// First column of level i in the correction map: the widths of the levels above.
+    pub fn correction_offset(&self, i: usize) -> usize {
+        (0..i).map(|k| self.correction_width(k)).sum()
+    }
+
+    /// The correction map of levels `from..to`, the columns of IKTC's correction QP: for a
+    /// level of full rank its block g_i of G (Algorithm 1); for a level of rank r_i < m_i the
+    /// r_i columns g_i U_i, U_i (m_i × r_i, orthonormal) spanning the changes of h_i that move
+    /// q̈ (the row space of J̄_i^{λ+}; [`Hierarchy::correction_demand`] maps back); nothing for
+    /// a level of rank 0. A correction Δh_i outside that row space changes ‖Δh_i‖ without
+    /// changing q̈, so the least correction lies in it, and with Δh_i = U_i z_i, ‖Δh_i‖ =
+    /// ‖z_i‖: the QP over z has the same optimum, with r_i instead of m_i variables. Allocates
+    /// nothing.
+    pub fn build_correction_map(&mut self, from: usize, to: usize) {
+        let n = self.n;
+        let to = to.min(self.dims.len());
+        if from >= to {
+            return;
+        }
+        let w: usize = (from..to).map(|i| self.correction_width(i)).sum();
+        if w == 0 {
+            return;
+        }
+        let mut co = 0;
+        for i in from..to {
+            if self.correction_width(i) == 0 {
+                continue;
+            }
+            let m = self.reduced_block_in(i, true, true);
+            for d in 0..n {
+                self.yall[d * w + co..d * w + co + m].copy_from_slice(&self.yb[d * m..(d + 1) * m]);
+            }
+            co += m;
+        }
+        self.refl
+            .apply_q_rows(&mut self.yall[..n * w], w, &mut self.qscratch);
+        let c0 = self.correction_offset(from);
+        let gs = &mut self.gc.as_mut_slice()[c0 * n..(c0 + w) * n];
+        for (c, col) in gs.chunks_exact_mut(n).enumerate() {
+            for (d, x) in col.iter_mut().enumerate() {
+                *x = self.yall[d * w + c];
+            }
+        }
+    }
+
+    /// The correction map (n × Σ widths), columns of level i from
+    /// [`Hierarchy::correction_offset`]`(i)`, valid once built.
+    pub fn correction_map(&self) -> &DMatrix<f64> {
+        &self.gc
+    }
+
+    /// Δh_i \[task units\] (length m_i) for the correction `z` of level i in the correction
+    /// map's coordinates (length [`Hierarchy::correction_width`]`(i)`): U_i z, z itself at full
+    /// rank, zero at rank 0.
+    pub fn correction_demand(&self, i: usize, z: &[f64], out: &mut [f64]) {
+        let (m, w) = (self.dims[i], self.correction_width(i));
+        if w == m {
+            out[..m].copy_from_slice(&z[..m]);
+            return;
+        }
+        out[..m].fill(0.0);
+        let f = &self.fac[i];
+        for (c, &pc) in f.perm.iter().enumerate() {
+            out[pc] = (0..w).map(|q| f.basis[(c, q)] * z[q]).sum();
+        }
+    }
 }
 
 /// The factors of one level's J̄^{λ+} in reduced coordinates: out = S⁻¹ R_r Πᵀ b with
@@ -499,6 +610,13 @@ struct LevelFactor {
     perm: Vec<usize>,
     /// λ = 0 and r = m: R_r is square and invertible, S⁻¹ R_r = R_r⁻ᵀ, one triangular solve.
     direct: bool,
+    /// 0 < r < m: the m × r orthonormal basis V of the column space of R_rᵀ (pivoted order)
+    /// in the first r columns, from a Householder QR of R_rᵀ ([`LevelFactor::row_space`]).
+    basis: DMatrix<f64>,
+    /// Scratch of the QR of R_rᵀ.
+    qr: DMatrix<f64>,
+    /// Whether `basis` is in use (0 < r < m).
+    reduced: bool,
 }
 
 impl LevelFactor {
@@ -508,6 +626,59 @@ impl LevelFactor {
             l: DMatrix::zeros(m, m),
             perm: vec![0; m],
             direct: false,
+            basis: DMatrix::zeros(m, m),
+            qr: DMatrix::zeros(m, m),
+            reduced: false,
+        }
+    }
+
+    /// When 0 < r < m: V (m × r, orthonormal columns) spanning the column space of R_rᵀ, by a
+    /// Householder QR R_rᵀ = V T (T upper triangular r × r, invertible since R_r has full row
+    /// rank): V = H_0 ⋯ H_{r−1} \[I_r; 0\]. The reflectors are kept in `qr` (vector j in
+    /// column j from row j on, τ_j in column r, free since r < m). Allocates nothing.
+    fn row_space(&mut self, r: usize, m: usize) {
+        self.reduced = r > 0 && r < m;
+        if !self.reduced {
+            return;
+        }
+        let rr = self.r.nrows();
+        let (rs, h, v) = (self.r.as_slice(), &mut self.qr, &mut self.basis);
+        // M = R_rᵀ: M[c, q] = R[q, c] (zero for c < q).
+        for q in 0..r {
+            for c in 0..m {
+                h[(c, q)] = if c >= q { rs[c * rr + q] } else { 0.0 };
+            }
+        }
+        for j in 0..r {
+            let norm = (j..m).map(|c| h[(c, j)] * h[(c, j)]).sum::<f64>().sqrt();
+            let x0 = h[(j, j)];
+            let alpha = if x0 >= 0.0 { -norm } else { norm };
+            h[(j, j)] = x0 - alpha;
+            let vv: f64 = (j..m).map(|c| h[(c, j)] * h[(c, j)]).sum();
+            let t = if vv > 0.0 { 2.0 / vv } else { 0.0 };
+            for q in j + 1..r {
+                let f = t * (j..m).map(|c| h[(c, j)] * h[(c, q)]).sum::<f64>();
+                for c in j..m {
+                    h[(c, q)] -= f * h[(c, j)];
+                }
+            }
+            h[(j, r)] = t;
+        }
+        for q in 0..r {
+            for c in 0..m {
+                v[(c, q)] = if c == q { 1.0 } else { 0.0 };
+            }
+        }
+        for j in (0..r).rev() {
+            let t = h[(j, r)];
+            for q in 0..r {
+                let f = t * (j..m).map(|c| h[(c, j)] * v[(c, q)]).sum::<f64>();
+                if f != 0.0 {
+                    for c in j..m {
+                        v[(c, q)] -= f * h[(c, j)];
+                    }
+                }
+            }
         }
     }
 

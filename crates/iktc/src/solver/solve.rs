@@ -272,8 +272,9 @@ impl Solver {
             Climb::FromBottom => nt - 1,
             Climb::FromLast => self.last_from.unwrap_or(nt - 1).min(nt - 1),
         };
-        // G blocks of levels start..n_T (Algorithm 1 builds them bottom-up; each is independent).
-        self.hierarchy.build_g_levels(start, nt);
+        // G blocks of levels start..n_T (Algorithm 1 builds them bottom-up; each is independent),
+        // in the coordinates of the corrections that move q̈ (`Hierarchy::build_correction_map`).
+        self.hierarchy.build_correction_map(start, nt);
         let mut found = None;
         if self.level_feasible(start)? {
             // Down the priorities while still feasible.
@@ -287,7 +288,7 @@ impl Solver {
         } else {
             // Up the priorities until feasible.
             for i in (0..start).rev() {
-                self.hierarchy.build_g_level(i);
+                self.hierarchy.build_correction_map(i, i + 1);
                 if self.level_feasible(i)? {
                     found = Some(i);
                     break;
@@ -305,9 +306,10 @@ impl Solver {
         let i = self.held_level(i)?;
         self.last_from = Some(i);
         self.report.corrected_from = Some(i);
-        let off = self.hierarchy.offset(i);
-        let total: usize = self.hierarchy.dims().iter().sum();
-        let g = self.hierarchy.g();
+        let h = &self.hierarchy;
+        let off = h.correction_offset(i);
+        let total = h.correction_offset(nt);
+        let g = h.correction_map();
         let x = &self.xs[i];
         for c in 0..total - off {
             let dh = x[c];
@@ -317,12 +319,12 @@ impl Solver {
                 }
             }
         }
+        // Δh of each corrected level from its coordinates in the map.
         let mut c = 0;
-        for corr in self.report.corrections.iter_mut().skip(i) {
-            for r in 0..corr.len() {
-                corr[r] = x[c];
-                c += 1;
-            }
+        for (k, corr) in self.report.corrections.iter_mut().enumerate().skip(i) {
+            let w = h.correction_width(k);
+            h.correction_demand(k, &x.as_slice()[c..c + w], corr.as_mut_slice());
+            c += w;
         }
         Ok(())
     }
@@ -339,34 +341,32 @@ impl Solver {
             // The climb started at the last level (= the held one) and went down from it.
             Climb::FromLast if self.last_from == Some(chosen) => true,
             _ => {
-                self.hierarchy.build_g_levels(chosen, found);
+                self.hierarchy.build_correction_map(chosen, found);
                 self.level_feasible(chosen)?
             }
         };
         Ok(if solved { chosen } else { found })
     }
 
-    /// Solves the correction QP of levels i..n_T into `xs[i]` (G blocks of those levels built);
-    /// true when it is feasible. Counts the QP in the report. Levels of rank 0 at the bottom
-    /// (zero columns of G) are left out of the QP and get a zero correction, which is their
-    /// value at the QP's optimum; when only such levels remain, no QP is run and the level is
+    /// Solves the correction QP of levels i..n_T into `xs[i]` (the correction map of those
+    /// levels built); true when it is feasible. Counts the QP in the report. The variables are
+    /// the map's coordinates (`Hierarchy::build_correction_map`): r_k per level of rank r_k,
+    /// none for a level of rank 0; when no level has any, no QP is run and the level is
     /// infeasible (q̈ is outside the box and they cannot move it).
     fn level_feasible(&mut self, i: usize) -> Result<bool> {
-        let off = self.hierarchy.offset(i);
-        // The corrections of levels of rank 0 below the last level of rank > 0 move nothing
-        // (their columns of G are zero) and are zero at the optimum: the QP is over the others.
-        let (dims, ranks) = (self.hierarchy.dims(), self.hierarchy.ranks());
-        let live_end = (i..dims.len())
-            .rev()
-            .find(|&k| ranks[k] > 0)
-            .map_or(off, |k| self.hierarchy.offset(k) + dims[k]);
-        let ma = live_end - off;
+        // The QP is over the correction map's columns of levels i..n_T: levels of rank 0 have
+        // none (they move nothing), levels of rank r < m have r.
+        let off = self.hierarchy.correction_offset(i);
+        let ma = self
+            .hierarchy
+            .correction_offset(self.hierarchy.dims().len())
+            - off;
         self.xs[i].fill(0.0);
         if ma == 0 {
             // Nothing to correct: feasible only if already inside, which it is not.
             return Ok(false);
         }
-        let g = self.hierarchy.g().columns(off, ma);
+        let g = self.hierarchy.correction_map().columns(off, ma);
         let mu = self.settings.continuity;
         if mu == 0.0
             && self.settings.warm_start
