@@ -219,10 +219,10 @@ fn the_correction_over_the_row_space_is_the_least_correction_over_all_rows() {
         );
         // The same corrections Δh, level by level.
         let mut c = 0;
-        for k in from..dims.len() {
-            let d = (&rep.corrections[k] - x.rows(c, dims[k])).amax();
+        for (k, &m) in dims.iter().enumerate().skip(from) {
+            let d = (&rep.corrections[k] - x.rows(c, m)).amax();
             assert!(d < 1e-7 * (1.0 + x.amax()), "case {case} level {k}: {d:e}");
-            c += dims[k];
+            c += m;
         }
         checked[from] += 1;
     }
