@@ -326,8 +326,8 @@ pub fn robot_meshes(profile: &RobotProfile) -> Option<MeshSet> {
             let folder = path.parent().unwrap_or(Path::new("."));
             match meshes_from_urdf(&text, folder, VIEWER_CELL) {
                 Ok(m) => {
-                    for w in &m.warnings {
-                        eprintln!("warning: viewer: {w}");
+                    for line in warning_lines(&m.warnings, m.set.meshes.is_empty()) {
+                        eprintln!("{line}");
                     }
                     Some(m.set)
                 }
@@ -342,6 +342,33 @@ pub fn robot_meshes(profile: &RobotProfile) -> Option<MeshSet> {
         }
     };
     set.filter(|s| !s.meshes.is_empty())
+}
+
+/// Meshes left out that are named one by one; the others are counted.
+const LISTED_MESH_WARNINGS: usize = 3;
+
+/// The stderr lines for the meshes of a URDF left out (`warnings`, one per mesh): the first
+/// [`LISTED_MESH_WARNINGS`] as they are, then how many more, and what the viewer draws
+/// (`none_read`: no mesh could be read, so a stick figure).
+fn warning_lines(warnings: &[String], none_read: bool) -> Vec<String> {
+    let mut out: Vec<String> = warnings
+        .iter()
+        .take(LISTED_MESH_WARNINGS)
+        .map(|w| format!("warning: viewer: {w}"))
+        .collect();
+    let more = warnings.len().saturating_sub(LISTED_MESH_WARNINGS);
+    if more > 0 {
+        out.push(format!(
+            "warning: viewer: {more} more meshes left out ({} in all){}",
+            warnings.len(),
+            if none_read {
+                "; no mesh could be read, the viewer draws a stick figure"
+            } else {
+                "; the viewer draws the links whose meshes were read"
+            }
+        ));
+    }
+    out
 }
 
 /// Puts `meshes` (of `robot`'s links) in `data` when there are any; warnings on stderr.
@@ -366,4 +393,33 @@ pub fn render_viewer(data: &ViewerData) -> Result<String> {
 pub fn write_viewer(path: &Path, data: &ViewerData) -> Result<()> {
     let html = render_viewer(data)?;
     std::fs::write(path, html).with_context(|| format!("writing {}", path.display()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn many_mesh_warnings_are_summarised() {
+        let ws: Vec<String> = (0..7).map(|i| format!("mesh {i} missing")).collect();
+        let lines = warning_lines(&ws, true);
+        assert_eq!(lines.len(), LISTED_MESH_WARNINGS + 1);
+        assert_eq!(lines[0], "warning: viewer: mesh 0 missing");
+        assert!(
+            lines[3].contains("4 more meshes left out (7 in all)"),
+            "{}",
+            lines[3]
+        );
+        assert!(lines[3].contains("stick figure"));
+        let few = warning_lines(&ws[..2], false);
+        assert_eq!(
+            few,
+            vec![
+                "warning: viewer: mesh 0 missing",
+                "warning: viewer: mesh 1 missing"
+            ]
+        );
+        assert!(warning_lines(&[], true).is_empty());
+        assert!(warning_lines(&ws, false)[3].contains("links whose meshes were read"));
+    }
 }
