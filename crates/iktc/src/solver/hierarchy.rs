@@ -263,6 +263,7 @@ impl Hierarchy {
         let (n, m, p) = (self.n, self.dims[i], self.refl.len());
         let k = n - p;
         self.ranks[i] = 0;
+        self.fac[i].reduced = false;
         if m == 0 || k == 0 {
             // No coordinate left (the levels above took all n) or no row: rank 0, and W_i is
             // never read (the residual, the reduced blocks and the propagation into lower
@@ -397,7 +398,8 @@ impl Hierarchy {
 
     fn reduced_block_in(&mut self, i: usize, propagate: bool, in_basis: bool) -> usize {
         let (n, m, r, p) = (self.n, self.dims[i], self.ranks[i], self.starts[i]);
-        let basis = in_basis && r > 0 && self.fac[i].reduced;
+        // `reduced` holds only for 0 < r < m (reset with the rank in `reduce_level`).
+        let basis = in_basis && self.fac[i].reduced;
         let nc = if basis { r } else { m };
         let yb = &mut self.yb[..n * nc];
         if r == 0 || nc == 0 {
