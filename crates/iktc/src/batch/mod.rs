@@ -2,8 +2,8 @@
 //! keypoints or joint angles),
 //! its outputs for training code ([`TrainingTrajectory`] as CSV and NPZ, written by
 //! [`npz`] without a dependency), its quality figures ([`ClipQuality`]), and a pool of worker
-//! threads over the clips ([`run_parallel`], the longest clips first with [`longest_first`]). Files, progress and the dataset report are the
-//! command line's (`iktc retarget`).
+//! threads over the clips ([`run_parallel`], the longest clips first with [`longest_first`]).
+//! Files, progress and the dataset report are the command line's (`iktc retarget`).
 
 pub mod npz;
 pub mod pool;

@@ -263,7 +263,6 @@ impl Hierarchy {
         let (n, m, p) = (self.n, self.dims[i], self.refl.len());
         let k = n - p;
         self.ranks[i] = 0;
-        self.fac[i].reduced = false;
         if m == 0 || k == 0 {
             // No coordinate left (the levels above took all n) or no row: rank 0, and W_i is
             // never read (the residual, the reduced blocks and the propagation into lower
@@ -381,7 +380,6 @@ impl Hierarchy {
             col[top..rank].fill(0.0);
         }
         f.factor(rank, m, lambda2);
-        f.row_space(rank, m);
     }
 
     /// Writes into `yb` (row-major n × m_i, rows p_i.. written, the rows above zero) the
@@ -398,8 +396,11 @@ impl Hierarchy {
 
     fn reduced_block_in(&mut self, i: usize, propagate: bool, in_basis: bool) -> usize {
         let (n, m, r, p) = (self.n, self.dims[i], self.ranks[i], self.starts[i]);
-        // `reduced` holds only for 0 < r < m (reset with the rank in `reduce_level`).
-        let basis = in_basis && self.fac[i].reduced;
+        let basis = in_basis && self.rank_deficient(i);
+        if basis {
+            // U_i is needed only here, when a correction map is built.
+            self.fac[i].row_space(r, m);
+        }
         let nc = if basis { r } else { m };
         let yb = &mut self.yb[..n * nc];
         if r == 0 || nc == 0 {
@@ -469,47 +470,65 @@ impl Hierarchy {
     /// per level). A level of rank 0 moves nothing (g_i = 0, nor does any level below it
     /// respond): its columns are zeroed, not computed. Allocates nothing.
     pub fn build_g_levels(&mut self, from: usize, to: usize) {
+        self.build_blocks(from, to, false);
+    }
+
+    /// The columns of levels `from..to` of G (`in_basis` false) or of the correction map
+    /// (`in_basis` true; [`Hierarchy::build_correction_map`]): the reduced blocks of the
+    /// levels with columns, side by side in `yall`, Q applied once to all of them, then each
+    /// level's columns into place.
+    fn build_blocks(&mut self, from: usize, to: usize, in_basis: bool) {
         let n = self.n;
         let to = to.min(self.dims.len());
         if from >= to {
             return;
         }
-        // The columns of the levels of rank > 0, side by side in `yall` (w of them).
-        let mut w = 0;
-        for i in from..to {
-            if self.ranks[i] > 0 {
-                w += self.dims[i];
+        let width = |h: &Self, i: usize| {
+            if in_basis {
+                h.correction_width(i)
+            } else if h.ranks[i] > 0 {
+                h.dims[i]
             } else {
+                0
+            }
+        };
+        if !in_basis {
+            for i in (from..to).filter(|&i| self.ranks[i] == 0) {
                 let (c, m) = (self.offsets[i], self.dims[i]);
                 self.g.as_mut_slice()[c * n..(c + m) * n].fill(0.0);
             }
         }
+        let w: usize = (from..to).map(|i| width(self, i)).sum();
         if w == 0 {
             return;
         }
         let mut co = 0;
         for i in from..to {
-            let m = self.dims[i];
-            if self.ranks[i] == 0 {
+            if width(self, i) == 0 {
                 continue;
             }
-            self.reduced_block(i, true);
+            let m = self.reduced_block_in(i, true, in_basis);
             for d in 0..n {
                 self.yall[d * w + co..d * w + co + m].copy_from_slice(&self.yb[d * m..(d + 1) * m]);
             }
             co += m;
         }
-        // G = Q Y on the rows of Y, then into the columns of G.
+        // Q Y on the rows of Y, then into the columns of each level.
         self.refl
             .apply_q_rows(&mut self.yall[..n * w], w, &mut self.qscratch);
         let mut co = 0;
         for i in from..to {
-            let m = self.dims[i];
-            if self.ranks[i] == 0 {
+            let m = width(self, i);
+            if m == 0 {
                 continue;
             }
-            let c0 = self.offsets[i];
-            let gs = &mut self.g.as_mut_slice()[c0 * n..(c0 + m) * n];
+            let c0 = if in_basis {
+                self.correction_offset(i)
+            } else {
+                self.offsets[i]
+            };
+            let target = if in_basis { &mut self.gc } else { &mut self.g };
+            let gs = &mut target.as_mut_slice()[c0 * n..(c0 + m) * n];
             for (c, col) in gs.chunks_exact_mut(n).enumerate() {
                 for (d, x) in col.iter_mut().enumerate() {
                     *x = self.yall[d * w + co + c];
@@ -522,14 +541,20 @@ impl Hierarchy {
     /// Columns of level i in the correction map ([`Hierarchy::build_correction_map`]): 0 when
     /// its rank is 0, r_i when 0 < r_i < m_i, m_i when it has full rank.
     pub fn correction_width(&self, i: usize) -> usize {
-        let r = self.ranks[i];
-        if r == 0 {
+        if self.rank_deficient(i) {
+            self.ranks[i]
+        } else if self.ranks[i] == 0 {
             0
-        } else if self.fac[i].reduced {
-            r
         } else {
             self.dims[i]
         }
+    }
+
+    /// Whether level i kept fewer rows than it has, but some (0 < r_i < m_i): its corrections
+    /// enter the correction map in the basis U_i.
+    fn rank_deficient(&self, i: usize) -> bool {
+        let r = self.ranks[i];
+        r > 0 && r < self.dims[i]
     }
 
     /// First column of level i in the correction map: the widths of the levels above.
@@ -546,35 +571,7 @@ impl Hierarchy {
     /// ‖z_i‖: the QP over z has the same optimum, with r_i instead of m_i variables. Allocates
     /// nothing.
     pub fn build_correction_map(&mut self, from: usize, to: usize) {
-        let n = self.n;
-        let to = to.min(self.dims.len());
-        if from >= to {
-            return;
-        }
-        let w: usize = (from..to).map(|i| self.correction_width(i)).sum();
-        if w == 0 {
-            return;
-        }
-        let mut co = 0;
-        for i in from..to {
-            if self.correction_width(i) == 0 {
-                continue;
-            }
-            let m = self.reduced_block_in(i, true, true);
-            for d in 0..n {
-                self.yall[d * w + co..d * w + co + m].copy_from_slice(&self.yb[d * m..(d + 1) * m]);
-            }
-            co += m;
-        }
-        self.refl
-            .apply_q_rows(&mut self.yall[..n * w], w, &mut self.qscratch);
-        let c0 = self.correction_offset(from);
-        let gs = &mut self.gc.as_mut_slice()[c0 * n..(c0 + w) * n];
-        for (c, col) in gs.chunks_exact_mut(n).enumerate() {
-            for (d, x) in col.iter_mut().enumerate() {
-                *x = self.yall[d * w + c];
-            }
-        }
+        self.build_blocks(from, to, true);
     }
 
     /// The correction map (n × Σ widths), columns of level i from
@@ -617,8 +614,6 @@ struct LevelFactor {
     basis: DMatrix<f64>,
     /// Scratch of the QR of R_rᵀ.
     qr: DMatrix<f64>,
-    /// Whether `basis` is in use (0 < r < m).
-    reduced: bool,
 }
 
 impl LevelFactor {
@@ -630,7 +625,6 @@ impl LevelFactor {
             direct: false,
             basis: DMatrix::zeros(m, m),
             qr: DMatrix::zeros(m, m),
-            reduced: false,
         }
     }
 
@@ -639,8 +633,7 @@ impl LevelFactor {
     /// rank): V = H_0 ⋯ H_{r−1} \[I_r; 0\]. The reflectors are kept in `qr` (vector j in
     /// column j from row j on, τ_j in column r, free since r < m). Allocates nothing.
     fn row_space(&mut self, r: usize, m: usize) {
-        self.reduced = r > 0 && r < m;
-        if !self.reduced {
+        if r == 0 || r >= m {
             return;
         }
         let rr = self.r.nrows();

@@ -354,8 +354,6 @@ impl Solver {
     /// none for a level of rank 0; when no level has any, no QP is run and the level is
     /// infeasible (q̈ is outside the box and they cannot move it).
     fn level_feasible(&mut self, i: usize) -> Result<bool> {
-        // The QP is over the correction map's columns of levels i..n_T: levels of rank 0 have
-        // none (they move nothing), levels of rank r < m have r.
         let off = self.hierarchy.correction_offset(i);
         let ma = self
             .hierarchy
