@@ -1,7 +1,7 @@
 """The Unitree G1 in MuJoCo driven by iktc tick by tick: standing imitation, identification, push.
 
     python crates/iktc-py/examples/mujoco_g1.py standing [--clip humanoid3d_dance_b]
-        [--plan joints|keypoints] [--time-scale 1] [--robot g1|profile.toml]
+        [--plan joints|keypoints|upper-body] [--time-scale 1] [--robot g1|profile.toml]
         [--json out.json] [--replay out.html]
     python crates/iktc-py/examples/mujoco_g1.py balance [--damping 0.72] [--designs 0.3,0.9]
         [--json out.json]
@@ -98,9 +98,11 @@ def main() -> None:
     ap.add_argument("--designs", help="balance: also push with these design ratios, e.g. "
                     "0.3,0.5,0.72,0.9, and print the measured ones")
     ap.add_argument("--clip", default="humanoid3d_dance_b")
-    ap.add_argument("--plan", default="joints", choices=["joints", "keypoints"],
+    ap.add_argument("--plan", default="joints", choices=["joints", "keypoints", "upper-body"],
                     help="standing: the imitation of Table 1 ticking in the loop (joint route), "
-                    "or the keypoint retargeting with the feet held, computed beforehand")
+                    "the keypoint retargeting with the feet held, or the keypoint retargeting's "
+                    "standing imitation (feet and pelvis held, the clip's upper body relative to "
+                    "its pelvis), both computed beforehand")
     ap.add_argument("--time-scale", type=float, default=1.0, help="play the clip this many times slower")
     ap.add_argument("--robot", default="g1", help="the built-in g1 or a G1 profile file (.toml)")
     ap.add_argument("--settle", type=float, default=0.5, help="time holding the start posture [s]")
@@ -123,11 +125,12 @@ def main() -> None:
 
 
 def standing(a) -> dict:
-    if a.plan == "keypoints":
+    if a.plan in ("keypoints", "upper-body"):
         if a.time_scale != 1.0:
             raise SystemExit("--time-scale applies to --plan joints only")
         loop = g1_sim.run_standing_keypoints(clip=a.clip, settle=a.settle,
-                                             robot=iktc.Robot(a.robot))
+                                             robot=iktc.Robot(a.robot),
+                                             standing=a.plan == "upper-body")
     else:
         loop = g1_sim.Loop(clip=a.clip, time_scale=a.time_scale, robot=iktc.Robot(a.robot))
         loop.settle(a.settle)

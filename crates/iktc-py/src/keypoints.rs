@@ -35,19 +35,26 @@ pub struct PyKeypointTrajectory {
 /// over `dt` [s]; the posture level follows the joint route's references where the profile has
 /// a map for the motion's format. `hold_feet`: every frame counts as stance, so both feet are
 /// held where they stand for the whole clip (a standing imitation) instead of stepping where
-/// the clip's feet leave the ground.
+/// the clip's feet leave the ground. `standing`: the feet and the pelvis held at the robot's
+/// start pose and only the clip's upper body imitated, relative to its pelvis (see
+/// `iktc::retarget::KeypointSettings::standing`). `smoothing`: cut-off [Hz] of the zero-phase
+/// low-pass applied to the body points before they are differentiated (`None`: as captured).
 #[pyfunction]
-#[pyo3(name = "retarget_keypoints", signature = (motion, robot, *, dt=0.005, hold_feet=false))]
+#[pyo3(name = "retarget_keypoints", signature = (motion, robot, *, dt=0.005, hold_feet=false, standing=false, smoothing=None))]
 pub fn py_retarget_keypoints(
     py: Python<'_>,
     motion: &PyMotion,
     robot: &PyRobot,
     dt: f64,
     hold_feet: bool,
+    standing: bool,
+    smoothing: Option<f64>,
 ) -> PyResult<PyKeypointTrajectory> {
     let profile = robot.required_profile("keypoint retargeting", "feet, pelvis and hands")?;
     let mut settings = KeypointSettings {
         dt,
+        standing,
+        smoothing,
         ..KeypointSettings::default()
     };
     if hold_feet {

@@ -50,3 +50,26 @@ def test_a_robot_without_a_profile_is_an_error():
 def test_a_bad_control_period_is_an_error_naming_it():
     with pytest.raises(iktc.IktcError, match="dt"):
         iktc.retarget_keypoints(iktc.load_motion("humanoid3d_dance_b"), iktc.Robot("g1"), dt=0.0)
+
+
+def test_standing_holds_the_feet_and_the_pelvis_and_moves_the_arms():
+    robot = iktc.Robot("g1")
+    t = iktc.retarget_keypoints(iktc.load_motion("humanoid3d_dance_b"), robot, standing=True)
+    feet = np.array([[robot.frame_pose(q, f)[:3, 3] for f in FEET] for q in t.q])
+    pelvis = np.array([robot.frame_pose(q, "pelvis") for q in t.q])
+    # The feet at their start (the first level holds them: 1e-7 m here); the pelvis within a few
+    # millimetres (the COM level above it moves it: 2.3 mm here), its z axis within a
+    # milliradian (0.2 mrad here).
+    assert np.abs(feet - feet[0]).max() < 1e-4
+    assert np.abs(pelvis[:, :3, 3] - pelvis[0, :3, 3]).max() < 5e-3
+    assert np.abs(pelvis[:, :3, 2] - pelvis[0, :3, 2]).max() < 1e-3
+    hand = np.array([robot.frame_pose(q, "left_rubber_hand")[:3, 3] for q in t.q])
+    assert np.linalg.norm(hand - hand[0], axis=1).max() > 0.1
+
+
+def test_smoothing_is_checked_and_keeps_the_shapes():
+    robot, motion = iktc.Robot("g1"), iktc.load_motion("humanoid3d_walk")
+    t = iktc.retarget_keypoints(motion, robot, smoothing=6.0)
+    assert t.q.shape == (len(t.times), robot.nq)
+    with pytest.raises(iktc.IktcError, match="smoothing"):
+        iktc.retarget_keypoints(motion, robot, smoothing=-1.0)

@@ -80,6 +80,30 @@ def test_standing_imitation_by_the_keypoint_route_keeps_the_feet_within_5_mm():
     assert s["foot_slip_max_m"] <= 5e-3, s
 
 
+# The keypoint route's standing imitation (``standing=True``: feet and pelvis held at G1's start
+# pose, the COM over the middle of the soles, the clip's upper body relative to its pelvis)
+# keeps G1 up and level. MuJoCo 4.0.0: pelvis 0.760–0.763 m, tilt at most 0.025 rad; the plan's
+# ZMP (inverse dynamics) outside the polygon on 14 of 508 ticks, against 378 for the joint route.
+def test_standing_imitation_of_the_upper_body_stays_up_and_level():
+    loop = g1_sim.run_standing_keypoints(standing=True)
+    s = loop.summary()
+    assert s["stayed_up"], s
+    assert s["pelvis_height_min_m"] > 0.74 and s["base_tilt_max_rad"] < 0.1, s
+    # The upper body does move (the arms' set points span more than a radian).
+    q = np.array(loop.log.q_cmd)[:, 7:]
+    assert np.ptp(q[:, loop.upper], axis=0).max() > 1.0
+
+
+# Its feet still slip 11 mm: the plan's arms do not come to rest even on a held first frame
+# (G1's keypoint stack leaves no coordinate to the posture level; the servos trail the arms'
+# set points by 0.67 rad rms), and the dance's arm swings twist the robot about the vertical.
+@pytest.mark.xfail(strict=True, reason="G1's feet slip 11 mm in the upper-body standing "
+                   "imitation of humanoid3d_dance_b (see the example's README section)")
+def test_standing_imitation_of_the_upper_body_keeps_the_feet_within_5_mm():
+    s = g1_sim.run_standing_keypoints(standing=True).summary()
+    assert s["foot_slip_max_m"] <= 5e-3, s
+
+
 def test_the_planned_zmp_is_the_com_standing_and_shifts_by_z_a_over_g_when_accelerated():
     loop = g1_sim.Loop(duration=0.1)
     q0 = loop.sim.q

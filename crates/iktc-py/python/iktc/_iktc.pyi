@@ -189,7 +189,8 @@ class KeypointTrajectory:
     def __len__(self) -> int: ...
 
 def retarget_keypoints(motion: Motion, robot: Robot, *, dt: float = 0.005,
-                       hold_feet: bool = False) -> KeypointTrajectory: ...
+                       hold_feet: bool = False, standing: bool = False,
+                       smoothing: Optional[float] = None) -> KeypointTrajectory: ...
 
 class Imitation:
     def __init__(self, robot: Robot, motion: Motion, *, map: Optional[str] = None,

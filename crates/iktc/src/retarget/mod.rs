@@ -143,6 +143,20 @@ pub struct KeypointSettings {
     /// Until it lands the foot is brought down in the second level, above the ground
     /// ([`FLOOR_ENGAGE`]).
     pub land_speed: f64,
+    /// Standing imitation (default false): the feet and the pelvis are held at the robot's
+    /// start pose for the whole clip, the COM over the middle of the soles, and only the clip's
+    /// upper body is imitated, relative to its pelvis (the torso's orientation, the elbows and
+    /// the hands). For a robot that must keep its stance while it moves like the captured
+    /// person from the waist up; the clip's steps, crouches and pelvis sway are left out.
+    pub standing: bool,
+    /// Cut-off \[Hz\] of the zero-phase low-pass ([`crate::motion::lowpass`]) applied to the
+    /// scaled body points before they are interpolated and differentiated into the tasks'
+    /// references (default `None`: as captured; a cut-off at or above the clip's Nyquist
+    /// frequency leaves them as captured too). Noise at the capture's frame rate otherwise
+    /// reaches the references' accelerations: on JVRC-1 `humanoid3d_dance_b`, 8 Hz lowers the
+    /// joints' RMS jerk from 5 940 to 5 070 rad/s³ and 6 Hz to 4 610. The quality figures
+    /// still compare the robot with the captured points.
+    pub smoothing: Option<f64>,
 }
 
 impl Default for KeypointSettings {
@@ -174,6 +188,8 @@ impl Default for KeypointSettings {
             posture_margin: 0.05,
             land_height: 0.02,
             land_speed: 0.06,
+            standing: false,
+            smoothing: None,
         }
     }
 }
@@ -203,6 +219,15 @@ impl KeypointSettings {
                     name: name.into(),
                     value: v.to_string(),
                     expected: format!("a finite {what}"),
+                });
+            }
+        }
+        if let Some(fc) = self.smoothing {
+            if !(fc.is_finite() && fc > 0.0) {
+                return Err(Error::InvalidSetting {
+                    name: "smoothing".into(),
+                    value: fc.to_string(),
+                    expected: "a cut-off frequency > 0 [Hz], or none".into(),
                 });
             }
         }

@@ -25,7 +25,7 @@ use super::scale::ScaledClip;
 use super::{KeypointSettings, SupportArea};
 use crate::error::{Error, Result};
 use crate::model::{Kinematics, Robot};
-use crate::motion::{BodyPoint, CubicSpline, Keypoints};
+use crate::motion::{lowpass, BodyPoint, CubicSpline, Keypoints};
 use crate::sim::imitate::{sole_pose, SupportSettings};
 use crate::task::{ComReference, FrameReference};
 use crate::walk::SupportPolygon;
@@ -251,15 +251,27 @@ pub(crate) fn plan(
         + 1;
     let times: Vec<f64> = (0..ticks).map(|k| (t0 + k as f64 * s.dt).min(t1)).collect();
     let idx = |p: BodyPoint| kp.points.iter().position(|q| *q == p);
-    // Splines through the scaled and aligned points.
-    let sample = |data: &[Vector3<f64>], k: usize| -> Result<Vec<Vector3<f64>>> {
+    // Splines through the scaled (low-passed, when asked and below the clip's Nyquist
+    // frequency) and aligned points.
+    let period = if frames > 1 {
+        (t1 - t0) / (frames - 1) as f64
+    } else {
+        0.0
+    };
+    let cutoff = s
+        .smoothing
+        .filter(|fc| frames > 1 && *fc > 0.0 && *fc * 2.0 * period < 1.0);
+    let sample = |data: &[Vector3<f64>], k: usize, smooth: bool| -> Result<Vec<Vector3<f64>>> {
         let mut out = vec![Vector3::zeros(); ticks];
         if frames == 1 {
             out.iter_mut().for_each(|o| *o = data[k]);
             return Ok(out);
         }
         for axis in 0..3 {
-            let y: Vec<f64> = (0..frames).map(|f| data[f * n + k][axis]).collect();
+            let mut y: Vec<f64> = (0..frames).map(|f| data[f * n + k][axis]).collect();
+            if let (true, Some(fc)) = (smooth, cutoff) {
+                y = lowpass(&y, period, fc)?;
+            }
             let spline = CubicSpline::new(&kp.times, &y)?;
             for (o, t) in out.iter_mut().zip(&times) {
                 o[axis] = spline.eval(*t)[0];
@@ -270,8 +282,8 @@ pub(crate) fn plan(
     let mut scaled: Vec<Option<Vec<Vector3<f64>>>> = vec![None; n];
     let mut aligned: Vec<Option<Vec<Vector3<f64>>>> = vec![None; n];
     for k in 0..n {
-        scaled[k] = Some(sample(&clip.scaled, k)?);
-        aligned[k] = Some(sample(&clip.aligned, k)?);
+        scaled[k] = Some(sample(&clip.scaled, k, true)?);
+        aligned[k] = Some(sample(&clip.aligned, k, false)?);
     }
     let track =
         |p: BodyPoint| -> Option<&Vec<Vector3<f64>>> { idx(p).and_then(|k| scaled[k].as_ref()) };
@@ -515,7 +527,7 @@ pub(crate) fn plan(
         latch_weights(&contact[0], s.dt),
         latch_weights(&contact[1], s.dt),
     ];
-    Ok(Plan {
+    let mut plan = Plan {
         ticks,
         feet,
         contact,
@@ -525,7 +537,81 @@ pub(crate) fn plan(
         torso,
         points,
         neutral,
-    })
+    };
+    if s.standing {
+        hold_stance(&mut plan, robot, kin, body, support, s.dt)?;
+    }
+    Ok(plan)
+}
+
+/// Standing imitation ([`KeypointSettings::standing`]): the feet and the pelvis held at the
+/// robot's start pose, both feet on the ground throughout, the COM over the midpoint of the
+/// two soles' centres, and the upper body imitated relative to the clip's pelvis. With
+/// `X_k = (x_k, R_k)` the pelvis reference the clip gives at tick k and `X₀` the robot's pelvis
+/// at its start, every tracked point becomes `p′_k = X₀ X_k⁻¹ p_k` and the torso's orientation
+/// `T′_k = R₀ R_k⁻¹ T_k`: what the clip's upper body does relative to its pelvis, placed on a
+/// pelvis that does not move. Rates and accelerations are the finite differences of the new
+/// references, as everywhere in the plan.
+fn hold_stance(
+    plan: &mut Plan,
+    robot: &Robot,
+    kin: &Kinematics,
+    body: &RobotBody,
+    support: &SupportSettings,
+    dt: f64,
+) -> Result<()> {
+    let ticks = plan.ticks;
+    let x0 = kin.frame_pose(robot, body.pelvis)?;
+    let to_robot: Vec<Isometry3<f64>> = plan
+        .pelvis
+        .iter()
+        .map(|p| {
+            x0 * Isometry3::from_parts(Translation3::from(p.position.position), p.rotation)
+                .inverse()
+        })
+        .collect();
+    for (_, refs) in plan.points.iter_mut() {
+        let x = refs
+            .iter()
+            .zip(&to_robot)
+            .map(|(r, t)| t.transform_point(&r.position.into()).coords)
+            .collect();
+        *refs = point_refs(x, dt);
+    }
+    let torso = plan
+        .torso
+        .iter()
+        .zip(&to_robot)
+        .map(|(r, t)| t.rotation * r.rotation)
+        .collect();
+    plan.torso = pose_refs(vec![Vector3::zeros(); ticks], torso, dt);
+    plan.pelvis = pose_refs(
+        vec![x0.translation.vector; ticks],
+        vec![x0.rotation; ticks],
+        dt,
+    );
+    let mut middle = Vector3::zeros();
+    for i in 0..2 {
+        let f0 = kin.frame_pose(robot, body.feet[i])?;
+        let sole = sole_pose(&f0, support);
+        middle += 0.5 * Vector3::new(sole.x, sole.y, 0.0);
+        plan.feet[i] = pose_refs(
+            vec![f0.translation.vector; ticks],
+            vec![f0.rotation; ticks],
+            dt,
+        );
+        plan.contact[i] = vec![true; ticks];
+        plan.latch_weight[i] = latch_weights(&plan.contact[i], dt);
+    }
+    plan.com = vec![
+        ComReference {
+            position: middle,
+            velocity: Vector3::zeros(),
+            acceleration: Vector3::zeros(),
+        };
+        ticks
+    ];
+    Ok(())
 }
 
 /// The points tracked below the pelvis: hands (level 4), then elbows (level 5, with the torso's
@@ -571,4 +657,159 @@ fn unwrap(mut a: Vec<f64>) -> Vec<f64> {
         a[k] = a[k - 1] + d;
     }
     a
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::profile::RobotProfile;
+    use crate::sim::ImitateConfig;
+
+    /// The plans of `clip` on `robot` as the keypoint route builds them, with and without
+    /// `standing`, and the robot's start kinematics and body.
+    fn plans(
+        robot: &str,
+        clip: &str,
+    ) -> (Robot, Kinematics, RobotBody, SupportSettings, Plan, Plan) {
+        plans_with(robot, clip, &KeypointSettings::default())
+    }
+
+    fn plans_with(
+        robot: &str,
+        clip: &str,
+        s: &KeypointSettings,
+    ) -> (Robot, Kinematics, RobotBody, SupportSettings, Plan, Plan) {
+        let profile = RobotProfile::builtin(robot).unwrap();
+        let robot = profile.robot().unwrap();
+        let cfg = profile.imitate_config(ImitateConfig::default()).unwrap();
+        let names = super::super::frame_names(&profile, &cfg).unwrap();
+        let mut kin = Kinematics::new(&robot, &crate::model::State::neutral(&robot)).unwrap();
+        let body = RobotBody::find(&robot, &kin, &names).unwrap();
+        let state = super::super::start_state(&robot, &cfg, &body).unwrap();
+        kin.update(&robot, &state).unwrap();
+        let kp = super::super::builtin_motion(clip)
+            .unwrap()
+            .keypoints(crate::motion::DEFAULT_MAX_GAP)
+            .unwrap();
+        let scaled =
+            super::super::scale::scale_clip(&robot, &kin, &body, &kp, cfg.support.ankle_height)
+                .unwrap();
+        let free = plan(&robot, &kin, &body, &kp, &scaled, &cfg.support, s).unwrap();
+        let standing = KeypointSettings {
+            standing: true,
+            ..s.clone()
+        };
+        let held = plan(&robot, &kin, &body, &kp, &scaled, &cfg.support, &standing).unwrap();
+        (robot, kin, body, cfg.support, free, held)
+    }
+
+    /// Standing: feet, pelvis and COM are constant at the robot's start, both feet on the ground
+    /// throughout; every tracked point is the free plan's point moved by X₀ X_k⁻¹ (recomputed
+    /// here from the free plan's pelvis as a rotation and a translation, not as an isometry
+    /// product) and the torso keeps its orientation relative to the pelvis.
+    #[test]
+    fn standing_holds_feet_and_pelvis_and_carries_the_upper_body_on_the_pelvis() {
+        for (robot_name, clip) in [("g1", "humanoid3d_dance_b"), ("jvrc1", "humanoid3d_punch")] {
+            let (robot, kin, body, support, free, held) = plans(robot_name, clip);
+            assert_eq!(free.ticks, held.ticks);
+            let x0 = kin.frame_pose(&robot, body.pelvis).unwrap();
+            // A pose read back from the kinematics and stored: exact up to rounding.
+            let tol = 1e-12;
+            for k in 0..held.ticks {
+                let p = &held.pelvis[k];
+                assert!((p.position.position - x0.translation.vector).norm() < tol);
+                assert!(p.rotation.angle_to(&x0.rotation) < tol);
+                assert!(p.position.velocity.norm() < tol && p.angular_velocity.norm() < tol);
+                for i in 0..2 {
+                    assert!(held.contact[i][k], "{robot_name}: foot {i} off at tick {k}");
+                    let f0 = kin.frame_pose(&robot, body.feet[i]).unwrap();
+                    assert!(
+                        (held.feet[i][k].position.position - f0.translation.vector).norm() < tol
+                    );
+                }
+                assert!((held.com[k].position - held.com[0].position).norm() < tol);
+                // The pelvis pose the free plan gives at tick k.
+                let (xk, rk) = (free.pelvis[k].position.position, free.pelvis[k].rotation);
+                for ((pf, rf), (ph, rh)) in free.points.iter().zip(&held.points) {
+                    assert_eq!(pf, ph);
+                    let expected = x0.rotation * (rk.inverse() * (rf[k].position - xk))
+                        + x0.translation.vector;
+                    assert!(
+                        (rh[k].position - expected).norm() < 1e-9,
+                        "{robot_name} {pf} tick {k}: {} vs {expected}",
+                        rh[k].position
+                    );
+                }
+                let rel_free = rk.inverse() * free.torso[k].rotation;
+                let rel_held = x0.rotation.inverse() * held.torso[k].rotation;
+                assert!(
+                    rel_free.angle_to(&rel_held) < 1e-9,
+                    "{robot_name} torso tick {k}"
+                );
+            }
+            // The COM over the middle of the soles: inside the support polygon of both feet.
+            let soles: Vec<_> = (0..2)
+                .map(|i| {
+                    let f0 = kin.frame_pose(&robot, body.feet[i]).unwrap();
+                    sole_pose(&f0, &support)
+                })
+                .collect();
+            let mut polygon = SupportPolygon::default();
+            polygon.set_hull_of_soles(
+                &soles[0],
+                &soles[1],
+                support.sole_length,
+                support.sole_width,
+            );
+            let c = held.com[0].position;
+            assert!(
+                polygon.margin((c.x, c.y)) > 0.0,
+                "{robot_name}: COM {c} outside"
+            );
+            // The upper body does move.
+            let (_, hand) = &held.points[0];
+            let travel = hand
+                .iter()
+                .map(|r| (r.position - hand[0].position).norm())
+                .fold(0.0, f64::max);
+            assert!(travel > 0.1, "{robot_name}: the hand moves {travel} m");
+        }
+    }
+
+    /// Share of ticks where the change of a reference acceleration reverses its sign.
+    fn reversals(a: &[f64]) -> f64 {
+        let d: Vec<f64> = a.windows(2).map(|w| w[1] - w[0]).collect();
+        let n = d.windows(2).filter(|w| w[0] * w[1] < 0.0).count();
+        n as f64 / (d.len() - 1) as f64
+    }
+
+    /// The low-pass takes the capture's frame-rate noise out of the references' accelerations:
+    /// as captured (60 Hz, cubic splines), the change of the wrists' and elbows' reference
+    /// acceleration reverses its sign on 21–23 % of the 200 Hz ticks (at the frames); low-passed
+    /// at 6 Hz, on 5–6 %. The references move by at most 2.1 cm (the dance's fastest arm
+    /// motions, at the cut-off).
+    #[test]
+    fn smoothing_takes_the_frame_rate_noise_out_of_the_references() {
+        let raw = plans_with("jvrc1", "humanoid3d_dance_b", &KeypointSettings::default()).4;
+        let s = KeypointSettings {
+            smoothing: Some(6.0),
+            ..KeypointSettings::default()
+        };
+        let smooth = plans_with("jvrc1", "humanoid3d_dance_b", &s).4;
+        for ((p, r), (_, f)) in raw.points.iter().zip(&smooth.points) {
+            let (mut rr, mut rf, mut moved) = (0.0_f64, 0.0_f64, 0.0_f64);
+            for axis in 0..3 {
+                let ar: Vec<f64> = r.iter().map(|x| x.acceleration[axis]).collect();
+                let af: Vec<f64> = f.iter().map(|x| x.acceleration[axis]).collect();
+                rr = rr.max(reversals(&ar));
+                rf = rf.max(reversals(&af));
+            }
+            for (a, b) in r.iter().zip(f) {
+                moved = moved.max((a.position - b.position).norm());
+            }
+            assert!(rr > 0.15, "{p}: as captured {rr}");
+            assert!(rf < 0.1, "{p}: low-passed {rf}");
+            assert!(moved < 0.03, "{p}: moved {moved} m");
+        }
+    }
 }
