@@ -23,6 +23,8 @@ pub struct Args {
     /// beside them), or the paper's joint-angle route (figures, summary and 3D viewer).
     #[arg(long, value_enum, default_value = "keypoints")]
     pub retarget: crate::cmd_keypoints::RetargetArg,
+    #[command(flatten)]
+    pub keypoints: crate::cmd_keypoints::KeypointArgs,
     /// Output directory.
     #[arg(long, default_value = "out/imitate")]
     pub out: PathBuf,
@@ -59,8 +61,12 @@ pub fn run(a: &Args) -> Result<()> {
             &sc.motion_options,
             &cfg,
             (bounds, map.as_ref()),
+            &a.keypoints,
             &a.out,
         );
+    }
+    if a.keypoints.standing || a.keypoints.smoothing.is_some() {
+        anyhow::bail!("--standing and --smoothing apply to --retarget keypoints only");
     }
     let (e, cfg, profile) = prepare(&a.scenario)?;
     let r = e.imitate(&cfg)?;

@@ -23,6 +23,40 @@ pub enum RetargetArg {
     Joints,
 }
 
+/// Options of the keypoint retargeting (`iktc imitate`, `iktc retarget`).
+#[derive(clap::Args, Debug, Clone, Default)]
+pub struct KeypointArgs {
+    /// Standing imitation: the feet and the pelvis held at the robot's start pose for the whole
+    /// clip, the COM over the middle of the soles, and only the clip's upper body imitated,
+    /// relative to its pelvis (torso orientation, elbows, hands).
+    #[arg(long)]
+    pub standing: bool,
+    /// Low-pass the body points at this cut-off [Hz] before they are differentiated into the
+    /// tasks' references (zero-phase Butterworth, forward and backward); removes the capture's
+    /// frame-rate noise from the reference accelerations (6 Hz is biomechanics' usual choice
+    /// for walking). Default: none, the points as captured.
+    #[arg(long, value_name = "HZ")]
+    pub smoothing: Option<f64>,
+}
+
+/// The keypoint retargeting's settings: the imitation's solver, period and tick limit from
+/// `cfg`, `bounds`, and the keypoint options `k`.
+pub fn keypoint_settings(
+    cfg: &ImitateConfig,
+    bounds: iktc::limits::BoundMethod,
+    k: &KeypointArgs,
+) -> KeypointSettings {
+    KeypointSettings {
+        method: cfg.method,
+        bounds,
+        dt: cfg.dt,
+        run_limits: cfg.run_limits,
+        standing: k.standing,
+        smoothing: k.smoothing,
+        ..KeypointSettings::default()
+    }
+}
+
 /// The keypoints of `spec` (a built-in clip or a motion file) and, for a skeleton, its clip in
 /// metres, Z up, with its format.
 fn load(
@@ -55,17 +89,12 @@ pub fn run(
         iktc::limits::BoundMethod,
         Option<&iktc::motion::RetargetMap>,
     ),
+    keypoint_args: &KeypointArgs,
     out: &Path,
 ) -> Result<()> {
     let (kp, clip) = load(spec, options)?;
     crate::outln!("{}", kp.summary())?;
-    let settings = KeypointSettings {
-        method: cfg.method,
-        bounds,
-        dt: cfg.dt,
-        run_limits: cfg.run_limits,
-        ..KeypointSettings::default()
-    };
+    let settings = keypoint_settings(cfg, bounds, keypoint_args);
     let robot = profile.robot()?;
     let posture = match &clip {
         Some((clip, format)) => posture_references(&robot, profile, clip, *format, map, cfg)?,
@@ -91,6 +120,8 @@ pub fn run(
         "gf_ticks": run.fallback_ticks,
         "stance_gf_ticks": run.stance_gf_ticks,
         "tick_median_us": run.tick_median_us,
+        "standing": settings.standing,
+        "smoothing_hz": settings.smoothing,
         "keypoints": run.quality,
         "joints": joints,
     });

@@ -36,6 +36,8 @@ pub struct Args {
     /// (captured rotations decomposed onto the robot's joints through a map).
     #[arg(long, value_enum, default_value = "keypoints")]
     pub retarget: crate::cmd_keypoints::RetargetArg,
+    #[command(flatten)]
+    pub keypoints: crate::cmd_keypoints::KeypointArgs,
     /// Output directory: one folder per clip, index.html and batch.json.
     #[arg(long, default_value = "out/retarget")]
     pub out: PathBuf,
@@ -105,6 +107,11 @@ pub fn run(a: &Args) -> Result<()> {
     if a.scenario.motion != iktc::sim::experiment::DEFAULT_CLIP {
         anyhow::bail!("`iktc retarget` takes its motions as INPUT arguments, not --motion");
     }
+    if a.retarget == crate::cmd_keypoints::RetargetArg::Joints
+        && (a.keypoints.standing || a.keypoints.smoothing.is_some())
+    {
+        anyhow::bail!("--standing and --smoothing apply to --retarget keypoints only");
+    }
     let jobs = match a.jobs {
         Some(0) => anyhow::bail!("--jobs 0: expected at least 1 worker thread"),
         Some(n) => n,
@@ -131,13 +138,11 @@ pub fn run(a: &Args) -> Result<()> {
         robot: resolved.robot.clone(),
         profile,
         map,
-        keypoints: iktc::retarget::KeypointSettings {
-            method: config.method,
-            bounds: crate::scenario::keypoint_bounds(&a.scenario),
-            dt: config.dt,
-            run_limits: config.run_limits,
-            ..iktc::retarget::KeypointSettings::default()
-        },
+        keypoints: crate::cmd_keypoints::keypoint_settings(
+            &config,
+            crate::scenario::keypoint_bounds(&a.scenario),
+            &a.keypoints,
+        ),
         config,
         motion_options: a.scenario.motion_options.options()?,
         rate: a.rate,

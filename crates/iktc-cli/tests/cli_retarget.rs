@@ -591,3 +591,61 @@ fn killed_batch_leaves_only_complete_files() {
         .iter()
         .all(|f| !f.to_string_lossy().ends_with(".tmp")));
 }
+
+/// `--standing`: G1's feet (the profile's ankle frames) and pelvis stay where they start while
+/// the clip's upper body moves the hands; the option enters the settings fingerprint (a run
+/// without it redoes the clip); `--smoothing` is checked, and both are refused by the joint
+/// route.
+#[test]
+fn standing_holds_feet_and_pelvis_and_is_part_of_the_settings() {
+    let dir = tmp("standing");
+    let clip = data().join("humanoid3d_dance_b.txt");
+    let out = dir.join("out");
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            clip.to_str().unwrap(),
+            "--robot",
+            "g1",
+            "--out",
+            out.to_str().unwrap(),
+            "--no-viewer",
+        ];
+        args.extend_from_slice(extra);
+        retarget(&args)
+    };
+    let o = run(&["--standing", "--smoothing", "6"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let npz = read_npz(&std::fs::read(out.join("humanoid3d_dance_b/motion.npz")).unwrap());
+    let bodies = strings(&npz, "body_names");
+    let (shape, body) = floats(&npz, "body_pos_w");
+    let (n, nb) = (shape[0], shape[1]);
+    let travel = |name: &str| {
+        let i = bodies.iter().position(|b| b == name).unwrap();
+        let at = |k: usize| &body[3 * (nb * k + i)..3 * (nb * k + i) + 3];
+        (0..n)
+            .map(|k| {
+                (0..3)
+                    .map(|d| (at(k)[d] - at(0)[d]).powi(2))
+                    .sum::<f64>()
+                    .sqrt()
+            })
+            .fold(0.0, f64::max)
+    };
+    // Held by the first level (sub-millimetre) and under the COM level (millimetres).
+    for foot in ["left_ankle_roll_link", "right_ankle_roll_link"] {
+        assert!(travel(foot) < 1e-3, "{foot}: {}", travel(foot));
+    }
+    assert!(travel("pelvis") < 1e-2, "pelvis: {}", travel("pelvis"));
+    assert!(travel("left_rubber_hand") > 0.1);
+    // Without the options the settings differ: the clip is redone, not skipped.
+    let o = run(&[]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(statuses(&out)["humanoid3d_dance_b"], "retargeted");
+    let o = run(&["--smoothing", "0"]);
+    assert!(!o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("smoothing") && err.contains("> 0"), "{err}");
+    let o = run(&["--standing", "--retarget", "joints"]);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--retarget keypoints only"));
+}
