@@ -82,8 +82,8 @@ def test_standing_imitation_by_the_keypoint_route_keeps_the_feet_within_5_mm():
 
 # The keypoint route's standing imitation (``standing=True``: feet and pelvis held at G1's start
 # pose, the COM over the middle of the soles, the clip's upper body relative to its pelvis)
-# keeps G1 up and level. MuJoCo 4.0.0: pelvis 0.760–0.763 m, tilt at most 0.025 rad; the plan's
-# ZMP (inverse dynamics) outside the polygon on 14 of 508 ticks, against 378 for the joint route.
+# keeps G1 up and level. MuJoCo 4.0.0: pelvis 0.760–0.763 m, tilt at most 0.022 rad; the plan's
+# ZMP (inverse dynamics) inside the polygon on all 508 ticks (the joint route's: outside on 378).
 def test_standing_imitation_of_the_upper_body_stays_up_and_level():
     loop = g1_sim.run_standing_keypoints(standing=True)
     s = loop.summary()
@@ -94,9 +94,8 @@ def test_standing_imitation_of_the_upper_body_stays_up_and_level():
     assert np.ptp(q[:, loop.upper], axis=0).max() > 1.0
 
 
-# Its feet still slip 11 mm: the plan's arms do not come to rest even on a held first frame
-# (G1's keypoint stack leaves no coordinate to the posture level; the servos trail the arms'
-# set points by 0.67 rad rms), and the dance's arm swings twist the robot about the vertical.
+# Its feet still slip 11 mm: the left foot creeps 9.6 mm over the clip's second half while the
+# servos trail the plan's arms by 0.41 rad rms (their accelerations 48 rad/s² rms).
 @pytest.mark.xfail(strict=True, reason="G1's feet slip 11 mm in the upper-body standing "
                    "imitation of humanoid3d_dance_b (see the example's README section)")
 def test_standing_imitation_of_the_upper_body_keeps_the_feet_within_5_mm():

@@ -150,6 +150,40 @@ fn joint_task_rows_select_joints() {
     assert!((eq.rhs[0] - h).abs() < 1e-12);
 }
 
+/// A weight w scales the joint task's rows, J and h alike (w J q̈ = w h), and leaves its
+/// errors as they are; a weight that is not finite and > 0 is refused.
+#[test]
+fn joint_task_weight_scales_its_rows() {
+    let robot = jvrc1(&ModelOptions::default()).unwrap();
+    let mut r = rng(5);
+    let s = random_state(&mut r, &robot);
+    let kin = Kinematics::new(&robot, &s).unwrap();
+    let names = ["WAIST_Y", "L_ELBOW_P", "R_KNEE"];
+    let mut one = JointTask::new(&robot, &names, Gains { kp: 9.0, kv: 6.0 }).unwrap();
+    one.set_reference(&[0.1, -0.5, 0.7], &[0.2, 0.0, -0.1], &[1.0, -1.0, 0.5])
+        .unwrap();
+    let mut heavy = one.clone();
+    heavy.set_weight(0.3).unwrap();
+    assert_eq!((one.weight(), heavy.weight()), (1.0, 0.3));
+    let mut e1 = TaskEquation::zeros("one", 3, robot.nv());
+    let mut ew = TaskEquation::zeros("weighted", 3, robot.nv());
+    one.linearize(&robot, &kin, &s, &mut e1, 0).unwrap();
+    heavy.linearize(&robot, &kin, &s, &mut ew, 0).unwrap();
+    // One multiplication by w per entry: equal to rounding of the product.
+    assert!((&ew.jacobian - &e1.jacobian * 0.3).abs().max() < 1e-15);
+    assert!((&ew.rhs - &e1.rhs * 0.3).abs().max() < 1e-12);
+    assert_eq!(ew.error, e1.error);
+    for w in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+        let e = heavy.set_weight(w).unwrap_err().to_string();
+        assert!(e.contains("weight"), "{e}");
+    }
+    assert_eq!(
+        heavy.weight(),
+        0.3,
+        "a refused weight leaves the task as it was"
+    );
+}
+
 #[test]
 fn tasks_reject_bad_input() {
     let robot = jvrc1(&ModelOptions::default()).unwrap();

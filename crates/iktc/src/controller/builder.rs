@@ -131,7 +131,15 @@ impl ControllerBuilder {
     ///
     /// Errors: no level started, no joint, an unknown or inactive joint, bad gains.
     pub fn joints(&mut self, joints: &[&str]) -> Result<JointsHandle> {
+        self.weighted_joints(joints, 1.0)
+    }
+
+    /// [`ControllerBuilder::joints`] with the rows weighted by `weight` ([`JointTask::set_weight`]):
+    /// a posture regulariser sharing a level with other tasks. Errors: as `joints`, and a weight
+    /// that is not finite and > 0.
+    pub fn weighted_joints(&mut self, joints: &[&str], weight: f64) -> Result<JointsHandle> {
         let mut task = JointTask::new(&self.robot, joints, self.gains)?;
+        task.set_weight(weight)?;
         let mut q = DVector::zeros(joints.len());
         for (slot, name) in q.iter_mut().zip(joints) {
             *slot = self.state.joint(&self.robot, name)?;

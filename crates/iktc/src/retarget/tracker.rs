@@ -9,8 +9,21 @@
 //! 3. `com_xy`: the COM over the support polygon, horizontal;
 //! 4. `pelvis`: the pelvis pose, 6D;
 //! 5. `hands_swing_feet`: the hand frames' positions and the feet in the air, 6D;
-//! 6. `elbows_head_torso`: the elbows' and the head's positions and the torso's orientation;
-//! 7. `posture`: every active joint at its posture reference (a regulariser).
+//! 6. `elbows_head_torso`: the elbows' and the head's positions and the torso's orientation,
+//!    and every active joint at its posture reference with its rows weighted by
+//!    [`KeypointSettings::posture_weight`] (a regulariser, see below);
+//! 7. `posture`: every active joint at its posture reference.
+//!
+//! The levels above the last can take every coordinate (on G1 the feet, COM, pelvis, hands,
+//! elbows and torso take all 35, leaving the posture level rank 0): each level is then solved
+//! exactly in what its betters leave it, however ill-conditioned that is, and nothing damps a
+//! joint's velocity but the tasks' own. Without the regulariser G1's arms never come to rest
+//! on a held frame (9–26 rad/s after 3 s on `humanoid3d_dance_b`, `_walk`, `_punch`), its
+//! joints' accelerations ride the box (RMS jerk 17 000–33 000 rad/s³ over the shared clips),
+//! and in MuJoCo its servos trail the arms' set points by 0.67 rad rms. In the sixth level the
+//! posture rows make the level's least-squares problem a compromise between the elbows, head
+//! and torso and the posture's `q̈_d + k_v (q̇_d − q̇) + k_p (q_d − q)`, which damps every joint
+//! that level moves.
 //!
 //! A foot is in the first level only once it has landed, and in the second only while it
 //! lands or its floor is engaged: one stack per pair of foot modes ([`FootMode`]: stance,
@@ -124,6 +137,9 @@ struct Tasks {
     pelvis: FrameHandle,
     torso: Option<FrameHandle>,
     points: Vec<(FrameHandle, usize)>,
+    /// The posture in the `elbows_head_torso` level, weighted by
+    /// [`KeypointSettings::posture_weight`] (none at weight 0).
+    regulariser: Option<JointsHandle>,
     posture: JointsHandle,
 }
 
@@ -273,6 +289,9 @@ fn set_references(
             posture_ref[d][j] = if hold && d > 0 { 0.0 } else { v };
         }
     }
+    if let Some(h) = t.regulariser {
+        ctl.set_joints_reference(h, &posture_ref[0], &posture_ref[1], &posture_ref[2])?;
+    }
     ctl.set_joints_reference(t.posture, &posture_ref[0], &posture_ref[1], &posture_ref[2])
 }
 
@@ -355,6 +374,11 @@ fn build_stack(
         feet.push((i, b.frame(&name(body.feet[i]), Axes::ORIENTATION)?));
     }
     let names: Vec<&str> = posture.iter().map(String::as_str).collect();
+    let regulariser = if s.posture_weight > 0.0 {
+        Some(b.weighted_joints(&names, s.posture_weight)?)
+    } else {
+        None
+    };
     let posture = b.level(KEYPOINT_LEVELS[6]).joints(&names)?;
     // The clone keeps the builder's identity: the handles address both controllers.
     let mut gf = b.clone();
@@ -373,6 +397,7 @@ fn build_stack(
             pelvis,
             torso,
             points,
+            regulariser,
             posture,
         },
     })

@@ -21,6 +21,10 @@ pub struct JointTask {
     pub velocity: DVector<f64>,
     /// Desired accelerations \[rad/s²\].
     pub acceleration: DVector<f64>,
+    /// Weight w of the task's rows \[–\] (default 1): they read `w q̈_j = w (q̈_d + k_v (q̇_d −
+    /// q̇) + k_p (q_d − q))`, which changes nothing where the task has a level of its own and
+    /// sets its share of the least-squares compromise in a level shared with other tasks.
+    weight: f64,
 }
 
 impl JointTask {
@@ -49,7 +53,27 @@ impl JointTask {
             position: DVector::zeros(m),
             velocity: DVector::zeros(m),
             acceleration: DVector::zeros(m),
+            weight: 1.0,
         })
+    }
+
+    /// Sets the weight of the task's rows ([`JointTask`]'s `weight`). Errors: a weight that is
+    /// not finite and > 0.
+    pub fn set_weight(&mut self, weight: f64) -> Result<()> {
+        if !(weight.is_finite() && weight > 0.0) {
+            return Err(Error::InvalidSetting {
+                name: "weight of a joint task".into(),
+                value: weight.to_string(),
+                expected: "a finite weight > 0 [–]".into(),
+            });
+        }
+        self.weight = weight;
+        Ok(())
+    }
+
+    /// The weight of the task's rows \[–\].
+    pub fn weight(&self) -> f64 {
+        self.weight
     }
 
     /// Names of the selected joints, in row order.
@@ -103,8 +127,9 @@ impl JointTask {
         for c in 0..nv {
             js[c * m + offset..c * m + offset + dim].fill(0.0);
         }
+        let w = self.weight;
         for (k, &iv) in self.v_index.iter().enumerate() {
-            js[iv * m + offset + k] = 1.0;
+            js[iv * m + offset + k] = w;
         }
         for k in 0..dim {
             let (iv, iq) = (self.v_index[k], self.q_index[k]);
@@ -117,6 +142,7 @@ impl JointTask {
                 0.0,
                 &self.gains,
             );
+            out.rhs[offset + k] *= w;
         }
         Ok(())
     }
