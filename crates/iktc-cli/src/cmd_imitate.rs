@@ -41,7 +41,8 @@ pub fn run(a: &Args) -> Result<()> {
         );
     }
     if a.retarget == crate::cmd_keypoints::RetargetArg::Keypoints {
-        let (resolved, cfg) = prepare_config(&a.scenario)?;
+        let (resolved, mut cfg) = prepare_config(&a.scenario)?;
+        cfg.smoothing = a.keypoints.smoothing;
         let profile = resolved
             .profile
             .as_ref()
@@ -65,10 +66,11 @@ pub fn run(a: &Args) -> Result<()> {
             &a.out,
         );
     }
-    if a.keypoints.standing || a.keypoints.smoothing.is_some() {
-        anyhow::bail!("--standing and --smoothing apply to --retarget keypoints only");
+    if a.keypoints.standing {
+        anyhow::bail!("--standing applies to --retarget keypoints only");
     }
-    let (e, cfg, profile) = prepare(&a.scenario)?;
+    let (e, mut cfg, profile) = prepare(&a.scenario)?;
+    cfg.smoothing = a.keypoints.smoothing;
     let r = e.imitate(&cfg)?;
     let meshes = crate::viewer::robot_meshes(&profile);
     let files = write_imitate(&r, &e, meshes.as_ref(), &a.out)?;

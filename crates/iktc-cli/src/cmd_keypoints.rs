@@ -31,10 +31,12 @@ pub struct KeypointArgs {
     /// relative to its pelvis (torso orientation, elbows, hands).
     #[arg(long)]
     pub standing: bool,
-    /// Low-pass the body points at this cut-off [Hz] before they are differentiated into the
-    /// tasks' references (zero-phase Butterworth, forward and backward); removes the capture's
-    /// frame-rate noise from the reference accelerations (6 Hz is biomechanics' usual choice
-    /// for walking). Default: none, the points as captured.
+    /// Low-pass the captured motion at this cut-off [Hz] before it is differentiated into the
+    /// tasks' references (zero-phase Butterworth, forward and backward): the body points of
+    /// the keypoint route, the joint angles and pelvis height and angles of the joint route
+    /// (and of the keypoint route's posture references). Removes the capture's frame-rate
+    /// noise from the reference accelerations (6 Hz is biomechanics' usual choice for
+    /// walking). Default: none, the motion as captured.
     #[arg(long, value_name = "HZ")]
     pub smoothing: Option<f64>,
 }

@@ -107,10 +107,8 @@ pub fn run(a: &Args) -> Result<()> {
     if a.scenario.motion != iktc::sim::experiment::DEFAULT_CLIP {
         anyhow::bail!("`iktc retarget` takes its motions as INPUT arguments, not --motion");
     }
-    if a.retarget == crate::cmd_keypoints::RetargetArg::Joints
-        && (a.keypoints.standing || a.keypoints.smoothing.is_some())
-    {
-        anyhow::bail!("--standing and --smoothing apply to --retarget keypoints only");
+    if a.retarget == crate::cmd_keypoints::RetargetArg::Joints && a.keypoints.standing {
+        anyhow::bail!("--standing applies to --retarget keypoints only");
     }
     let jobs = match a.jobs {
         Some(0) => anyhow::bail!("--jobs 0: expected at least 1 worker thread"),
@@ -122,7 +120,8 @@ pub fn run(a: &Args) -> Result<()> {
             anyhow::bail!("--rate {r}: expected a finite rate > 0 [Hz]");
         }
     }
-    let (resolved, config) = prepare_config(&a.scenario)?;
+    let (resolved, mut config) = prepare_config(&a.scenario)?;
+    config.smoothing = a.keypoints.smoothing;
     let profile = resolved
         .profile
         .clone()

@@ -125,9 +125,11 @@ impl PyImitation {
     /// narrowed ranges (the tasks below the level a narrowed joint blocks are corrected);
     /// `duration` [s] keeps the clip's frames up to the first at or past it (default: all);
     /// `time_scale` [–] plays the clip that many times slower (its frame times multiplied:
-    /// rates divided by it, accelerations by its square), before the cut.
+    /// rates divided by it, accelerations by its square), before the cut. `smoothing` [Hz]: the
+    /// cut-off of the zero-phase low-pass applied to the retargeted angles before they are
+    /// differentiated (`iktc::sim::ImitateConfig::smoothing`; default none).
     #[new]
-    #[pyo3(signature = (robot, motion, *, map=None, dt=0.005, method="iktc", bounds="quiet", duration=None, time_scale=1.0, level_hold=None, rebase_release=1.0, continuity=0.0, narrow=None))]
+    #[pyo3(signature = (robot, motion, *, map=None, dt=0.005, method="iktc", bounds="quiet", duration=None, time_scale=1.0, level_hold=None, rebase_release=1.0, continuity=0.0, narrow=None, smoothing=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -143,6 +145,7 @@ impl PyImitation {
         rebase_release: f64,
         continuity: f64,
         narrow: Option<Vec<(String, f64, f64)>>,
+        smoothing: Option<f64>,
     ) -> PyResult<Self> {
         let profile = robot.required_profile("the imitation", "feet, pelvis and posture")?;
         let base = ImitateConfig {
@@ -164,6 +167,7 @@ impl PyImitation {
         if let Some(n) = narrow {
             cfg.narrow = narrowed(n);
         }
+        cfg.smoothing = smoothing;
         let map = resolve_map(robot, motion, map)?;
         let clip = motion.clip()?;
         let part = clip_part(clip, time_scale, duration).map_err(to_py)?;

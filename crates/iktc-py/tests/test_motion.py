@@ -145,6 +145,31 @@ def test_the_imitation_refuses_unknown_bounds_and_solver_settings_out_of_range()
         iktc.Imitation(robot, motion, bounds="soft")
     with pytest.raises(iktc.IktcError, match="rebase_release"):
         iktc.Imitation(robot, motion, duration=0.1, rebase_release=0.0)
+    with pytest.raises(iktc.IktcError, match="smoothing"):
+        iktc.Imitation(robot, motion, duration=0.1, smoothing=0.0)
+
+
+def test_the_imitation_low_passes_its_references_when_asked():
+    robot, motion = iktc.Robot("g1"), iktc.load_motion("humanoid3d_dance_b")
+
+    def figures(**kw):
+        sim = iktc.Imitation(robot, motion, duration=1.0, **kw)
+        refs = []
+        for _ in range(sim.ticks):
+            refs.append(sim.upper_body_reference())
+            sim.tick()
+        a = np.diff(np.array(refs), 2, axis=0) / DT ** 2
+        d = np.diff(a, axis=0)
+        reversals = np.mean(np.sign(d[1:]) * np.sign(d[:-1]) < 0, axis=0)
+        jerk = np.sqrt(np.mean((d / DT) ** 2, axis=0))
+        return np.median(jerk), np.median(reversals)
+
+    # Per upper-body joint, the median over the joints: RMS jerk of the references 2 470 →
+    # 1 060 rad/s³ at 6 Hz, the change of their acceleration reversing on 17.5 % → 4.5 % of
+    # the ticks. (A few joints' decomposition swings past the shoulder's gimbal lock dominate
+    # the RMS over all joints, which falls only 3 %.)
+    (j0, r0), (j6, r6) = figures(), figures(smoothing=6.0)
+    assert j6 < 0.5 * j0 and r0 > 0.1 and r6 < 0.1, (j0, r0, j6, r6)
 
 
 def test_a_com_offset_ramp_lags_by_kv_over_kp_unless_its_rates_are_fed_forward():

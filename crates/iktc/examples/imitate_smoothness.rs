@@ -1,6 +1,7 @@
 //! Smoothness of the paper's imitation run (JVRC-1, the default clip, L_KNEE and L_HIP_R
 //! narrowed) under Algorithm 2 as printed with the viable bounds, and under the smoothing
-//! settings one at a time: the quiet bounds, the level hold (the defaults), the continuity term.
+//! settings one at a time: the quiet bounds, the level hold (the defaults), the continuity term,
+//! the clip low-passed at 6 and 8 Hz before retargeting (`ImitateConfig::smoothing`).
 //!
 //! ```sh
 //! cargo run --release -p iktc --example imitate_smoothness
@@ -26,9 +27,14 @@ fn main() -> iktc::Result<()> {
         defaults.solver.level_hold
     );
     let variants = [
-        ("Algorithm 2, viable bounds", BoundMethod::viable(), printed),
-        ("quiet bounds", BoundMethod::quiet(), printed),
-        (hold.as_str(), defaults.bounds, defaults.solver),
+        (
+            "Algorithm 2, viable bounds",
+            BoundMethod::viable(),
+            printed,
+            None,
+        ),
+        ("quiet bounds", BoundMethod::quiet(), printed, None),
+        (hold.as_str(), defaults.bounds, defaults.solver, None),
         (
             "the defaults with the continuity term, μ = 0.3",
             defaults.bounds,
@@ -36,12 +42,26 @@ fn main() -> iktc::Result<()> {
                 continuity: 0.3,
                 ..defaults.solver
             },
+            None,
+        ),
+        (
+            "the defaults, the clip low-passed at 8 Hz",
+            defaults.bounds,
+            defaults.solver,
+            Some(8.0),
+        ),
+        (
+            "the defaults, the clip low-passed at 6 Hz",
+            defaults.bounds,
+            defaults.solver,
+            Some(6.0),
         ),
     ];
-    for (name, bounds, solver) in variants {
+    for (name, bounds, solver, smoothing) in variants {
         let mut cfg = ImitateConfig {
             bounds,
             solver,
+            smoothing,
             ..defaults.clone()
         };
         cfg.health.keep_going = true;

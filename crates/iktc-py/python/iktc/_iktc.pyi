@@ -198,7 +198,8 @@ class Imitation:
                  duration: Optional[float] = None, time_scale: float = 1.0,
                  level_hold: Optional[int] = None, rebase_release: float = 1.0,
                  continuity: float = 0.0,
-                 narrow: Optional[Sequence[Tuple[str, float, float]]] = None) -> None: ...
+                 narrow: Optional[Sequence[Tuple[str, float, float]]] = None,
+                 smoothing: Optional[float] = None) -> None: ...
     @property
     def ticks(self) -> int: ...
     @property

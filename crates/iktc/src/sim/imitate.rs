@@ -89,6 +89,11 @@ pub struct ImitateConfig {
     /// The run's checks (feet held, state finite, ZMP inside the support polygon) and whether
     /// a failed one stops the run ([`crate::sim::health`]).
     pub health: HealthSettings,
+    /// Cut-off \[Hz\] of the zero-phase low-pass ([`crate::motion::lowpass`]) applied to the
+    /// retargeted joint angles and pelvis height and angles at the clip's rate, before they
+    /// are clamped into the ranges and differentiated into references (default `None`: as
+    /// captured; a cut-off at or above the clip's Nyquist frequency leaves them too).
+    pub smoothing: Option<f64>,
 }
 
 impl ImitateConfig {
@@ -141,6 +146,7 @@ impl ImitateConfig {
                 ..SolverSettings::default()
             },
             health: HealthSettings::default(),
+            smoothing: None,
         }
     }
 
@@ -152,6 +158,15 @@ impl ImitateConfig {
             expected: expected.into(),
         };
         self.run_limits.check_dt("dt", self.dt)?;
+        if let Some(fc) = self.smoothing {
+            if !(fc.is_finite() && fc > 0.0) {
+                return Err(bad(
+                    "smoothing",
+                    fc,
+                    "a cut-off frequency > 0 [Hz], or none",
+                ));
+            }
+        }
         if !(self.reference_margin.is_finite() && self.reference_margin >= 0.0) {
             return Err(bad(
                 "reference_margin",
@@ -236,6 +251,22 @@ pub fn imitation_references(
 ) -> Result<RobotReferences> {
     cfg.validate()?;
     let mut r = crate::motion::retarget(clip, robot, map)?;
+    if let Some(fc) = cfg.smoothing {
+        // The frames' mean period: the captured tracks are evenly sampled.
+        let n = r.times.len();
+        if n > 1 {
+            let period = (r.times[n - 1] - r.times[0]) / (n - 1) as f64;
+            if fc * 2.0 * period < 1.0 {
+                for t in r.joint_angles.iter_mut() {
+                    *t = crate::motion::lowpass(t, period, fc)?;
+                }
+                r.pelvis_height = crate::motion::lowpass(&r.pelvis_height, period, fc)?;
+                for t in r.pelvis_angles.iter_mut() {
+                    *t = crate::motion::lowpass(t, period, fc)?;
+                }
+            }
+        }
+    }
     r.clamp_to_limits(robot, cfg.reference_margin)?;
     for n in &cfg.narrow {
         let (lo, hi) = crate::motion::shrunk_range(n.lower, n.upper, cfg.reference_margin);
