@@ -114,6 +114,35 @@ pub fn lowpass(x: &[f64], period: f64, cutoff: f64) -> Result<Vec<f64>> {
     Ok(y[pad..pad + n].to_vec())
 }
 
+/// Checks an optional cut-off setting `smoothing` \[Hz\]: none, or finite and > 0.
+pub fn check_smoothing(smoothing: Option<f64>) -> Result<()> {
+    match smoothing {
+        Some(fc) if !(fc.is_finite() && fc > 0.0) => Err(Error::InvalidSetting {
+            name: "smoothing".into(),
+            value: fc.to_string(),
+            expected: "a cut-off frequency > 0 [Hz], or none".into(),
+        }),
+        _ => Ok(()),
+    }
+}
+
+/// [`lowpass`] of a captured track `x` sampled at `times` \[s\] (evenly, at their mean
+/// period): the track unchanged when it has fewer than two samples or `cutoff` is at or above
+/// its Nyquist frequency (nothing to take out). Errors: as [`lowpass`] for a cut-off that is
+/// not finite and > 0 or a non-finite sample; `times` and `x` of different lengths.
+pub fn lowpass_track(x: &[f64], times: &[f64], cutoff: f64) -> Result<Vec<f64>> {
+    crate::error::check_dim("times of a track to low-pass", x.len(), times.len())?;
+    let n = x.len();
+    if n < 2 {
+        return Ok(x.to_vec());
+    }
+    let period = (times[n - 1] - times[0]) / (n - 1) as f64;
+    if cutoff.is_finite() && cutoff * 2.0 * period >= 1.0 {
+        return Ok(x.to_vec());
+    }
+    lowpass(x, period, cutoff)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -214,5 +243,25 @@ mod tests {
         assert!(e.contains("sample 7"), "{e}");
         assert_eq!(lowpass(&[1.5], T, 6.0).unwrap(), vec![1.5]);
         assert!(lowpass(&[], T, 6.0).unwrap().is_empty());
+        for fc in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+            assert!(check_smoothing(Some(fc)).is_err(), "{fc}");
+        }
+        assert!(check_smoothing(None).is_ok() && check_smoothing(Some(6.0)).is_ok());
+    }
+
+    /// A track's cut-off at or above its Nyquist frequency leaves it as it is; below, it is
+    /// [`lowpass`] at the mean period.
+    #[test]
+    fn a_track_is_low_passed_only_below_its_nyquist_frequency() {
+        let x = sine(10.0, 120);
+        let times: Vec<f64> = (0..x.len()).map(|k| 0.5 + k as f64 * T).collect();
+        assert_eq!(lowpass_track(&x, &times, 30.0).unwrap(), x);
+        assert_eq!(lowpass_track(&x, &times, 45.0).unwrap(), x);
+        assert_eq!(
+            lowpass_track(&x, &times, 6.0).unwrap(),
+            lowpass(&x, T, 6.0).unwrap()
+        );
+        assert!(lowpass_track(&x, &times, 0.0).is_err());
+        assert!(lowpass_track(&x, &times[1..], 6.0).is_err());
     }
 }

@@ -92,7 +92,7 @@ pub use load::{
     detect_format, find_asf, load_motion, motion_from_content, scale_clip, Motion, MotionContent,
     MotionFormat, MotionOptions,
 };
-pub use lowpass::{lowpass, PAD_PERIODS};
+pub use lowpass::{check_smoothing, lowpass, lowpass_track, PAD_PERIODS};
 pub use markers::{FilledGap, MarkerSet, DEFAULT_MAX_GAP};
 pub use points_csv::read_points_csv;
 pub use recognise::{

@@ -240,15 +240,7 @@ impl KeypointSettings {
                 });
             }
         }
-        if let Some(fc) = self.smoothing {
-            if !(fc.is_finite() && fc > 0.0) {
-                return Err(Error::InvalidSetting {
-                    name: "smoothing".into(),
-                    value: fc.to_string(),
-                    expected: "a cut-off frequency > 0 [Hz], or none".into(),
-                });
-            }
-        }
+        crate::motion::check_smoothing(self.smoothing)?;
         self.gains.validate()?;
         self.bounds.validate()?;
         self.solver.validate()

@@ -25,7 +25,7 @@ use super::scale::ScaledClip;
 use super::{KeypointSettings, SupportArea};
 use crate::error::{Error, Result};
 use crate::model::{Kinematics, Robot};
-use crate::motion::{lowpass, BodyPoint, CubicSpline, Keypoints};
+use crate::motion::{lowpass_track, BodyPoint, CubicSpline, Keypoints};
 use crate::sim::imitate::{sole_pose, SupportSettings};
 use crate::task::{ComReference, FrameReference};
 use crate::walk::SupportPolygon;
@@ -251,16 +251,7 @@ pub(crate) fn plan(
         + 1;
     let times: Vec<f64> = (0..ticks).map(|k| (t0 + k as f64 * s.dt).min(t1)).collect();
     let idx = |p: BodyPoint| kp.points.iter().position(|q| *q == p);
-    // Splines through the scaled (low-passed, when asked and below the clip's Nyquist
-    // frequency) and aligned points.
-    let period = if frames > 1 {
-        (t1 - t0) / (frames - 1) as f64
-    } else {
-        0.0
-    };
-    let cutoff = s
-        .smoothing
-        .filter(|fc| frames > 1 && *fc > 0.0 && *fc * 2.0 * period < 1.0);
+    // Splines through the scaled (low-passed, when asked) and aligned points.
     let sample = |data: &[Vector3<f64>], k: usize, smooth: bool| -> Result<Vec<Vector3<f64>>> {
         let mut out = vec![Vector3::zeros(); ticks];
         if frames == 1 {
@@ -269,8 +260,8 @@ pub(crate) fn plan(
         }
         for axis in 0..3 {
             let mut y: Vec<f64> = (0..frames).map(|f| data[f * n + k][axis]).collect();
-            if let (true, Some(fc)) = (smooth, cutoff) {
-                y = lowpass(&y, period, fc)?;
+            if let (true, Some(fc)) = (smooth, s.smoothing) {
+                y = lowpass_track(&y, &kp.times, fc)?;
             }
             let spline = CubicSpline::new(&kp.times, &y)?;
             for (o, t) in out.iter_mut().zip(&times) {

@@ -158,15 +158,7 @@ impl ImitateConfig {
             expected: expected.into(),
         };
         self.run_limits.check_dt("dt", self.dt)?;
-        if let Some(fc) = self.smoothing {
-            if !(fc.is_finite() && fc > 0.0) {
-                return Err(bad(
-                    "smoothing",
-                    fc,
-                    "a cut-off frequency > 0 [Hz], or none",
-                ));
-            }
-        }
+        crate::motion::check_smoothing(self.smoothing)?;
         if !(self.reference_margin.is_finite() && self.reference_margin >= 0.0) {
             return Err(bad(
                 "reference_margin",
@@ -252,20 +244,18 @@ pub fn imitation_references(
     cfg.validate()?;
     let mut r = crate::motion::retarget(clip, robot, map)?;
     if let Some(fc) = cfg.smoothing {
-        // The frames' mean period: the captured tracks are evenly sampled.
-        let n = r.times.len();
-        if n > 1 {
-            let period = (r.times[n - 1] - r.times[0]) / (n - 1) as f64;
-            if fc * 2.0 * period < 1.0 {
-                for t in r.joint_angles.iter_mut() {
-                    *t = crate::motion::lowpass(t, period, fc)?;
-                }
-                r.pelvis_height = crate::motion::lowpass(&r.pelvis_height, period, fc)?;
-                for t in r.pelvis_angles.iter_mut() {
-                    *t = crate::motion::lowpass(t, period, fc)?;
-                }
-            }
-        }
+        let low = |x: &[f64]| crate::motion::lowpass_track(x, &r.times, fc);
+        let joints = r
+            .joint_angles
+            .iter()
+            .map(|t| low(t))
+            .collect::<Result<_>>()?;
+        let height = low(&r.pelvis_height)?;
+        let [a0, a1, a2] = &r.pelvis_angles;
+        let angles = [low(a0)?, low(a1)?, low(a2)?];
+        r.joint_angles = joints;
+        r.pelvis_height = height;
+        r.pelvis_angles = angles;
     }
     r.clamp_to_limits(robot, cfg.reference_margin)?;
     for n in &cfg.narrow {
