@@ -157,8 +157,9 @@ pub struct KeypointSettings {
     /// joints' RMS jerk from 5 940 to 5 070 rad/s³ and 6 Hz to 4 610. The quality figures
     /// still compare the robot with the captured points.
     pub smoothing: Option<f64>,
-    /// Weight of the posture rows added to the `elbows_head_torso` level \[–\] (default
-    /// [`POSTURE_WEIGHT`]; 0 leaves them out): a joint's acceleration 1 rad/s² off its posture
+    /// Weight of the posture rows in the `elbows_head_torso` level \[–\] (default
+    /// [`POSTURE_WEIGHT`]; 0 puts them in a seventh level of their own, below all tracking, as
+    /// before 0.2.0): a joint's acceleration 1 rad/s² off its posture
     /// reference costs as much there as an elbow's `weight` m/s² off its reference. The levels
     /// above the posture level can take every coordinate (on G1 all 35), and each is then
     /// solved exactly in what the levels above leave it, however ill-conditioned, with no

@@ -12,7 +12,9 @@
 //! 6. `elbows_head_torso`: the elbows' and the head's positions and the torso's orientation,
 //!    and every active joint at its posture reference with its rows weighted by
 //!    [`KeypointSettings::posture_weight`] (a regulariser, see below);
-//! 7. `posture`: every active joint at its posture reference.
+//! 7. `posture`: only with a posture weight of 0, every active joint at its posture reference
+//!    in a level of its own (below the weighted rows such a level could only move what they
+//!    already move: it would have rank 0).
 //!
 //! The levels above the last can take every coordinate (on G1 the feet, COM, pelvis, hands,
 //! elbows and torso take all 35, leaving the posture level rank 0): each level is then solved
@@ -137,9 +139,6 @@ struct Tasks {
     pelvis: FrameHandle,
     torso: Option<FrameHandle>,
     points: Vec<(FrameHandle, usize)>,
-    /// The posture in the `elbows_head_torso` level, weighted by
-    /// [`KeypointSettings::posture_weight`] (none at weight 0).
-    regulariser: Option<JointsHandle>,
     posture: JointsHandle,
 }
 
@@ -289,9 +288,6 @@ fn set_references(
             posture_ref[d][j] = if hold && d > 0 { 0.0 } else { v };
         }
     }
-    if let Some(h) = t.regulariser {
-        ctl.set_joints_reference(h, &posture_ref[0], &posture_ref[1], &posture_ref[2])?;
-    }
     ctl.set_joints_reference(t.posture, &posture_ref[0], &posture_ref[1], &posture_ref[2])
 }
 
@@ -374,12 +370,13 @@ fn build_stack(
         feet.push((i, b.frame(&name(body.feet[i]), Axes::ORIENTATION)?));
     }
     let names: Vec<&str> = posture.iter().map(String::as_str).collect();
-    let regulariser = if s.posture_weight > 0.0 {
-        Some(b.weighted_joints(&names, s.posture_weight)?)
+    // Weighted into the sixth level, or (weight 0) a level of its own: never both, as a
+    // posture level below the weighted rows could only move what they already move.
+    let posture = if s.posture_weight > 0.0 {
+        b.weighted_joints(&names, s.posture_weight)?
     } else {
-        None
+        b.level(KEYPOINT_LEVELS[6]).joints(&names)?
     };
-    let posture = b.level(KEYPOINT_LEVELS[6]).joints(&names)?;
     // The clone keeps the builder's identity: the handles address both controllers.
     let mut gf = b.clone();
     gf.settings(ControllerSettings {
@@ -397,7 +394,6 @@ fn build_stack(
             pelvis,
             torso,
             points,
-            regulariser,
             posture,
         },
     })
