@@ -42,7 +42,7 @@ pub fn run(a: &Args) -> Result<()> {
     }
     if a.retarget == crate::cmd_keypoints::RetargetArg::Keypoints {
         let (resolved, mut cfg) = prepare_config(&a.scenario)?;
-        cfg.smoothing = a.keypoints.smoothing;
+        a.keypoints.apply(a.retarget, &mut cfg)?;
         let profile = resolved
             .profile
             .as_ref()
@@ -66,11 +66,8 @@ pub fn run(a: &Args) -> Result<()> {
             &a.out,
         );
     }
-    if a.keypoints.standing {
-        anyhow::bail!("--standing applies to --retarget keypoints only");
-    }
     let (e, mut cfg, profile) = prepare(&a.scenario)?;
-    cfg.smoothing = a.keypoints.smoothing;
+    a.keypoints.apply(a.retarget, &mut cfg)?;
     let r = e.imitate(&cfg)?;
     let meshes = crate::viewer::robot_meshes(&profile);
     let files = write_imitate(&r, &e, meshes.as_ref(), &a.out)?;

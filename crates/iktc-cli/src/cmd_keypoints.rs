@@ -41,6 +41,18 @@ pub struct KeypointArgs {
     pub smoothing: Option<f64>,
 }
 
+impl KeypointArgs {
+    /// Gives `cfg` the `--smoothing` (both routes use it) and refuses `--standing` on the joint
+    /// route.
+    pub fn apply(&self, route: RetargetArg, cfg: &mut ImitateConfig) -> Result<()> {
+        if route == RetargetArg::Joints && self.standing {
+            anyhow::bail!("--standing applies to --retarget keypoints only");
+        }
+        cfg.smoothing = self.smoothing;
+        Ok(())
+    }
+}
+
 /// The keypoint retargeting's settings: the imitation's solver, period and tick limit from
 /// `cfg`, `bounds`, and the keypoint options `k`.
 pub fn keypoint_settings(

@@ -107,9 +107,6 @@ pub fn run(a: &Args) -> Result<()> {
     if a.scenario.motion != iktc::sim::experiment::DEFAULT_CLIP {
         anyhow::bail!("`iktc retarget` takes its motions as INPUT arguments, not --motion");
     }
-    if a.retarget == crate::cmd_keypoints::RetargetArg::Joints && a.keypoints.standing {
-        anyhow::bail!("--standing applies to --retarget keypoints only");
-    }
     let jobs = match a.jobs {
         Some(0) => anyhow::bail!("--jobs 0: expected at least 1 worker thread"),
         Some(n) => n,
@@ -121,7 +118,7 @@ pub fn run(a: &Args) -> Result<()> {
         }
     }
     let (resolved, mut config) = prepare_config(&a.scenario)?;
-    config.smoothing = a.keypoints.smoothing;
+    a.keypoints.apply(a.retarget, &mut config)?;
     let profile = resolved
         .profile
         .clone()
