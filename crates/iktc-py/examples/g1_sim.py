@@ -32,8 +32,19 @@ MJCF = REPO / "crates" / "iktc" / "data" / "robots" / "g1" / "g1_29dof_rev_1_0.x
 KP = 500.0
 #: Servo damping [N·m·s/rad].
 KV = 20.0
-#: Physics step [s]: 1 ms with ``implicitfast`` stands; explicit Euler at 1 ms falls.
-PHYSICS_STEP = 0.001
+#: Physics step [s]: 0.1 ms, where the figures have converged. ``implicitfast`` damps a servo's
+#: rate term implicitly only while its torque is inside the joint's force range; at a limit the
+#: torque is a constant and one step changes the joint's rate by h·τ_max/M. Where that is more
+#: than the band of rates 2·τ_max/KV in which the servo is not saturated, h > 2M/KV, the servo
+#: jumps across the band and flips between its two force limits every step, for good (one hinge
+#: of 1.8 g·m² at 25 N·m, commanded 3 rad/s: 0 and 13.9 rad/s in turn at 1 ms; it settles at 0.1 ms).
+#: On G1 the wrists (0.6–5 g·m² about their axes) and the shoulders' yaw (6–10 g·m²) are that
+#: light: at 1 ms a servo flipped on 361 of the 508 ticks of the upper-body standing imitation
+#: (``run_standing_keypoints(standing=True)``), the servos trailed its plan by 0.41 rad rms and the
+#: feet slipped 11.3 mm. At 0.5, 0.2, 0.1, 0.05 and 0.02 ms: flips on 324, 221, 65, 11 and 2 ticks,
+#: servos 0.140, 0.036, 0.026, 0.025, 0.025 rad rms behind, feet slipping 4.60, 3.66, 3.22, 3.06,
+#: 2.98 mm. (Explicit Euler at 1 ms falls.)
+PHYSICS_STEP = 0.0001
 #: Control period [s]: one iktc tick, then CONTROL_PERIOD / PHYSICS_STEP physics steps.
 CONTROL_PERIOD = 0.005
 #: A foot whose sensed normal force is at most this is unloaded [N] (sensor noise is none here;
@@ -81,6 +92,12 @@ def plant_xml(mjcf: pathlib.Path = MJCF, kp: float = KP, kv: float = KV,
     return ET.tostring(root, encoding="unicode")
 
 
+def yaw_between(h0: np.ndarray, h1: np.ndarray) -> float:
+    """The turn about the world's vertical from pose h0 to pose h1 (4 × 4) [rad]."""
+    r = h1[:3, :3] @ h0[:3, :3].T
+    return math.atan2(float(r[1, 0]), float(r[0, 0]))
+
+
 def tilt(xmat: np.ndarray) -> float:
     """Angle between a body's z axis and the world's [rad]."""
     return math.acos(max(-1.0, min(1.0, float(xmat.reshape(3, 3)[2, 2]))))
@@ -109,6 +126,17 @@ class Plant:
                                  m.sensor_adr[m.sensor(f"{side}_ankle_force").id],
                                  m.sensor_adr[m.sensor(f"{side}_ankle_torque").id])
         self.substeps = int(round(CONTROL_PERIOD / m.opt.timestep))
+        # The joints' force ranges, for the servo flips counted by `advance`.
+        jid = [m.joint(n).id for n in names]
+        self.force_low = np.array([m.jnt_actfrcrange[j][0] if m.jnt_actfrclimited[j] else -np.inf
+                                   for j in jid])
+        self.force_high = np.array([m.jnt_actfrcrange[j][1] if m.jnt_actfrclimited[j] else np.inf
+                                    for j in jid])
+        self._at_low = np.zeros(len(names), dtype=bool)
+        self._at_high = np.zeros(len(names), dtype=bool)
+        #: Joints whose servo torque went from one force limit to the other between two
+        #: consecutive physics steps during the last `advance` (see PHYSICS_STEP).
+        self.flipped = np.zeros(len(names), dtype=bool)
 
     def set_state(self, q: np.ndarray) -> None:
         """Places the robot at iktc's q (base position, quaternion x y z w, joints), at rest."""
@@ -131,8 +159,14 @@ class Plant:
         d = self.data
         if push is not None:
             d.xfrc_applied[self.pelvis, :3] = push
+        self.flipped[:] = False
         for _ in range(self.substeps):
             mujoco.mj_step(self.model, d)
+            tau = d.qfrc_actuator[self.dadr]
+            low = tau <= self.force_low + 1e-9
+            high = tau >= self.force_high - 1e-9
+            self.flipped |= (low & self._at_high) | (high & self._at_low)
+            self._at_low, self._at_high = low, high
         if push is not None:
             d.xfrc_applied[self.pelvis, :3] = 0.0
 
@@ -186,6 +220,8 @@ class Log:
     com_offset: list = field(default_factory=list)
     qpos: list = field(default_factory=list)
     q_cmd: list = field(default_factory=list)
+    servo_flips: list = field(default_factory=list)
+    foot_yaw: list = field(default_factory=list)
 
 
 def summarise(log: Log, fallen_height: float) -> dict:
@@ -202,6 +238,9 @@ def summarise(log: Log, fallen_height: float) -> dict:
         "pelvis_height_max_m": float(h.max()),
         "base_tilt_max_rad": float(np.max(log.tilt)),
         "foot_slip_max_m": float(np.max(log.slip)),
+        # The feet's largest turn about the vertical from where they stood [rad]: a foot turning
+        # on the ground slips more at its toe and heel than at the ankle `foot_slip_max_m` follows.
+        "foot_yaw_max_rad": float(np.max(np.abs(log.foot_yaw))) if log.foot_yaw else 0.0,
         "zmp_ticks_measured": int(margins.size),
         "zmp_margin_min_m": float(margins.min()) if margins.size else float("nan"),
         "zmp_inside": bool(margins.size == len(log.t) and margins.min() > 0.0),
@@ -209,6 +248,9 @@ def summarise(log: Log, fallen_height: float) -> dict:
         "joint_error_max_rad": float(np.abs(je).max()),
         "upper_body_error_rms_rad": float(np.sqrt(np.mean(ue ** 2))),
         "upper_body_error_max_rad": float(np.abs(ue).max()),
+        # Ticks on which a servo went from one force limit to the other between two physics
+        # steps: the integration is not resolving it (see PHYSICS_STEP).
+        "servo_limit_flip_ticks": int(np.count_nonzero(log.servo_flips)),
     }
 
 
@@ -288,6 +330,8 @@ class Loop:
         log.zmp_margin.append(None if zmp is None else self.sim.support_margin(zmp, feet))
         log.slip.append(max(float(np.linalg.norm(f[:2, 3] - f0[:2, 3]))
                             for f, f0 in zip(feet, self.feet0)))
+        log.foot_yaw.append(max((abs(yaw_between(f0, f)) for f, f0 in zip(feet, self.feet0)),
+                                key=abs))
         qj = p.joint_positions()
         err = qj - q[7:]
         log.joint_error.append(float(np.abs(err).max()))
@@ -296,6 +340,7 @@ class Loop:
         log.com_offset.append(com_offset)
         log.qpos.append(p.data.qpos.copy())
         log.q_cmd.append(q.copy())
+        log.servo_flips.append(int(p.flipped.sum()))
 
     def summary(self) -> dict:
         # Fallen: the pelvis 0.25 m below its standing height (0.76 m).
@@ -316,7 +361,8 @@ def run_standing(duration: float | None = None, settle: float = 0.5,
 
 
 def run_standing_keypoints(clip: str = "humanoid3d_dance_b", settle: float = 0.5,
-                           robot: iktc.Robot | None = None, standing: bool = False) -> Loop:
+                           robot: iktc.Robot | None = None, standing: bool = False,
+                           physics_step: float = PHYSICS_STEP) -> Loop:
     """(a′) Standing imitation by the keypoint route (``iktc.retarget_keypoints(...,
     hold_feet=True)``: the clip's body points scaled to G1, both feet held where they stand,
     the COM reference over the support polygon); its q and v per tick are the servos' set
@@ -325,7 +371,7 @@ def run_standing_keypoints(clip: str = "humanoid3d_dance_b", settle: float = 0.5
     pose, the COM over the middle of the soles, the clip's upper body relative to its pelvis).
     The loop's imitation (one tick long) serves only for the support polygon; the upper body is
     measured against the plan's own upper-body angles. Returns the loop."""
-    loop = Loop(clip=clip, duration=CONTROL_PERIOD, robot=robot)
+    loop = Loop(clip=clip, duration=CONTROL_PERIOD, robot=robot, physics_step=physics_step)
     plan = iktc.retarget_keypoints(iktc.load_motion(clip), loop.robot, dt=CONTROL_PERIOD,
                                    hold_feet=True, standing=standing)
     qs, vs = plan.q, plan.v
