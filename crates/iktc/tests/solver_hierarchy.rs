@@ -366,3 +366,140 @@ fn pinv_is_the_pseudo_inverse_of_the_projected_jacobian() {
         }
     }
 }
+
+/// Random levels above a bottom level that selects `m` distinct coordinates (a joint or
+/// posture task, each row scaled by a weight in ±[0.5, 2]), the upper rows `n − m` in two
+/// levels, so that the stacked rows are as many as the coordinates.
+fn levels_over_a_selection(
+    r: &mut rand_chacha::ChaCha8Rng,
+    n: usize,
+    m: usize,
+) -> Vec<TaskEquation> {
+    use rand::seq::SliceRandom;
+    use rand::Rng;
+    let upper = n - m;
+    let a = 1 + r.random_range(0..upper);
+    let dims: Vec<usize> = [a, upper - a, m].into_iter().filter(|&d| d > 0).collect();
+    let mut levels = random_levels(r, n, &dims);
+    let bottom = levels.last_mut().unwrap();
+    bottom.jacobian.fill(0.0);
+    let mut coords: Vec<usize> = (0..n).collect();
+    coords.shuffle(r);
+    for (row, &c) in coords[..m].iter().enumerate() {
+        let s = r.random_range(0.5..2.0) * if r.random_bool(0.5) { 1.0 } else { -1.0 };
+        bottom.jacobian[(row, c)] = s;
+    }
+    levels
+}
+
+/// The correction-map block of the bottom level (built from `levels`) and the G block of the
+/// general construction, and whether the closed form built the first.
+fn bottom_blocks(levels: &[TaskEquation], damping: Damping) -> (DMatrix<f64>, DMatrix<f64>, bool) {
+    let n = levels[0].nv();
+    let dims: Vec<usize> = levels.iter().map(|l| l.dim()).collect();
+    let i = dims.len() - 1;
+    let settings = SolverSettings {
+        damping,
+        ..Default::default()
+    };
+    let mut h = Hierarchy::new(n, &dims);
+    let mut q0 = DVector::zeros(n);
+    h.solve(levels, &settings, &mut q0).unwrap();
+    assert_eq!(h.ranks(), &dims[..], "the random levels have full rank");
+    let closed = h.build_correction_map(levels, i, i + 1);
+    let map = h
+        .correction_map()
+        .columns(h.correction_offset(i), dims[i])
+        .clone_owned();
+    h.build_g_levels(i, i + 1);
+    let g = h.g().columns(h.offset(i), dims[i]).clone_owned();
+    (map, g, closed)
+}
+
+#[test]
+fn a_bottom_selection_level_completing_the_rank_gets_the_general_block_in_closed_form() {
+    let mut r = rng(77);
+    for case in 0..60 {
+        let n = 6 + case % 13;
+        let m = 1 + case % (n - 1);
+        let levels = levels_over_a_selection(&mut r, n, m);
+        let (map, g, closed) = bottom_blocks(&levels, Damping::None);
+        assert!(closed, "case {case}: the closed form applies");
+        let scale = g.amax().max(1.0);
+        assert!(
+            (&map - &g).amax() <= REL_TOL * scale,
+            "case {case}: {}",
+            (&map - &g).amax()
+        );
+        // Independently: J_i g = I and J_k g = 0 above.
+        let (bottom, above) = levels.split_last().unwrap();
+        let eye = DMatrix::<f64>::identity(m, m);
+        assert!(
+            (&bottom.jacobian * &map - eye).amax() <= REL_TOL * scale,
+            "case {case}"
+        );
+        for l in above {
+            assert!(
+                (&l.jacobian * &map).amax() <= REL_TOL * scale,
+                "case {case}"
+            );
+        }
+    }
+}
+
+#[test]
+fn the_closed_form_declines_what_it_does_not_cover_and_the_block_stays_the_same() {
+    let mut r = rng(78);
+    for case in 0..30 {
+        let n = 6 + case % 7;
+        let m = 2 + case % (n - 2);
+        let mut levels = levels_over_a_selection(&mut r, n, m);
+        let damping = match case % 3 {
+            // A row with a second entry: not a selection.
+            0 => {
+                let bottom = levels.last_mut().unwrap();
+                let c = (0..n).find(|&c| bottom.jacobian[(0, c)] == 0.0).unwrap();
+                bottom.jacobian[(0, c)] = 0.3;
+                Damping::None
+            }
+            // Two rows on one coordinate (the level is then rank deficient: not solved
+            // exactly, and not a selection).
+            1 => {
+                let bottom = levels.last_mut().unwrap();
+                let c = (0..n).find(|&c| bottom.jacobian[(0, c)] != 0.0).unwrap();
+                bottom.jacobian[(1, c)] = 1.0;
+                for c2 in 0..n {
+                    if c2 != c {
+                        bottom.jacobian[(1, c2)] = 0.0;
+                    }
+                }
+                Damping::None
+            }
+            // Damped: not solved exactly.
+            _ => Damping::Fixed(0.2),
+        };
+        let n_levels = levels.len();
+        let dims: Vec<usize> = levels.iter().map(|l| l.dim()).collect();
+        let settings = SolverSettings {
+            damping,
+            ..Default::default()
+        };
+        let mut h = Hierarchy::new(n, &dims);
+        let mut q0 = DVector::zeros(n);
+        h.solve(&levels, &settings, &mut q0).unwrap();
+        let i = n_levels - 1;
+        assert!(!h.build_correction_map(&levels, i, i + 1), "case {case}");
+        if h.ranks()[i] == dims[i] {
+            let map = h
+                .correction_map()
+                .columns(h.correction_offset(i), dims[i])
+                .clone_owned();
+            h.build_g_levels(i, i + 1);
+            let g = h.g().columns(h.offset(i), dims[i]);
+            assert!(
+                (&map - g).amax() <= REL_TOL * g.amax().max(1.0),
+                "case {case}"
+            );
+        }
+    }
+}

@@ -52,8 +52,9 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use super::kernels::{axpy, axpy2, dot};
+use super::kernels::{axpy, axpy2, dot, reflect_columns};
 use super::reflectors::Reflectors;
+use super::selection::SelectionBlock;
 use super::settings::{Damping, SolverSettings};
 use crate::error::{check_dim, Error, Result};
 use crate::task::TaskEquation;
@@ -107,6 +108,8 @@ pub struct Hierarchy {
     gc: DMatrix<f64>,
     /// J̄_i^{λ+} formed on request ([`Hierarchy::pinv`]); never in the tick.
     pinv: Vec<DMatrix<f64>>,
+    /// The closed form of a bottom selection level's block ([`super::selection`]).
+    selection: SelectionBlock,
 }
 
 impl Hierarchy {
@@ -143,6 +146,7 @@ impl Hierarchy {
             g: DMatrix::zeros(n, total.max(1)),
             gc: DMatrix::zeros(n, total.max(1)),
             pinv: dims.iter().map(|&m| DMatrix::zeros(n, m)).collect(),
+            selection: SelectionBlock::new(n, mmax),
         }
     }
 
@@ -331,18 +335,12 @@ impl Hierarchy {
             let vcol = self.refl.next_slot();
             vcol.copy_from_slice(&asl[st * ar + st..st * ar + k]);
             vcol[0] = x0 - alpha;
-            let (tau, end) = self.refl.commit();
+            let (tau, _) = self.refl.commit();
             let v = self.refl.vector(p + st);
             // Apply H to the remaining columns of A: column st becomes α e1.
             asl[st * ar + st] = alpha;
             asl[st * ar + st + 1..st * ar + k].fill(0.0);
-            for c in st + 1..m {
-                let col = &mut asl[c * ar + st..c * ar + st + end];
-                let f = tau * dot(v, col);
-                if f != 0.0 {
-                    axpy(-f, v, col);
-                }
-            }
+            reflect_trailing(v, tau, asl, ar, st, m);
             for c in st + 1..m {
                 let top = asl[c * ar + st];
                 self.colnorm[c] -= top * top;
@@ -470,18 +468,28 @@ impl Hierarchy {
     /// per level). A level of rank 0 moves nothing (g_i = 0, nor does any level below it
     /// respond): its columns are zeroed, not computed. Allocates nothing.
     pub fn build_g_levels(&mut self, from: usize, to: usize) {
-        self.build_blocks(from, to, false);
+        let _ = self.build_blocks(None, from, to, false);
     }
 
     /// The columns of levels `from..to` of G (`in_basis` false) or of the correction map
     /// (`in_basis` true; [`Hierarchy::build_correction_map`]): the reduced blocks of the
     /// levels with columns, side by side in `yall`, Q applied once to all of them, then each
     /// level's columns into place.
-    fn build_blocks(&mut self, from: usize, to: usize, in_basis: bool) {
+    ///
+    /// With `levels` (those of the last solve), a block that the closed form of the
+    /// `selection` module covers is built that way instead.
+    /// Returns whether the closed form built them.
+    fn build_blocks(
+        &mut self,
+        levels: Option<&[TaskEquation]>,
+        from: usize,
+        to: usize,
+        in_basis: bool,
+    ) -> bool {
         let n = self.n;
         let to = to.min(self.dims.len());
         if from >= to {
-            return;
+            return false;
         }
         let width = |h: &Self, i: usize| {
             if in_basis {
@@ -500,7 +508,12 @@ impl Hierarchy {
         }
         let w: usize = (from..to).map(|i| width(self, i)).sum();
         if w == 0 {
-            return;
+            return false;
+        }
+        if let Some(levels) = levels {
+            if self.selection_block(levels, from, to, in_basis) {
+                return true;
+            }
         }
         let mut co = 0;
         for i in from..to {
@@ -536,6 +549,40 @@ impl Hierarchy {
             }
             co += m;
         }
+        false
+    }
+
+    /// The block of the one level with columns among `from..to` by the closed form of the
+    /// `selection` module, when its conditions hold: that level is the last of rank > 0,
+    /// solved exactly (full rank, no damping), under levels of full rank. False (nothing
+    /// written that the general construction does not overwrite) otherwise.
+    fn selection_block(
+        &mut self,
+        levels: &[TaskEquation],
+        from: usize,
+        to: usize,
+        in_basis: bool,
+    ) -> bool {
+        let nt = self.dims.len();
+        let Some(i) = (from..to).find(|&k| self.ranks[k] > 0) else {
+            return false;
+        };
+        if levels.len() != nt
+            || !self.fac[i].direct
+            || (i + 1..nt).any(|k| self.ranks[k] > 0)
+            || (0..i).any(|k| self.ranks[k] != self.dims[k])
+        {
+            return false;
+        }
+        let (n, m) = (self.n, self.dims[i]);
+        let c0 = if in_basis {
+            self.correction_offset(i)
+        } else {
+            self.offsets[i]
+        };
+        let target = if in_basis { &mut self.gc } else { &mut self.g };
+        let out = &mut target.as_mut_slice()[c0 * n..(c0 + m) * n];
+        self.selection.build(&levels[..i], &levels[i], n, out)
     }
 
     /// Columns of level i in the correction map ([`Hierarchy::build_correction_map`]): 0 when
@@ -570,8 +617,18 @@ impl Hierarchy {
     /// changing q̈, so the least correction lies in it, and with Δh_i = U_i z_i, ‖Δh_i‖ =
     /// ‖z_i‖: the QP over z has the same optimum, with r_i instead of m_i variables. Allocates
     /// nothing.
-    pub fn build_correction_map(&mut self, from: usize, to: usize) {
-        self.build_blocks(from, to, true);
+    ///
+    /// `levels` are those of the last [`Hierarchy::solve`] (only their Jacobians are read): a
+    /// bottom level that selects coordinates and completes the rank gets its block in closed
+    /// form from them (the `selection` module), the same map up to rounding. Returns whether
+    /// it was.
+    pub fn build_correction_map(
+        &mut self,
+        levels: &[TaskEquation],
+        from: usize,
+        to: usize,
+    ) -> bool {
+        self.build_blocks(Some(levels), from, to, true)
     }
 
     /// The correction map (n × Σ widths), columns of level i from
@@ -843,5 +900,35 @@ impl LevelFactor {
             let tail = dot(&ls[q * lr + q + 1..q * lr + r], &out[q + 1..r]);
             out[q] = (out[q] - tail) / ls[q + q * lr];
         }
+    }
+}
+
+/// Applies the reflector `H = I − τ v vᵀ` of QR step `st` to the columns `st + 1..m` of the
+/// column-major `a` (leading dimension `ar`), on the rows `st..st + v.len()`: four columns at
+/// a time ([`reflect_columns`]), then the rest one by one.
+fn reflect_trailing(v: &[f64], tau: f64, a: &mut [f64], ar: usize, st: usize, m: usize) {
+    let len = v.len();
+    let mut c = st + 1;
+    while c + 4 <= m {
+        let block = &mut a[c * ar + st..];
+        let (c0, rest) = block.split_at_mut(ar);
+        let (c1, rest) = rest.split_at_mut(ar);
+        let (c2, c3) = rest.split_at_mut(ar);
+        reflect_columns::<4>(
+            v,
+            tau,
+            [
+                &mut c0[..len],
+                &mut c1[..len],
+                &mut c2[..len],
+                &mut c3[..len],
+            ],
+        );
+        c += 4;
+    }
+    while c < m {
+        let col = &mut a[c * ar + st..c * ar + st + len];
+        reflect_columns::<1>(v, tau, [col]);
+        c += 1;
     }
 }

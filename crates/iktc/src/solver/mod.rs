@@ -13,6 +13,7 @@ mod rebase;
 mod reflectors;
 mod report;
 mod screen;
+mod selection;
 mod settings;
 mod solve;
 mod warm;

@@ -274,7 +274,7 @@ impl Solver {
         };
         // G blocks of levels start..n_T (Algorithm 1 builds them bottom-up; each is independent),
         // in the coordinates of the corrections that move q̈ (`Hierarchy::build_correction_map`).
-        self.hierarchy.build_correction_map(start, nt);
+        let _ = self.hierarchy.build_correction_map(levels, start, nt);
         let mut found = None;
         if self.level_feasible(start)? {
             // Down the priorities while still feasible.
@@ -288,7 +288,7 @@ impl Solver {
         } else {
             // Up the priorities until feasible.
             for i in (0..start).rev() {
-                self.hierarchy.build_correction_map(i, i + 1);
+                let _ = self.hierarchy.build_correction_map(levels, i, i + 1);
                 if self.level_feasible(i)? {
                     found = Some(i);
                     break;
@@ -303,7 +303,7 @@ impl Solver {
             return Ok(());
         };
         self.report.feasible_from = Some(i);
-        let i = self.held_level(i)?;
+        let i = self.held_level(levels, i)?;
         self.last_from = Some(i);
         self.report.corrected_from = Some(i);
         let h = &self.hierarchy;
@@ -332,7 +332,7 @@ impl Solver {
     /// The level to correct from, given Algorithm 2's `found` (see the `continuity` module):
     /// the held level when the hold keeps it, its QP solved into `xs` if the climb did not;
     /// `found` if that QP fails (it cannot, feasibility being monotone, but for rounding).
-    fn held_level(&mut self, found: usize) -> Result<usize> {
+    fn held_level(&mut self, levels: &[TaskEquation], found: usize) -> Result<usize> {
         let chosen = self.hold.choose(found, self.settings.level_hold);
         if chosen == found {
             return Ok(found);
@@ -341,7 +341,7 @@ impl Solver {
             // The climb started at the last level (= the held one) and went down from it.
             Climb::FromLast if self.last_from == Some(chosen) => true,
             _ => {
-                self.hierarchy.build_correction_map(chosen, found);
+                let _ = self.hierarchy.build_correction_map(levels, chosen, found);
                 self.level_feasible(chosen)?
             }
         };
