@@ -73,7 +73,7 @@ pub struct PyPlaneModel {
 }
 
 impl PyPlaneModel {
-    fn params(&self) -> FullModelParams {
+    pub(crate) fn params(&self) -> FullModelParams {
         FullModelParams {
             ipcj: IpcjParams {
                 length: self.length,

@@ -1,13 +1,15 @@
 //! `iktc.Walking`: walking while imitating (the walking pattern of `iktc::walk` driving the feet
 //! and COM tasks of the Section 5.3 stack) stepped tick by tick from Python, for a robot with a
-//! profile, without the damping controller (the physics loop around it is the caller's).
+//! profile; the physics loop around it is the caller's, and so is the measured ZMP the damping
+//! controller (off by default) reads.
 
 use iktc::sim::{imitation_references, WalkImitateConfig, WalkingController};
 use iktc::walk::SupportPolygon;
-use nalgebra::Isometry3;
+use nalgebra::{Isometry3, Rotation2, Vector2};
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
 
+use crate::balance::PyPlaneModel;
 use crate::controller::PySolveReport;
 use crate::convert::{array, pose_matrix};
 use crate::imitate::narrowed;
@@ -15,11 +17,17 @@ use crate::motion::{resolve_map, PyMotion};
 use crate::robot::PyRobot;
 use crate::to_py;
 
+/// The pattern's model ZMP (world) \[m\] and the local frame's yaw \[rad\] of a tick.
+type PatternZmp = (Vector2<f64>, f64);
+
 /// Walking while imitating: `steps` footsteps of `step_length` [m] (default: the robot
 /// profile's `walk` settings, else 0.1 m steps, 0.8 s initial and final double support, 0.6 s
-/// single, 0.1 s double, 4 cm swing), the upper body imitating `motion`, the damping
-/// controller off; `narrow` a list of (joint, lower, upper) [rad] replacing the
-/// profile's narrowed ranges.
+/// single, 0.1 s double, 4 cm swing), the upper body imitating `motion`; `narrow` a list of
+/// (joint, lower, upper) [rad] replacing the profile's narrowed ranges. With `damping` the
+/// damping controller of Section 4 is in the loop: each `tick(zmp)` it reads the measured ZMP's
+/// deviation from the pattern's and moves the COM reference; `cases` are its four models
+/// (xz SSP, xz DSP, yz SSP, yz DSP, `PlaneModel`s; their length is replaced by the COM height),
+/// None the synthetic ones of `iktc::balance::CaseParams::synthetic`.
 #[pyclass(name = "Walking", module = "iktc")]
 pub struct PyWalking {
     ctl: WalkingController,
@@ -27,12 +35,17 @@ pub struct PyWalking {
     k: usize,
     dt: f64,
     polygon: SupportPolygon,
+    /// The pattern's model ZMP (world) and the local frame's yaw of the last tick, which the
+    /// next tick's measured ZMP is compared with.
+    last_zmp: Option<PatternZmp>,
 }
 
 #[pymethods]
 impl PyWalking {
     #[new]
-    #[pyo3(signature = (robot, motion, *, map=None, steps=4, step_length=None, narrow=None))]
+    #[pyo3(signature = (robot, motion, *, map=None, steps=4, step_length=None, narrow=None,
+                        damping=false, cases=None))]
+    #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
         robot: &PyRobot,
@@ -41,6 +54,8 @@ impl PyWalking {
         steps: usize,
         step_length: Option<f64>,
         narrow: Option<Vec<(String, f64, f64)>>,
+        damping: bool,
+        cases: Option<Vec<Bound<'_, PyPlaneModel>>>,
     ) -> PyResult<Self> {
         let profile = robot.required_profile("walking", "feet, pelvis and posture")?;
         let mut cfg = profile
@@ -54,7 +69,22 @@ impl PyWalking {
             cfg.step_length = l;
         }
         cfg.push = None;
-        cfg.damping = false;
+        cfg.damping = damping;
+        if let Some(c) = cases {
+            let [xz_ssp, xz_dsp, yz_ssp, yz_dsp] = c.as_slice() else {
+                return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                    "cases: expected four PlaneModels (xz SSP, xz DSP, yz SSP, yz DSP), got {}",
+                    c.len()
+                )));
+            };
+            cfg.cases = iktc::balance::CaseParams {
+                xz_ssp: xz_ssp.get().params(),
+                xz_dsp: xz_dsp.get().params(),
+                yz_ssp: yz_ssp.get().params(),
+                yz_dsp: yz_dsp.get().params(),
+            };
+            cfg.cases.validate().map_err(to_py)?;
+        }
         cfg.noise_std = 0.0;
         let map = resolve_map(robot, motion, map)?;
         let clip = motion.clip()?;
@@ -71,6 +101,7 @@ impl PyWalking {
             k: 0,
             dt: cfg.imitate.dt,
             polygon: SupportPolygon::default(),
+            last_zmp: None,
         })
     }
 
@@ -86,24 +117,48 @@ impl PyWalking {
         self.k
     }
 
-    /// One control tick: pattern sample, COM and feet references, IK solve, integration; k
-    /// advances. Returns (report, phase) with phase "double" or "single". The GIL is released.
-    fn tick(&mut self, py: Python<'_>) -> PyResult<(PySolveReport, &'static str)> {
+    /// One control tick: pattern sample, damping controller, COM and feet references, IK
+    /// solve, integration; k advances. `zmp`: the measured ZMP (world x, y) [m] after the last
+    /// tick, or None (no measurement: a deviation of 0); the damping controller (if on) reads
+    /// its deviation from the last tick's pattern ZMP (cart-table model), in the local frame of
+    /// Figure 11. Returns (report, phase) with phase "double" or "single". The GIL is released.
+    #[pyo3(signature = (zmp=None))]
+    fn tick(
+        &mut self,
+        py: Python<'_>,
+        zmp: Option<(f64, f64)>,
+    ) -> PyResult<(PySolveReport, &'static str)> {
+        let dev = match (zmp, self.last_zmp) {
+            (Some((x, y)), Some((model, yaw))) => {
+                let d = Rotation2::new(-yaw) * (Vector2::new(x, y) - model);
+                [d.x, d.y]
+            }
+            _ => [0.0, 0.0],
+        };
         let (ctl, robot, k) = (&mut self.ctl, &self.robot, self.k);
         let out = py
-            .detach(|| -> iktc::Result<(PySolveReport, &'static str)> {
-                let wt = ctl.tick(robot, k, [0.0, 0.0])?;
-                let report = PySolveReport::from(ctl.imitation().report());
-                ctl.integrate(robot)?;
-                let phase = match wt.phase {
-                    iktc::balance::SupportPhase::Double => "double",
-                    iktc::balance::SupportPhase::Single => "single",
-                };
-                Ok((report, phase))
-            })
+            .detach(
+                || -> iktc::Result<(PySolveReport, &'static str, PatternZmp)> {
+                    let wt = ctl.tick(robot, k, dev)?;
+                    let report = PySolveReport::from(ctl.imitation().report());
+                    ctl.integrate(robot)?;
+                    let phase = match wt.phase {
+                        iktc::balance::SupportPhase::Double => "double",
+                        iktc::balance::SupportPhase::Single => "single",
+                    };
+                    let o = ctl.origin();
+                    let m = wt.sample.zmp_model;
+                    Ok((
+                        report,
+                        phase,
+                        (Vector2::new(m.0 + o.x, m.1 + o.y), wt.local_yaw),
+                    ))
+                },
+            )
             .map_err(to_py)?;
+        self.last_zmp = Some(out.2);
         self.k += 1;
-        Ok(out)
+        Ok((out.0, out.1))
     }
 
     /// The configuration q (numpy, length nq) at the start of the next tick.

@@ -293,6 +293,27 @@ def test_the_walking_binding_moves_the_feet_as_the_pattern_says():
     assert worst < 0.01, worst
 
 
+def test_the_walking_binding_feeds_the_measured_zmp_back_only_with_the_damping_controller():
+    robot = iktc.Robot("g1")
+    motion = iktc.load_motion("humanoid3d_dance_b")
+    plain = iktc.Walking(robot, motion)
+    ignored = iktc.Walking(robot, motion)
+    damped = iktc.Walking(robot, motion, damping=True)
+    for _ in range(60):
+        plain.tick()
+        # A measured ZMP 2 cm ahead of and 1 cm left of the initial feet's centre.
+        at = (float(np.mean([f[0, 3] for f in plain.feet0()])) + 0.02 + 0.035,
+              float(np.mean([f[1, 3] for f in plain.feet0()])) + 0.01)
+        ignored.tick(at)
+        damped.tick(at)
+    # Off, the measurement is not read; on, it moves the plan (the COM reference), within cm.
+    assert np.array_equal(plain.q, ignored.q)
+    moved = float(np.abs(damped.q[:2] - plain.q[:2]).max())
+    assert 1e-4 < moved < 0.05, moved
+    with pytest.raises(ValueError, match="four PlaneModels"):
+        iktc.Walking(robot, motion, damping=True, cases=[iktc.PlaneModel(0.6, 15.0, 0.5, 0.1, 0.01)])
+
+
 # The plan's ZMP is outside on 471 of 480 single-support ticks (a straightened knee and the
 # dance's upper body); without feedback on the ZMP G1 falls even on a feasible-looking plan
 # (README).
