@@ -629,27 +629,33 @@ ON_GROUND = 1e-3
 
 def run_walking(steps: int = 4, step_length: float = 0.1, clip: str = "humanoid3d_dance_b",
                 settle: float = 0.5, rate_feedforward: bool = True, narrow=None,
-                kp: float = KP, kv: float = KV) -> dict:
-    """Walking `steps` footsteps while imitating the clip, on the MuJoCo G1, the damping
-    controller off (`narrow`: narrowed joint ranges, as for `iktc.Walking`). Returns the
-    figures: stayed up, pelvis height, base tilt, the largest horizontal error of a standing
-    foot against its reference (slip), the ZMP from the ankle sensors against the pattern's
-    support polygon, servo tracking."""
+                kp: float = KP, kv: float = KV, damping: bool = False, cases=None) -> dict:
+    """Walking `steps` footsteps while imitating the clip, on the MuJoCo G1 (`narrow`: narrowed
+    joint ranges, as for `iktc.Walking`). With `damping` the measured ZMP (ankle sensors) is fed
+    back every tick through the damping controller (`iktc.Walking(damping=True, cases=cases)`),
+    else the loop is open. Returns the figures: stayed up (and when it fell), pelvis height,
+    base tilt, the largest horizontal error of a standing foot against its reference (slip), the
+    ZMP from the ankle sensors against the pattern's support polygon (per phase), the plan's ZMP
+    (``planned_zmp``) against it, the knees' lowest planned angles, servo tracking and flips."""
     robot = iktc.Robot("g1")
+    kw = {} if cases is None else {"cases": cases}
     walk = iktc.Walking(robot, iktc.load_motion(clip), steps=steps, step_length=step_length,
-                        narrow=narrow)
+                        narrow=narrow, damping=damping, **kw)
     plant = Plant(robot, kp=kp, kv=kv)
     plant.set_state(walk.q)
     z0 = [f[2, 3] for f in walk.feet0()]
     for _ in range(int(round(settle / CONTROL_PERIOD))):
         plant.command(walk.q)
         plant.advance()
-    heights, tilts, slips, margins, errs, phases = [], [], [], [], [], []
+    heights, tilts, slips, margins, errs, phases, qs, flips = [], [], [], [], [], [], [], []
+    plan_margins = []
+    zmp = None
     for _ in range(walk.ticks):
-        report, phase = walk.tick()
+        report, phase = walk.tick(zmp if damping else None)
         if report.violation > 1e-9:
             raise AssertionError(f"iktc left its acceleration box by {report.violation}")
         q = walk.q
+        qs.append(q.copy())
         plant.command(q, walk.v if rate_feedforward else None)
         plant.advance()
         heights.append(plant.pelvis_height())
@@ -664,21 +670,54 @@ def run_walking(steps: int = 4, step_length: float = 0.1, clip: str = "humanoid3
         margins.append(None if zmp is None else walk.support_margin(zmp))
         errs.append(float(np.abs(plant.joint_positions() - q[7:]).max()))
         phases.append(phase)
+        flips.append(int(plant.flipped.sum()))
+    # The plan's ZMP against the same polygons: replayed (the plan does not see the plant
+    # without the damping controller; with it, the ZMP of the commanded motion).
+    replay = iktc.Walking(robot, iktc.load_motion(clip), steps=steps, step_length=step_length,
+                          narrow=narrow)
+    for p in planned_zmp(plant, qs):
+        replay.tick()
+        plan_margins.append(replay.support_margin(tuple(p)) if np.all(np.isfinite(p)) else None)
     h = np.array(heights)
-    m = np.array([x for x in margins if x is not None])
-    return {
+    ph = np.array(phases)
+    m = np.array([np.nan if x is None else x for x in margins])
+    pm = np.array([np.nan if x is None else x for x in plan_margins])
+    fallen = np.nonzero(h < 0.5)[0]
+    names = robot.joint_names
+    knees = [7 + names.index(f"{s}_knee_joint") for s in ("left", "right")]
+    out = {
         "ticks": walk.ticks,
         "stayed_up": bool(h.min() > 0.5),
+        "fell_at_s": float(fallen[0] * CONTROL_PERIOD) if fallen.size else None,
         "pelvis_height_min_m": float(h.min()),
         "base_tilt_max_rad": float(np.max(tilts)),
         "standing_foot_error_max_m": float(np.max(slips)),
-        "zmp_ticks_measured": int(m.size),
-        "zmp_margin_min_m": float(m.min()) if m.size else float("nan"),
+        "zmp_ticks_measured": int(np.sum(np.isfinite(m))),
+        "zmp_margin_min_m": float(np.nanmin(m)) if np.any(np.isfinite(m)) else float("nan"),
         "zmp_ticks_outside": int(np.sum(m < 0)),
-        "zmp_inside": bool(m.size == walk.ticks and m.min() > 0.0),
+        "zmp_inside": bool(np.all(np.isfinite(m)) and m.min() > 0.0),
         "joint_error_max_rad": float(np.max(errs)),
+        "servo_limit_flip_ticks": int(np.count_nonzero(flips)),
+        "knee_plan_min_rad": float(np.min(np.array(qs)[:, knees])),
         "forward_progress_m": float(plant.data.xpos[plant.pelvis][0] - walk.feet0()[0][0, 3]),
     }
+    for name in ("single", "double"):
+        sel = ph == name
+        out[f"zmp_outside_{name}"] = f"{int(np.sum(m[sel] < 0))} of {int(np.sum(sel))}"
+        out[f"plan_zmp_outside_{name}"] = (f"{int(np.sum(pm[sel] < 0))} of "
+                                           f"{int(np.sum(np.isfinite(pm[sel])))}")
+    return out
+
+
+def held_clip(path, clip: str = "humanoid3d_dance_b") -> str:
+    """Writes the built-in DeepMimic `clip` with every frame its first (the upper body and the
+    pelvis held at the clip's start) to `path`; returns the path: walking without the dance."""
+    import json
+    src = REPO / "crates" / "iktc" / "data" / "motions" / "deepmimic" / f"{clip}.txt"
+    data = json.loads(src.read_text())
+    data["Frames"] = [list(data["Frames"][0]) for _ in data["Frames"]]
+    pathlib.Path(path).write_text(json.dumps(data))
+    return str(path)
 
 
 # --- causes of the failures (diagnostic settings, not defaults) ----------------------------
