@@ -629,16 +629,19 @@ ON_GROUND = 1e-3
 
 def run_walking(steps: int = 4, step_length: float = 0.1, clip: str = "humanoid3d_dance_b",
                 settle: float = 0.5, rate_feedforward: bool = True, narrow=None,
-                kp: float = KP, kv: float = KV, damping: bool = False, cases=None) -> dict:
+                kp: float = KP, kv: float = KV, damping: bool = False, cases=None,
+                offset_feedforward: bool = True) -> dict:
     """Walking `steps` footsteps while imitating the clip, on the MuJoCo G1 (`narrow`: narrowed
     joint ranges, as for `iktc.Walking`). With `damping` the measured ZMP (ankle sensors) is fed
-    back every tick through the damping controller (`iktc.Walking(damping=True, cases=cases)`),
-    else the loop is open. Returns the figures: stayed up (and when it fell), pelvis height,
+    back every tick through the damping controller (`iktc.Walking(damping=True, cases=cases,
+    offset_feedforward=offset_feedforward)`), else the loop is open. Returns the figures: stayed up (and when it fell), pelvis height,
     base tilt, the largest horizontal error of a standing foot against its reference (slip), the
     ZMP from the ankle sensors against the pattern's support polygon (per phase), the plan's ZMP
     (``planned_zmp``) against it, the knees' lowest planned angles, servo tracking and flips."""
     robot = iktc.Robot("g1")
     kw = {} if cases is None else {"cases": cases}
+    if not offset_feedforward:
+        kw["offset_feedforward"] = False
     walk = iktc.Walking(robot, iktc.load_motion(clip), steps=steps, step_length=step_length,
                         narrow=narrow, damping=damping, **kw)
     plant = Plant(robot, kp=kp, kv=kv)

@@ -27,7 +27,9 @@ type PatternZmp = (Vector2<f64>, f64);
 /// damping controller of Section 4 is in the loop: each `tick(zmp)` it reads the measured ZMP's
 /// deviation from the pattern's and moves the COM reference; `cases` are its four models
 /// (xz SSP, xz DSP, yz SSP, yz DSP, `PlaneModel`s; their length is replaced by the COM height),
-/// None the synthetic ones of `iktc::balance::CaseParams::synthetic`.
+/// None the synthetic ones of `iktc::balance::CaseParams::synthetic`; `offset_feedforward`
+/// False gives the COM task the controller's offset without its rates fed forward (as
+/// `g1_sim`'s identification sweeps it).
 #[pyclass(name = "Walking", module = "iktc")]
 pub struct PyWalking {
     ctl: WalkingController,
@@ -44,7 +46,7 @@ pub struct PyWalking {
 impl PyWalking {
     #[new]
     #[pyo3(signature = (robot, motion, *, map=None, steps=4, step_length=None, narrow=None,
-                        damping=false, cases=None))]
+                        damping=false, cases=None, offset_feedforward=true))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -56,6 +58,7 @@ impl PyWalking {
         narrow: Option<Vec<(String, f64, f64)>>,
         damping: bool,
         cases: Option<Vec<Bound<'_, PyPlaneModel>>>,
+        offset_feedforward: bool,
     ) -> PyResult<Self> {
         let profile = robot.required_profile("walking", "feet, pelvis and posture")?;
         let mut cfg = profile
@@ -89,12 +92,13 @@ impl PyWalking {
         let map = resolve_map(robot, motion, map)?;
         let clip = motion.clip()?;
         let r = &robot.robot;
-        let ctl = py
+        let mut ctl = py
             .detach(|| -> iktc::Result<WalkingController> {
                 let refs = imitation_references(r, clip, &map, &cfg.imitate)?;
                 WalkingController::new(r, &refs, &cfg)
             })
             .map_err(to_py)?;
+        ctl.set_offset_feedforward(offset_feedforward);
         Ok(Self {
             ctl,
             robot: robot.robot.clone(),

@@ -233,7 +233,8 @@ class Walking:
                  steps: int = 4, step_length: Optional[float] = None,
                  narrow: Optional[Sequence[Tuple[str, float, float]]] = None,
                  damping: bool = False,
-                 cases: Optional[Sequence[PlaneModel]] = None) -> None: ...
+                 cases: Optional[Sequence[PlaneModel]] = None,
+                 offset_feedforward: bool = True) -> None: ...
     @property
     def ticks(self) -> int: ...
     @property

@@ -343,6 +343,8 @@ pub struct WalkingController {
     feet_refs: [FrameReference; 2],
     dc_prev: Vector2<f64>,
     dcd_prev: Vector2<f64>,
+    /// Whether Δc's rate and acceleration are fed forward to the COM task.
+    offset_feedforward: bool,
 }
 
 impl WalkingController {
@@ -441,7 +443,16 @@ impl WalkingController {
             com_blend_time: cfg.com_blend_time,
             dc_prev: Vector2::zeros(),
             dcd_prev: Vector2::zeros(),
+            offset_feedforward: true,
         })
+    }
+
+    /// Whether the damping controller's COM offset Δc reaches the COM task with its backward
+    /// differences (rate, acceleration) fed forward (the default: the commanded COM follows Δc
+    /// within a tick) or as a position alone (the COM task's CLIK then follows it through its
+    /// second-order response, as in an identification that sweeps the COM reference).
+    pub fn set_offset_feedforward(&mut self, on: bool) {
+        self.offset_feedforward = on;
     }
 
     /// Ticks in the walk (its duration over Δt, plus one).
@@ -521,6 +532,11 @@ impl WalkingController {
         let dcdd = (dcd - self.dcd_prev) / dt;
         self.dc_prev = offset_world;
         self.dcd_prev = dcd;
+        let (dcd, dcdd) = if self.offset_feedforward {
+            (dcd, dcdd)
+        } else {
+            (Vector2::zeros(), Vector2::zeros())
+        };
         self.ctl.set_com_override(Some(ComReference {
             position: Vector3::new(cref.x, cref.y, self.com0.z),
             velocity: Vector3::new(
