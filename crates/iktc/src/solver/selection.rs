@@ -268,6 +268,65 @@ mod tests {
     }
 
     #[test]
+    fn pivoting_handles_a_zero_on_the_diagonal() {
+        // [[0, 1], [1, 0]] (column-major the same): without row exchanges the first pivot is 0.
+        let mut a = vec![0.0, 1.0, 1.0, 0.0];
+        let mut piv = vec![0; 2];
+        assert!(lu_factor(&mut a, 2, &mut piv));
+        let mut x = vec![3.0, 5.0];
+        lu_solve_rows(&a, 2, &piv, &mut x, 1);
+        assert_eq!(x, vec![5.0, 3.0]);
+        // A tiny pivot left in place would lose every digit of the first unknown:
+        // [[1e-20, 1], [1, 1]] x = [1, 2] has x ≈ [1, 1].
+        let mut a = vec![1e-20, 1.0, 1.0, 1.0];
+        assert!(lu_factor(&mut a, 2, &mut piv));
+        let mut x = vec![1.0, 2.0];
+        lu_solve_rows(&a, 2, &piv, &mut x, 1);
+        assert!(
+            (x[0] - 1.0).abs() < 1e-12 && (x[1] - 1.0).abs() < 1e-12,
+            "{x:?}"
+        );
+    }
+
+    #[test]
+    fn a_non_finite_pivot_is_refused() {
+        let mut a = vec![f64::INFINITY, 0.0, 0.0, 1.0];
+        let mut piv = vec![0; 2];
+        assert!(!lu_factor(&mut a, 2, &mut piv));
+    }
+
+    /// One level of `rows` × `n` from (row, column, value) entries.
+    fn level(rows: usize, n: usize, entries: &[(usize, usize, f64)]) -> TaskEquation {
+        let mut e = TaskEquation::zeros("level", rows, n);
+        for &(r, c, v) in entries {
+            e.jacobian[(r, c)] = v;
+        }
+        e
+    }
+
+    #[test]
+    fn the_block_of_a_selection_and_what_is_not_one() {
+        // n = 3: one row above (x0 + 2 x1 + x2), a bottom level selecting x2 (scale 2) and x0.
+        let above = [level(1, 3, &[(0, 0, 1.0), (0, 1, 2.0), (0, 2, 1.0)])];
+        let bottom = level(2, 3, &[(0, 2, 2.0), (1, 0, 1.0)]);
+        let mut b = SelectionBlock::new(3, 2);
+        let mut g = vec![0.0; 6];
+        assert!(b.build(&above, &bottom, 3, &mut g));
+        let g = DMatrix::from_column_slice(3, 2, &g);
+        // By hand: column 0 moves x2 by 1/2 and x1 by −(1/2)/2; column 1 moves x0 by 1 and
+        // x1 by −1/2.
+        let want = DMatrix::from_row_slice(3, 2, &[0.0, 1.0, -0.25, -0.5, 0.5, 0.0]);
+        assert!((&g - &want).amax() < 1e-15, "{g}");
+        // Two rows on one coordinate, a row with two entries, rows that do not add up to n.
+        let twice = level(2, 3, &[(0, 2, 2.0), (1, 2, 1.0)]);
+        assert!(!b.build(&above, &twice, 3, &mut vec![0.0; 6]));
+        let wide = level(2, 3, &[(0, 2, 2.0), (1, 0, 1.0), (1, 1, 1.0)]);
+        assert!(!b.build(&above, &wide, 3, &mut vec![0.0; 6]));
+        let short = level(1, 3, &[(0, 2, 2.0)]);
+        assert!(!b.build(&above, &short, 3, &mut vec![0.0; 3]));
+    }
+
+    #[test]
     fn a_singular_matrix_is_refused() {
         let mut a = vec![1.0, 2.0, 2.0, 4.0];
         let mut piv = vec![0; 2];
