@@ -319,11 +319,11 @@ mod tests {
         assert!((&g - &want).amax() < 1e-15, "{g}");
         // Two rows on one coordinate, a row with two entries, rows that do not add up to n.
         let twice = level(2, 3, &[(0, 2, 2.0), (1, 2, 1.0)]);
-        assert!(!b.build(&above, &twice, 3, &mut vec![0.0; 6]));
+        assert!(!b.build(&above, &twice, 3, &mut [0.0; 6]));
         let wide = level(2, 3, &[(0, 2, 2.0), (1, 0, 1.0), (1, 1, 1.0)]);
-        assert!(!b.build(&above, &wide, 3, &mut vec![0.0; 6]));
+        assert!(!b.build(&above, &wide, 3, &mut [0.0; 6]));
         let short = level(1, 3, &[(0, 2, 2.0)]);
-        assert!(!b.build(&above, &short, 3, &mut vec![0.0; 3]));
+        assert!(!b.build(&above, &short, 3, &mut [0.0; 3]));
     }
 
     #[test]
