@@ -392,9 +392,17 @@ fn levels_over_a_selection(
     levels
 }
 
-/// The correction-map block of the bottom level (built from `levels`) and the G block of the
-/// general construction, and whether the closed form built the first.
-fn bottom_blocks(levels: &[TaskEquation], damping: Damping) -> (DMatrix<f64>, DMatrix<f64>, bool) {
+/// What the bottom level of `levels` gets: its correction-map block (built from `levels`), the
+/// G block of the general construction, whether the closed form built the first, and the ranks
+/// every level kept (the two blocks are comparable when the bottom level kept all its rows).
+struct BottomBlocks {
+    map: DMatrix<f64>,
+    g: DMatrix<f64>,
+    closed: bool,
+    ranks: Vec<usize>,
+}
+
+fn bottom_blocks(levels: &[TaskEquation], damping: Damping) -> BottomBlocks {
     let n = levels[0].nv();
     let dims: Vec<usize> = levels.iter().map(|l| l.dim()).collect();
     let i = dims.len() - 1;
@@ -405,7 +413,6 @@ fn bottom_blocks(levels: &[TaskEquation], damping: Damping) -> (DMatrix<f64>, DM
     let mut h = Hierarchy::new(n, &dims);
     let mut q0 = DVector::zeros(n);
     h.solve(levels, &settings, &mut q0).unwrap();
-    assert_eq!(h.ranks(), &dims[..], "the random levels have full rank");
     let closed = h.build_correction_map(levels, i, i + 1);
     let map = h
         .correction_map()
@@ -413,7 +420,12 @@ fn bottom_blocks(levels: &[TaskEquation], damping: Damping) -> (DMatrix<f64>, DM
         .clone_owned();
     h.build_g_levels(i, i + 1);
     let g = h.g().columns(h.offset(i), dims[i]).clone_owned();
-    (map, g, closed)
+    BottomBlocks {
+        map,
+        g,
+        closed,
+        ranks: h.ranks().to_vec(),
+    }
 }
 
 #[test]
@@ -423,7 +435,14 @@ fn a_bottom_selection_level_completing_the_rank_gets_the_general_block_in_closed
         let n = 6 + case % 13;
         let m = 1 + case % (n - 1);
         let levels = levels_over_a_selection(&mut r, n, m);
-        let (map, g, closed) = bottom_blocks(&levels, Damping::None);
+        let dims: Vec<usize> = levels.iter().map(|l| l.dim()).collect();
+        let BottomBlocks {
+            map,
+            g,
+            closed,
+            ranks,
+        } = bottom_blocks(&levels, Damping::None);
+        assert_eq!(ranks, dims, "case {case}: the random levels have full rank");
         assert!(closed, "case {case}: the closed form applies");
         let scale = g.amax().max(1.0);
         assert!(
@@ -478,26 +497,13 @@ fn the_closed_form_declines_what_it_does_not_cover_and_the_block_stays_the_same(
             // Damped: not solved exactly.
             _ => Damping::Fixed(0.2),
         };
-        let n_levels = levels.len();
-        let dims: Vec<usize> = levels.iter().map(|l| l.dim()).collect();
-        let settings = SolverSettings {
-            damping,
-            ..Default::default()
-        };
-        let mut h = Hierarchy::new(n, &dims);
-        let mut q0 = DVector::zeros(n);
-        h.solve(&levels, &settings, &mut q0).unwrap();
-        let i = n_levels - 1;
-        assert!(!h.build_correction_map(&levels, i, i + 1), "case {case}");
-        if h.ranks()[i] == dims[i] {
-            let map = h
-                .correction_map()
-                .columns(h.correction_offset(i), dims[i])
-                .clone_owned();
-            h.build_g_levels(i, i + 1);
-            let g = h.g().columns(h.offset(i), dims[i]);
+        let i = levels.len() - 1;
+        let m = levels[i].dim();
+        let b = bottom_blocks(&levels, damping);
+        assert!(!b.closed, "case {case}");
+        if b.ranks[i] == m {
             assert!(
-                (&map - g).amax() <= REL_TOL * g.amax().max(1.0),
+                (&b.map - &b.g).amax() <= REL_TOL * b.g.amax().max(1.0),
                 "case {case}"
             );
         }

@@ -125,12 +125,17 @@ fn orientation_and_com_errors_follow_eq_12_on_jvrc1() {
     }
 }
 
+/// JVRC-1 at a random state drawn from `seed`, and its kinematics.
+fn jvrc1_at_random_state(seed: u64) -> (Robot, State, Kinematics) {
+    let robot = jvrc1(&ModelOptions::default()).unwrap();
+    let s = random_state(&mut rng(seed), &robot);
+    let kin = Kinematics::new(&robot, &s).unwrap();
+    (robot, s, kin)
+}
+
 #[test]
 fn joint_task_rows_select_joints() {
-    let robot = jvrc1(&ModelOptions::default()).unwrap();
-    let mut r = rng(4);
-    let s = random_state(&mut r, &robot);
-    let kin = Kinematics::new(&robot, &s).unwrap();
+    let (robot, s, kin) = jvrc1_at_random_state(4);
     let mut jt = JointTask::new(
         &robot,
         &["WAIST_Y", "L_ELBOW_P"],
@@ -154,10 +159,7 @@ fn joint_task_rows_select_joints() {
 /// errors as they are; a weight that is not finite and > 0 is refused.
 #[test]
 fn joint_task_weight_scales_its_rows() {
-    let robot = jvrc1(&ModelOptions::default()).unwrap();
-    let mut r = rng(5);
-    let s = random_state(&mut r, &robot);
-    let kin = Kinematics::new(&robot, &s).unwrap();
+    let (robot, s, kin) = jvrc1_at_random_state(5);
     let names = ["WAIST_Y", "L_ELBOW_P", "R_KNEE"];
     let mut one = JointTask::new(&robot, &names, Gains { kp: 9.0, kv: 6.0 }).unwrap();
     one.set_reference(&[0.1, -0.5, 0.7], &[0.2, 0.0, -0.1], &[1.0, -1.0, 0.5])

@@ -535,11 +535,7 @@ impl Hierarchy {
             if m == 0 {
                 continue;
             }
-            let c0 = if in_basis {
-                self.correction_offset(i)
-            } else {
-                self.offsets[i]
-            };
+            let c0 = self.block_offset(i, in_basis);
             let target = if in_basis { &mut self.gc } else { &mut self.g };
             let gs = &mut target.as_mut_slice()[c0 * n..(c0 + m) * n];
             for (c, col) in gs.chunks_exact_mut(n).enumerate() {
@@ -550,6 +546,15 @@ impl Hierarchy {
             co += m;
         }
         false
+    }
+
+    /// First column of level i's block: in the correction map with `in_basis`, in G otherwise.
+    fn block_offset(&self, i: usize, in_basis: bool) -> usize {
+        if in_basis {
+            self.correction_offset(i)
+        } else {
+            self.offsets[i]
+        }
     }
 
     /// The block of the one level with columns among `from..to` by the closed form of the
@@ -575,11 +580,7 @@ impl Hierarchy {
             return false;
         }
         let (n, m) = (self.n, self.dims[i]);
-        let c0 = if in_basis {
-            self.correction_offset(i)
-        } else {
-            self.offsets[i]
-        };
+        let c0 = self.block_offset(i, in_basis);
         let target = if in_basis { &mut self.gc } else { &mut self.g };
         let out = &mut target.as_mut_slice()[c0 * n..(c0 + m) * n];
         self.selection.build(&levels[..i], &levels[i], n, out)
