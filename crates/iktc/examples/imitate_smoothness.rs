@@ -1,7 +1,9 @@
 //! Smoothness of the paper's imitation run (JVRC-1, the default clip, L_KNEE and L_HIP_R
 //! narrowed) under Algorithm 2 as printed with the viable bounds, and under the smoothing
-//! settings one at a time: the quiet bounds, the level hold (the defaults), the continuity term,
-//! the clip low-passed at 6 and 8 Hz before retargeting (`ImitateConfig::smoothing`).
+//! settings added one at a time: the quiet bounds, the level hold, the soft approach to the
+//! range ends (`ViableSettings::approach_rate`), the clip low-passed before retargeting
+//! (`ImitateConfig::smoothing`; with all four, the defaults), and the defaults with the
+//! continuity term.
 //!
 //! ```sh
 //! cargo run --release -p iktc --example imitate_smoothness
@@ -11,7 +13,7 @@
 //! `(q̈ₖ − q̈ₖ₋₁)/Δt` over all joints, and per narrowed joint its RMS jerk and the share of ticks
 //! where the change of q̈ reverses its sign; and the largest excursion beyond a limit.
 
-use iktc::limits::BoundMethod;
+use iktc::limits::{BoundMethod, ViableSettings};
 use iktc::sim::{Experiment, ImitateConfig};
 use iktc::solver::SolverSettings;
 
@@ -22,9 +24,27 @@ fn main() -> iktc::Result<()> {
         continuity: 0.0,
         ..defaults.solver
     };
-    let hold = format!(
-        "quiet bounds, hold {} (the defaults)",
-        defaults.solver.level_hold
+    let hold = SolverSettings {
+        level_hold: defaults.solver.level_hold,
+        ..printed
+    };
+    let BoundMethod::Quiet(approach) = defaults.bounds else {
+        unreachable!("the imitation's defaults use the quiet bounds")
+    };
+    let no_approach = BoundMethod::Quiet(ViableSettings {
+        approach_rate: 0.0,
+        ..approach
+    });
+    let with_hold = format!("quiet bounds, hold {} ticks", defaults.solver.level_hold);
+    let with_approach = format!(
+        "quiet bounds, hold {}, approach ω = {} /s",
+        defaults.solver.level_hold, approach.approach_rate
+    );
+    let with_all = format!(
+        "the defaults: quiet bounds, hold {}, approach ω = {} /s, clip low-passed at {} Hz",
+        defaults.solver.level_hold,
+        approach.approach_rate,
+        defaults.smoothing.unwrap_or(f64::NAN)
     );
     let variants = [
         (
@@ -33,8 +53,26 @@ fn main() -> iktc::Result<()> {
             printed,
             None,
         ),
-        ("quiet bounds", BoundMethod::quiet(), printed, None),
-        (hold.as_str(), defaults.bounds, defaults.solver, None),
+        ("quiet bounds", no_approach, printed, None),
+        (with_hold.as_str(), no_approach, hold, None),
+        (
+            with_approach.as_str(),
+            defaults.bounds,
+            defaults.solver,
+            None,
+        ),
+        (
+            "the defaults without the approach",
+            no_approach,
+            defaults.solver,
+            defaults.smoothing,
+        ),
+        (
+            with_all.as_str(),
+            defaults.bounds,
+            defaults.solver,
+            defaults.smoothing,
+        ),
         (
             "the defaults with the continuity term, μ = 0.3",
             defaults.bounds,
@@ -42,19 +80,7 @@ fn main() -> iktc::Result<()> {
                 continuity: 0.3,
                 ..defaults.solver
             },
-            None,
-        ),
-        (
-            "the defaults, the clip low-passed at 8 Hz",
-            defaults.bounds,
-            defaults.solver,
-            Some(8.0),
-        ),
-        (
-            "the defaults, the clip low-passed at 6 Hz",
-            defaults.bounds,
-            defaults.solver,
-            Some(6.0),
+            defaults.smoothing,
         ),
     ];
     for (name, bounds, solver, smoothing) in variants {

@@ -248,18 +248,20 @@ fn bad_settings_are_errors() {
         .contains("NOPE"));
 }
 
-/// The default settings (quiet bounds, level hold `IMITATE_LEVEL_HOLD`) against Algorithm 2 as printed with the
-/// viable bounds, one run each: on the narrowed joints the RMS jerk of
-/// q̈ is at least 1.5× lower and q̈'s change reverses its sign on at most 30 % of the ticks (from
-/// about 40 %; the issue's goal, 3× and 10 %, is not reached: what remains comes from the
-/// correction of the levels above as other joints' bounds come and go, not from resting on a
-/// limit); at most 5 level changes are undone at the next tick (from 73); no limit exceeded;
-/// the pelvis is still corrected while a narrowed joint sits on its limit.
+/// The default settings (quiet bounds with the soft approach at the tasks' rate √k_p, level
+/// hold `IMITATE_LEVEL_HOLD`, the clip low-passed at `IMITATE_SMOOTHING`) against Algorithm 2
+/// as printed with the viable bounds on the clip as captured, one run each (issue "smooth at
+/// the limits"): on the narrowed joints the RMS jerk of q̈ is at least 3× lower and q̈'s change
+/// reverses its sign on at most 10 % of the ticks (from about 40 %); at most 5 level changes
+/// are undone at the next tick (from 60); no limit exceeded; the pelvis is still corrected
+/// while a narrowed joint sits on its limit.
 #[test]
 fn default_run_is_smooth_at_the_limits() {
-    use iktc::limits::BoundMethod;
+    use iktc::limits::{BoundMethod, ViableSettings};
     use iktc::solver::SolverSettings;
-    let (robot, refs) = setup();
+    let robot = jvrc1(&ModelOptions::default()).unwrap();
+    let clip = builtin_clip("humanoid3d_dance_b").unwrap();
+    let map = builtin_map("deepmimic_jvrc1").unwrap();
     let new = ImitateConfig::default();
     let old = ImitateConfig {
         bounds: BoundMethod::viable(),
@@ -267,11 +269,21 @@ fn default_run_is_smooth_at_the_limits() {
             level_hold: 1,
             ..new.solver
         },
+        smoothing: None,
         ..ImitateConfig::default()
     };
-    assert_eq!(new.bounds, BoundMethod::quiet());
+    assert_eq!(
+        new.bounds,
+        BoundMethod::Quiet(ViableSettings {
+            approach_rate: new.gains.kp.sqrt(),
+            ..ViableSettings::default()
+        })
+    );
     assert_eq!(new.solver.level_hold, iktc::sim::IMITATE_LEVEL_HOLD);
-    let before = run_imitate(&robot, &refs, &old).unwrap();
+    assert_eq!(new.smoothing, Some(iktc::sim::IMITATE_SMOOTHING));
+    let refs_old = imitation_references(&robot, &clip, &map, &old).unwrap();
+    let refs = imitation_references(&robot, &clip, &map, &new).unwrap();
+    let before = run_imitate(&robot, &refs_old, &old).unwrap();
     let after = run_imitate(&robot, &refs, &new).unwrap();
     let (b, a) = (&before.summary, &after.summary);
     for (jb, ja) in b.narrowed_smoothness.iter().zip(&a.narrowed_smoothness) {
@@ -286,9 +298,8 @@ fn default_run_is_smooth_at_the_limits() {
             100.0 * sb.reversal_share,
             100.0 * sa.reversal_share
         );
-        assert!(sa.rms_jerk * 1.5 <= sb.rms_jerk, "{}", ja.joint);
-        assert!(sa.reversal_share <= 0.30, "{}", ja.joint);
-        assert!(sa.reversal_share < sb.reversal_share, "{}", ja.joint);
+        assert!(sa.rms_jerk * 3.0 <= sb.rms_jerk, "{}", ja.joint);
+        assert!(sa.reversal_share <= 0.10, "{}", ja.joint);
     }
     println!(
         "level changes {} ({} undone) → {} ({} undone); pelvis corrected with a narrowed joint on its limit {} → {}",

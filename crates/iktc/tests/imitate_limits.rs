@@ -71,8 +71,12 @@ fn knee_with_a_huge_acceleration_limit_stays_in_its_narrowed_range() {
         ..ModelOptions::default()
     });
     for method in [Method::Iktc, Method::Clamp] {
+        // The hard bounds only: no soft approach, the clip as captured (the knee reaches its
+        // limit).
         let mut cfg = ImitateConfig {
             method,
+            bounds: iktc::limits::BoundMethod::quiet(),
+            smoothing: None,
             ..ImitateConfig::default()
         };
         // This test is about the joint limits: the run goes on when the feet task is given up
@@ -159,6 +163,7 @@ fn zero_width_range_holds_the_joint() {
 fn recover() -> BoundMethod {
     BoundMethod::Viable(ViableSettings {
         outside: OutsideLimits::Recover,
+        approach_rate: 0.0,
         ..ViableSettings::default()
     })
 }

@@ -26,6 +26,7 @@ fn recover(fraction: f64) -> BoundMethod {
     BoundMethod::Viable(ViableSettings {
         braking_fraction: fraction,
         outside: OutsideLimits::Recover,
+        approach_rate: 0.0,
     })
 }
 
@@ -206,6 +207,7 @@ fn recovery_acceleration_by_hand() {
     let s = ViableSettings {
         braking_fraction: 0.5,
         outside: OutsideLimits::Recover,
+        approach_rate: 0.0,
     };
     assert_eq!(
         viable::recovery_acceleration(&k, &s, 1.95, 0.0, 0.01),

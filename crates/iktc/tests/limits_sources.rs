@@ -347,6 +347,7 @@ fn sources(lower: [f64; 4], upper: [f64; 4]) -> DofBoundSources {
         position: v[2],
         viability: v[3],
         jerk: f64::INFINITY.copysign(v[0]),
+        approach: f64::INFINITY.copysign(v[0]),
     };
     DofBoundSources {
         lower: side(lower),

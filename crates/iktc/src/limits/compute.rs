@@ -3,9 +3,10 @@
 use crate::error::{check_all_finite, check_dim, check_finite, Error, Result};
 
 use super::acceleration_box::AccelerationBox;
+use super::approach::{apply_approach, approach_interval};
 use super::intersect::{intersect, DofBounds};
 use super::joint_limits::{DofLimits, JointLimits};
-use super::method::{BoundMethod, OutsideLimits};
+use super::method::{BoundMethod, OutsideLimits, MAX_APPROACH_STEP};
 use super::paper::paper_sources;
 use super::quiet::quiet_sources;
 use super::source::{BoundSource, DofBoundSources, DroppedSources};
@@ -94,7 +95,11 @@ fn resolve(
             };
         }
     }
-    intersect(sources, method)
+    apply_approach(
+        intersect(sources, method),
+        sources.lower.approach,
+        sources.upper.approach,
+    )
 }
 
 /// The sources and the resolved interval of a single dof; the one-dof version of
@@ -127,11 +132,18 @@ fn sources_unchecked(
     qd: f64,
     dt: f64,
 ) -> DofBoundSources {
-    match method {
-        BoundMethod::Paper => paper_sources(dof, q, qd, dt),
-        BoundMethod::Viable(settings) => viable_sources(dof, settings, q, qd, dt),
-        BoundMethod::Quiet(settings) => quiet_sources(dof, settings, q, qd, dt),
+    let (mut sources, settings) = match method {
+        BoundMethod::Paper => return paper_sources(dof, q, qd, dt),
+        BoundMethod::Viable(settings) => (viable_sources(dof, settings, q, qd, dt), settings),
+        BoundMethod::Quiet(settings) => (quiet_sources(dof, settings, q, qd, dt), settings),
+    };
+    if settings.approach_rate > 0.0 {
+        let rate = settings.approach_rate.min(MAX_APPROACH_STEP / dt);
+        let (lower, upper) = approach_interval(dof, q, qd, rate);
+        sources.lower.approach = lower;
+        sources.upper.approach = upper;
     }
+    sources
 }
 
 fn check_time_step(dt: f64) -> Result<()> {

@@ -116,6 +116,7 @@ fn negate(side: &SourceBounds) -> SourceBounds {
         position: -side.position,
         viability: -side.viability,
         jerk: -side.jerk,
+        approach: -side.approach,
     }
 }
 

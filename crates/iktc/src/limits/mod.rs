@@ -43,6 +43,7 @@
 //! ```
 
 mod acceleration_box;
+pub mod approach;
 mod compute;
 mod from_robot;
 mod integrator;
@@ -63,7 +64,7 @@ pub use integrator::{integrate_constant_acceleration, peak_in_step, StepExtremes
 pub use intersect::{intersect, DofBounds};
 pub use jerk::limit_jerk;
 pub use joint_limits::{DofLimits, JointLimits};
-pub use method::{BoundMethod, OutsideLimits, ViableSettings};
+pub use method::{BoundMethod, OutsideLimits, ViableSettings, MAX_APPROACH_STEP};
 pub use narrow::NarrowedJoint;
 pub use paper::paper_sources;
 pub use quiet::quiet_sources;

@@ -78,6 +78,7 @@ pub fn paper_sources(limits: &DofLimits, q: f64, qd: f64, dt: f64) -> DofBoundSo
             position: position_term_lower(q, qd, limits.position_min, a_max, dt),
             viability: f64::NEG_INFINITY,
             jerk: f64::NEG_INFINITY,
+            approach: f64::NEG_INFINITY,
         },
         upper: SourceBounds {
             acceleration: a_max,
@@ -85,6 +86,7 @@ pub fn paper_sources(limits: &DofLimits, q: f64, qd: f64, dt: f64) -> DofBoundSo
             position: position_term_upper(q, qd, limits.position_max, a_max, dt),
             viability: f64::INFINITY,
             jerk: f64::INFINITY,
+            approach: f64::INFINITY,
         },
     }
 }

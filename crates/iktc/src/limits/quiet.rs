@@ -186,6 +186,7 @@ mod tests {
         let settings = ViableSettings {
             braking_fraction: 0.25,
             outside: OutsideLimits::Error,
+            approach_rate: 0.0,
         };
         let (q, qd) = (0.45, 0.6);
         let s = quiet_sources(&lim, &settings, q, qd, DT);

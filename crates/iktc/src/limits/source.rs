@@ -26,6 +26,9 @@ pub enum BoundSource {
     /// The jerk limit: `q̈` within `j_max Δt` of the previous tick's `q̈`
     /// ([`limit_jerk`](super::limit_jerk)).
     Jerk,
+    /// The soft approach to a range end of [`ViableSettings::approach_rate`](super::ViableSettings):
+    /// `q̈ ≤ ω² (q_max − q) − 2ω q̇` (mirrored below), see [`approach`](super::approach).
+    Approach,
 }
 
 /// Which sources conflict resolution removed for one dof (both sides).
@@ -43,12 +46,17 @@ pub struct DroppedSources {
     /// sources lies outside `q̈₋ ± j_max Δt`, and the point of it nearest to that interval is
     /// taken.
     pub jerk: bool,
+    /// The soft approach to a range end gave way ([`approach`](super::approach)): the other
+    /// sources' interval lies outside the approach interval, and the point of it nearest to
+    /// that interval is taken (a joint moving faster than the approach allows brakes at the
+    /// other limits instead).
+    pub approach: bool,
 }
 
 impl DroppedSources {
     /// Whether any source was dropped.
     pub fn any(&self) -> bool {
-        self.acceleration || self.viability || self.jerk
+        self.acceleration || self.viability || self.jerk || self.approach
     }
 }
 
@@ -71,6 +79,10 @@ pub struct SourceBounds {
     /// From the jerk limit: `q̈₋ ± j_max Δt` ([`limit_jerk`](super::limit_jerk)); infinite
     /// when the dof has no jerk limit or the box was computed without one.
     pub jerk: f64,
+    /// From the soft approach to the range end: `ω² (q_max − q) − 2ω q̇` on the upper side,
+    /// `−ω² (q − q_min) − 2ω q̇` on the lower ([`approach`](super::approach)); infinite when
+    /// [`ViableSettings::approach_rate`](super::ViableSettings) is 0 or the range end is.
+    pub approach: f64,
 }
 
 impl SourceBounds {
@@ -86,6 +98,7 @@ impl SourceBounds {
             position: value,
             viability: value,
             jerk: value,
+            approach: value,
         }
     }
 }

@@ -80,6 +80,7 @@ fn intersect_follows_its_rule_on_every_combination() {
             position: pick(&mut rng, sign),
             viability: pick(&mut rng, sign),
             jerk: f64::INFINITY * sign,
+            approach: f64::INFINITY * sign,
         };
         let s = DofBoundSources {
             lower: side(-1.0),
@@ -113,6 +114,7 @@ fn intersect_follows_its_rule_on_every_combination() {
                 BoundSource::Position | BoundSource::PaperPosition => side.position,
                 BoundSource::Viability => side.viability,
                 BoundSource::Recovery | BoundSource::Jerk => f64::NAN,
+                BoundSource::Approach => side.approach,
             };
             // After conflict resolution a side may take the other side's value and source.
             let other = if lower { &s.upper } else { &s.lower };
@@ -153,6 +155,7 @@ fn ties_name_position_then_viability_then_velocity_then_acceleration() {
         position: v,
         viability: v,
         jerk: v,
+        approach: v,
     };
     let s = DofBoundSources {
         lower: side(-1.0),
@@ -189,6 +192,7 @@ fn ties_name_position_then_viability_then_velocity_then_acceleration() {
         acceleration: false,
         viability: true,
         jerk: false,
+        approach: false,
     }
     .any());
     assert!(DroppedSources {
@@ -362,6 +366,7 @@ fn every_validation_rule_has_its_error() {
         let s = ViableSettings {
             braking_fraction: f,
             outside: OutsideLimits::Error,
+            approach_rate: 0.0,
         };
         assert!(s.validate().is_err(), "{f}");
         assert!(BoundMethod::Viable(s).validate().is_err());
@@ -371,6 +376,7 @@ fn every_validation_rule_has_its_error() {
         let s = ViableSettings {
             braking_fraction: f,
             outside: OutsideLimits::Error,
+            approach_rate: 0.0,
         };
         assert!(s.validate().is_ok(), "{f}");
     }
@@ -382,6 +388,7 @@ fn every_validation_rule_has_its_error() {
     let recover = ViableSettings {
         braking_fraction: 0.5,
         outside: OutsideLimits::Recover,
+        approach_rate: 0.0,
     };
     assert_eq!(
         BoundMethod::Viable(recover).outside_limits(),
@@ -505,6 +512,7 @@ fn compute_box_fills_every_dof_and_rejects_bad_input_unchanged() {
     let bad_method = BoundMethod::Viable(ViableSettings {
         braking_fraction: 2.0,
         outside: OutsideLimits::Error,
+        approach_rate: 0.0,
     });
     assert!(compute_box(&lim, &bad_method, &q, &qd, dt, &mut out).is_err());
     assert!(compute_dof(&dof(1.0, 0.0, 1.0, 1.0), &method, 0.0, 0.0, dt).is_err());
@@ -519,6 +527,7 @@ fn recovery_replaces_the_box_only_outside_the_range() {
     let recover = BoundMethod::Viable(ViableSettings {
         braking_fraction: 0.5,
         outside: OutsideLimits::Recover,
+        approach_rate: 0.0,
     });
     let d = dof(-1.0, 1.0, 2.0, 10.0);
     let dt = 0.01;

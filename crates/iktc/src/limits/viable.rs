@@ -344,6 +344,7 @@ pub fn viable_sources(
             position: position_lower(q, qd, limits.position_min, dt),
             viability: lower,
             jerk: f64::NEG_INFINITY,
+            approach: f64::NEG_INFINITY,
         },
         upper: SourceBounds {
             acceleration: a_max,
@@ -351,6 +352,7 @@ pub fn viable_sources(
             position: position_upper(q, qd, limits.position_max, dt),
             viability: upper,
             jerk: f64::INFINITY,
+            approach: f64::INFINITY,
         },
     }
 }

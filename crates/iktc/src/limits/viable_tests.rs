@@ -287,6 +287,7 @@ fn viable_sources_pick_the_regime_and_the_braking_fraction() {
     let settings = ViableSettings {
         braking_fraction: 0.25,
         outside: OutsideLimits::Error,
+        approach_rate: 0.0,
     };
     let (q, qd, dt) = (0.3, 0.4, 0.01);
     let lim = DofLimits {

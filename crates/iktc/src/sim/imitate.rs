@@ -25,7 +25,9 @@ use crate::controller::{
     ComHandle, Controller, ControllerBuilder, ControllerSettings, FrameHandle, JointsHandle,
 };
 use crate::error::{check_dim, Error, Result};
-use crate::limits::{AccelerationBox, BoundMethod, JointLimits, NarrowedJoint, OutsideLimits};
+use crate::limits::{
+    AccelerationBox, BoundMethod, JointLimits, NarrowedJoint, OutsideLimits, ViableSettings,
+};
 use crate::model::{Kinematics, Robot, State};
 use crate::motion::RobotReferences;
 use crate::resources::RunLimits;
@@ -111,15 +113,19 @@ impl ImitateConfig {
             posture.push((format!("{side}_KNEE"), 0.8));
             posture.push((format!("{side}_ANKLE_P"), -0.4));
         }
+        let gains = Gains {
+            kp: 100.0,
+            kv: 20.0,
+        };
         Self {
             method: Method::Iktc,
-            bounds: BoundMethod::quiet(),
+            bounds: BoundMethod::Quiet(ViableSettings {
+                approach_rate: gains.kp.sqrt(),
+                ..ViableSettings::default()
+            }),
             dt: 0.005,
             run_limits: RunLimits::default(),
-            gains: Gains {
-                kp: 100.0,
-                kv: 20.0,
-            },
+            gains,
             feet: vec!["r_ankle".into(), "l_ankle".into()],
             pelvis: "PELVIS_S".into(),
             initial_posture: posture,
@@ -146,7 +152,7 @@ impl ImitateConfig {
                 ..SolverSettings::default()
             },
             health: HealthSettings::default(),
-            smoothing: None,
+            smoothing: Some(IMITATE_SMOOTHING),
         }
     }
 
@@ -221,6 +227,12 @@ impl ImitateConfig {
 /// `tests/walk_imitate.rs` without the damping controller puts its ZMP 0.2 mm outside the
 /// support polygon for one tick.
 pub const IMITATE_LEVEL_HOLD: usize = 4;
+
+/// The cut-off of the low-pass applied to captured motion in the imitation's defaults \[Hz\]
+/// ([`ImitateConfig::smoothing`]): 6 Hz, the cut-off customary for filtering captured human
+/// movement in biomechanics (most of its power lies below it; D. A. Winter, *Biomechanics and
+/// Motor Control of Human Movement*), which takes out the frame-rate zigzag of the clips.
+pub const IMITATE_SMOOTHING: f64 = 6.0;
 
 impl Default for ImitateConfig {
     fn default() -> Self {

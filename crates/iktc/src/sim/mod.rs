@@ -26,7 +26,7 @@ pub use health::{HealthCheck, HealthIssue, HealthMonitor, HealthReport, HealthSe
 #[cfg(all(feature = "urdf", feature = "json", feature = "toml"))]
 pub use imitate::{
     imitation_references, run_imitate, ImitateConfig, ImitateRun, ImitateStep, ImitateSummary,
-    ImitationController, ImitationTasks, IMITATE_LEVEL_HOLD,
+    ImitationController, ImitationTasks, IMITATE_LEVEL_HOLD, IMITATE_SMOOTHING,
 };
 pub use margins::{dof_margins, held_limit, median, percentile, DofMargins, JointMargin};
 pub use planar3r::{
