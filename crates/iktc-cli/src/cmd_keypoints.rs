@@ -36,19 +36,28 @@ pub struct KeypointArgs {
     /// the keypoint route, the joint angles and pelvis height and angles of the joint route
     /// (and of the keypoint route's posture references). Removes the capture's frame-rate
     /// noise from the reference accelerations (6 Hz is biomechanics' usual choice for
-    /// walking). Default: none, the motion as captured.
-    #[arg(long, value_name = "HZ")]
+    /// walking). Default: 6 Hz on the joint route, none on the keypoint route.
+    #[arg(long, value_name = "HZ", conflicts_with = "no_smoothing")]
     pub smoothing: Option<f64>,
+    /// The motion as captured, not low-passed, on either route.
+    #[arg(long)]
+    pub no_smoothing: bool,
 }
 
 impl KeypointArgs {
-    /// Gives `cfg` the `--smoothing` (both routes use it) and refuses `--standing` on the joint
-    /// route.
+    /// Gives `cfg` the `--smoothing` (both routes use it; without it the joint route keeps
+    /// `cfg`'s default, [`iktc::sim::IMITATE_SMOOTHING`], and the keypoint route none),
+    /// `--no-smoothing`, and refuses `--standing` on the joint route.
     pub fn apply(&self, route: RetargetArg, cfg: &mut ImitateConfig) -> Result<()> {
         if route == RetargetArg::Joints && self.standing {
             anyhow::bail!("--standing applies to --retarget keypoints only");
         }
-        cfg.smoothing = self.smoothing;
+        cfg.smoothing = match (self.no_smoothing, self.smoothing, route) {
+            (true, _, _) => None,
+            (false, Some(hz), _) => Some(hz),
+            (false, None, RetargetArg::Joints) => cfg.smoothing,
+            (false, None, RetargetArg::Keypoints) => None,
+        };
         Ok(())
     }
 }
@@ -66,7 +75,7 @@ pub fn keypoint_settings(
         dt: cfg.dt,
         run_limits: cfg.run_limits,
         standing: k.standing,
-        smoothing: k.smoothing,
+        smoothing: if k.no_smoothing { None } else { k.smoothing },
         ..KeypointSettings::default()
     }
 }
@@ -111,7 +120,9 @@ pub fn run(
     let settings = keypoint_settings(cfg, bounds, keypoint_args);
     let robot = profile.robot()?;
     let posture = match &clip {
-        Some((clip, format)) => posture_references(&robot, profile, clip, *format, map, cfg)?,
+        Some((clip, format)) => {
+            posture_references(&robot, profile, clip, *format, map, cfg, settings.smoothing)?
+        }
         None => Posture::Start("the motion has no skeleton".into()),
     };
     if let Posture::Start(_) = &posture {

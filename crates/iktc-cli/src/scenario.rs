@@ -46,6 +46,12 @@ pub struct ScenarioArgs {
     /// acceleration limit (viable or quiet bounds); without it such a start is an error.
     #[arg(long)]
     pub recover: bool,
+    /// Soft approach to the range ends at this rate [1/s] (viable or quiet bounds): a joint
+    /// nearing a limit is braked like a critically damped spring, so its command changes
+    /// smoothly. Default: the tasks' rate √k_p (10 /s) on the joint route and in walking, none
+    /// in keypoint retargeting; 0 turns it off.
+    #[arg(long, value_name = "RATE")]
+    pub approach_rate: Option<f64>,
     /// Control period [s].
     #[arg(long, default_value_t = 0.005)]
     pub dt: f64,
@@ -87,12 +93,23 @@ pub fn keypoint_bounds(a: &ScenarioArgs) -> BoundMethod {
         || iktc::retarget::KeypointSettings::default().bounds,
         BoundsArg::method,
     );
-    if a.recover {
-        if let BoundMethod::Viable(s) | BoundMethod::Quiet(s) = &mut bounds {
+    if let BoundMethod::Viable(s) | BoundMethod::Quiet(s) = &mut bounds {
+        if a.recover {
             s.outside = OutsideLimits::Recover;
+        }
+        if let Some(rate) = a.approach_rate {
+            s.approach_rate = rate;
         }
     }
     bounds
+}
+
+/// The approach rate of the imitation's defaults \[1/s\] (0 when they have none).
+fn default_approach_rate() -> f64 {
+    match ImitateConfig::default().bounds {
+        BoundMethod::Viable(s) | BoundMethod::Quiet(s) => s.approach_rate,
+        BoundMethod::Paper => 0.0,
+    }
 }
 
 pub fn prepare_config(a: &ScenarioArgs) -> Result<(ResolvedRobot, ImitateConfig)> {
@@ -125,12 +142,20 @@ pub fn prepare_config(a: &ScenarioArgs) -> Result<(ResolvedRobot, ImitateConfig)
         })
         .map_err(|e| resolved.explain(e))?;
     cfg.run_limits.check_dt("--dt", a.dt)?;
-    if a.recover {
-        match &mut cfg.bounds {
-            BoundMethod::Viable(settings) | BoundMethod::Quiet(settings) => {
-                settings.outside = OutsideLimits::Recover
+    match &mut cfg.bounds {
+        BoundMethod::Viable(settings) | BoundMethod::Quiet(settings) => {
+            if a.recover {
+                settings.outside = OutsideLimits::Recover;
             }
-            BoundMethod::Paper => anyhow::bail!("--recover needs --bounds viable or quiet"),
+            settings.approach_rate = a.approach_rate.unwrap_or_else(default_approach_rate);
+        }
+        BoundMethod::Paper => {
+            if a.recover {
+                anyhow::bail!("--recover needs --bounds viable or quiet");
+            }
+            if a.approach_rate.is_some() {
+                anyhow::bail!("--approach-rate needs --bounds viable or quiet");
+            }
         }
     }
     cfg.health.keep_going = a.keep_going;

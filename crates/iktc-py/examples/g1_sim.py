@@ -790,17 +790,18 @@ def standing_figures(frozen=(), **kw) -> dict:
             "ticks": s["ticks"], "legs_qdd_max_rad_s2": peak}
 
 
-def walking_plan_figures(clip: str = "humanoid3d_dance_b", narrow=None) -> dict:
+def walking_plan_figures(clip: str = "humanoid3d_dance_b", narrow=None, **walking) -> dict:
     """The walking plan alone (no physics): its ZMP against the pattern's support polygon per
-    phase, and the lowest angle of each knee [rad] with the first time at its lower limit [s]."""
+    phase, and the lowest angle of each knee [rad] with the first time at its lower limit [s].
+    `walking`: further keywords of `iktc.Walking` (smoothing, approach_rate)."""
     robot = iktc.Robot("g1")
     qs, phases = [], []
-    walk = iktc.Walking(robot, iktc.load_motion(clip), narrow=narrow)
+    walk = iktc.Walking(robot, iktc.load_motion(clip), narrow=narrow, **walking)
     for _ in range(walk.ticks):
         phases.append(walk.tick()[1])
         qs.append(walk.q.copy())
     plan = planned_zmp(Plant(robot), qs)
-    replay = iktc.Walking(robot, iktc.load_motion(clip), narrow=narrow)
+    replay = iktc.Walking(robot, iktc.load_motion(clip), narrow=narrow, **walking)
     out = {}
     for k, p in enumerate(plan):
         replay.tick()

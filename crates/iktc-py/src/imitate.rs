@@ -4,7 +4,7 @@
 //! controller's output) and the support-polygon margin of a measured ZMP is computed from the
 //! profile's soles.
 
-use iktc::limits::NarrowedJoint;
+use iktc::limits::{BoundMethod, NarrowedJoint};
 use iktc::motion::Clip;
 use iktc::sim::imitate::support_polygon;
 use iktc::sim::{imitation_references, ImitateConfig, ImitationController};
@@ -127,9 +127,12 @@ impl PyImitation {
     /// `time_scale` [–] plays the clip that many times slower (its frame times multiplied:
     /// rates divided by it, accelerations by its square), before the cut. `smoothing` [Hz]: the
     /// cut-off of the zero-phase low-pass applied to the retargeted angles before they are
-    /// differentiated (`iktc::sim::ImitateConfig::smoothing`; default none).
+    /// differentiated (`iktc::sim::ImitateConfig::smoothing`; default 6 Hz, None: as captured).
+    /// `approach_rate` [1/s]: the soft approach to the range ends with viable or quiet bounds
+    /// (`iktc::limits::ViableSettings::approach_rate`; default None: the imitation's, the tasks'
+    /// rate √k_p = 10 /s; 0 turns it off).
     #[new]
-    #[pyo3(signature = (robot, motion, *, map=None, dt=0.005, method="iktc", bounds="quiet", duration=None, time_scale=1.0, level_hold=None, rebase_release=1.0, continuity=0.0, narrow=None, smoothing=None))]
+    #[pyo3(signature = (robot, motion, *, map=None, dt=0.005, method="iktc", bounds="quiet", duration=None, time_scale=1.0, level_hold=None, rebase_release=1.0, continuity=0.0, narrow=None, smoothing=Some(iktc::sim::IMITATE_SMOOTHING), approach_rate=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -146,13 +149,28 @@ impl PyImitation {
         continuity: f64,
         narrow: Option<Vec<(String, f64, f64)>>,
         smoothing: Option<f64>,
+        approach_rate: Option<f64>,
     ) -> PyResult<Self> {
         let profile = robot.required_profile("the imitation", "feet, pelvis and posture")?;
+        let defaults = ImitateConfig::default();
+        let mut bounds = parse_bounds(bounds)?;
+        match (&mut bounds, &defaults.bounds) {
+            (
+                BoundMethod::Viable(s) | BoundMethod::Quiet(s),
+                BoundMethod::Viable(d) | BoundMethod::Quiet(d),
+            ) => s.approach_rate = approach_rate.unwrap_or(d.approach_rate),
+            (BoundMethod::Paper, _) if approach_rate.is_some() => {
+                return Err(IktcError::new_err(
+                    "approach_rate needs bounds=\"viable\" or \"quiet\"",
+                ))
+            }
+            _ => {}
+        }
         let base = ImitateConfig {
             method: parse_method(method)?,
-            bounds: parse_bounds(bounds)?,
+            bounds,
             dt,
-            ..ImitateConfig::default()
+            ..defaults
         };
         let base = ImitateConfig {
             solver: SolverSettings {

@@ -77,6 +77,7 @@ pub fn py_retarget_keypoints(
                 motion.motion.format,
                 None,
                 &cfg,
+                settings.smoothing,
             )?,
             None => Posture::Start("the motion has no skeleton".into()),
         };

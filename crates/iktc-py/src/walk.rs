@@ -29,7 +29,9 @@ type PatternZmp = (Vector2<f64>, f64);
 /// (xz SSP, xz DSP, yz SSP, yz DSP, `PlaneModel`s; their length is replaced by the COM height),
 /// None the synthetic ones of `iktc::balance::CaseParams::synthetic`; `offset_feedforward`
 /// False gives the COM task the controller's offset without its rates fed forward (as
-/// `g1_sim`'s identification sweeps it).
+/// `g1_sim`'s identification sweeps it); `smoothing` [Hz] and `approach_rate` [1/s] as in
+/// `Imitation` (default 6 Hz and the imitation's approach, √k_p = 10 /s; None and 0 turn
+/// them off).
 #[pyclass(name = "Walking", module = "iktc")]
 pub struct PyWalking {
     ctl: WalkingController,
@@ -46,7 +48,8 @@ pub struct PyWalking {
 impl PyWalking {
     #[new]
     #[pyo3(signature = (robot, motion, *, map=None, steps=4, step_length=None, narrow=None,
-                        damping=false, cases=None, offset_feedforward=true))]
+                        damping=false, cases=None, offset_feedforward=true,
+                        smoothing=Some(iktc::sim::IMITATE_SMOOTHING), approach_rate=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -59,6 +62,8 @@ impl PyWalking {
         damping: bool,
         cases: Option<Vec<Bound<'_, PyPlaneModel>>>,
         offset_feedforward: bool,
+        smoothing: Option<f64>,
+        approach_rate: Option<f64>,
     ) -> PyResult<Self> {
         let profile = robot.required_profile("walking", "feet, pelvis and posture")?;
         let mut cfg = profile
@@ -66,6 +71,14 @@ impl PyWalking {
             .map_err(to_py)?;
         if let Some(n) = narrow {
             cfg.imitate.narrow = narrowed(n);
+        }
+        cfg.imitate.smoothing = smoothing;
+        if let (
+            Some(rate),
+            iktc::limits::BoundMethod::Viable(s) | iktc::limits::BoundMethod::Quiet(s),
+        ) = (approach_rate, &mut cfg.imitate.bounds)
+        {
+            s.approach_rate = rate;
         }
         cfg.steps = steps;
         if let Some(l) = step_length {

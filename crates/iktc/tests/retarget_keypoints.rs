@@ -93,8 +93,11 @@ fn check_robot(name: &str) {
         let clip = motion.clip().unwrap().unwrap();
         let refs = match profile.retarget_map(format_key(&motion), &robot) {
             Ok(map) => {
+                // As the product builds the posture references (`posture_references`): the
+                // narrowed ranges left out, the keypoint route's low-pass.
                 let cfg = ImitateConfig {
                     narrow: Vec::new(),
+                    smoothing: s.smoothing,
                     ..profile.imitate_config(ImitateConfig::default()).unwrap()
                 };
                 match imitation_references(&robot, &clip, &map, &cfg) {

@@ -199,7 +199,8 @@ class Imitation:
                  level_hold: Optional[int] = None, rebase_release: float = 1.0,
                  continuity: float = 0.0,
                  narrow: Optional[Sequence[Tuple[str, float, float]]] = None,
-                 smoothing: Optional[float] = None) -> None: ...
+                 smoothing: Optional[float] = 6.0,
+                 approach_rate: Optional[float] = None) -> None: ...
     @property
     def ticks(self) -> int: ...
     @property
@@ -234,7 +235,9 @@ class Walking:
                  narrow: Optional[Sequence[Tuple[str, float, float]]] = None,
                  damping: bool = False,
                  cases: Optional[Sequence[PlaneModel]] = None,
-                 offset_feedforward: bool = True) -> None: ...
+                 offset_feedforward: bool = True,
+                 smoothing: Optional[float] = 6.0,
+                 approach_rate: Optional[float] = None) -> None: ...
     @property
     def ticks(self) -> int: ...
     @property

@@ -160,7 +160,8 @@ impl Posture {
 
 /// The keypoint route's posture references for a skeleton `clip` in `format` on `profile`'s
 /// robot `robot`: the joint route's references ([`imitation_references`] with `cfg`, the
-/// narrowed ranges left out) through `map`, else the profile's map for the format. The posture
+/// narrowed ranges left out, low-passed at the keypoint route's `smoothing` \[Hz\] instead of
+/// `cfg`'s) through `map`, else the profile's map for the format. The posture
 /// is a regulariser below every keypoint task, so a profile map that does not fit the clip
 /// (a built-in BVH map naming joints another rig lacks) leaves the start posture, with the
 /// reason; a `map` the caller gave that does not fit is an error.
@@ -173,9 +174,11 @@ pub fn posture_references(
     format: MotionFormat,
     map: Option<&RetargetMap>,
     cfg: &ImitateConfig,
+    smoothing: Option<f64>,
 ) -> Result<Posture> {
     let cfg = ImitateConfig {
         narrow: Vec::new(),
+        smoothing,
         ..cfg.clone()
     };
     let map = match map {
@@ -387,6 +390,7 @@ impl BatchRetarget {
             format,
             self.map.as_ref(),
             &cfg,
+            self.keypoints.smoothing,
         )
     }
 

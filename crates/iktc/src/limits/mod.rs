@@ -10,8 +10,9 @@
 //! | [`BoundMethod::Quiet`] | as `Viable`, with a discrete braking profile that ends at rest at a tick ([`quiet`]) | yes, from a quietly viable state; the box never empties and a joint pushed into a limit rests on it with `q̈ = 0` |
 //!
 //! Each source of bound (acceleration, velocity, position, viability) is computed separately,
-//! as in TSID, then intersected ([`intersect`]). Optional jerk limits are a fourth source,
-//! applied last with the lowest precedence ([`limit_jerk`], [`jerk`]). From a viable state the sources of `Viable`
+//! as in TSID, then intersected ([`intersect`]). An optional soft approach to the range ends
+//! (a critically damped wall, [`approach`]) is applied next at lower precedence, and optional
+//! jerk limits last with the lowest ([`limit_jerk`], [`jerk`]). From a viable state the sources of `Viable`
 //! never conflict (beyond rounding); from any other state the acceleration limit is dropped
 //! first (exceeded by the least amount), then viability; position and velocity are kept, and
 //! if they conflict the box is reported empty. A run checks its start state
