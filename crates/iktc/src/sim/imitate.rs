@@ -48,7 +48,8 @@ pub const LEVEL_NAMES: [&str; 5] = [
 pub struct ImitateConfig {
     /// Solver (IKTC by default).
     pub method: Method,
-    /// Joint bounds (viable by default).
+    /// Joint bounds (default: quiet, with the soft approach to the range ends at the tasks' rate
+    /// √k_p, [`ViableSettings::approach_rate`]).
     pub bounds: BoundMethod,
     /// Control period Δt \[s\]; must equal the references' period.
     pub dt: f64,
@@ -93,16 +94,19 @@ pub struct ImitateConfig {
     pub health: HealthSettings,
     /// Cut-off \[Hz\] of the zero-phase low-pass ([`crate::motion::lowpass`]) applied to the
     /// retargeted joint angles and pelvis height and angles at the clip's rate, before they
-    /// are clamped into the ranges and differentiated into references (default `None`: as
-    /// captured; a cut-off at or above the clip's Nyquist frequency leaves them too).
+    /// are clamped into the ranges and differentiated into references (default
+    /// [`IMITATE_SMOOTHING`], 6 Hz; `None`: as captured; a cut-off at or above the clip's
+    /// Nyquist frequency leaves them too).
     pub smoothing: Option<f64>,
 }
 
 impl ImitateConfig {
-    /// The defaults for JVRC-1: IKTC, quiet bounds and a hold of
-    /// [`IMITATE_LEVEL_HOLD`] ticks on the corrected level (a joint pushed into a limit rests on
-    /// it and the corrected level does not flicker; `BoundMethod::viable()` and a hold of 1 are
-    /// Algorithm 2 as printed with the discrete-time bounds), Δt = 5 ms, feet `r_ankle` and `l_ankle`,
+    /// The defaults for JVRC-1: IKTC, quiet bounds with the soft approach to the range ends at
+    /// the tasks' rate √k_p = 10 /s (a limit is approached no faster than a task converges, and
+    /// the command changes smoothly as it starts to bind), a hold of [`IMITATE_LEVEL_HOLD`]
+    /// ticks on the corrected level (a joint pushed into a limit rests on it and the corrected
+    /// level does not flicker; `BoundMethod::viable()` and a hold of 1 are Algorithm 2 as
+    /// printed with the discrete-time bounds), the clip low-passed at [`IMITATE_SMOOTHING`], Δt = 5 ms, feet `r_ankle` and `l_ankle`,
     /// pelvis `PELVIS_S`, hip pitch −0.4, knee 0.8, ankle pitch −0.4 rad, L_KNEE narrowed to
     /// \[0.55, 0.95\] rad and L_HIP_R to \[−0.05, 0.05\] rad (so that the pelvis height and
     /// attitude tasks get corrected, as in Fig. 20), reference margin 0.05 rad.
