@@ -171,11 +171,16 @@ mod tests {
         assert_eq!(apply_approach(empty, -0.5, 0.5), empty);
     }
 
-    /// Rate 0 leaves the box of every state exactly as without the setting; a positive rate
-    /// records the approach among the sources and binds where it is the tightest.
+    /// Rate 0 leaves the box of every state exactly as without the setting; a positive rate,
+    /// however slow, records the approach among the sources and binds where it is the tightest.
     #[test]
     fn rate_zero_changes_nothing_and_a_rate_records_the_source() {
         let dt = 0.005;
+        let (slow, _) = compute_dof(&LIMITS, &quiet(0.5), 0.3, 0.4, dt).unwrap();
+        assert_eq!(
+            slow.upper.approach,
+            approach_interval(&LIMITS, 0.3, 0.4, 0.5).1
+        );
         for i in 0..200 {
             let q = -0.5 + i as f64 * 0.005;
             for qd in [-2.5, -0.7, 0.0, 0.3, 2.9] {
