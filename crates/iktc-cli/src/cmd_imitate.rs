@@ -83,8 +83,12 @@ pub fn run(a: &Args) -> Result<()> {
 fn print_summary(r: &ImitateRun) -> std::io::Result<()> {
     let s = &r.summary;
     crate::outln!(
-        "imitation, {} with {} bounds, {} ticks of {} s: worst margins position {:+.2e} rad, velocity {:+.2e} rad/s, acceleration {:+.2e} rad/s²",
-        s.solver, s.bounds, s.steps, s.dt, s.worst_position_margin, s.worst_velocity_margin, s.worst_acceleration_margin
+        "imitation, {} with {} bounds (soft approach {}), clip {}, {} ticks of {} s: worst margins position {:+.2e} rad, velocity {:+.2e} rad/s, acceleration {:+.2e} rad/s²",
+        s.solver,
+        s.bounds,
+        if s.approach_rate > 0.0 { format!("{} /s", s.approach_rate) } else { "off".into() },
+        s.smoothing_hz.map_or_else(|| "as captured".into(), |hz| format!("low-passed at {hz} Hz")),
+        s.steps, s.dt, s.worst_position_margin, s.worst_velocity_margin, s.worst_acceleration_margin
     )?;
     crate::outln!(
         "limits binding: position {} ticks, velocity {}, acceleration {}; pelvis corrected {} ticks ({} with a narrowed joint on its limit)",

@@ -62,10 +62,66 @@ fn g1_imitates_the_default_clip_within_its_limits() {
     }
     assert_eq!(s["nv"].as_u64(), Some(35));
     assert!(s["foot_drift"].as_f64().unwrap() < 1e-3);
+    // The imitation's defaults, reported: the soft approach at the tasks' rate √k_p and the
+    // clip low-passed at 6 Hz.
+    assert_eq!(s["approach_rate"].as_f64(), Some(10.0));
+    assert_eq!(s["smoothing_hz"].as_f64(), Some(6.0));
     let viewer = std::fs::read_to_string(out.join("viewer.html")).unwrap();
     assert!(
         viewer.contains("\"g1_29dof_rev_1_0\""),
         "the viewer shows the G1"
+    );
+}
+
+/// `--approach-rate 0 --no-smoothing` turn the defaults off (the summary says so); an
+/// approach rate with the paper's bound, a negative rate and both smoothing flags are errors
+/// naming the flag or setting.
+#[test]
+fn the_approach_and_the_low_pass_can_be_turned_off_and_bad_values_are_named() {
+    let out = tmp("off");
+    let o = iktc()
+        .args([
+            "imitate",
+            "--retarget",
+            "joints",
+            "--approach-rate",
+            "0",
+            "--no-smoothing",
+            "--out",
+        ])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let s = json(&out.join("summary.json"));
+    assert_eq!(s["approach_rate"].as_f64(), Some(0.0));
+    assert!(s["smoothing_hz"].is_null(), "{}", s["smoothing_hz"]);
+    assert!(s["worst_position_margin"].as_f64().unwrap() <= LIMIT_SLACK);
+    let o = run(&[
+        "imitate",
+        "--retarget",
+        "joints",
+        "--bounds",
+        "paper",
+        "--approach-rate",
+        "5",
+    ]);
+    assert!(
+        !o.status.success() && stderr(&o).contains("--approach-rate"),
+        "{}",
+        stderr(&o)
+    );
+    let o = run(&["imitate", "--retarget", "joints", "--approach-rate", "-1"]);
+    assert!(
+        !o.status.success() && stderr(&o).contains("approach_rate"),
+        "{}",
+        stderr(&o)
+    );
+    let o = run(&["imitate", "--smoothing", "6", "--no-smoothing"]);
+    assert!(
+        !o.status.success() && stderr(&o).contains("--no-smoothing"),
+        "{}",
+        stderr(&o)
     );
 }
 

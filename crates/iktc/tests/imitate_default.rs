@@ -310,6 +310,9 @@ fn default_run_is_smooth_at_the_limits() {
         b.pelvis_corrected_while_narrowed_at_limit,
         a.pelvis_corrected_while_narrowed_at_limit
     );
+    // The summaries say which settings ran.
+    assert_eq!((a.approach_rate, a.smoothing_hz), (10.0, Some(6.0)));
+    assert_eq!((b.approach_rate, b.smoothing_hz), (0.0, None));
     assert!(a.level_switches.flips <= 5, "{:?}", a.level_switches);
     assert!(a.pelvis_corrected_while_narrowed_at_limit > 50);
     assert!(a.worst_position_margin <= LIMIT_ROUNDING);

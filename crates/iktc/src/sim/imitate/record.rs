@@ -117,6 +117,12 @@ pub struct ImitateSummary {
     pub solver: String,
     /// Bound method.
     pub bounds: String,
+    /// The soft approach's rate \[1/s\] ([`ViableSettings::approach_rate`](crate::limits::ViableSettings)),
+    /// as used at the run's Δt (capped at `MAX_APPROACH_STEP/Δt`); 0 without it.
+    pub approach_rate: f64,
+    /// Cut-off of the low-pass applied to the clip \[Hz\] ([`ImitateConfig::smoothing`]); `None`:
+    /// the clip as captured.
+    pub smoothing_hz: Option<f64>,
     /// Δt \[s\].
     pub dt: f64,
     /// Duration \[s\].
@@ -499,6 +505,13 @@ pub(crate) fn summarize(
     ImitateSummary {
         solver: cfg.method.name().into(),
         bounds: cfg.bounds.name().into(),
+        approach_rate: match cfg.bounds {
+            crate::limits::BoundMethod::Viable(s) | crate::limits::BoundMethod::Quiet(s) => s
+                .approach_rate
+                .min(crate::limits::MAX_APPROACH_STEP / cfg.dt),
+            crate::limits::BoundMethod::Paper => 0.0,
+        },
+        smoothing_hz: cfg.smoothing,
         dt: cfg.dt,
         duration: steps.len() as f64 * cfg.dt,
         steps: steps.len(),
