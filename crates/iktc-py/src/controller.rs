@@ -138,10 +138,13 @@ impl PyControllerBuilder {
 #[pymethods]
 impl PyControllerBuilder {
     /// `robot`, the state (q, v = 0 by default) the tasks hold at, CLIK gains k_p [s⁻²] and
-    /// k_v [s⁻¹] (default critical damping 2√k_p), the solver method (iktc, gf, clamp) and the
-    /// bound method (quiet, the default; viable; paper).
+    /// k_v [s⁻¹] (default critical damping 2√k_p), the solver method (iktc, gf, clamp), the
+    /// bound method (quiet, the default; viable; paper) and the rate [1/s] of the soft approach
+    /// to the range ends with viable or quiet bounds (`iktc::limits::ViableSettings::approach_rate`;
+    /// 0, the default, leaves it out; √k_p is the imitation's choice).
     #[new]
-    #[pyo3(signature = (robot, q, v=None, *, kp=100.0, kv=None, method="iktc", bounds="quiet"))]
+    #[pyo3(signature = (robot, q, v=None, *, kp=100.0, kv=None, method="iktc", bounds="quiet", approach_rate=0.0))]
+    #[allow(clippy::too_many_arguments)]
     fn new(
         robot: &PyRobot,
         q: &Bound<'_, PyAny>,
@@ -150,6 +153,7 @@ impl PyControllerBuilder {
         kv: Option<f64>,
         method: &str,
         bounds: &str,
+        approach_rate: f64,
     ) -> PyResult<Self> {
         let state = robot.state(q, v)?;
         let mut b = ControllerBuilder::new(robot.robot.clone(), &state).map_err(to_py)?;
@@ -157,9 +161,20 @@ impl PyControllerBuilder {
             Some(kv) => Gains { kp, kv },
             None => Gains::critical(kp),
         };
+        let mut bounds = parse_bounds(bounds)?;
+        match &mut bounds {
+            BoundMethod::Viable(s) | BoundMethod::Quiet(s) => s.approach_rate = approach_rate,
+            BoundMethod::Paper if approach_rate != 0.0 => {
+                return Err(IktcError::new_err(
+                    "approach_rate needs bounds=\"viable\" or \"quiet\"",
+                ))
+            }
+            BoundMethod::Paper => {}
+        }
+        bounds.validate().map_err(to_py)?;
         let settings = iktc::controller::ControllerSettings {
             method: parse_method(method)?,
-            bounds: parse_bounds(bounds)?,
+            bounds,
             ..Default::default()
         };
         b.gains(gains).settings(settings);

@@ -211,3 +211,39 @@ def test_the_3r_arm_from_python_equals_the_rust_scenario():
         ctrl.step(q, v, DT)
     # Same equations, same solver: equal up to rounding and the CSV's printed digits.
     assert worst < 1e-6, worst
+
+
+def test_the_soft_approach_brakes_a_joint_gently_into_its_limit():
+    # The neck's yaw driven 0.3 rad beyond its upper limit by a joint task (k_p = 100 s⁻²),
+    # feet held. The quiet bound brakes as late as possible: as it takes over, the command
+    # changes by 18.8 rad/s² in one tick. With the approach at 10 /s the largest change of the
+    # run is 6.6 rad/s². Both keep every limit, and the neck ends on its limit either way.
+    robot = iktc.Robot("jvrc1")
+    lower, upper, vmax, amax = robot.limits()
+    name = "NECK_Y"
+    iv = robot.v_index(name)
+    jumps, ends = {}, {}
+    for rate in (0.0, 10.0):
+        q, v = bent_knees(robot)
+        b = iktc.ControllerBuilder(robot, q, kp=100.0, approach_rate=rate)
+        b.level("feet")
+        b.frame("r_ankle")
+        b.frame("l_ankle")
+        b.level("elbow")
+        elbow = b.joints([name])
+        ctrl = b.build()
+        ctrl.set_joints_reference(elbow, [upper[iv] + 0.3])
+        qdd = []
+        for _ in range(600):
+            report = ctrl.step(q, v, DT)
+            assert report.violation <= 1e-9
+            qdd.append(ctrl.qdd[iv])
+            assert lower[iv] - 1e-9 <= q[robot.q_index(name)] <= upper[iv] + 1e-9
+        jumps[rate] = np.abs(np.diff(qdd)).max()
+        ends[rate] = upper[iv] - q[robot.q_index(name)]
+    assert jumps[10.0] < 0.5 * jumps[0.0], jumps
+    assert ends[0.0] < 1e-9 and ends[10.0] < 1e-6, ends
+    with pytest.raises(iktc.IktcError, match="approach_rate"):
+        iktc.ControllerBuilder(robot, bent_knees(robot)[0], approach_rate=-1.0)
+    with pytest.raises(iktc.IktcError, match="approach_rate"):
+        iktc.ControllerBuilder(robot, bent_knees(robot)[0], bounds="paper", approach_rate=5.0)
