@@ -362,18 +362,19 @@ def run_standing(duration: float | None = None, settle: float = 0.5,
 
 def run_standing_keypoints(clip: str = "humanoid3d_dance_b", settle: float = 0.5,
                            robot: iktc.Robot | None = None, standing: bool = False,
-                           physics_step: float = PHYSICS_STEP) -> Loop:
+                           physics_step: float = PHYSICS_STEP, **keypoints) -> Loop:
     """(a′) Standing imitation by the keypoint route (``iktc.retarget_keypoints(...,
     hold_feet=True)``: the clip's body points scaled to G1, both feet held where they stand,
     the COM reference over the support polygon); its q and v per tick are the servos' set
     points, the plan computed beforehand (it does not see the plant). With `standing` the
     route's standing imitation instead (``standing=True``: feet and pelvis held at G1's start
     pose, the COM over the middle of the soles, the clip's upper body relative to its pelvis).
+    `keypoints`: further keywords of ``iktc.retarget_keypoints`` (smoothing, approach_rate).
     The loop's imitation (one tick long) serves only for the support polygon; the upper body is
     measured against the plan's own upper-body angles. Returns the loop."""
     loop = Loop(clip=clip, duration=CONTROL_PERIOD, robot=robot, physics_step=physics_step)
     plan = iktc.retarget_keypoints(iktc.load_motion(clip), loop.robot, dt=CONTROL_PERIOD,
-                                   hold_feet=True, standing=standing)
+                                   hold_feet=True, standing=standing, **keypoints)
     qs, vs = plan.q, plan.v
     loop.plant.set_state(qs[0])
     for _ in range(int(round(settle / CONTROL_PERIOD))):

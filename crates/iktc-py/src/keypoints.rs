@@ -39,8 +39,11 @@ pub struct PyKeypointTrajectory {
 /// start pose and only the clip's upper body imitated, relative to its pelvis (see
 /// `iktc::retarget::KeypointSettings::standing`). `smoothing`: cut-off [Hz] of the zero-phase
 /// low-pass applied to the body points before they are differentiated (`None`: as captured).
+/// `approach_rate` [1/s]: the soft approach to the range ends
+/// (`iktc::limits::ViableSettings::approach_rate`; 0, the default, leaves it out).
 #[pyfunction]
-#[pyo3(name = "retarget_keypoints", signature = (motion, robot, *, dt=0.005, hold_feet=false, standing=false, smoothing=None))]
+#[pyo3(name = "retarget_keypoints", signature = (motion, robot, *, dt=0.005, hold_feet=false, standing=false, smoothing=None, approach_rate=0.0))]
+#[allow(clippy::too_many_arguments)]
 pub fn py_retarget_keypoints(
     py: Python<'_>,
     motion: &PyMotion,
@@ -49,6 +52,7 @@ pub fn py_retarget_keypoints(
     hold_feet: bool,
     standing: bool,
     smoothing: Option<f64>,
+    approach_rate: f64,
 ) -> PyResult<PyKeypointTrajectory> {
     let profile = robot.required_profile("keypoint retargeting", "feet, pelvis and hands")?;
     let mut settings = KeypointSettings {
@@ -57,6 +61,11 @@ pub fn py_retarget_keypoints(
         smoothing,
         ..KeypointSettings::default()
     };
+    if let iktc::limits::BoundMethod::Viable(s) | iktc::limits::BoundMethod::Quiet(s) =
+        &mut settings.bounds
+    {
+        s.approach_rate = approach_rate;
+    }
     if hold_feet {
         // Any height above the clip's lowest ankle and any speed count as on the ground.
         settings.contact_height = f64::MAX;

@@ -73,3 +73,19 @@ def test_smoothing_is_checked_and_keeps_the_shapes():
     assert t.q.shape == (len(t.times), robot.nq)
     with pytest.raises(iktc.IktcError, match="smoothing"):
         iktc.retarget_keypoints(motion, robot, smoothing=-1.0)
+
+
+def test_the_soft_approach_halves_the_plans_jerk_and_bad_rates_are_errors():
+    # G1, humanoid3d_dance_b: the joints' RMS jerk of the plan (q̈'s change over a tick, per
+    # second) is 14 500 rad/s³ with the viable bounds alone and 7 050 with the soft approach to
+    # the range ends at 10 /s (not the route's default: on CMU 131_01 G1's sole then dips 8.7 mm
+    # below the ground).
+    robot, motion = iktc.Robot("g1"), iktc.load_motion("humanoid3d_dance_b")
+
+    def rms_jerk(**kw):
+        qdd = np.asarray(iktc.retarget_keypoints(motion, robot, **kw).qdd)[:, 6:]
+        return np.sqrt(np.mean((np.diff(qdd, axis=0) / 0.005) ** 2))
+
+    assert rms_jerk(approach_rate=10.0) < 0.6 * rms_jerk()
+    with pytest.raises(iktc.IktcError, match="approach_rate"):
+        iktc.retarget_keypoints(motion, robot, approach_rate=-1.0)
