@@ -48,7 +48,7 @@ pub fn run(a: &Args) -> Result<()> {
             .as_ref()
             .context("`planar3r` has no profile and cannot imitate a motion")?;
         let sc = &a.scenario;
-        let bounds = crate::scenario::keypoint_bounds(sc);
+        let bounds = crate::scenario::keypoint_bounds(sc)?;
         let map = match &sc.map {
             Some(spec) => Some(
                 iktc::sim::load_map(spec, &resolved.robot)

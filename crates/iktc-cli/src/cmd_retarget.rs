@@ -136,7 +136,7 @@ pub fn run(a: &Args) -> Result<()> {
         map,
         keypoints: crate::cmd_keypoints::keypoint_settings(
             &config,
-            crate::scenario::keypoint_bounds(&a.scenario),
+            crate::scenario::keypoint_bounds(&a.scenario)?,
             &a.keypoints,
         ),
         config,

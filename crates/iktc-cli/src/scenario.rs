@@ -88,28 +88,25 @@ fn choose_map(spec: Option<&str>, format: MotionFormat, r: &ResolvedRobot) -> Re
 /// bounds, control period, recovery, run checks).
 /// The joint bounds of keypoint retargeting: `--bounds`, else its own default (viable, unlike
 /// the rest of the command line); `--recover` applies to them too.
-pub fn keypoint_bounds(a: &ScenarioArgs) -> BoundMethod {
+pub fn keypoint_bounds(a: &ScenarioArgs) -> Result<BoundMethod> {
     let mut bounds = a.bounds.map_or_else(
         || iktc::retarget::KeypointSettings::default().bounds,
         BoundsArg::method,
     );
-    if let BoundMethod::Viable(s) | BoundMethod::Quiet(s) = &mut bounds {
-        if a.recover {
-            s.outside = OutsideLimits::Recover;
-        }
-        if let Some(rate) = a.approach_rate {
-            s.approach_rate = rate;
-        }
+    if let (true, BoundMethod::Viable(s) | BoundMethod::Quiet(s)) = (a.recover, &mut bounds) {
+        s.outside = OutsideLimits::Recover;
     }
-    bounds
+    match a.approach_rate {
+        Some(rate) => with_approach_rate(bounds, rate),
+        None => Ok(bounds),
+    }
 }
 
-/// The approach rate of the imitation's defaults \[1/s\] (0 when they have none).
-fn default_approach_rate() -> f64 {
-    match ImitateConfig::default().bounds {
-        BoundMethod::Viable(s) | BoundMethod::Quiet(s) => s.approach_rate,
-        BoundMethod::Paper => 0.0,
-    }
+/// `bounds` with `--approach-rate RATE`; an error names the flag.
+fn with_approach_rate(bounds: BoundMethod, rate: f64) -> Result<BoundMethod> {
+    bounds
+        .with_approach_rate(rate)
+        .with_context(|| format!("--approach-rate {rate}"))
 }
 
 pub fn prepare_config(a: &ScenarioArgs) -> Result<(ResolvedRobot, ImitateConfig)> {
@@ -143,19 +140,20 @@ pub fn prepare_config(a: &ScenarioArgs) -> Result<(ResolvedRobot, ImitateConfig)
         .map_err(|e| resolved.explain(e))?;
     cfg.run_limits.check_dt("--dt", a.dt)?;
     match &mut cfg.bounds {
-        BoundMethod::Viable(settings) | BoundMethod::Quiet(settings) => {
-            if a.recover {
-                settings.outside = OutsideLimits::Recover;
-            }
-            settings.approach_rate = a.approach_rate.unwrap_or_else(default_approach_rate);
+        BoundMethod::Viable(settings) | BoundMethod::Quiet(settings) if a.recover => {
+            settings.outside = OutsideLimits::Recover;
         }
-        BoundMethod::Paper => {
-            if a.recover {
-                anyhow::bail!("--recover needs --bounds viable or quiet");
-            }
-            if a.approach_rate.is_some() {
-                anyhow::bail!("--approach-rate needs --bounds viable or quiet");
-            }
+        BoundMethod::Paper if a.recover => {
+            anyhow::bail!("--recover needs --bounds viable or quiet");
+        }
+        _ => {}
+    }
+    // The imitation's default rate with the viable or quiet bounds; the paper's bound has none.
+    match (a.approach_rate, cfg.bounds) {
+        (None, BoundMethod::Paper) => {}
+        (rate, bounds) => {
+            let rate = rate.unwrap_or_else(|| ImitateConfig::default().bounds.approach_rate());
+            cfg.bounds = with_approach_rate(bounds, rate)?;
         }
     }
     cfg.health.keep_going = a.keep_going;

@@ -161,17 +161,9 @@ impl PyControllerBuilder {
             Some(kv) => Gains { kp, kv },
             None => Gains::critical(kp),
         };
-        let mut bounds = parse_bounds(bounds)?;
-        match &mut bounds {
-            BoundMethod::Viable(s) | BoundMethod::Quiet(s) => s.approach_rate = approach_rate,
-            BoundMethod::Paper if approach_rate != 0.0 => {
-                return Err(IktcError::new_err(
-                    "approach_rate needs bounds=\"viable\" or \"quiet\"",
-                ))
-            }
-            BoundMethod::Paper => {}
-        }
-        bounds.validate().map_err(to_py)?;
+        let bounds = parse_bounds(bounds)?
+            .with_approach_rate(approach_rate)
+            .map_err(to_py)?;
         let settings = iktc::controller::ControllerSettings {
             method: parse_method(method)?,
             bounds,

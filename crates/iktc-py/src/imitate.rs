@@ -112,6 +112,17 @@ fn pose_of(m: &PyReadonlyArray2<'_, f64>) -> PyResult<Isometry3<f64>> {
     ))
 }
 
+/// `bounds` with the soft approach at `rate` \[1/s\], by default the imitation's with the viable
+/// or quiet bounds (none with the paper's).
+pub(crate) fn imitation_bounds(bounds: BoundMethod, rate: Option<f64>) -> PyResult<BoundMethod> {
+    let rate = match (rate, bounds) {
+        (Some(r), _) => r,
+        (None, BoundMethod::Paper) => 0.0,
+        (None, _) => ImitateConfig::default().bounds.approach_rate(),
+    };
+    bounds.with_approach_rate(rate).map_err(to_py)
+}
+
 #[pymethods]
 impl PyImitation {
     /// `robot` must have a profile (feet, pelvis, posture, narrowed ranges, soles); `motion` a
@@ -153,19 +164,7 @@ impl PyImitation {
     ) -> PyResult<Self> {
         let profile = robot.required_profile("the imitation", "feet, pelvis and posture")?;
         let defaults = ImitateConfig::default();
-        let mut bounds = parse_bounds(bounds)?;
-        match (&mut bounds, &defaults.bounds) {
-            (
-                BoundMethod::Viable(s) | BoundMethod::Quiet(s),
-                BoundMethod::Viable(d) | BoundMethod::Quiet(d),
-            ) => s.approach_rate = approach_rate.unwrap_or(d.approach_rate),
-            (BoundMethod::Paper, _) if approach_rate.is_some() => {
-                return Err(IktcError::new_err(
-                    "approach_rate needs bounds=\"viable\" or \"quiet\"",
-                ))
-            }
-            _ => {}
-        }
+        let bounds = imitation_bounds(parse_bounds(bounds)?, approach_rate)?;
         let base = ImitateConfig {
             method: parse_method(method)?,
             bounds,

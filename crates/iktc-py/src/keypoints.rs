@@ -61,11 +61,10 @@ pub fn py_retarget_keypoints(
         smoothing,
         ..KeypointSettings::default()
     };
-    if let iktc::limits::BoundMethod::Viable(s) | iktc::limits::BoundMethod::Quiet(s) =
-        &mut settings.bounds
-    {
-        s.approach_rate = approach_rate;
-    }
+    settings.bounds = settings
+        .bounds
+        .with_approach_rate(approach_rate)
+        .map_err(to_py)?;
     if hold_feet {
         // Any height above the clip's lowest ankle and any speed count as on the ground.
         settings.contact_height = f64::MAX;

@@ -73,12 +73,8 @@ impl PyWalking {
             cfg.imitate.narrow = narrowed(n);
         }
         cfg.imitate.smoothing = smoothing;
-        if let (
-            Some(rate),
-            iktc::limits::BoundMethod::Viable(s) | iktc::limits::BoundMethod::Quiet(s),
-        ) = (approach_rate, &mut cfg.imitate.bounds)
-        {
-            s.approach_rate = rate;
+        if let Some(rate) = approach_rate {
+            cfg.imitate.bounds = cfg.imitate.bounds.with_approach_rate(rate).map_err(to_py)?;
         }
         cfg.steps = steps;
         if let Some(l) = step_length {

@@ -35,8 +35,8 @@ fn bench(c: &mut Criterion) {
             method,
             ..ImitateConfig::default()
         };
-        if let (false, iktc::limits::BoundMethod::Quiet(s)) = (approach, &mut cfg.bounds) {
-            s.approach_rate = 0.0;
+        if !approach {
+            cfg.bounds = cfg.bounds.with_approach_rate(0.0).expect("rate 0");
         }
         if printed {
             cfg.bounds = iktc::limits::BoundMethod::viable();

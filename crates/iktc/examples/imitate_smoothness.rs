@@ -13,7 +13,7 @@
 //! `(q̈ₖ − q̈ₖ₋₁)/Δt` over all joints, and per narrowed joint its RMS jerk and the share of ticks
 //! where the change of q̈ reverses its sign; and the largest excursion beyond a limit.
 
-use iktc::limits::{BoundMethod, ViableSettings};
+use iktc::limits::BoundMethod;
 use iktc::sim::{Experiment, ImitateConfig};
 use iktc::solver::SolverSettings;
 
@@ -28,22 +28,17 @@ fn main() -> iktc::Result<()> {
         level_hold: defaults.solver.level_hold,
         ..printed
     };
-    let BoundMethod::Quiet(approach) = defaults.bounds else {
-        unreachable!("the imitation's defaults use the quiet bounds")
-    };
-    let no_approach = BoundMethod::Quiet(ViableSettings {
-        approach_rate: 0.0,
-        ..approach
-    });
+    let no_approach = defaults.bounds.with_approach_rate(0.0)?;
     let with_hold = format!("quiet bounds, hold {} ticks", defaults.solver.level_hold);
     let with_approach = format!(
         "quiet bounds, hold {}, approach ω = {} /s",
-        defaults.solver.level_hold, approach.approach_rate
+        defaults.solver.level_hold,
+        defaults.bounds.approach_rate()
     );
     let with_all = format!(
         "the defaults: quiet bounds, hold {}, approach ω = {} /s, clip low-passed at {} Hz",
         defaults.solver.level_hold,
-        approach.approach_rate,
+        defaults.bounds.approach_rate(),
         defaults.smoothing.unwrap_or(f64::NAN)
     );
     let variants = [

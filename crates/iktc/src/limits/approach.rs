@@ -242,4 +242,25 @@ mod tests {
             approach_interval(&LIMITS, 0.2, 0.1, 117.0).1
         );
     }
+
+    /// `with_approach_rate` sets the rate on viable and quiet bounds and reads back; the
+    /// paper's bound takes only 0; a bad rate is an error naming it.
+    #[test]
+    fn with_approach_rate_sets_reads_and_refuses() {
+        for m in [BoundMethod::viable(), BoundMethod::quiet()] {
+            let a = m.with_approach_rate(12.5).unwrap();
+            assert_eq!(a.approach_rate(), 12.5);
+            assert_eq!(a.name(), m.name());
+            assert_eq!(a.with_approach_rate(0.0).unwrap(), m);
+            let e = m.with_approach_rate(-1.0).unwrap_err();
+            assert!(e.to_string().contains("approach_rate"), "{e}");
+        }
+        assert_eq!(
+            BoundMethod::Paper.with_approach_rate(0.0).unwrap(),
+            BoundMethod::Paper
+        );
+        assert_eq!(BoundMethod::Paper.approach_rate(), 0.0);
+        let e = BoundMethod::Paper.with_approach_rate(5.0).unwrap_err();
+        assert!(e.to_string().contains("approach_rate"), "{e}");
+    }
 }

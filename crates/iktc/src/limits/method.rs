@@ -62,6 +62,44 @@ impl BoundMethod {
         }
     }
 
+    /// The rate of the soft approach to the range ends \[1/s\]
+    /// ([`ViableSettings::approach_rate`]); 0 for [`BoundMethod::Paper`], which has none.
+    pub fn approach_rate(&self) -> f64 {
+        match self {
+            Self::Paper => 0.0,
+            Self::Viable(s) | Self::Quiet(s) => s.approach_rate,
+        }
+    }
+
+    /// The same method with the soft approach at `rate` \[1/s\] (0 leaves it out).
+    ///
+    /// # Errors
+    /// [`Error::InvalidSetting`] naming `approach_rate` for a rate the settings refuse
+    /// ([`ViableSettings::validate`]) or a positive rate with [`BoundMethod::Paper`], whose
+    /// bound has no such source.
+    pub fn with_approach_rate(self, rate: f64) -> Result<Self> {
+        let out = match self {
+            Self::Paper if rate == 0.0 => Self::Paper,
+            Self::Paper => return Err(Error::InvalidSetting {
+                name: "approach_rate".to_string(),
+                value: rate.to_string(),
+                expected:
+                    "0 with the paper's bound (the soft approach needs the viable or quiet bounds)"
+                        .to_string(),
+            }),
+            Self::Viable(s) => Self::Viable(ViableSettings {
+                approach_rate: rate,
+                ..s
+            }),
+            Self::Quiet(s) => Self::Quiet(ViableSettings {
+                approach_rate: rate,
+                ..s
+            }),
+        };
+        out.validate()?;
+        Ok(out)
+    }
+
     /// What a run does with a state outside the limits at its start: the setting of
     /// [`ViableSettings::outside`]; always [`OutsideLimits::Error`] for [`BoundMethod::Paper`]
     /// (the paper's bound has no recovery).

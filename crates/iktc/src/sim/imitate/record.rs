@@ -505,12 +505,10 @@ pub(crate) fn summarize(
     ImitateSummary {
         solver: cfg.method.name().into(),
         bounds: cfg.bounds.name().into(),
-        approach_rate: match cfg.bounds {
-            crate::limits::BoundMethod::Viable(s) | crate::limits::BoundMethod::Quiet(s) => s
-                .approach_rate
-                .min(crate::limits::MAX_APPROACH_STEP / cfg.dt),
-            crate::limits::BoundMethod::Paper => 0.0,
-        },
+        approach_rate: cfg
+            .bounds
+            .approach_rate()
+            .min(crate::limits::MAX_APPROACH_STEP / cfg.dt),
         smoothing_hz: cfg.smoothing,
         dt: cfg.dt,
         duration: steps.len() as f64 * cfg.dt,
