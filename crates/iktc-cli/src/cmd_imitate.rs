@@ -86,8 +86,8 @@ fn print_summary(r: &ImitateRun) -> std::io::Result<()> {
         "imitation, {} with {} bounds (soft approach {}), clip {}, {} ticks of {} s: worst margins position {:+.2e} rad, velocity {:+.2e} rad/s, acceleration {:+.2e} rad/s²",
         s.solver,
         s.bounds,
-        if s.approach_rate > 0.0 { format!("{} /s", s.approach_rate) } else { "off".into() },
-        s.smoothing_hz.map_or_else(|| "as captured".into(), |hz| format!("low-passed at {hz} Hz")),
+        crate::cmd_walk::approach_text(s.approach_rate),
+        crate::cmd_walk::smoothing_text(s.smoothing_hz),
         s.steps, s.dt, s.worst_position_margin, s.worst_velocity_margin, s.worst_acceleration_margin
     )?;
     crate::outln!(

@@ -48,6 +48,24 @@ pub struct WalkArgs {
     /// 0.080 m/s (5 N·s on JVRC-1's 62.4 kg)].
     #[arg(long)]
     pub push: Option<String>,
+    /// Low-pass the captured motion at this cut-off [Hz] before it becomes the upper body's
+    /// references [default: 6, the imitation's].
+    #[arg(long, value_name = "HZ", conflicts_with = "no_smoothing")]
+    pub smoothing: Option<f64>,
+    /// The motion as captured, not low-passed.
+    #[arg(long)]
+    pub no_smoothing: bool,
+}
+
+impl WalkArgs {
+    /// `imitate` with `--smoothing` or `--no-smoothing` (unchanged without either).
+    pub fn apply_smoothing(&self, imitate: &mut ImitateConfig) {
+        if self.no_smoothing {
+            imitate.smoothing = None;
+        } else if let Some(hz) = self.smoothing {
+            imitate.smoothing = Some(hz);
+        }
+    }
 }
 
 fn parse_push(s: &str) -> Result<Option<Push>> {
@@ -118,7 +136,8 @@ fn run_walk(
 
 /// Runs `iktc walk`.
 pub fn run(a: &Args) -> Result<()> {
-    let (e, cfg, profile) = prepare(&a.scenario)?;
+    let (e, mut cfg, profile) = prepare(&a.scenario)?;
+    a.walk.apply_smoothing(&mut cfg);
     let (figs, with, without) = run_walk(&e, &profile, &cfg, &a.walk, &a.out)?;
     print_walk(&with, &without)?;
     crate::outln!(
@@ -129,12 +148,30 @@ pub fn run(a: &Args) -> Result<()> {
     Ok(())
 }
 
+/// "10 /s", or "off" for a rate of 0.
+pub fn approach_text(rate: f64) -> String {
+    if rate > 0.0 {
+        format!("{rate} /s")
+    } else {
+        "off".into()
+    }
+}
+
+/// "low-passed at 6 Hz", or "as captured".
+pub fn smoothing_text(hz: Option<f64>) -> String {
+    hz.map_or_else(
+        || "as captured".into(),
+        |hz| format!("low-passed at {hz} Hz"),
+    )
+}
+
 /// Prints the two summaries.
 pub fn print_walk(with: &WalkRun, without: &WalkRun) -> std::io::Result<()> {
     for r in [with, without] {
         let s = &r.summary;
         crate::outln!(
-            "walking imitation, damping controller {}: ZMP min margin {:+.4} m (inside: {}), stance feet error {:.2e} m / slip {:.2e} m, worst margins {:+.1e} rad {:+.1e} rad/s {:+.1e} rad/s²",
+            "walking imitation (soft approach {}, clip {}), damping controller {}: ZMP min margin {:+.4} m (inside: {}), stance feet error {:.2e} m / slip {:.2e} m, worst margins {:+.1e} rad {:+.1e} rad/s {:+.1e} rad/s²",
+            approach_text(s.approach_rate), smoothing_text(s.smoothing_hz),
             if s.damping { "on " } else { "off" }, s.min_zmp_margin, s.zmp_inside, s.max_stance_foot_error, s.max_stance_foot_slip, s.worst_margins[0], s.worst_margins[1], s.worst_margins[2]
         )?;
         match &s.push {
@@ -472,6 +509,8 @@ pub fn walk_section(out: &Path) -> Result<Section> {
         step_length: None,
         no_damping: false,
         push: None,
+        smoothing: None,
+        no_smoothing: false,
     };
     let dir = out.join("walk");
     let (figs, with, without) = run_walk(&e, &profile, &imitate, &w, &dir)?;

@@ -194,6 +194,21 @@ fn g1_walks_while_imitating_within_its_limits() {
     assert_eq!(s["with_damping"]["health"]["healthy"], false);
 }
 
+/// `iktc walk --no-smoothing --approach-rate 0`: the defaults off, and the summary says so.
+#[test]
+fn the_walk_takes_the_clip_as_captured_and_no_approach_when_asked() {
+    let (s, _) = g1_walk(
+        "g1walkraw",
+        &["--no-smoothing", "--approach-rate", "0", "--keep-going"],
+    );
+    for run in ["with_damping", "without_damping"] {
+        assert_eq!(s[run]["approach_rate"].as_f64(), Some(0.0), "{run}");
+        assert!(s[run]["smoothing_hz"].is_null(), "{run}");
+    }
+    let (s, _) = g1_walk("g1walk8", &["--smoothing", "8", "--keep-going"]);
+    assert_eq!(s["with_damping"]["smoothing_hz"].as_f64(), Some(8.0));
+}
+
 #[test]
 fn g1_walks_healthily_under_its_default_push_scaled_to_its_mass() {
     // The G1 profile gives no push: the default one changes the COM velocity as much as 5 N·s
@@ -203,6 +218,9 @@ fn g1_walks_healthily_under_its_default_push_scaled_to_its_mass() {
     let (s, _) = g1_walk("g1walkscaled", &[]);
     for run in ["with_damping", "without_damping"] {
         let r = &s[run];
+        // The imitation's defaults, reported.
+        assert_eq!(r["approach_rate"].as_f64(), Some(10.0), "{run}");
+        assert_eq!(r["smoothing_hz"].as_f64(), Some(6.0), "{run}");
         let impulse = r["push"]["push"]["impulse"][0].as_f64().unwrap();
         assert!((impulse - 2.67).abs() < 0.01, "{run}: push {impulse} N·s");
         assert_eq!(r["health"]["healthy"], true, "{run}: {}", r["health"]);

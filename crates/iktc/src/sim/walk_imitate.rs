@@ -179,6 +179,11 @@ pub struct WalkStep {
 pub struct WalkSummary {
     /// Whether the damping controller was in the loop.
     pub damping: bool,
+    /// The soft approach's rate \[1/s\] as used at the run's Δt (0 without it), as in
+    /// [`ImitateSummary::approach_rate`](crate::sim::ImitateSummary).
+    pub approach_rate: f64,
+    /// Cut-off of the low-pass applied to the clip \[Hz\] (`None`: as captured).
+    pub smoothing_hz: Option<f64>,
     /// Footsteps.
     pub steps: usize,
     /// Duration \[s\].
@@ -828,6 +833,12 @@ fn summarize(
     );
     Ok(WalkSummary {
         damping: cfg.damping,
+        approach_rate: cfg
+            .imitate
+            .bounds
+            .approach_rate()
+            .min(crate::limits::MAX_APPROACH_STEP / cfg.imitate.dt),
+        smoothing_hz: cfg.imitate.smoothing,
         steps: cfg.steps,
         duration,
         min_zmp_margin: min_margin,
