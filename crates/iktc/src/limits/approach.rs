@@ -40,7 +40,7 @@
 //! approach gives way by the least amount (a joint already faster than the wall allows is braked
 //! by the viability bound as before) and every other limit holds exactly as without it.
 
-use super::intersect::DofBounds;
+use super::intersect::{give_way, DofBounds};
 use super::joint_limits::DofLimits;
 use super::source::BoundSource;
 
@@ -67,28 +67,8 @@ pub fn approach_interval(limits: &DofLimits, q: f64, qd: f64, rate: f64) -> (f64
 /// intersection when not empty, otherwise the point of `resolved` nearest to it (module docs).
 /// An empty `resolved` is returned unchanged.
 pub fn apply_approach(resolved: DofBounds, lower: f64, upper: f64) -> DofBounds {
-    if resolved.is_empty() {
-        return resolved;
-    }
-    let mut out = resolved;
-    if lower > resolved.upper {
-        out.lower = resolved.upper;
-        out.lower_source = resolved.upper_source;
-        out.dropped.approach = true;
-    } else if upper < resolved.lower {
-        out.upper = resolved.lower;
-        out.upper_source = resolved.lower_source;
-        out.dropped.approach = true;
-    } else {
-        if lower > resolved.lower {
-            out.lower = lower;
-            out.lower_source = BoundSource::Approach;
-        }
-        if upper < resolved.upper {
-            out.upper = upper;
-            out.upper_source = BoundSource::Approach;
-        }
-    }
+    let (mut out, gave_way) = give_way(resolved, lower, upper, BoundSource::Approach);
+    out.dropped.approach |= gave_way;
     out
 }
 

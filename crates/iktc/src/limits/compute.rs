@@ -6,7 +6,7 @@ use super::acceleration_box::AccelerationBox;
 use super::approach::{apply_approach, approach_interval};
 use super::intersect::{intersect, DofBounds};
 use super::joint_limits::{DofLimits, JointLimits};
-use super::method::{BoundMethod, OutsideLimits, MAX_APPROACH_STEP};
+use super::method::{BoundMethod, OutsideLimits};
 use super::paper::paper_sources;
 use super::quiet::quiet_sources;
 use super::source::{BoundSource, DofBoundSources, DroppedSources};
@@ -138,8 +138,7 @@ fn sources_unchecked(
         BoundMethod::Quiet(settings) => (quiet_sources(dof, settings, q, qd, dt), settings),
     };
     if settings.approach_rate > 0.0 {
-        let rate = settings.approach_rate.min(MAX_APPROACH_STEP / dt);
-        let (lower, upper) = approach_interval(dof, q, qd, rate);
+        let (lower, upper) = approach_interval(dof, q, qd, method.approach_rate_at(dt));
         sources.lower.approach = lower;
         sources.upper.approach = upper;
     }

@@ -63,6 +63,43 @@ pub fn intersect(sources: &DofBoundSources, method: &BoundMethod) -> DofBounds {
     bounds
 }
 
+/// `resolved` = `[L, U]` with a lower-precedence source's interval `[lower, upper]` \[rad/s²\]
+/// applied (the approach and the jerk sources): their intersection when it is not empty, the
+/// sides it tightens named `source`; otherwise the point of `[L, U]` nearest to it (`U` when
+/// the interval lies above, `L` when below), so the source gives way by the least amount and
+/// every other limit holds. The flag says whether it gave way. An empty `resolved` is
+/// returned unchanged.
+pub(crate) fn give_way(
+    resolved: DofBounds,
+    lower: f64,
+    upper: f64,
+    source: BoundSource,
+) -> (DofBounds, bool) {
+    if resolved.is_empty() {
+        return (resolved, false);
+    }
+    let mut out = resolved;
+    if lower > resolved.upper {
+        out.lower = resolved.upper;
+        out.lower_source = resolved.upper_source;
+        return (out, true);
+    }
+    if upper < resolved.lower {
+        out.upper = resolved.lower;
+        out.upper_source = resolved.lower_source;
+        return (out, true);
+    }
+    if lower > resolved.lower {
+        out.lower = lower;
+        out.lower_source = source;
+    }
+    if upper < resolved.upper {
+        out.upper = upper;
+        out.upper_source = source;
+    }
+    (out, false)
+}
+
 /// The part of a non-empty `[L, U]` closest to `[−a_max, a_max]` (see [`intersect`]); an empty
 /// interval is returned unchanged.
 fn closest_to_acceleration_limit(relaxed: DofBounds, sources: &DofBoundSources) -> DofBounds {

@@ -35,7 +35,7 @@
 use crate::error::{check_all_finite, check_dim, Result};
 
 use super::acceleration_box::AccelerationBox;
-use super::intersect::DofBounds;
+use super::intersect::{give_way, DofBounds};
 use super::joint_limits::JointLimits;
 use super::source::BoundSource;
 
@@ -55,29 +55,8 @@ pub fn jerk_interval(previous: f64, jerk_max: f64, dt: f64) -> (f64, f64) {
 /// jerk interval `[jerk_lower, jerk_upper]` \[rad/s²\], with `dropped.jerk` set. An empty
 /// `resolved` is returned unchanged.
 pub fn apply_jerk(resolved: DofBounds, jerk_lower: f64, jerk_upper: f64) -> DofBounds {
-    if resolved.is_empty() {
-        return resolved;
-    }
-    let mut out = resolved;
-    if jerk_lower > resolved.upper {
-        // The jerk interval lies above [L, U]: U is nearest.
-        out.lower = resolved.upper;
-        out.lower_source = resolved.upper_source;
-        out.dropped.jerk = true;
-    } else if jerk_upper < resolved.lower {
-        out.upper = resolved.lower;
-        out.upper_source = resolved.lower_source;
-        out.dropped.jerk = true;
-    } else {
-        if jerk_lower > resolved.lower {
-            out.lower = jerk_lower;
-            out.lower_source = BoundSource::Jerk;
-        }
-        if jerk_upper < resolved.upper {
-            out.upper = jerk_upper;
-            out.upper_source = BoundSource::Jerk;
-        }
-    }
+    let (mut out, gave_way) = give_way(resolved, jerk_lower, jerk_upper, BoundSource::Jerk);
+    out.dropped.jerk |= gave_way;
     out
 }
 

@@ -71,6 +71,12 @@ impl BoundMethod {
         }
     }
 
+    /// The rate of the soft approach as used at the control period `dt` \[s\]: the setting,
+    /// capped at [`MAX_APPROACH_STEP`]`/dt` \[1/s\]; 0 without it.
+    pub fn approach_rate_at(&self, dt: f64) -> f64 {
+        self.approach_rate().min(MAX_APPROACH_STEP / dt)
+    }
+
     /// The same method with the soft approach at `rate` \[1/s\] (0 leaves it out).
     ///
     /// # Errors

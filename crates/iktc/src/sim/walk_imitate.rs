@@ -833,11 +833,7 @@ fn summarize(
     );
     Ok(WalkSummary {
         damping: cfg.damping,
-        approach_rate: cfg
-            .imitate
-            .bounds
-            .approach_rate()
-            .min(crate::limits::MAX_APPROACH_STEP / cfg.imitate.dt),
+        approach_rate: cfg.imitate.bounds.approach_rate_at(cfg.imitate.dt),
         smoothing_hz: cfg.imitate.smoothing,
         steps: cfg.steps,
         duration,

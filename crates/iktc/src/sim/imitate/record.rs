@@ -505,10 +505,7 @@ pub(crate) fn summarize(
     ImitateSummary {
         solver: cfg.method.name().into(),
         bounds: cfg.bounds.name().into(),
-        approach_rate: cfg
-            .bounds
-            .approach_rate()
-            .min(crate::limits::MAX_APPROACH_STEP / cfg.dt),
+        approach_rate: cfg.bounds.approach_rate_at(cfg.dt),
         smoothing_hz: cfg.smoothing,
         dt: cfg.dt,
         duration: steps.len() as f64 * cfg.dt,
