@@ -7,20 +7,18 @@
 //! task's change and the approach bound's change `ω² |Δq| + 2ω |Δq̇|` (the bound is Lipschitz in
 //! the state: it takes over from the task without a step).
 
-use iktc::limits::{
-    compute_box, compute_dof, integrate_constant_acceleration, peak_in_step, AccelerationBox,
-    BoundMethod, BoundSource, DofLimits, JointLimits, ViableSettings, MAX_APPROACH_STEP,
-};
-use iktc::solver::{Method, Solver, SolverSettings};
-use iktc::task::TaskEquation;
-use nalgebra::{DMatrix, DVector};
-use proptest::prelude::*;
-use proptest::test_runner::{Config, RngAlgorithm, RngSeed};
+mod common;
 
-/// Rounding slack on positions [rad].
-const POSITION_SLACK: f64 = 1e-12;
-/// Rounding slack on velocities [rad/s].
-const VELOCITY_SLACK: f64 = 1e-9;
+use common::bounds::{
+    proptest_config, ThreeJointRunner, ThreeJoints, DT, POSITION_SLACK, VELOCITY_SLACK,
+};
+use iktc::limits::{
+    compute_dof, integrate_constant_acceleration, peak_in_step, BoundMethod, BoundSource,
+    DofLimits, ViableSettings, MAX_APPROACH_STEP,
+};
+use proptest::prelude::*;
+use proptest::test_runner::Config;
+
 /// Relative rounding slack on accelerations and their changes [–].
 const RELATIVE_SLACK: f64 = 1e-9;
 /// A joint counts as resting on its limit when it is within this of it [rad] …
@@ -32,13 +30,7 @@ const REST_VELOCITY: f64 = 1e-9;
 const REST_ROUNDING: f64 = 1e-6;
 
 fn config(cases: u32) -> Config {
-    Config {
-        cases,
-        rng_algorithm: RngAlgorithm::ChaCha,
-        rng_seed: RngSeed::Fixed(0x0a11_0ac4),
-        failure_persistence: None,
-        ..Config::default()
-    }
+    proptest_config(cases, 0x0a11_0ac4)
 }
 
 fn method(fraction: f64, rate: f64) -> BoundMethod {
@@ -157,94 +149,33 @@ proptest! {
 #[test]
 fn iktc_drives_a_joint_onto_its_limit_smoothly() {
     use iktc::sim::DofSmoothness;
-    use rand::{Rng, SeedableRng};
+    use rand::SeedableRng;
     /// Distance to the limit counted as settled after 2.5 s at ω = 20 /s \[rad\].
     const SETTLED: f64 = 1e-3;
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(0xa990);
-    let (nv, dt, ticks, rate) = (3, 0.005, 500, 20.0);
-    let (kp, kv) = (100.0, 20.0);
-    let dims = [1, 2];
-    let mut solver = Solver::new(nv, &dims, SolverSettings::default()).unwrap();
-    let mut eqs: Vec<TaskEquation> = dims
-        .iter()
-        .map(|&m| TaskEquation::zeros("level", m, nv))
-        .collect();
-    let mut bx = AccelerationBox::new(nv);
-    let mut qdd = DVector::zeros(nv);
+    let rate = 20.0;
+    let mut runner = ThreeJointRunner::new();
     let cases = 10_000;
     let (mut reversals_quiet, mut reversals_approach) = (0.0, 0.0);
     let (mut rms_quiet, mut rms_approach) = (0.0, 0.0);
     let (mut max_quiet, mut max_approach) = (0.0_f64, 0.0_f64);
     let mut farthest = 0.0_f64;
     for case in 0..cases {
-        let dof = DofLimits {
-            position_min: -0.5,
-            position_max: 0.5,
-            velocity_max: rng.random_range(1.0..4.0),
-            acceleration_max: rng.random_range(20.0..80.0),
-            jerk_max: f64::INFINITY,
-        };
-        let limits = JointLimits::new(vec![dof; nv]).unwrap();
-        let j = DMatrix::from_fn(3, nv, |r, c| {
-            if r == c {
-                1.0 + rng.random_range(0.0..0.5)
-            } else {
-                rng.random_range(-0.4..0.4)
-            }
-        });
-        let upper = rng.random_bool(0.5);
-        let limit0 = if upper { 0.5 } else { -0.5 };
-        let target = DVector::from_vec(vec![
-            limit0 + if upper { 0.2 } else { -0.2 },
-            rng.random_range(-0.3..0.3),
-            rng.random_range(-0.3..0.3),
-        ]);
-        let x_d = &j * &target;
-        let q0 = DVector::from_fn(nv, |_, _| rng.random_range(-0.3..0.3));
+        let c = ThreeJoints::random(&mut rng);
         for (approach, reversals) in [(0.0, &mut reversals_quiet), (rate, &mut reversals_approach)]
         {
-            let m = method(0.5, approach);
-            let mut q = q0.clone();
-            let mut v = DVector::<f64>::zeros(nv);
-            let mut history = Vec::with_capacity(ticks);
-            for k in 0..ticks {
-                let x = &j * &q;
-                let xd = &j * &v;
-                let mut row = 0;
-                for eq in eqs.iter_mut() {
-                    for r in 0..eq.dim() {
-                        for c in 0..nv {
-                            eq.jacobian[(r, c)] = j[(row, c)];
-                        }
-                        eq.error[r] = x_d[row] - x[row];
-                        eq.error_rate[r] = -xd[row];
-                        eq.rhs[r] = kp * eq.error[r] + kv * eq.error_rate[r];
-                        row += 1;
-                    }
-                }
-                compute_box(&limits, &m, q.as_slice(), v.as_slice(), dt, &mut bx).unwrap();
-                assert!(!bx.is_empty(), "case {case} tick {k}");
-                solver.solve(Method::Iktc, &eqs, &bx, &mut qdd).unwrap();
-                assert!(
-                    bx.max_violation(qdd.as_slice()).unwrap() <= 1e-9,
-                    "case {case} tick {k}"
-                );
-                history.push(qdd[0]);
-                for d in 0..nv {
-                    let ex = peak_in_step(q[d], v[d], qdd[d], dt);
-                    assert!(ex.max <= 0.5 + POSITION_SLACK && ex.min >= -0.5 - POSITION_SLACK);
-                    (q[d], v[d]) = integrate_constant_acceleration(q[d], v[d], qdd[d], dt);
-                }
-            }
+            let label = format!("case {case}, approach {approach}");
+            let (history, q) = runner.run(&c, &method(0.5, approach), &label, |_, _, _, _| {});
             if approach > 0.0 {
-                farthest = farthest.max((q[0] - limit0).abs());
+                farthest = farthest.max((q[0] - c.limit0).abs());
                 assert!(
-                    (q[0] - limit0).abs() <= SETTLED,
-                    "case {case}: joint 0 at {} (limit {limit0})",
-                    q[0]
+                    (q[0] - c.limit0).abs() <= SETTLED,
+                    "case {case}: joint 0 at {} (limit {})",
+                    q[0],
+                    c.limit0
                 );
             }
-            let sm = DofSmoothness::of(&history, dt);
+            let sm = DofSmoothness::of(&history[0], DT);
             *reversals += sm.reversal_share;
             if approach > 0.0 {
                 rms_approach += sm.rms_jerk.powi(2);

@@ -10,14 +10,17 @@
 //! into a limit). Every step taken is counted: 40 000 single steps and 400 runs of 500 steps
 //! (2.4·10⁵ steps), plus 36 000 dof-steps through `compute_box`.
 
+mod common;
+
 use std::sync::atomic::{AtomicUsize, Ordering};
 
+use common::bounds::proptest_config;
 use iktc::limits::{
     compute_box, compute_dof, integrate_constant_acceleration, peak_in_step, viable,
     AccelerationBox, BoundMethod, DofBounds, DofLimits, JointLimits, ViableSettings,
 };
 use proptest::prelude::*;
-use proptest::test_runner::{Config, RngAlgorithm, RngSeed, TestRunner};
+use proptest::test_runner::{Config, TestRunner};
 
 /// Relative rounding slack [–]: the bounds are exact, the arithmetic is not. Positions are
 /// compared within `ROUNDING · (1 + |q| + v_max Δt + a_max Δt²)` \[rad\], velocities within
@@ -30,13 +33,7 @@ const ROUNDING: f64 = 1e-9;
 const POSITION_RESOLUTION: f64 = 1e-14;
 
 fn config(cases: u32) -> Config {
-    Config {
-        cases,
-        rng_algorithm: RngAlgorithm::ChaCha,
-        rng_seed: RngSeed::Fixed(0x1c7c_b0d5),
-        failure_persistence: None,
-        ..Config::default()
-    }
+    proptest_config(cases, 0x1c7c_b0d5)
 }
 
 #[derive(Debug, Clone, Copy)]

@@ -9,20 +9,18 @@
 //! the stopping distance of the discrete braking profile `D(s) = a_stop Δt² (k²/2 + (s − k)(k + ½))`
 //! (`k = ⌊s⌋`, `s = q̇/(a_stop Δt)`) with a bisection.
 
-use iktc::limits::{
-    compute_box, compute_dof, integrate_constant_acceleration, peak_in_step, AccelerationBox,
-    BoundMethod, DofLimits, JointLimits, ViableSettings,
-};
-use iktc::solver::{Method, Solver, SolverSettings};
-use iktc::task::TaskEquation;
-use nalgebra::{DMatrix, DVector};
-use proptest::prelude::*;
-use proptest::test_runner::{Config, RngAlgorithm, RngSeed};
+mod common;
 
-/// Rounding slack on positions [rad]: the bounds are exact, the arithmetic is not.
-const POSITION_SLACK: f64 = 1e-12;
-/// Rounding slack on velocities [rad/s].
-const VELOCITY_SLACK: f64 = 1e-9;
+use common::bounds::{
+    proptest_config, ThreeJointRunner, ThreeJoints, DT, POSITION_SLACK, VELOCITY_SLACK,
+};
+use iktc::limits::{
+    compute_dof, integrate_constant_acceleration, peak_in_step, BoundMethod, DofLimits,
+    ViableSettings,
+};
+use proptest::prelude::*;
+use proptest::test_runner::Config;
+
 /// A joint counts as resting on its limit when it is within this of it [rad] …
 const REST_POSITION: f64 = 1e-9;
 /// … and its |q̇| is below this [rad/s];
@@ -32,13 +30,7 @@ const REST_VELOCITY: f64 = 1e-9;
 const REST_ACCELERATION: f64 = 1e-5;
 
 fn config(cases: u32) -> Config {
-    Config {
-        cases,
-        rng_algorithm: RngAlgorithm::ChaCha,
-        rng_seed: RngSeed::Fixed(0x9b1e_7a11),
-        failure_persistence: None,
-        ..Config::default()
-    }
+    proptest_config(cases, 0x9b1e_7a11)
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -285,90 +277,34 @@ fn pushing_at_the_bound_arrives_within_the_profile_time() {
 #[test]
 fn iktc_drives_a_joint_onto_its_limit_and_it_rests_there() {
     use iktc::sim::DofSmoothness;
-    use rand::{Rng, SeedableRng};
+    use rand::SeedableRng;
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(0x3105);
-    let (nv, dt, ticks) = (3, 0.005, 500);
-    let (kp, kv) = (100.0, 20.0);
-    let dims = [1, 2];
-    let mut solver = Solver::new(nv, &dims, SolverSettings::default()).unwrap();
-    let mut eqs: Vec<TaskEquation> = dims
-        .iter()
-        .map(|&m| TaskEquation::zeros("level", m, nv))
-        .collect();
-    let mut bx = AccelerationBox::new(nv);
-    let mut qdd = DVector::zeros(nv);
+    let mut runner = ThreeJointRunner::new();
     let mut shares = Vec::new();
     let (mut rested, mut worst_reversals) = (0, 0.0_f64);
     let cases = 10_000;
     for case in 0..cases {
-        let dof = DofLimits {
-            position_min: -0.5,
-            position_max: 0.5,
-            velocity_max: rng.random_range(1.0..4.0),
-            acceleration_max: rng.random_range(20.0..80.0),
-            jerk_max: f64::INFINITY,
-        };
-        let limits = JointLimits::new(vec![dof; nv]).unwrap();
-        let method = BoundMethod::quiet();
-        let j = DMatrix::from_fn(3, nv, |r, c| {
-            if r == c {
-                1.0 + rng.random_range(0.0..0.5)
-            } else {
-                rng.random_range(-0.4..0.4)
-            }
-        });
-        let upper = rng.random_bool(0.5);
-        let limit0 = if upper { 0.5 } else { -0.5 };
-        let target = DVector::from_vec(vec![
-            limit0 + if upper { 0.2 } else { -0.2 },
-            rng.random_range(-0.3..0.3),
-            rng.random_range(-0.3..0.3),
-        ]);
-        let x_d = &j * &target;
-        let mut q = DVector::from_fn(nv, |_, _| rng.random_range(-0.3..0.3));
-        let mut v = DVector::<f64>::zeros(nv);
-        let mut history = vec![Vec::with_capacity(ticks); nv];
+        let c = ThreeJoints::random(&mut rng);
         let mut rest = false;
-        for k in 0..ticks {
-            let x = &j * &q;
-            let xd = &j * &v;
-            let mut row = 0;
-            for eq in eqs.iter_mut() {
-                for r in 0..eq.dim() {
-                    for c in 0..nv {
-                        eq.jacobian[(r, c)] = j[(row, c)];
-                    }
-                    eq.error[r] = x_d[row] - x[row];
-                    eq.error_rate[r] = -xd[row];
-                    eq.rhs[r] = kp * eq.error[r] + kv * eq.error_rate[r];
-                    row += 1;
+        let (history, _) = runner.run(
+            &c,
+            &BoundMethod::quiet(),
+            &format!("case {case}"),
+            |k, q, v, bx| {
+                assert!(!bx.any_dropped(), "case {case} tick {k}");
+                if (q[0] - c.limit0).abs() <= REST_POSITION && v[0].abs() <= REST_VELOCITY {
+                    rest = true;
+                    let toward = if c.upper { bx.upper[0] } else { -bx.lower[0] };
+                    assert!(
+                        toward.abs() <= REST_ACCELERATION,
+                        "case {case} tick {k}: {toward}"
+                    );
                 }
-            }
-            compute_box(&limits, &method, q.as_slice(), v.as_slice(), dt, &mut bx).unwrap();
-            assert!(!bx.is_empty() && !bx.any_dropped(), "case {case} tick {k}");
-            if (q[0] - limit0).abs() <= REST_POSITION && v[0].abs() <= REST_VELOCITY {
-                rest = true;
-                let toward = if upper { bx.upper[0] } else { -bx.lower[0] };
-                assert!(
-                    toward.abs() <= REST_ACCELERATION,
-                    "case {case} tick {k}: {toward}"
-                );
-            }
-            solver.solve(Method::Iktc, &eqs, &bx, &mut qdd).unwrap();
-            assert!(
-                bx.max_violation(qdd.as_slice()).unwrap() <= 1e-9,
-                "case {case} tick {k}"
-            );
-            for d in 0..nv {
-                history[d].push(qdd[d]);
-                let ex = peak_in_step(q[d], v[d], qdd[d], dt);
-                assert!(ex.max <= 0.5 + POSITION_SLACK && ex.min >= -0.5 - POSITION_SLACK);
-                (q[d], v[d]) = integrate_constant_acceleration(q[d], v[d], qdd[d], dt);
-            }
-        }
+            },
+        );
         rested += usize::from(rest);
         for (d, h) in history.iter().enumerate() {
-            let sm = DofSmoothness::of(h, dt);
+            let sm = DofSmoothness::of(h, DT);
             if d == 0 {
                 worst_reversals = worst_reversals.max(sm.reversal_share);
             } else {

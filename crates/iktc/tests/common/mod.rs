@@ -4,6 +4,7 @@
 #![allow(dead_code)]
 
 pub mod alloc;
+pub mod bounds;
 pub mod model;
 pub mod qp;
 pub mod solver;
