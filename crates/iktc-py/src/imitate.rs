@@ -114,7 +114,7 @@ fn pose_of(m: &PyReadonlyArray2<'_, f64>) -> PyResult<Isometry3<f64>> {
 
 /// `bounds` with the soft approach at `rate` \[1/s\], by default the imitation's with the viable
 /// or quiet bounds (none with the paper's).
-pub(crate) fn imitation_bounds(bounds: BoundMethod, rate: Option<f64>) -> PyResult<BoundMethod> {
+fn imitation_bounds(bounds: BoundMethod, rate: Option<f64>) -> PyResult<BoundMethod> {
     let rate = match (rate, bounds) {
         (Some(r), _) => r,
         (None, BoundMethod::Paper) => 0.0,
