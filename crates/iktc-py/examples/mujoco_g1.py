@@ -5,7 +5,8 @@
         [--json out.json] [--replay out.html]
     python crates/iktc-py/examples/mujoco_g1.py balance [--damping 0.72] [--designs 0.3,0.9]
         [--json out.json]
-    python crates/iktc-py/examples/mujoco_g1.py walking [--steps 4] [--json out.json]
+    python crates/iktc-py/examples/mujoco_g1.py walking [--steps 4] [--clip humanoid3d_walk]
+        [--hold-upper-body] [--no-feedforward] [--json out.json]
     python crates/iktc-py/examples/mujoco_g1.py causes [--json out.json]
 
 `standing` prints the run's figures (stayed up, pelvis height, base tilt, foot slip, ZMP margin
@@ -14,8 +15,10 @@ for (MuJoCo's inverse dynamics of the plan), which says whether any plant could 
 without tipping. `balance` identifies the IPCJ model of the sagittal plane on MuJoCo by the sine
 sweep of Section 4.2, places the poles, and pushes the standing robot at the pelvis with and
 without the damping controller, printing the fit and the damping ratios. `walking` walks
-while imitating the clip (damping controller off) and prints whether the robot stayed up, the
-standing feet's errors and the ZMP against the pattern's support polygon. `causes` prints the
+while imitating the clip (damping controller off; the plan's joint torques fed forward to the
+servos unless `--no-feedforward`; `--hold-upper-body` holds the clip's first frame) and prints
+whether the robot stayed up, the standing feet's errors and the ZMP against the support polygon
+of the feet carrying load and against the pattern's. `causes` prints the
 figures behind the expected failures: the standing run with the knees narrowed, the viable
 bounds and Algorithm 2's level as printed,
 the pelvis held, the clip slower, the arms frozen in the plan; the walking plan's ZMP and knees
@@ -94,6 +97,10 @@ def main() -> None:
     ap.add_argument("run", nargs="?", default="standing",
                     choices=["standing", "balance", "walking", "causes"])
     ap.add_argument("--steps", type=int, default=4, help="footsteps of the walking run")
+    ap.add_argument("--hold-upper-body", action="store_true",
+                    help="walking: every frame of the clip its first (upper body and pelvis held)")
+    ap.add_argument("--no-feedforward", action="store_true",
+                    help="walking: the servos without the plan's joint torques")
     ap.add_argument("--damping", type=float, default=0.72, help="design damping ratio [–]")
     ap.add_argument("--designs", help="balance: also push with these design ratios, e.g. "
                     "0.3,0.5,0.72,0.9, and print the measured ones")
@@ -115,7 +122,11 @@ def main() -> None:
     elif a.run == "causes":
         s = causes(a)
     elif a.run == "walking":
-        s = g1_sim.run_walking(steps=a.steps, clip=a.clip)
+        clip = a.clip
+        if a.hold_upper_body:
+            import tempfile
+            clip = g1_sim.held_clip(pathlib.Path(tempfile.mkdtemp()) / f"held_{a.clip}.txt", a.clip)
+        s = g1_sim.run_walking(steps=a.steps, clip=clip, feedforward=not a.no_feedforward)
     else:
         s = standing(a)
     print(json.dumps(s, indent=1))

@@ -93,7 +93,7 @@ pub(crate) fn narrowed(n: Vec<(String, f64, f64)>) -> Vec<NarrowedJoint> {
 }
 
 /// A pose from a 4 × 4 homogeneous matrix (its rotation block re-orthonormalised).
-fn pose_of(m: &PyReadonlyArray2<'_, f64>) -> PyResult<Isometry3<f64>> {
+pub(crate) fn pose_of(m: &PyReadonlyArray2<'_, f64>) -> PyResult<Isometry3<f64>> {
     let a = m.as_array();
     if a.shape() != [4, 4] {
         return Err(IktcError::new_err(format!(

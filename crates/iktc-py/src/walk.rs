@@ -3,16 +3,17 @@
 //! profile; the physics loop around it is the caller's, and so is the measured ZMP the damping
 //! controller (off by default) reads.
 
+use iktc::sim::imitate::{support_polygon, SupportSettings};
 use iktc::sim::{imitation_references, WalkImitateConfig, WalkingController};
 use iktc::walk::SupportPolygon;
 use nalgebra::{Isometry3, Rotation2, Vector2};
-use numpy::{PyArray1, PyArray2};
+use numpy::{PyArray1, PyArray2, PyReadonlyArray2};
 use pyo3::prelude::*;
 
 use crate::balance::PyPlaneModel;
 use crate::controller::PySolveReport;
 use crate::convert::{array, pose_matrix};
-use crate::imitate::narrowed;
+use crate::imitate::{narrowed, pose_of};
 use crate::motion::{resolve_map, PyMotion};
 use crate::robot::PyRobot;
 use crate::to_py;
@@ -39,6 +40,8 @@ pub struct PyWalking {
     k: usize,
     dt: f64,
     polygon: SupportPolygon,
+    /// The soles (for the polygon of given feet).
+    support: SupportSettings,
     /// The pattern's model ZMP (world) and the local frame's yaw of the last tick, which the
     /// next tick's measured ZMP is compared with.
     last_zmp: Option<PatternZmp>,
@@ -114,6 +117,7 @@ impl PyWalking {
             k: 0,
             dt: cfg.imitate.dt,
             polygon: SupportPolygon::default(),
+            support: cfg.imitate.support,
             last_zmp: None,
         })
     }
@@ -195,9 +199,21 @@ impl PyWalking {
             .collect()
     }
 
-    /// Signed distance [m] from the world point (x, y) to the edge of the pattern's support
-    /// polygon at the last tick (positive inside).
-    fn support_margin(&mut self, point: (f64, f64)) -> PyResult<f64> {
+    /// Signed distance [m] from the world point (x, y) to the edge of a support polygon
+    /// (positive inside): with `feet` (ankle poses, 4 × 4 world, at least one) the convex hull
+    /// of their soles, else the pattern's polygon at the last tick (the stance sole in single
+    /// support, both soles in double support).
+    #[pyo3(signature = (point, feet=None))]
+    fn support_margin(
+        &mut self,
+        point: (f64, f64),
+        feet: Option<Vec<PyReadonlyArray2<'_, f64>>>,
+    ) -> PyResult<f64> {
+        if let Some(f) = feet {
+            let poses = f.iter().map(pose_of).collect::<PyResult<Vec<_>>>()?;
+            let p = support_polygon(&poses, &self.support).map_err(to_py)?;
+            return Ok(p.margin(point));
+        }
         let t = self.k.saturating_sub(1) as f64 * self.dt;
         let o = self.ctl.origin();
         self.ctl

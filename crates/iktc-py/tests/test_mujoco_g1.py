@@ -319,26 +319,22 @@ def test_the_walking_binding_feeds_the_measured_zmp_back_only_with_the_damping_c
         iktc.Walking(robot, motion, damping=True, cases=[iktc.PlaneModel(0.6, 15.0, 0.5, 0.1, 0.01)])
 
 
-# Measured at the 0.1 ms physics step (`g1_sim.run_walking()`): G1 falls at 2.04 s (the second
-# single support; pelvis 0.01 m); the measured ZMP is outside the stance sole on 328 of 480
-# single-support ticks. The plan itself cannot be followed: its ZMP (MuJoCo's inverse dynamics)
-# is outside on 408 of 480 single-support ticks and 163 of 377 double-support ones. The clip's
-# pelvis height straightens the right knee from 0.57 s (its lower limit, -0.087 rad); with the
-# pelvis held (``held_pelvis_map``) the knees stay >= 0.50 rad and 191 of 480 remain outside:
-# the dance's upper body. Without the dance the plan is feasible, yet G1 still falls (next two
-# tests): the open loop does not follow it on G1's 5 cm soles. Feeding the measured ZMP back
-# through the damping controller (``run_walking(damping=True, cases=...)``) does not keep it up
-# either (the synthetic cases: down at 1.97 s without the dance; G1's identified double-support
-# models in both phases: 2.2 s, and the dance 2.84 s; with those models and without the
-# offset's rates fed forward, which the identification did not have: 2.50 s, the dance 2.45 s).
-# See the README.
-@pytest.mark.xfail(strict=True, reason="G1 in MuJoCo falls at 2.04 s (second single support): "
-                   "the plan's ZMP is outside on 408 of 480 single-support ticks (the clip's "
-                   "pelvis straightens a knee; the dance's upper body), and even a feasible plan "
-                   "is not followed open loop (see the README's MuJoCo section)")
-def test_walking_four_steps_in_mujoco_stays_up_with_the_zmp_inside():
-    s = g1_sim.run_walking()
-    assert s["stayed_up"] and s["zmp_inside"], s
+def test_the_fed_forward_torques_hold_the_standing_robot_where_it_is_commanded():
+    # MuJoCo's own contact forces against the wrench split of ``Feedforward``: with the plan's
+    # torques fed forward the servos (K_P 500 N·m/rad) hold G1's start posture 140 times more
+    # closely after 1 s (MuJoCo 4.0.0: largest joint error 0.17 against 23.5 mrad).
+    robot = iktc.Robot("g1")
+    q = iktc.Walking(robot, iktc.load_motion("humanoid3d_dance_b")).q
+    errors = []
+    for feed in (False, True):
+        plant = g1_sim.Plant(robot)
+        plant.set_state(q)
+        ff = g1_sim.Feedforward(plant)
+        for _ in range(200):
+            plant.command(q, None, ff.torques(q, (True, True)) if feed else None)
+            plant.advance()
+        errors.append(float(np.abs(plant.joint_positions() - q[7:]).max()))
+    assert errors[1] < errors[0] / 20, errors
 
 
 @pytest.fixture(scope="module")
@@ -357,20 +353,56 @@ def test_walking_without_the_dance_plans_a_zmp_inside_the_support_polygon(walkin
     assert s["knee_plan_min_rad"] > 0.4, s
 
 
-# The feasible plan is not followed: at the first lift-off (0.8 s) the measured ZMP is still 8 cm inside of the plan's (the swing foot carries 40 % of the
-# weight), through the first single support it sits at the stance sole's outer edge (y −0.145
-# to −0.150 m against the plan's −0.121 to −0.131, the sole centred at −0.119, 25 mm half-width),
-# the body rolls outward (0.09 rad by the second single support) and the weight never moves to
-# the other foot: at the second lift-off the foot to swing carries 314 N, the stance one none;
-# G1 falls at 2.84 s. Not the servos alone: K_P 5 000 N·m/rad (joint errors < 0.01 rad) falls at
-# 3.47 s, 20 000 at 2.37 s; slower steps fall sooner (single/double support 0.6/0.3 s at 1.94 s,
-# 0.8/0.4 at 1.69 s, 1.0/0.6 at 1.48 s: the open loop diverges over a single support); stepping
-# in place stays up. The damping controller on G1's identified double-support models falls at
-# 2.2 s (2.50 s without the offset's rates fed forward).
-@pytest.mark.xfail(strict=True, reason="without the dance the plan is feasible, but G1 open loop "
-                   "rolls over the stance sole's outer edge and falls at 2.84 s (README)")
-def test_walking_without_the_dance_stays_up(walking_without_the_dance):
+def test_walking_four_steps_in_mujoco_stays_up_with_the_zmp_inside(walking_without_the_dance):
+    # The servos get the plan's joint torques (``g1_sim.Feedforward``). MuJoCo 4.0.0: G1 walks
+    # the four steps (the pelvis 0.29 m ahead), tilts at most 0.04 rad, and the measured ZMP is
+    # inside the polygon of the feet carrying load on all 861 ticks (at least 2.0 mm).
     s = walking_without_the_dance
+    assert s["stayed_up"] and s["zmp_inside"], s
+    assert s["zmp_ticks_measured"] == s["ticks"], s
+    assert s["base_tilt_max_rad"] < 0.1, s
+    # Four steps of 0.1 m, the last one closing the feet: the pelvis ends about 0.3 m ahead.
+    assert 0.25 < s["forward_progress_m"] < 0.35, s
+
+
+def test_walking_needs_the_plans_torques_fed_forward(tmp_path):
+    # Without them the servos (K_P 500 N·m/rad) trail the plan's weight shift: at the first
+    # lift-off the measured ZMP is 8 cm inside of the plan's, through the first single support
+    # it sits on the stance sole's outer edge and G1 falls (at 2.84 s with MuJoCo 4.0.0).
+    held = g1_sim.held_clip(tmp_path / "held_dance_b.txt")
+    s = g1_sim.run_walking(clip=held, feedforward=False)
+    assert not s["stayed_up"], s
+
+
+def test_walking_while_imitating_the_walk_clip_stays_up():
+    # The arms of humanoid3d_walk while walking: G1 stays up (MuJoCo 4.0.0: tilt at most
+    # 0.18 rad, the pelvis 0.27 m ahead). The plan's own ZMP leaves the pattern's polygon on
+    # 33 of 480 single-support ticks (the pattern plans the COM on the cart-table, not the
+    # arms' dynamics), and the measured ZMP reaches a sole's edge (53 ticks, at most 3.7 mm
+    # past the rectangle of its contact spheres' centres): next test.
+    s = g1_sim.run_walking(clip="humanoid3d_walk")
+    assert s["stayed_up"], s
+    assert s["base_tilt_max_rad"] < 0.3, s
+
+
+@pytest.mark.xfail(strict=True, reason="the plan's ZMP (MuJoCo's inverse dynamics) leaves the "
+                   "pattern's polygon on 33 of 480 single-support ticks: the pattern does not "
+                   "plan for the arms' dynamics; the stance foot tips onto its edge (README)")
+def test_walking_while_imitating_the_walk_clip_keeps_the_zmp_inside():
+    s = g1_sim.run_walking(clip="humanoid3d_walk")
+    assert s["zmp_inside"], s
+
+
+# With the dance (``run_walking()``, humanoid3d_dance_b) G1 falls at 2.48 s: the plan's ZMP is
+# outside the pattern's polygon on 264 of 480 single-support ticks and 52 of 377 double-support
+# ones (the dance's upper body; with the clip's pelvis height a knee is also driven straight
+# unless the imitation's soft approach keeps it off its limit). The damping controller
+# (``run_walking(damping=True, cases=...)``) reads the measured ZMP against the cart-table's and
+# does not help (README).
+@pytest.mark.xfail(strict=True, reason="G1 in MuJoCo falls walking with the dance: the plan's "
+                   "ZMP is outside on 264 of 480 single-support ticks (README)")
+def test_walking_while_dancing_stays_up():
+    s = g1_sim.run_walking()
     assert s["stayed_up"] and s["zmp_inside"], s
 
 
