@@ -740,7 +740,8 @@ ON_GROUND = 1e-3
 def run_walking(steps: int = 4, step_length: float = 0.1, clip: str = "humanoid3d_dance_b",
                 settle: float = 0.5, rate_feedforward: bool = True, narrow=None,
                 kp: float = KP, kv: float = KV, damping: bool = False, cases=None,
-                offset_feedforward: bool = True, feedforward: bool = True) -> dict:
+                offset_feedforward: bool = True, feedforward: bool = True,
+                replay: str | None = None) -> dict:
     """Walking `steps` footsteps while imitating the clip, on the MuJoCo G1 (`narrow`: narrowed
     joint ranges, as for `iktc.Walking`). With `damping` the measured ZMP (ankle sensors) is fed
     back every tick through the damping controller (`iktc.Walking(damping=True, cases=cases,
@@ -753,7 +754,8 @@ def run_walking(steps: int = 4, step_length: float = 0.1, clip: str = "humanoid3
     ticks outside, ``zmp_inside``) and against the pattern's polygon per phase (stance sole in
     single support; a tick without a measured ZMP counts as outside), the plan's ZMP
     (``planned_zmp``) against the pattern's polygon, the knees' lowest planned angles, servo
-    tracking and flips."""
+    tracking and flips. With `replay` an HTML replay of the physics run next to the plan is
+    written to that path (``write_replay``)."""
     robot = iktc.Robot("g1")
     kw = {} if cases is None else {"cases": cases}
     if not offset_feedforward:
@@ -768,6 +770,7 @@ def run_walking(steps: int = 4, step_length: float = 0.1, clip: str = "humanoid3
         plant.command(walk.q, None, None if ff is None else ff.torques(walk.q, (True, True)))
         plant.advance()
     heights, tilts, slips, margins, errs, phases, qs, flips = [], [], [], [], [], [], [], []
+    physics = []
     plan_margins, contact_margins = [], []
     zmp = None
     for _ in range(walk.ticks):
@@ -780,6 +783,7 @@ def run_walking(steps: int = 4, step_length: float = 0.1, clip: str = "humanoid3
         plant.command(q, walk.v if rate_feedforward else None,
                       None if ff is None else ff.torques(q, on))
         plant.advance()
+        physics.append(plant.data.qpos.copy())
         heights.append(plant.pelvis_height())
         tilts.append(plant.base_tilt())
         refs = walk.feet_references()
@@ -797,6 +801,8 @@ def run_walking(steps: int = 4, step_length: float = 0.1, clip: str = "humanoid3
         errs.append(float(np.abs(plant.joint_positions() - q[7:]).max()))
         phases.append(phase)
         flips.append(int(plant.flipped.sum()))
+    if replay is not None:
+        write_replay(replay, plant, physics, qs, f"G1 walking {steps} steps, {pathlib.Path(clip).stem}")
     # The plan's ZMP against the same polygons: replayed (the plan does not see the plant
     # without the damping controller; with it, the ZMP of the commanded motion).
     replay = iktc.Walking(robot, iktc.load_motion(clip), steps=steps, step_length=step_length,

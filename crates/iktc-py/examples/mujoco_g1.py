@@ -6,7 +6,7 @@
     python crates/iktc-py/examples/mujoco_g1.py balance [--damping 0.72] [--designs 0.3,0.9]
         [--json out.json]
     python crates/iktc-py/examples/mujoco_g1.py walking [--steps 4] [--clip humanoid3d_walk]
-        [--hold-upper-body] [--no-feedforward] [--json out.json]
+        [--hold-upper-body] [--no-feedforward] [--json out.json] [--replay out.html]
     python crates/iktc-py/examples/mujoco_g1.py causes [--json out.json]
 
 `standing` prints the run's figures (stayed up, pelvis height, base tilt, foot slip, ZMP margin
@@ -114,7 +114,7 @@ def main() -> None:
     ap.add_argument("--robot", default="g1", help="the built-in g1 or a G1 profile file (.toml)")
     ap.add_argument("--settle", type=float, default=0.5, help="time holding the start posture [s]")
     ap.add_argument("--json", help="write the figures to this file")
-    ap.add_argument("--replay", help="standing: write an HTML replay of the physics run next to "
+    ap.add_argument("--replay", help="standing, walking: write an HTML replay of the physics run next to "
                     "iktc's plan to this file")
     a = ap.parse_args()
     if a.run == "balance":
@@ -126,7 +126,8 @@ def main() -> None:
         if a.hold_upper_body:
             import tempfile
             clip = g1_sim.held_clip(pathlib.Path(tempfile.mkdtemp()) / f"held_{a.clip}.txt", a.clip)
-        s = g1_sim.run_walking(steps=a.steps, clip=clip, feedforward=not a.no_feedforward)
+        s = g1_sim.run_walking(steps=a.steps, clip=clip, feedforward=not a.no_feedforward,
+                               replay=a.replay)
     else:
         s = standing(a)
     print(json.dumps(s, indent=1))

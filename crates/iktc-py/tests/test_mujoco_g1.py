@@ -406,6 +406,16 @@ def test_walking_while_dancing_stays_up():
     assert s["stayed_up"] and s["zmp_inside"], s
 
 
+def test_the_walking_replay_holds_both_runs_tick_by_tick(tmp_path):
+    import json
+    path = tmp_path / "walk.html"
+    s = g1_sim.run_walking(steps=1, clip="humanoid3d_walk", replay=str(path))
+    data = json.loads(path.read_text().split("const D = ", 1)[1].split(";\n", 1)[0])
+    assert len(data["physics"]) == len(data["plan"]) == s["ticks"]
+    # Both start where the plan starts: the physics run's first tick follows a settle at rest.
+    assert np.allclose(data["physics"][0], data["plan"][0], atol=0.01)
+
+
 def test_the_replay_holds_both_runs_tick_by_tick(tmp_path):
     import json
     loop = g1_sim.Loop(duration=0.1)
