@@ -741,7 +741,7 @@ def run_walking(steps: int = 4, step_length: float = 0.1, clip: str = "humanoid3
                 settle: float = 0.5, rate_feedforward: bool = True, narrow=None,
                 kp: float = KP, kv: float = KV, damping: bool = False, cases=None,
                 offset_feedforward: bool = True, feedforward: bool = True,
-                replay: str | None = None) -> dict:
+                replay: str | None = None, push=None) -> dict:
     """Walking `steps` footsteps while imitating the clip, on the MuJoCo G1 (`narrow`: narrowed
     joint ranges, as for `iktc.Walking`). With `damping` the measured ZMP (ankle sensors) is fed
     back every tick through the damping controller (`iktc.Walking(damping=True, cases=cases,
@@ -755,7 +755,8 @@ def run_walking(steps: int = 4, step_length: float = 0.1, clip: str = "humanoid3
     single support; a tick without a measured ZMP counts as outside), the plan's ZMP
     (``planned_zmp``) against the pattern's polygon, the knees' lowest planned angles, servo
     tracking and flips. With `replay` an HTML replay of the physics run next to the plan is
-    written to that path (``write_replay``)."""
+    written to that path (``write_replay``). `push` = (time [s], force (x, y, z) [N], duration
+    [s]) applies that force at the pelvis over the control periods from `time` on."""
     robot = iktc.Robot("g1")
     kw = {} if cases is None else {"cases": cases}
     if not offset_feedforward:
@@ -773,7 +774,7 @@ def run_walking(steps: int = 4, step_length: float = 0.1, clip: str = "humanoid3
     physics = []
     plan_margins, contact_margins = [], []
     zmp = None
-    for _ in range(walk.ticks):
+    for k in range(walk.ticks):
         report, phase = walk.tick(zmp if damping else None)
         if report.violation > 1e-9:
             raise AssertionError(f"iktc left its acceleration box by {report.violation}")
@@ -782,7 +783,8 @@ def run_walking(steps: int = 4, step_length: float = 0.1, clip: str = "humanoid3
         on = [abs(r[2, 3] - z0[i]) < ON_GROUND for i, r in enumerate(walk.feet_references())]
         plant.command(q, walk.v if rate_feedforward else None,
                       None if ff is None else ff.torques(q, on))
-        plant.advance()
+        pushing = push is not None and push[0] <= k * CONTROL_PERIOD < push[0] + push[2] - 1e-9
+        plant.advance(np.asarray(push[1], dtype=float) if pushing else None)
         physics.append(plant.data.qpos.copy())
         heights.append(plant.pelvis_height())
         tilts.append(plant.base_tilt())
