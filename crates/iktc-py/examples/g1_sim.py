@@ -508,11 +508,14 @@ def plan_chatter(qs: np.ndarray, dt: float = CONTROL_PERIOD) -> dict:
             "joint_acceleration_sign_changes_median": f"{int(np.median(flips))} of {len(a) - 1}"}
 
 
-def planned_zmp(plant: Plant, qs: list, dt: float = CONTROL_PERIOD) -> np.ndarray:
+def planned_zmp(plant: Plant, qs: list, dt: float = CONTROL_PERIOD,
+                per_tick: bool = False) -> np.ndarray:
     """The ZMP the kinematic plan asks for [m], one row per tick (NaN at the two ends).
 
     The plan's configurations `qs` (iktc's q per tick) are put into MuJoCo's coordinates; rates
-    and accelerations by central differences (``mj_differentiatePos``); MuJoCo's inverse
+    and accelerations by central differences (``mj_differentiatePos``; with `per_tick` the
+    acceleration of each tick, (v_{k+1} − v_k)/Δt with v_k = (q_k − q_{k−1})/Δt, which is
+    iktc's own q̈_k, and the rate (v_k + v_{k+1})/2; NaN at the first and last tick); MuJoCo's inverse
     dynamics (``mj_inverse``) then gives the wrench the ground must exert on the free base, force
     F and torque τ at the base origin o (world axes), and the ZMP is the ground point where its
     horizontal moment vanishes: p_x = o_x − (τ_y + o_z F_x)/F_z, p_y = o_y + (τ_x − o_z F_y)/F_z.
@@ -524,28 +527,32 @@ def planned_zmp(plant: Plant, qs: list, dt: float = CONTROL_PERIOD) -> np.ndarra
     flags = m.opt.disableflags
     m.opt.disableflags = flags | mujoco.mjtDisableBit.mjDSBL_CONSTRAINT
     try:
-        return _planned_zmp(plant, m, d, qs, dt)
+        return _planned_zmp(plant, m, d, qs, dt, per_tick)
     finally:
         m.opt.disableflags = flags
 
 
-def _planned_zmp(plant, m, d, qs, dt):
-    qpos = []
-    for q in qs:
-        x = np.zeros(m.nq)
-        x[:3] = q[:3]
-        x[3:7] = [q[6], q[3], q[4], q[5]]
-        x[plant.qadr] = q[7:]
-        qpos.append(x)
+def _planned_zmp(plant, m, d, qs, dt, per_tick=False):
+    qpos = [to_mujoco_qpos(plant, q) for q in qs]
     n = len(qpos)
     out = np.full((n, 2), np.nan)
     vel = np.zeros((n, m.nv))
-    for k in range(1, n - 1):
-        mujoco.mj_differentiatePos(m, vel[k], 2 * dt, qpos[k - 1], qpos[k + 1])
-    for k in range(2, n - 2):
+    if per_tick:
+        for k in range(1, n):
+            mujoco.mj_differentiatePos(m, vel[k], dt, qpos[k - 1], qpos[k])
+        ticks = range(1, n - 1)
+    else:
+        for k in range(1, n - 1):
+            mujoco.mj_differentiatePos(m, vel[k], 2 * dt, qpos[k - 1], qpos[k + 1])
+        ticks = range(2, n - 2)
+    for k in ticks:
         d.qpos[:] = qpos[k]
-        d.qvel[:] = vel[k]
-        d.qacc[:] = (vel[k + 1] - vel[k - 1]) / (2 * dt)
+        if per_tick:
+            d.qvel[:] = 0.5 * (vel[k] + vel[k + 1])
+            d.qacc[:] = (vel[k + 1] - vel[k]) / dt
+        else:
+            d.qvel[:] = vel[k]
+            d.qacc[:] = (vel[k + 1] - vel[k - 1]) / (2 * dt)
         mujoco.mj_inverse(m, d)
         r = d.xmat[plant.pelvis].reshape(3, 3)
         f = d.qfrc_inverse[:3]  # free joint: linear part in world axes

@@ -6,7 +6,7 @@ use std::sync::Arc;
 
 use iktc::model::{builtin_robot, BaseKind, Kinematics, ModelOptions, Robot, State};
 use iktc::profile::{RobotProfile, BUILTIN_PROFILES};
-use numpy::{PyArray1, PyArray2};
+use numpy::{PyArray1, PyArray2, PyReadonlyArray2};
 use pyo3::prelude::*;
 
 use crate::convert::{array, matrix, pose_matrix, vector};
@@ -194,6 +194,42 @@ impl PyRobot {
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let kin = self.kinematics(q)?;
         Ok(array(py, kin.com().as_slice()))
+    }
+
+    /// The ZMP [m] (world x, y, shape (n, 2)) of the robot moving through the configurations
+    /// `qs` (shape (n, nq), n ≥ 3, one row every `dt` [s]) on the ground plane `z = ground` [m]:
+    /// the links' ZMP from their masses, centres of mass and inertias, accelerations by central
+    /// differences (`iktc::walk::configuration_zmp`). Where it leaves the support polygon no
+    /// plant can follow the motion without tipping.
+    #[pyo3(signature = (qs, dt, ground=0.0, gravity=9.81))]
+    fn zmp<'py>(
+        &self,
+        py: Python<'py>,
+        qs: PyReadonlyArray2<'py, f64>,
+        dt: f64,
+        ground: f64,
+        gravity: f64,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let a = qs.as_array();
+        if a.ncols() != self.robot.nq() {
+            return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                "qs: expected {} columns (nq), got {}",
+                self.robot.nq(),
+                a.ncols()
+            )));
+        }
+        let rows: Vec<Vec<f64>> = a.rows().into_iter().map(|r| r.to_vec()).collect();
+        let robot = &self.robot;
+        let z = py
+            .detach(|| {
+                let refs: Vec<&[f64]> = rows.iter().map(Vec::as_slice).collect();
+                iktc::walk::configuration_zmp(robot, &refs, dt, ground, gravity)
+            })
+            .map_err(to_py)?;
+        Ok(matrix(
+            py,
+            &nalgebra::DMatrix::from_fn(z.len(), 2, |i, j| z[i][j]),
+        ))
     }
 
     fn __repr__(&self) -> String {

@@ -14,6 +14,7 @@
 //! * [`dare`]: the discrete algebraic Riccati equation by the doubling algorithm;
 //! * [`preview`]: the cart-table model and the optimal preview servo (Kajita et al. 2003);
 //! * [`swing`]: foot trajectories (quintic horizontal, sextic vertical);
+//! * [`multibody`]: the ZMP of a sampled multibody motion (the links, not the cart-table);
 //! * [`pattern`]: [`WalkingPattern`], all of it precomputed for a plan, queried per tick.
 //!
 //! Conventions: world frame with `z` up and the ground at `z = 0`; a foot's frame is the centre
@@ -35,6 +36,7 @@
 
 pub mod dare;
 pub mod footstep;
+pub mod multibody;
 pub mod pattern;
 pub mod polygon;
 pub mod preview;
@@ -44,6 +46,7 @@ pub mod timeline;
 
 pub use dare::{dare_residual, solve_dare, DareSettings, DareSolution, DareStatus};
 pub use footstep::{Footstep, FootstepPlan, Pose2, RootPlanParams, RootSample};
+pub use multibody::{configuration_zmp, link_masses, multibody_zmp, BodyMass};
 pub use pattern::{ComState, WalkSample, WalkingPattern, MAX_PATTERN_SAMPLES};
 pub use polygon::{sole_corners, PolygonEdge, SupportPolygon, MAX_POLYGON_VERTICES, MAX_SOLES};
 pub use preview::{
