@@ -199,8 +199,9 @@ impl PyRobot {
     /// The ZMP [m] (world x, y, shape (n, 2)) of the robot moving through the configurations
     /// `qs` (shape (n, nq), n ≥ 3, one row every `dt` [s]) on the ground plane `z = ground` [m]:
     /// the links' ZMP from their masses, centres of mass and inertias, accelerations by central
-    /// differences (`iktc::walk::configuration_zmp`). Where it leaves the support polygon no
-    /// plant can follow the motion without tipping.
+    /// differences (`iktc::walk::configuration_zmp`); NaN where the ground would have to pull
+    /// (the body falling faster than gravity). Where it leaves the support polygon no plant
+    /// can follow the motion without tipping.
     #[pyo3(signature = (qs, dt, ground=0.0, gravity=9.81))]
     fn zmp<'py>(
         &self,
@@ -228,7 +229,7 @@ impl PyRobot {
             .map_err(to_py)?;
         Ok(matrix(
             py,
-            &nalgebra::DMatrix::from_fn(z.len(), 2, |i, j| z[i][j]),
+            &nalgebra::DMatrix::from_fn(z.len(), 2, |i, j| z[i].map_or(f64::NAN, |p| p[j])),
         ))
     }
 

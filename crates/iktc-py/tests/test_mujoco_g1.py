@@ -341,6 +341,11 @@ def test_iktc_computes_the_plans_zmp_as_mujocos_inverse_dynamics_does():
     assert d.max() < 2e-3 and np.median(d) < 1e-5, (d.max(), np.median(d))
     # The arms matter: the same walk's cart-table ZMP is not what the links give.
     assert np.abs(ours[both] - ours[both].mean(axis=0)).max() > 0.05
+    # A base snapped down faster than gravity (its height's second difference −800 m/s²):
+    # the ground would have to pull, there is no ZMP.
+    snap = qs[:3].copy()
+    snap[1, 2] += 0.01
+    assert np.isnan(robot.zmp(snap, g1_sim.CONTROL_PERIOD)).all()
     with pytest.raises(ValueError, match="columns"):
         robot.zmp(qs[:, :10], g1_sim.CONTROL_PERIOD)
     with pytest.raises(iktc.IktcError, match="at least 3"):

@@ -50,15 +50,16 @@ pub fn link_masses(robot: &Robot) -> Vec<BodyMass> {
 /// The ZMP \[m\] (world x, y, on the plane `z = ground` \[m\]) of the robot moving through the
 /// configurations `qs` (one `q` per sample, each of length `nq`; base position, quaternion
 /// x y z w, joints) sampled every `dt` \[s\], under `gravity` \[m/s²\]: the links' ZMP
-/// ([`multibody_zmp`]) of their poses by forward kinematics. Errors: a configuration of the
-/// wrong length or not valid for the robot, and [`multibody_zmp`]'s.
+/// ([`multibody_zmp`], `None` where the ground would have to pull) of their poses by forward
+/// kinematics. Errors: a configuration of the wrong length or not valid for the robot, and
+/// [`multibody_zmp`]'s.
 pub fn configuration_zmp(
     robot: &Robot,
     qs: &[&[f64]],
     dt: f64,
     ground: f64,
     gravity: f64,
-) -> Result<Vec<[f64; 2]>> {
+) -> Result<Vec<Option<[f64; 2]>>> {
     let mut state = State::neutral(robot);
     let mut kin: Option<Kinematics> = None;
     let mut poses = Vec::with_capacity(qs.len());
@@ -85,16 +86,17 @@ pub fn configuration_zmp(
 
 /// The ZMP \[m\] (world x, y) on the ground plane `z = ground` \[m\] of bodies with masses
 /// `bodies` whose frames are `poses[k][i]` (world) at `t_k = k dt` \[s\], under gravity
-/// `gravity` \[m/s²\] (module documentation). Errors: fewer than three samples, a sample
-/// without one pose per body, a non-positive `dt` or `gravity`, non-finite poses, or a total
-/// vertical force that is not positive (the bodies falling at least as fast as gravity).
+/// `gravity` \[m/s²\] (module documentation); `None` at a sample whose total vertical force
+/// `Σ m_i (z̈_i + g)` is not positive (the bodies falling at least as fast as gravity: the
+/// ground would have to pull). Errors: fewer than three samples, a sample without one pose per
+/// body, a non-positive `dt` or `gravity`, non-finite poses.
 pub fn multibody_zmp(
     bodies: &[BodyMass],
     poses: &[Vec<Isometry3<f64>>],
     dt: f64,
     ground: f64,
     gravity: f64,
-) -> Result<Vec<[f64; 2]>> {
+) -> Result<Vec<Option<[f64; 2]>>> {
     let n = poses.len();
     if n < 3 {
         return Err(Error::InsufficientData {
@@ -169,14 +171,7 @@ pub fn multibody_zmp(
                 mx += ld.x;
             }
         }
-        if fz.is_nan() || fz <= 0.0 {
-            return Err(Error::InvalidSetting {
-                name: format!("multibody ZMP vertical force at sample {k}"),
-                value: format!("{fz} N"),
-                expected: "positive (bodies not falling faster than gravity)".into(),
-            });
-        }
-        out.push([my / fz, mx / fz]);
+        out.push((fz > 0.0).then(|| [my / fz, mx / fz]));
     }
     Ok(out)
 }
@@ -208,6 +203,7 @@ mod tests {
             (2.0 * -0.2 + 6.0 * 0.2) / 8.0,
         ];
         for p in zmp {
+            let p = p.unwrap();
             assert!(
                 (p[0] - c[0]).abs() < 1e-12 && (p[1] - c[1]).abs() < 1e-12,
                 "{p:?}"
@@ -227,6 +223,7 @@ mod tests {
             .collect();
         let zmp = multibody_zmp(&[point(3.0)], &poses, dt, h, g).unwrap();
         for (k, p) in zmp.iter().enumerate().skip(1).take(5) {
+            let p = p.unwrap();
             let t = k as f64 * dt;
             let expected = 0.5 * a * t * t - a * (z - h) / g;
             assert!(
@@ -260,6 +257,7 @@ mod tests {
         let zmp = multibody_zmp(&[body], &poses, dt, 0.0, g).unwrap();
         let expected = 0.2 - iyy * alpha / (m * g);
         for p in &zmp[2..7] {
+            let p = p.unwrap();
             assert!((p[0] - expected).abs() < 1e-6, "{} vs {expected}", p[0]);
         }
     }
@@ -276,6 +274,7 @@ mod tests {
         let z = configuration_zmp(&robot, &[q, q, q, q, q], 0.005, 0.0, 9.81).unwrap();
         let c = kin.com();
         for p in z {
+            let p = p.unwrap();
             assert!(
                 (p[0] - c.x).abs() < 1e-12 && (p[1] - c.y).abs() < 1e-12,
                 "{p:?} {c}"
@@ -299,13 +298,16 @@ mod tests {
         assert!(multibody_zmp(&bodies, &nan, 0.005, 0.0, 9.81).is_err());
         let ok = vec![vec![at(0.0, 0.0, 1.0)]; 3];
         assert!(multibody_zmp(&bodies, &ok, 0.0, 0.0, 9.81).is_err());
-        // Falling faster than gravity: z = −g t² (accelerating down at 2g).
-        let falling: Vec<Vec<Isometry3<f64>>> = (0..3)
-            .map(|k| {
-                let t = k as f64 * 0.01;
-                vec![at(0.0, 0.0, 1.0 - 9.81 * t * t)]
-            })
-            .collect();
-        assert!(multibody_zmp(&bodies, &falling, 0.01, 0.0, 9.81).is_err());
+        // Falling faster than gravity (z = −g t², 2 g down), and at exactly g: no ZMP.
+        for rate in [9.81, 0.5 * 9.81] {
+            let falling: Vec<Vec<Isometry3<f64>>> = (0..3)
+                .map(|k| {
+                    let t = k as f64 * 0.01;
+                    vec![at(0.0, 0.0, 1.0 - rate * t * t)]
+                })
+                .collect();
+            let z = multibody_zmp(&bodies, &falling, 0.01, 0.0, 9.81).unwrap();
+            assert!(z.iter().all(Option::is_none), "{rate}: {z:?}");
+        }
     }
 }
