@@ -286,6 +286,37 @@ mod tests {
     }
 
     #[test]
+    fn a_turned_wheel_spinning_up_about_x_moves_the_zmp_sideways_by_its_momentum_rate() {
+        // The body turned 90° about z (its x axis along world y, its y axis along −x), then
+        // spun about world x with angular acceleration α: about world x it presents its
+        // body-y moment I_yy, and L̇_x = I_yy α moves p_y by + I_yy α / (m g).
+        let (m, alpha, dt, g) = (2.0, 4.0, 0.01, 9.81);
+        let body = BodyMass {
+            mass: m,
+            com: Vector3::zeros(),
+            inertia: Matrix3::from_diagonal(&Vector3::new(0.05, 0.3, 0.1)),
+        };
+        let turn = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), std::f64::consts::FRAC_PI_2);
+        let poses: Vec<Vec<Isometry3<f64>>> = (0..9)
+            .map(|k| {
+                let t = k as f64 * dt;
+                let spin = UnitQuaternion::from_axis_angle(&Vector3::x_axis(), 0.5 * alpha * t * t);
+                vec![Isometry3::from_parts(
+                    Translation3::new(0.0, -0.1, 0.7),
+                    spin * turn,
+                )]
+            })
+            .collect();
+        let zmp = multibody_zmp(&[body], &poses, dt, 0.0, g).unwrap();
+        let expected = -0.1 + 0.3 * alpha / (m * g);
+        for p in &zmp[2..7] {
+            let p = p.unwrap();
+            assert!((p[1] - expected).abs() < 1e-6, "{} vs {expected}", p[1]);
+            assert!(p[0].abs() < 1e-9, "{}", p[0]);
+        }
+    }
+
+    #[test]
     fn bad_samples_are_errors() {
         let bodies = [point(1.0)];
         let few = vec![vec![at(0.0, 0.0, 1.0)]; 2];
