@@ -184,6 +184,10 @@ pub fn print_walk(with: &WalkRun, without: &WalkRun) -> std::io::Result<()> {
             None => crate::outln!("  no push")?,
         }
         crate::outln!(
+            "  the commanded motion's own ZMP (links' masses and inertias) outside the pattern's polygon on {} single- and {} double-support ticks (smallest margin {:+.4} m): no robot follows the plan there without tipping",
+            s.plan_zmp_outside_single, s.plan_zmp_outside_double, s.plan_zmp_min_margin
+        )?;
+        crate::outln!(
             "  tick median {:.1} µs, p99 {:.1} µs; {}",
             s.tick_median_us,
             s.tick_p99_us,

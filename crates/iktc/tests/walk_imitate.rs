@@ -131,3 +131,67 @@ fn without_the_offset_feedforward_the_com_follows_the_damping_offset_more_slowly
     }
     assert!(lag_on < lag_off, "{lag_on} vs {lag_off}");
 }
+
+/// Every reference track held at its first value: the upper body and pelvis stand still.
+fn held(refs: &RobotReferences) -> RobotReferences {
+    let mut r = refs.clone();
+    let hold = |t: &mut iktc::motion::Track| {
+        let p0 = t.position[0];
+        t.position.iter_mut().for_each(|p| *p = p0);
+        t.velocity.iter_mut().for_each(|v| *v = 0.0);
+        t.acceleration.iter_mut().for_each(|a| *a = 0.0);
+    };
+    r.joints.iter_mut().for_each(hold);
+    hold(&mut r.height);
+    r.angles.iter_mut().for_each(hold);
+    let a0 = r.attitude[0];
+    r.attitude.iter_mut().for_each(|a| *a = a0);
+    r.angular_velocity
+        .iter_mut()
+        .for_each(|w| *w = nalgebra::Vector3::zeros());
+    r.angular_acceleration
+        .iter_mut()
+        .for_each(|w| *w = nalgebra::Vector3::zeros());
+    r
+}
+
+/// The commanded motion's own ZMP (the links' masses and inertias, `plan_zmp_*`) on G1,
+/// without the damping controller and the push. With the upper body and pelvis held the walk
+/// is the cart-table's and its ZMP stays inside the pattern's polygon on every tick (as
+/// MuJoCo's inverse dynamics of the same plan says); the dance's upper body takes it outside
+/// on many single-support ticks, which the pattern's cart-table model does not see.
+#[test]
+fn the_plans_own_zmp_leaves_the_polygon_only_with_the_dance() {
+    let profile = iktc::profile::RobotProfile::builtin("g1").unwrap();
+    let robot = profile.robot().unwrap();
+    let mut cfg = profile
+        .walk_config(&robot, WalkImitateConfig::jvrc1().unwrap())
+        .unwrap();
+    cfg.damping = false;
+    cfg.push = None;
+    let clip = builtin_clip("humanoid3d_dance_b").unwrap();
+    let map = profile.retarget_map("deepmimic", &robot).unwrap();
+    let refs = iktc::sim::imitation_references(&robot, &clip, &map, &cfg.imitate).unwrap();
+    let still = run_walk_imitate(&robot, &held(&refs), &cfg)
+        .unwrap()
+        .summary;
+    let dance = run_walk_imitate(&robot, &refs, &cfg).unwrap().summary;
+    eprintln!(
+        "G1 plan ZMP outside (single, double): held {} {} (margin {:.4} m), dance {} {}",
+        still.plan_zmp_outside_single,
+        still.plan_zmp_outside_double,
+        still.plan_zmp_min_margin,
+        dance.plan_zmp_outside_single,
+        dance.plan_zmp_outside_double
+    );
+    assert_eq!(
+        (still.plan_zmp_outside_single, still.plan_zmp_outside_double),
+        (0, 0)
+    );
+    assert!(still.plan_zmp_min_margin > 0.0);
+    assert!(
+        dance.plan_zmp_outside_single > 100,
+        "{}",
+        dance.plan_zmp_outside_single
+    );
+}

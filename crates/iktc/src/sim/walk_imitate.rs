@@ -24,7 +24,9 @@
 
 use std::time::Instant;
 
-use nalgebra::{Isometry3, Rotation2, Translation3, UnitQuaternion, Vector2, Vector3, Vector6};
+use nalgebra::{
+    Isometry3, Quaternion, Rotation2, Translation3, UnitQuaternion, Vector2, Vector3, Vector6,
+};
 use serde::Serialize;
 
 use super::health::{HealthMonitor, HealthReport, Verdict};
@@ -41,8 +43,8 @@ use crate::model::{Robot, State};
 use crate::motion::RobotReferences;
 use crate::task::{ComReference, FrameReference};
 use crate::walk::{
-    smoothstep, FootState, FootstepPlan, Phase, PreviewSettings, Side, SupportPolygon, WalkSample,
-    WalkSettings, WalkingPattern,
+    link_masses, multibody_zmp, smoothstep, FootState, FootstepPlan, Phase, PreviewSettings, Side,
+    SupportPolygon, WalkSample, WalkSettings, WalkingPattern,
 };
 
 /// A push on the COM during the walk.
@@ -192,6 +194,16 @@ pub struct WalkSummary {
     pub min_zmp_margin: f64,
     /// The measured ZMP stayed inside the support polygon at every tick.
     pub zmp_inside: bool,
+    /// Single-support ticks where the ZMP of the commanded motion itself (the links' masses
+    /// and inertias, [`multibody_zmp`]) is outside the pattern's support polygon, or the body
+    /// falls faster than gravity: no plant can follow the plan there without tipping, what
+    /// the pattern's cart-table model does not see (the upper body's own motion).
+    pub plan_zmp_outside_single: usize,
+    /// The same in double support.
+    pub plan_zmp_outside_double: usize,
+    /// Smallest signed distance of the commanded motion's ZMP inside the support polygon \[m\]
+    /// (−∞ where the body falls faster than gravity).
+    pub plan_zmp_min_margin: f64,
     /// Largest horizontal error of a stance foot's ankle against its reference \[m\].
     pub max_stance_foot_error: f64,
     /// Largest horizontal drift of a stance foot within one stance interval \[m\].
@@ -747,7 +759,16 @@ pub fn run_walk_imitate(
         .iter()
         .map(|p| (p.start, p.end, p.phase))
         .collect();
-    let summary = summarize(robot, cfg, ctl, &steps, pattern.duration(), health.report())?;
+    let plan_zmp = plan_zmp_figures(robot, cfg, pattern, origin, &steps)?;
+    let summary = summarize(
+        robot,
+        cfg,
+        ctl,
+        &steps,
+        pattern.duration(),
+        health.report(),
+        plan_zmp,
+    )?;
     Ok(WalkRun {
         steps,
         footsteps,
@@ -756,6 +777,62 @@ pub fn run_walk_imitate(
     })
 }
 
+/// The ZMP of the commanded motion ([`multibody_zmp`] of the recorded links' poses, the ground
+/// at the soles' start height) against the pattern's support polygon of each tick: (ticks
+/// outside in single support, in double support, the smallest margin \[m\]). A tick where the
+/// body falls faster than gravity counts as outside.
+fn plan_zmp_figures(
+    robot: &Robot,
+    cfg: &WalkImitateConfig,
+    pattern: &WalkingPattern,
+    origin: Vector2<f64>,
+    steps: &[WalkStep],
+) -> Result<(usize, usize, f64)> {
+    if steps.len() < 3 {
+        return Ok((0, 0, f64::NAN));
+    }
+    let poses: Vec<Vec<Isometry3<f64>>> = steps
+        .iter()
+        .map(|s| {
+            s.links
+                .iter()
+                .zip(&s.link_rotations)
+                .map(|(p, r)| {
+                    Isometry3::from_parts(
+                        Translation3::new(p[0], p[1], p[2]),
+                        UnitQuaternion::new_normalize(Quaternion::new(r[3], r[0], r[1], r[2])),
+                    )
+                })
+                .collect()
+        })
+        .collect();
+    let ground = steps[0].feet[0][2].min(steps[0].feet[1][2]) - cfg.imitate.support.ankle_height;
+    let zmp = multibody_zmp(
+        &link_masses(robot),
+        &poses,
+        cfg.imitate.dt,
+        ground,
+        cfg.preview.gravity,
+    )?;
+    let mut polygon = SupportPolygon::default();
+    let (mut single, mut double, mut worst) = (0, 0, f64::INFINITY);
+    for (s, p) in steps.iter().zip(&zmp) {
+        pattern.support_polygon_into(s.t, &mut polygon)?;
+        let m = p.map_or(f64::NEG_INFINITY, |p| {
+            polygon.margin((p[0] - origin.x, p[1] - origin.y))
+        });
+        if m < 0.0 {
+            match s.phase {
+                Phase::SingleSupport { .. } => single += 1,
+                Phase::DoubleSupport => double += 1,
+            }
+        }
+        worst = worst.min(m);
+    }
+    Ok((single, double, worst))
+}
+
+#[allow(clippy::too_many_arguments)]
 fn summarize(
     robot: &Robot,
     cfg: &WalkImitateConfig,
@@ -763,6 +840,7 @@ fn summarize(
     steps: &[WalkStep],
     duration: f64,
     health: HealthReport,
+    plan_zmp: (usize, usize, f64),
 ) -> Result<WalkSummary> {
     let dt = cfg.imitate.dt;
     let names = robot.dof_names();
@@ -839,6 +917,9 @@ fn summarize(
         duration,
         min_zmp_margin: min_margin,
         zmp_inside: min_margin >= 0.0,
+        plan_zmp_outside_single: plan_zmp.0,
+        plan_zmp_outside_double: plan_zmp.1,
+        plan_zmp_min_margin: plan_zmp.2,
         max_stance_foot_error: max_err,
         max_stance_foot_slip: max_slip,
         worst_margins: worst,
