@@ -748,13 +748,15 @@ def run_walking(steps: int = 4, step_length: float = 0.1, clip: str = "humanoid3
                 settle: float = 0.5, rate_feedforward: bool = True, narrow=None,
                 kp: float = KP, kv: float = KV, damping: bool = False, cases=None,
                 offset_feedforward: bool = True, feedforward: bool = True,
-                replay: str | None = None, push=None) -> dict:
+                replay: str | None = None, push=None, zmp_passes: int = 1) -> dict:
     """Walking `steps` footsteps while imitating the clip, on the MuJoCo G1 (`narrow`: narrowed
     joint ranges, as for `iktc.Walking`). With `damping` the measured ZMP (ankle sensors) is fed
     back every tick through the damping controller (`iktc.Walking(damping=True, cases=cases,
     offset_feedforward=offset_feedforward)`), else the loop is open. With `feedforward` the
     servos also get the plan's joint torques (``Feedforward``; the feet on the ground are those
-    whose reference is within ``ON_GROUND`` of its start height). Returns the figures: stayed
+    whose reference is within ``ON_GROUND`` of its start height). `zmp_passes` passes of the
+    ZMP correction (``iktc.Walking(zmp_passes=…)``: where the plan's own ZMP comes within 5 mm
+    of the polygon's edge, the COM reference is moved so that it does not). Returns the figures: stayed
     up (and when it fell), pelvis height, base tilt, the largest horizontal error of a standing
     foot against its reference (slip), the ZMP from the ankle sensors against the support
     polygon of the feet carrying load (normal force above ``MIN_NORMAL_FORCE``: its margin,
@@ -769,7 +771,7 @@ def run_walking(steps: int = 4, step_length: float = 0.1, clip: str = "humanoid3
     if not offset_feedforward:
         kw["offset_feedforward"] = False
     walk = iktc.Walking(robot, iktc.load_motion(clip), steps=steps, step_length=step_length,
-                        narrow=narrow, damping=damping, **kw)
+                        narrow=narrow, damping=damping, zmp_passes=zmp_passes, **kw)
     plant = Plant(robot, kp=kp, kv=kv)
     plant.set_state(walk.q)
     z0 = [f[2, 3] for f in walk.feet0()]
@@ -815,7 +817,7 @@ def run_walking(steps: int = 4, step_length: float = 0.1, clip: str = "humanoid3
     # The plan's ZMP against the same polygons: replayed (the plan does not see the plant
     # without the damping controller; with it, the ZMP of the commanded motion).
     replay = iktc.Walking(robot, iktc.load_motion(clip), steps=steps, step_length=step_length,
-                          narrow=narrow)
+                          narrow=narrow, zmp_passes=zmp_passes)
     for p in planned_zmp(plant, qs):
         replay.tick()
         plan_margins.append(replay.support_margin(tuple(p)) if np.all(np.isfinite(p)) else None)
@@ -842,6 +844,7 @@ def run_walking(steps: int = 4, step_length: float = 0.1, clip: str = "humanoid3
         "servo_limit_flip_ticks": int(np.count_nonzero(flips)),
         "knee_plan_min_rad": float(np.min(np.array(qs)[:, knees])),
         "forward_progress_m": float(plant.data.xpos[plant.pelvis][0] - walk.feet0()[0][0, 3]),
+        "zmp_corrections_m": walk.zmp_corrections(),
     }
     for name in ("single", "double"):
         sel = ph == name

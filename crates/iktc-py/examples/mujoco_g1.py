@@ -6,7 +6,7 @@
     python crates/iktc-py/examples/mujoco_g1.py balance [--damping 0.72] [--designs 0.3,0.9]
         [--json out.json]
     python crates/iktc-py/examples/mujoco_g1.py walking [--steps 4] [--clip humanoid3d_walk]
-        [--hold-upper-body] [--no-feedforward] [--json out.json] [--replay out.html]
+        [--hold-upper-body] [--no-feedforward] [--zmp-passes 1] [--json out.json] [--replay out.html]
     python crates/iktc-py/examples/mujoco_g1.py causes [--json out.json]
 
 `standing` prints the run's figures (stayed up, pelvis height, base tilt, foot slip, ZMP margin
@@ -101,6 +101,8 @@ def main() -> None:
                     help="walking: every frame of the clip its first (upper body and pelvis held)")
     ap.add_argument("--no-feedforward", action="store_true",
                     help="walking: the servos without the plan's joint torques")
+    ap.add_argument("--zmp-passes", type=int, default=1,
+                    help="walking: passes of the ZMP correction of the pattern (0: the cart-table alone)")
     ap.add_argument("--damping", type=float, default=0.72, help="design damping ratio [–]")
     ap.add_argument("--designs", help="balance: also push with these design ratios, e.g. "
                     "0.3,0.5,0.72,0.9, and print the measured ones")
@@ -127,7 +129,7 @@ def main() -> None:
             import tempfile
             clip = g1_sim.held_clip(pathlib.Path(tempfile.mkdtemp()) / f"held_{a.clip}.txt", a.clip)
         s = g1_sim.run_walking(steps=a.steps, clip=clip, feedforward=not a.no_feedforward,
-                               replay=a.replay)
+                               replay=a.replay, zmp_passes=a.zmp_passes)
     else:
         s = standing(a)
     print(json.dumps(s, indent=1))

@@ -32,7 +32,10 @@ type PatternZmp = (Vector2<f64>, f64);
 /// False gives the COM task the controller's offset without its rates fed forward (as
 /// `g1_sim`'s identification sweeps it); `smoothing` [Hz] and `approach_rate` [1/s] as in
 /// `Imitation` (default 6 Hz and the imitation's approach, √k_p = 10 /s; None and 0 turn
-/// them off).
+/// them off); `zmp_passes` passes of the ZMP correction (`WalkingController::correct_zmp`:
+/// where the plan's own multibody ZMP comes within 5 mm of the support polygon's edge, the COM
+/// reference is moved by preview control so that it does not; 0, the default, is the paper's
+/// cart-table pattern).
 #[pyclass(name = "Walking", module = "iktc")]
 pub struct PyWalking {
     ctl: WalkingController,
@@ -52,7 +55,8 @@ impl PyWalking {
     #[new]
     #[pyo3(signature = (robot, motion, *, map=None, steps=4, step_length=None, narrow=None,
                         damping=false, cases=None, offset_feedforward=true,
-                        smoothing=Some(iktc::sim::IMITATE_SMOOTHING), approach_rate=None))]
+                        smoothing=Some(iktc::sim::IMITATE_SMOOTHING), approach_rate=None,
+                        zmp_passes=0))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -67,6 +71,7 @@ impl PyWalking {
         offset_feedforward: bool,
         smoothing: Option<f64>,
         approach_rate: Option<f64>,
+        zmp_passes: usize,
     ) -> PyResult<Self> {
         let profile = robot.required_profile("walking", "feet, pelvis and posture")?;
         let mut cfg = profile
@@ -101,6 +106,7 @@ impl PyWalking {
             cfg.cases.validate().map_err(to_py)?;
         }
         cfg.noise_std = 0.0;
+        cfg.zmp_passes = zmp_passes;
         let map = resolve_map(robot, motion, map)?;
         let clip = motion.clip()?;
         let r = &robot.robot;
@@ -221,6 +227,12 @@ impl PyWalking {
             .support_polygon_into(t, &mut self.polygon)
             .map_err(to_py)?;
         Ok(self.polygon.margin((point.0 - o.x, point.1 - o.y)))
+    }
+
+    /// Per ZMP correction pass, the largest move [m] it asked of the plan's ZMP (empty
+    /// without `zmp_passes`).
+    fn zmp_corrections(&self) -> Vec<f64> {
+        self.ctl.zmp_corrections().to_vec()
     }
 
     /// The initial ankle poses (right, then left), 4 × 4.

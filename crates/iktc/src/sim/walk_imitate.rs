@@ -47,6 +47,14 @@ use crate::walk::{
     SupportPolygon, WalkSample, WalkSettings, WalkingPattern,
 };
 
+/// How far inside the support polygon the ZMP correction brings the plan's ZMP \[m\]
+/// ([`WalkingController::correct_zmp`]): a quarter of G1's 5 cm sole width, above the
+/// measured ZMP's lag of a few millimetres behind the plan's in MuJoCo.
+pub const ZMP_CORRECTION_MARGIN: f64 = 0.005;
+
+/// Bisection steps of the ZMP correction's move (2⁻⁴⁰ of the distance to the reference).
+const BISECTIONS: usize = 40;
+
 /// A push on the COM during the walk.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Push {
@@ -85,6 +93,10 @@ pub struct WalkImitateConfig {
     /// The initial difference between the robot's COM and the pattern's is blended out over
     /// this time \[s\] (quintic, zero rate and acceleration at both ends).
     pub com_blend_time: f64,
+    /// Passes of the ZMP correction of the COM reference
+    /// ([`WalkingController::correct_zmp`]); 0 plans on the cart-table alone (the paper's
+    /// pattern, the default).
+    pub zmp_passes: usize,
 }
 
 impl WalkImitateConfig {
@@ -115,6 +127,7 @@ impl WalkImitateConfig {
             noise_std: 1e-3,
             seed: 7,
             com_blend_time: 0.5,
+            zmp_passes: 0,
         })
     }
 }
@@ -362,6 +375,13 @@ pub struct WalkingController {
     dcd_prev: Vector2<f64>,
     /// Whether Δc's rate and acceleration are fed forward to the COM task.
     offset_feedforward: bool,
+    /// The ground plane's height \[m\] (the soles at the start).
+    ground: f64,
+    /// Per tick, the multibody correction of the COM reference, world x then y, each
+    /// (position \[m\], rate \[m/s\], acceleration \[m/s²\]); empty without correction.
+    com_correction: Vec<[[f64; 3]; 2]>,
+    /// Per ZMP correction pass, the largest move it asked of the ZMP \[m\].
+    multibody_residuals: Vec<f64>,
 }
 
 impl WalkingController {
@@ -443,7 +463,8 @@ impl WalkingController {
             com0.x - origin.x - s0.com.position.x,
             com0.y - origin.y - s0.com.position.y,
         );
-        Ok(Self {
+        let ground = r0.translation.z.min(l0.translation.z) - support.ankle_height;
+        let mut wc = Self {
             feet_refs: [FrameReference::hold(r0), FrameReference::hold(l0)],
             feet,
             ctl,
@@ -461,7 +482,109 @@ impl WalkingController {
             dc_prev: Vector2::zeros(),
             dcd_prev: Vector2::zeros(),
             offset_feedforward: true,
-        })
+            ground,
+            com_correction: Vec::new(),
+            multibody_residuals: Vec::new(),
+        };
+        for _ in 0..cfg.zmp_passes {
+            wc.correct_zmp(robot)?;
+        }
+        Ok(wc)
+    }
+
+    /// One pass of the ZMP correction, after the second stage of Kajita et al. 2003 but only
+    /// where the plan is infeasible. A copy of this controller runs the whole walk without the
+    /// damping controller; the ZMP of its links' motion `p_mb` ([`multibody_zmp`]) is taken,
+    /// tick by tick, against the pattern's support polygon: where it is less than
+    /// [`ZMP_CORRECTION_MARGIN`] inside (or outside), `Δp` is the shortest move along the
+    /// segment to the pattern's ZMP reference `p_target` that brings it that far inside,
+    /// elsewhere 0. The COM that the preview controller makes the cart-table follow for `Δp`
+    /// is added to the COM reference (with its rate and acceleration): moving the cart-table's
+    /// COM by Δc moves its ZMP by Δp, and the links' ZMP responds to the COM as the cart-table's
+    /// does as far as the upper body's own motion is unchanged. `p_target` is the cart-table
+    /// ZMP of the COM the controller asks for: the pattern's plus the blend of the initial
+    /// offset, `b − (z_c/g) b̈`. A plan already inside by the margin is left as it is. Returns
+    /// the largest `|Δp|` \[m\] of this pass (also in
+    /// [`WalkingController::zmp_corrections`]). Allocates (once per pass, not per tick).
+    pub fn correct_zmp(&mut self, robot: &Robot) -> Result<f64> {
+        let n = self.ticks();
+        let mut sim = self.clone();
+        sim.damping = false;
+        let mut poses = Vec::with_capacity(n);
+        let mut target = Vec::with_capacity(n);
+        let (zc, g) = (
+            self.com0.z - self.ground,
+            self.pattern.controller().settings().gravity,
+        );
+        for k in 0..n {
+            let wt = sim.tick(robot, k, [0.0, 0.0])?;
+            poses.push(sim.ctl.kinematics().link_poses().to_vec());
+            let t = k as f64 * self.dt;
+            let (s, _, sdd) = smoothstep(0.0, self.com_blend_time, t);
+            let blend = self.blend0 * (1.0 - s) + self.blend0 * (zc / g) * sdd;
+            let m = wt.sample.zmp_model;
+            target.push([m.0 + self.origin.x + blend.x, m.1 + self.origin.y + blend.y]);
+            sim.integrate(robot)?;
+        }
+        let zmp = multibody_zmp(&link_masses(robot), &poses, self.dt, self.ground, g)?;
+        let mut polygon = SupportPolygon::default();
+        let mut dx = vec![0.0; n];
+        let mut dy = vec![0.0; n];
+        for k in 0..n {
+            // A tick where the body falls faster than gravity has no ZMP to move.
+            let Some(p) = zmp[k] else { continue };
+            self.pattern
+                .support_polygon_into(k as f64 * self.dt, &mut polygon)?;
+            let local = (p[0] - self.origin.x, p[1] - self.origin.y);
+            if polygon.margin(local) >= ZMP_CORRECTION_MARGIN {
+                continue;
+            }
+            let r = (target[k][0] - self.origin.x, target[k][1] - self.origin.y);
+            // The fraction of the way to the reference that reaches the margin (bisection; the
+            // whole way if the reference itself is closer to the edge).
+            let (mut lo, mut hi) = (0.0, 1.0);
+            if polygon.margin(r) >= ZMP_CORRECTION_MARGIN {
+                for _ in 0..BISECTIONS {
+                    let mid = 0.5 * (lo + hi);
+                    let q = (
+                        local.0 + mid * (r.0 - local.0),
+                        local.1 + mid * (r.1 - local.1),
+                    );
+                    if polygon.margin(q) >= ZMP_CORRECTION_MARGIN {
+                        hi = mid;
+                    } else {
+                        lo = mid;
+                    }
+                }
+            }
+            dx[k] = hi * (r.0 - local.0);
+            dy[k] = hi * (r.1 - local.1);
+        }
+        let residual = dx
+            .iter()
+            .zip(&dy)
+            .map(|(x, y)| x.hypot(*y))
+            .fold(0.0, f64::max);
+        let ctrl = self.pattern.controller();
+        let (cx, cy) = (ctrl.track(&dx)?, ctrl.track(&dy)?);
+        if self.com_correction.len() != n {
+            self.com_correction = vec![[[0.0; 3]; 2]; n];
+        }
+        for (c, (sx, sy)) in self.com_correction.iter_mut().zip(cx.iter().zip(&cy)) {
+            for (axis, sample) in c.iter_mut().zip([sx, sy]) {
+                for (v, d) in axis.iter_mut().zip(sample.state.iter()) {
+                    *v += d;
+                }
+            }
+        }
+        self.multibody_residuals.push(residual);
+        Ok(residual)
+    }
+
+    /// Per ZMP correction pass, the largest move `|Δp|` it asked of the ZMP \[m\] (empty
+    /// without correction; a pass that found the plan feasible reports 0).
+    pub fn zmp_corrections(&self) -> &[f64] {
+        &self.multibody_residuals
     }
 
     /// Whether the damping controller's COM offset Δc reaches the COM task with its backward
@@ -543,7 +666,9 @@ impl WalkingController {
         let (b, bd, bdd) = (1.0 - s_blend, -sd_blend, -sdd_blend);
         let (origin, blend0) = (self.origin, self.blend0);
         let cp = s.com.position;
-        let nominal = Vector2::new(cp.x + origin.x, cp.y + origin.y) + blend0 * b;
+        let corr = self.com_correction.get(k).copied().unwrap_or([[0.0; 3]; 2]);
+        let nominal =
+            Vector2::new(cp.x + origin.x + corr[0][0], cp.y + origin.y + corr[1][0]) + blend0 * b;
         let cref = nominal + offset_world;
         let dcd = (offset_world - self.dc_prev) / dt;
         let dcdd = (dcd - self.dcd_prev) / dt;
@@ -557,13 +682,13 @@ impl WalkingController {
         self.ctl.set_com_override(Some(ComReference {
             position: Vector3::new(cref.x, cref.y, self.com0.z),
             velocity: Vector3::new(
-                s.com.velocity.x + blend0.x * bd + dcd.x,
-                s.com.velocity.y + blend0.y * bd + dcd.y,
+                s.com.velocity.x + blend0.x * bd + dcd.x + corr[0][1],
+                s.com.velocity.y + blend0.y * bd + dcd.y + corr[1][1],
                 0.0,
             ),
             acceleration: Vector3::new(
-                s.com.acceleration.x + blend0.x * bdd + dcdd.x,
-                s.com.acceleration.y + blend0.y * bdd + dcdd.y,
+                s.com.acceleration.x + blend0.x * bdd + dcdd.x + corr[0][2],
+                s.com.acceleration.y + blend0.y * bdd + dcdd.y + corr[1][2],
                 0.0,
             ),
         }));
