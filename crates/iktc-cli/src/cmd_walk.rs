@@ -55,6 +55,12 @@ pub struct WalkArgs {
     /// The motion as captured, not low-passed.
     #[arg(long)]
     pub no_smoothing: bool,
+    /// Passes of the ZMP correction of the walking pattern: where the commanded motion's own
+    /// ZMP (its links' masses and inertias) comes within 5 mm of the support polygon's edge,
+    /// the COM reference is moved by preview control so that it does not [default: 0, the
+    /// paper's cart-table pattern].
+    #[arg(long, default_value_t = 0)]
+    pub zmp_passes: usize,
 }
 
 impl WalkArgs {
@@ -106,6 +112,7 @@ fn config(
         .context("the robot profile's walking settings")?;
     cfg.steps = w.steps;
     cfg.damping = !w.no_damping;
+    cfg.zmp_passes = w.zmp_passes;
     if let Some(l) = w.step_length {
         cfg.step_length = l;
     }
@@ -515,6 +522,7 @@ pub fn walk_section(out: &Path) -> Result<Section> {
         push: None,
         smoothing: None,
         no_smoothing: false,
+        zmp_passes: 0,
     };
     let dir = out.join("walk");
     let (figs, with, without) = run_walk(&e, &profile, &imitate, &w, &dir)?;
