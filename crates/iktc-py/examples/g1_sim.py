@@ -144,9 +144,7 @@ class Plant:
     def set_state(self, q: np.ndarray) -> None:
         """Places the robot at iktc's q (base position, quaternion x y z w, joints), at rest."""
         d = self.data
-        d.qpos[:3] = q[:3]
-        d.qpos[3:7] = [q[6], q[3], q[4], q[5]]  # MuJoCo's quaternion is w x y z
-        d.qpos[self.qadr] = q[7:]
+        d.qpos[:] = to_mujoco_qpos(self, q)
         d.qvel[:] = 0.0
         d.ctrl[self.act] = q[7:]
         d.ctrl[self.act_rate] = 0.0
@@ -219,7 +217,8 @@ MIN_SHARE = 1e-6
 
 
 def to_mujoco_qpos(plant: "Plant", q: np.ndarray) -> np.ndarray:
-    """MuJoCo's qpos of iktc's q (base position, quaternion x y z w, joints)."""
+    """MuJoCo's qpos of iktc's q (base position, quaternion x y z w, joints; MuJoCo's
+    quaternion is w x y z). Every coordinate of the plant's qpos is one of these."""
     x = np.zeros(plant.model.nq)
     x[:3] = q[:3]
     x[3:7] = [q[6], q[3], q[4], q[5]]
@@ -1021,12 +1020,7 @@ def write_replay(path, plant: Plant, qpos_physics: list, q_plan: list, title: st
     def frames(rows, from_plan):
         out = []
         for r in rows:
-            if from_plan:
-                d.qpos[:3] = r[:3]
-                d.qpos[3:7] = [r[6], r[3], r[4], r[5]]
-                d.qpos[plant.qadr] = r[7:]
-            else:
-                d.qpos[:] = r
+            d.qpos[:] = to_mujoco_qpos(plant, r) if from_plan else r
             mujoco.mj_kinematics(m, d)
             out.append([[round(float(v), 4) for v in d.xpos[b]] for b in bodies])
         return out

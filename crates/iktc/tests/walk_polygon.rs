@@ -91,3 +91,19 @@ fn four_soles_on_a_square_give_the_closed_form_hull() {
     five.set_hull_of_sole_poses(&[], 0.2, 0.1);
     assert!(five.vertices().is_empty());
 }
+
+/// `pull_towards` on a 0.2 m × 0.1 m sole centred at the origin, margin 0.01 m: a point already
+/// that far inside stays; one outside moves along the segment to the target until it is 0.01 m
+/// inside (here the edge x = 0.1 − 0.01, a closed form); a target itself nearer the edge is
+/// returned.
+#[test]
+fn pull_towards_stops_at_the_margin_on_the_segment() {
+    let mut p = SupportPolygon::default();
+    p.set_sole(&Pose2::new(0.0, 0.0, 0.0), 0.2, 0.1);
+    assert_eq!(p.pull_towards((0.05, 0.0), (0.0, 0.0), 0.01), (0.05, 0.0));
+    let q = p.pull_towards((0.3, 0.02), (0.0, 0.0), 0.01);
+    assert!((q.0 - 0.09).abs() < 1e-10, "{q:?}");
+    assert!((q.1 - 0.02 * 0.09 / 0.3).abs() < 1e-10, "{q:?}");
+    assert!((p.margin(q) - 0.01).abs() < 1e-10);
+    assert_eq!(p.pull_towards((0.3, 0.0), (0.095, 0.0), 0.01), (0.095, 0.0));
+}

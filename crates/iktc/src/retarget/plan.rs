@@ -196,28 +196,12 @@ fn torso_frame(
 /// Pulls `p` into `polygon` until its margin is at least `margin` \[m\], along the segment to the
 /// polygon's vertex centroid (bisection).
 fn pull_inside(polygon: &SupportPolygon, p: (f64, f64), margin: f64) -> (f64, f64) {
-    if polygon.margin(p) >= margin {
-        return p;
-    }
     let v = polygon.vertices();
     let n = v.len().max(1) as f64;
     let c = v
         .iter()
         .fold((0.0, 0.0), |a, q| (a.0 + q.0 / n, a.1 + q.1 / n));
-    if polygon.margin(c) < margin {
-        return c;
-    }
-    let (mut lo, mut hi) = (0.0, 1.0); // fraction of the way from c to p
-    for _ in 0..40 {
-        let mid = 0.5 * (lo + hi);
-        let q = (c.0 + mid * (p.0 - c.0), c.1 + mid * (p.1 - c.1));
-        if polygon.margin(q) >= margin {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    (c.0 + lo * (p.0 - c.0), c.1 + lo * (p.1 - c.1))
+    polygon.pull_towards(p, c, margin)
 }
 
 fn moving_average(x: &mut [Vector3<f64>], half: usize) {

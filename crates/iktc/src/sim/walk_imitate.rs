@@ -52,9 +52,6 @@ use crate::walk::{
 /// measured ZMP's lag of a few millimetres behind the plan's in MuJoCo.
 pub const ZMP_CORRECTION_MARGIN: f64 = 0.005;
 
-/// Bisection steps of the ZMP correction's move (2⁻⁴⁰ of the distance to the reference).
-const BISECTIONS: usize = 40;
-
 /// A push on the COM during the walk.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Push {
@@ -381,7 +378,7 @@ pub struct WalkingController {
     /// (position \[m\], rate \[m/s\], acceleration \[m/s²\]); empty without correction.
     com_correction: Vec<[[f64; 3]; 2]>,
     /// Per ZMP correction pass, the largest move it asked of the ZMP \[m\].
-    multibody_residuals: Vec<f64>,
+    zmp_corrections: Vec<f64>,
 }
 
 impl WalkingController {
@@ -484,7 +481,7 @@ impl WalkingController {
             offset_feedforward: true,
             ground,
             com_correction: Vec::new(),
-            multibody_residuals: Vec::new(),
+            zmp_corrections: Vec::new(),
         };
         for _ in 0..cfg.zmp_passes {
             wc.correct_zmp(robot)?;
@@ -536,29 +533,10 @@ impl WalkingController {
             self.pattern
                 .support_polygon_into(k as f64 * self.dt, &mut polygon)?;
             let local = (p[0] - self.origin.x, p[1] - self.origin.y);
-            if polygon.margin(local) >= ZMP_CORRECTION_MARGIN {
-                continue;
-            }
             let r = (target[k][0] - self.origin.x, target[k][1] - self.origin.y);
-            // The fraction of the way to the reference that reaches the margin (bisection; the
-            // whole way if the reference itself is closer to the edge).
-            let (mut lo, mut hi) = (0.0, 1.0);
-            if polygon.margin(r) >= ZMP_CORRECTION_MARGIN {
-                for _ in 0..BISECTIONS {
-                    let mid = 0.5 * (lo + hi);
-                    let q = (
-                        local.0 + mid * (r.0 - local.0),
-                        local.1 + mid * (r.1 - local.1),
-                    );
-                    if polygon.margin(q) >= ZMP_CORRECTION_MARGIN {
-                        hi = mid;
-                    } else {
-                        lo = mid;
-                    }
-                }
-            }
-            dx[k] = hi * (r.0 - local.0);
-            dy[k] = hi * (r.1 - local.1);
+            let q = polygon.pull_towards(local, r, ZMP_CORRECTION_MARGIN);
+            dx[k] = q.0 - local.0;
+            dy[k] = q.1 - local.1;
         }
         let residual = dx
             .iter()
@@ -577,14 +555,14 @@ impl WalkingController {
                 }
             }
         }
-        self.multibody_residuals.push(residual);
+        self.zmp_corrections.push(residual);
         Ok(residual)
     }
 
     /// Per ZMP correction pass, the largest move `|Δp|` it asked of the ZMP \[m\] (empty
     /// without correction; a pass that found the plan feasible reports 0).
     pub fn zmp_corrections(&self) -> &[f64] {
-        &self.multibody_residuals
+        &self.zmp_corrections
     }
 
     /// Whether the damping controller's COM offset Δc reaches the COM task with its backward

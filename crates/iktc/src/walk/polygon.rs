@@ -150,4 +150,31 @@ impl SupportPolygon {
     pub fn contains(&self, p: (f64, f64), margin: f64) -> bool {
         self.margin(p) >= margin
     }
+
+    /// `p` pulled along the segment to `toward` until it is at least `margin` \[m\] inside:
+    /// `p` itself if it already is, `toward` if `toward` is not, else the point of the segment
+    /// nearest `p` that is (bisection of the fraction from `toward` to `p`, to 2⁻⁴⁰).
+    pub fn pull_towards(&self, p: (f64, f64), toward: (f64, f64), margin: f64) -> (f64, f64) {
+        if self.margin(p) >= margin {
+            return p;
+        }
+        let c = toward;
+        if self.margin(c) < margin {
+            return c;
+        }
+        let (mut lo, mut hi) = (0.0, 1.0); // fraction of the way from c to p
+        for _ in 0..PULL_BISECTIONS {
+            let mid = 0.5 * (lo + hi);
+            let q = (c.0 + mid * (p.0 - c.0), c.1 + mid * (p.1 - c.1));
+            if self.margin(q) >= margin {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        (c.0 + lo * (p.0 - c.0), c.1 + lo * (p.1 - c.1))
+    }
 }
+
+/// Bisection steps of [`SupportPolygon::pull_towards`].
+const PULL_BISECTIONS: usize = 40;
