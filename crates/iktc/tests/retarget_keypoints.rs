@@ -19,20 +19,20 @@ const CMU_MAX_PELVIS_DEG: f64 = 90.0;
 /// tighter bound on every clip).
 const CMU_MAX_SLIP_MM: f64 = 150.0;
 
-/// Largest stance slip on every shared clip and both robots \[mm\] (0.2.0 with the floor and
-/// the landing rule: at most 3.5 mm, JVRC-1 dance_a; up to 60 mm before, landings forced at
-/// speed).
-const MAX_SLIP_MM: f64 = 4.0;
+/// Largest stance slip on every shared clip and both robots \[mm\]: the target (0.2.0:
+/// at most 1.9 mm, G1 scaled_131_02, with the held feet's drift compensation and the sole
+/// latched where it touched; 3.8 mm before, JVRC-1 131_01; up to 60 mm before the floor and
+/// the landing rule, landings forced at speed).
+const MAX_SLIP_MM: f64 = 2.0;
 
 /// Deepest sole corner below the ground on every shared clip and both robots \[mm\] (0.2.0 with
-/// the swing feet's floor: at most 0.8 mm; up to 233 mm before). The floor asks the foot
+/// the swing feet's floor: at most 1.2 mm, G1 dance_a; up to 233 mm before). The floor asks the foot
 /// frame's vertical acceleration from its lowest corner's motion, so a foot turning while it
 /// lands dips by a fraction of a millimetre.
 const MAX_BELOW_MM: f64 = 2.0;
 
-/// The targets for every clip and robot: stance slip at most this \[mm\] ...
-const TARGET_SLIP_MM: f64 = 2.0;
-/// ... and no sole corner deeper below the ground than this \[mm\] (rounding, not contact).
+/// The target for every clip and robot: no sole corner deeper below the ground than
+/// this \[mm\] (rounding, not contact).
 const TARGET_BELOW_MM: f64 = 0.1;
 
 /// Every shared clip: the DeepMimic clips shipped with the crate and the CMU test clips.
@@ -193,13 +193,13 @@ fn every_shared_clip_onto_g1() {
     check_robot("g1");
 }
 
-/// The targets: stance feet slip at most [`TARGET_SLIP_MM`] and never go below the
-/// ground, on every shared clip and both robots. Not met in 0.2.0: slip up to 3.2 mm (G1,
-/// CMU 131_01; above 2 mm on four of the twelve runs) and soles up to 0.8 mm below the ground
-/// (the floor bounds the foot frame's acceleration, not each corner's).
+/// The target: soles never below the ground, on every shared clip and both robots,
+/// without the joint route's posture references. Not met in 0.2.0: up to 0.8 mm (G1, CMU
+/// 131_01, a swing foot turning while the floor holds its ankle's height; JVRC-1 131_01
+/// 0.2 mm); the stance slip's target holds there too (at most 1.6 mm).
 #[test]
-#[ignore = "target not met in 0.2.0: slip up to 3.2 mm, soles up to 0.8 mm below the ground"]
-fn stance_feet_hold_and_stay_above_ground() {
+#[ignore = "target not met in 0.2.0: soles up to 0.8 mm below the ground"]
+fn soles_stay_above_ground() {
     let mut failures = Vec::new();
     for name in ["jvrc1", "g1"] {
         let profile = RobotProfile::builtin(name).unwrap();
@@ -209,7 +209,7 @@ fn stance_feet_hold_and_stay_above_ground() {
             let q = retarget_keypoints(&profile, &kp, None, &KeypointSettings::default())
                 .unwrap()
                 .quality;
-            if q.slip_mm > TARGET_SLIP_MM || q.below_ground_mm > TARGET_BELOW_MM {
+            if q.slip_mm > MAX_SLIP_MM || q.below_ground_mm > TARGET_BELOW_MM {
                 failures.push(format!(
                     "{name} {}: slip {:.1} mm, below the ground {:.1} mm",
                     path.display(),
@@ -222,8 +222,11 @@ fn stance_feet_hold_and_stay_above_ground() {
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
-/// Largest joint speed \[rad/s\] of G1 after `seconds` on the held first frame of `clip`.
-fn held_frame_speed(clip: &str, posture_weight: f64, seconds: f64) -> f64 {
+/// Median over the ticks from `from` to `to` seconds \[s\] of G1's largest joint speed
+/// \[rad/s\] on the held first frame of `clip` (the motion on a held frame does not come to
+/// rest: the swing foot of `humanoid3d_walk`'s first frame hovers at the floor's threshold and
+/// the stack switches with it, so a single sample says little).
+fn held_frame_speed(clip: &str, posture_weight: f64, (from, to): (f64, f64)) -> f64 {
     let profile = RobotProfile::builtin("g1").unwrap();
     let robot = profile.robot().unwrap();
     let kp = iktc::retarget::builtin_motion(clip)
@@ -235,26 +238,33 @@ fn held_frame_speed(clip: &str, posture_weight: f64, seconds: f64) -> f64 {
         ..KeypointSettings::default()
     };
     let mut c = iktc::retarget::keypoint_controller(&profile, &kp, None, &s).unwrap();
-    for _ in 0..(seconds / s.dt).round() as usize {
+    let base = robot.nv() - robot.n_active();
+    let mut speeds = Vec::new();
+    for k in 0..(to / s.dt).round() as usize {
         c.tick(0, true).unwrap();
         c.integrate().unwrap();
+        if k as f64 * s.dt >= from {
+            let v = c.state().qd.as_slice()[base..]
+                .iter()
+                .fold(0.0, |m: f64, v| m.max(v.abs()));
+            speeds.push(v);
+        }
     }
-    let base = robot.nv() - robot.n_active();
-    c.state().qd.as_slice()[base..]
-        .iter()
-        .fold(0.0, |m: f64, v| m.max(v.abs()))
+    speeds.sort_by(f64::total_cmp);
+    speeds[speeds.len() / 2]
 }
 
 /// On a held frame the references stand still. With the posture rows in the sixth level
-/// (`KeypointSettings::posture_weight`) G1's joints come nearly to rest within 3 s (0.28 and
-/// 0.46 rad/s on these clips); without them the arms keep moving at 14–16 rad/s, their
-/// accelerations on the box.
+/// (`KeypointSettings::posture_weight`) G1's fastest joint moves at a median 0.6–0.7 rad/s
+/// between 2 s and 6 s on these clips; without them the arms keep moving at 8–16 rad/s,
+/// their accelerations on the box.
 #[test]
 fn g1_slows_down_on_a_held_frame_with_the_posture_rows() {
     for clip in ["humanoid3d_dance_b", "humanoid3d_walk"] {
-        let with = held_frame_speed(clip, KeypointSettings::default().posture_weight, 3.0);
-        let without = held_frame_speed(clip, 0.0, 3.0);
-        eprintln!("{clip}: {with:.3} rad/s with the posture rows, {without:.3} without");
+        let window = (2.0, 6.0);
+        let with = held_frame_speed(clip, KeypointSettings::default().posture_weight, window);
+        let without = held_frame_speed(clip, 0.0, window);
+        eprintln!("{clip}: median {with:.3} rad/s with the posture rows, {without:.3} without");
         assert!(with < 1.0, "{clip}: {with} rad/s");
         assert!(without > 5.0, "{clip}: {without} rad/s");
     }

@@ -34,6 +34,7 @@
 
 mod body;
 mod contacts;
+mod drift;
 mod floor;
 mod plan;
 mod quality;
@@ -138,8 +139,9 @@ pub struct KeypointSettings {
     /// than [`LAND_TILT`]. A held foot decelerates under the first level's gains: a foot
     /// landing at speed `v` slides about `v / (e ω)` (`ω` = 20 rad/s, the held feet's
     /// gains), about 1.1 mm at the default; faster landings slide more, slower ones land later
-    /// and hold the feet for less of the clip's stance (at 0.03 m/s: slip at most 2.3 mm
-    /// instead of 3.5 mm over the shared clips, but mean keypoint errors up to 5.3 cm larger).
+    /// and hold the feet for less of the clip's stance (measured before the held feet's drift
+    /// compensation: at 0.03 m/s slip at most 2.3 mm instead of 3.5 mm over the shared clips,
+    /// but mean keypoint errors up to 5.3 cm larger).
     /// Until it lands the foot is brought down in the second level, above the ground
     /// ([`FLOOR_ENGAGE`]).
     pub land_speed: f64,

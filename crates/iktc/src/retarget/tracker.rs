@@ -39,10 +39,12 @@
 //! `land_speed` ([`KeypointSettings`]) and its sole tilted less than [`LAND_TILT`]; a foot
 //! that does not get there is not held (landing it at speed, or in the air, would make it
 //! slide or stamp). At landing the offset `δ = (x, y, ψ)_robot − (x, y, ψ)_plan` of the
-//! robot's foot from the plan's hold (horizontal position \[m\] and yaw \[rad\]) is latched and
-//! added to the foot's reference with the weight [`Plan::latch_weight`] (1 in stance, fading
-//! to 0 over the next swing): the foot is held where it landed, at rest, not pulled to where
-//! the plan wanted it.
+//! robot's foot from the plan's hold (horizontal position of the sole's centre \[m\] and yaw
+//! \[rad\]) is latched and added to the foot's reference with the weight [`Plan::latch_weight`]
+//! (1 in stance, fading to 0 over the next swing): the foot is held where its sole landed, at
+//! rest, not pulled to where the plan wanted it, and flattened about its sole's centre. A held
+//! foot's reference also carries the compensation of the integration's drift
+//! ([`super::drift`]).
 //!
 //! Each level is linearised as in the controller (`J_i q̈ = ẍ_d + k_v(ẋ_d − ẋ) + k_p(x_d − x)
 //! − J̇_i q̇`, eqs. 3, 11) and solved under the viable box of the robot's own joint limits with
@@ -50,9 +52,10 @@
 
 use std::sync::Arc;
 
-use nalgebra::{DVector, UnitQuaternion, Vector3};
+use nalgebra::{DVector, Point3, UnitQuaternion, Vector3};
 
 use super::body::RobotBody;
+use super::drift::StanceDrift;
 use super::floor::{engaged, floor_acceleration, lowest_corner, sole_corners};
 use super::plan::Plan;
 use super::KeypointSettings;
@@ -110,6 +113,8 @@ pub struct KeypointController {
     floor: [Floor; 2],
     /// The sole's corners in the foot frame \[m\].
     corners: [Vector3<f64>; 4],
+    /// The sole's centre in the foot frame \[m\]: a landing foot is held where it puts it.
+    sole: Vector3<f64>,
     /// The tasks' gains (the floor's approach uses them too).
     gains: Gains,
     /// Ticks with a swing foot's floor engaged so far.
@@ -117,6 +122,8 @@ pub struct KeypointController {
     robot: Arc<Robot>,
     posture_track: Vec<[Vec<f64>; 3]>,
     posture_ref: [Vec<f64>; 3],
+    /// The held feet's compensation of the integration's drift ([`super::drift`]).
+    drift: StanceDrift,
 }
 
 /// The controllers of one contact state: IKTC, and GF for the ticks where IKTC's answer leaves
@@ -146,8 +153,9 @@ struct Tasks {
 const FLOOR_AXES: Axes = Axes([false, false, true, true, true, false]);
 
 /// A foot lands only while its sole is tilted less than this from the ground \[rad\] (about
-/// 1.7°): the first level holds it flat, and flattening a foot tilted by `θ` moves its sole's
-/// centre by about `ankle_height · sin θ` (1 mm at G1's 0.035 m and this angle).
+/// 1.7°): the first level holds it flat, about the sole's centre where it landed (flattened
+/// about the ankle, its sole's centre would slide by `ankle_height · sin θ`: 3 mm on JVRC-1
+/// at this angle).
 pub const LAND_TILT: f64 = 0.03;
 
 /// Gains of the held feet's level (k_p \[1/s²\], k_v \[1/s\]; critically damped, ω = 20 rad/s),
@@ -155,7 +163,7 @@ pub const LAND_TILT: f64 = 0.03;
 /// drifted by up to 6.6 mm over a stance at the default 100 / 20 (G1, dance_a), the
 /// integration's error over a tick (constant q̈ over Δt on a whirling floating base) acting
 /// as a disturbance that the feedback pulls back in proportion to `1/k_p`. At 900 / 60 a run
-/// diverged (G1, punch).
+/// diverged (G1, punch). The disturbance is now also compensated ([`super::drift`]).
 const STANCE_GAINS: Gains = Gains {
     kp: 400.0,
     kv: 40.0,
@@ -240,6 +248,7 @@ fn set_references(
     t: &Tasks,
     p: &Plan,
     latch: &[(Vector3<f64>, f64); 2],
+    drift: &StanceDrift,
     floor: &[Floor; 2],
     posture_track: &[[Vec<f64>; 3]],
     posture_ref: &mut [Vec<f64>; 3],
@@ -247,7 +256,9 @@ fn set_references(
     hold: bool,
 ) -> Result<()> {
     for (i, h) in &t.feet {
-        ctl.set_frame_reference(*h, foot_reference(p, *i, k, hold, latch[*i]))?;
+        let mut r = foot_reference(p, *i, k, hold, latch[*i]);
+        r.acceleration += drift.compensation(*i);
+        ctl.set_frame_reference(*h, r)?;
     }
     for (i, h) in &t.floor {
         let mut r = foot_reference(p, *i, k, hold, latch[*i]);
@@ -410,6 +421,8 @@ impl KeypointController {
         s: &KeypointSettings,
     ) -> Result<Self> {
         let kin = Kinematics::new(&robot, &state)?;
+        let corners = sole_corners(support);
+        let sole = corners.iter().sum::<Vector3<f64>>() / 4.0;
         let mut stacks = Vec::with_capacity(16);
         for right in FootMode::ALL {
             for left in FootMode::ALL {
@@ -433,7 +446,8 @@ impl KeypointController {
             latch: [(Vector3::zeros(), 0.0); 2],
             kin,
             floor: [Floor::default(); 2],
-            corners: sole_corners(support),
+            corners,
+            sole,
             gains: s.gains,
             floor_ticks: 0,
             robot: robot.clone(),
@@ -441,6 +455,7 @@ impl KeypointController {
             landing: (s.land_height, s.land_speed),
             posture_track: posture.1,
             posture_ref: [vec![0.0; m], vec![0.0; m], vec![0.0; m]],
+            drift: StanceDrift::new(robot.nv()),
         })
     }
 
@@ -493,10 +508,18 @@ impl KeypointController {
                     let slow = v.fixed_rows::<3>(0).norm() <= speed;
                     let flat = (pose.rotation * Vector3::z()).z >= LAND_TILT.cos();
                     if low && slow && flat {
-                        let mut d = pose.translation.vector - plan.position.position;
-                        d.z = 0.0;
+                        // The offset of the sole centre from the plan's (the plan's foot turned
+                        // by the latched yaw): the first level then flattens the foot about
+                        // where its sole touched, not about the ankle, which would slide the
+                        // sole by `ankle_height · sin θ` (3 mm on JVRC-1 at LAND_TILT).
                         let x = (pose.rotation * plan.rotation.inverse()) * Vector3::x();
-                        self.latch[i] = (d, x.y.atan2(x.x));
+                        let yaw = x.y.atan2(x.x);
+                        let turned = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), yaw)
+                            * plan.rotation;
+                        let mut d = pose * Point3::from(self.sole)
+                            - (plan.position.position + turned * self.sole);
+                        d.z = 0.0;
+                        self.latch[i] = (d.coords, yaw);
                         self.stance[i] = true;
                         continue;
                     }
@@ -532,11 +555,13 @@ impl KeypointController {
         let stack = &mut self.stacks[self.active & 15];
         let tolerance = stack.ctl.settings().solver.box_tolerance;
         let (p, l, fl, pt) = (&self.plan, &self.latch, &self.floor, &self.posture_track);
+        let dr = &self.drift;
         set_references(
             &mut stack.ctl,
             &stack.tasks,
             p,
             l,
+            dr,
             fl,
             pt,
             &mut self.posture_ref,
@@ -558,6 +583,7 @@ impl KeypointController {
             &stack.tasks,
             p,
             l,
+            dr,
             fl,
             pt,
             &mut self.posture_ref,
@@ -642,6 +668,19 @@ impl KeypointController {
     /// last integration.
     pub fn integrate(&mut self) -> Result<()> {
         let s = &mut self.stacks[self.active & 15];
+        let ctl = if self.used_fallback {
+            &s.fallback
+        } else {
+            &s.ctl
+        };
+        self.drift.observe(
+            &self.robot,
+            ctl.kinematics(),
+            &self.feet,
+            self.stance,
+            ctl.qdd(),
+            self.dt,
+        )?;
         if self.used_fallback {
             s.fallback.integrate(&mut self.state)
         } else {
