@@ -125,7 +125,7 @@ pub struct KeypointSettings {
     /// Wider is smoother but lags the support changes.
     pub com_smoothing: f64,
     /// A leg is not asked to stretch beyond this fraction of its length (hip–knee plus
-    /// knee–ankle) \[–\]: the pelvis is lowered instead (default 0.95). Larger values keep the
+    /// knee–ankle) \[–\]: the pelvis is lowered instead (default 0.85). Larger values keep the
     /// pelvis height of the clip longer but bring the knees near their singularity, where the
     /// feet's level loses rank.
     pub max_leg_extension: f64,

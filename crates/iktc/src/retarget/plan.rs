@@ -2,7 +2,10 @@
 //!
 //! The scaled points ([`super::scale`]) are interpolated at the tick times by natural cubic
 //! splines ([`CubicSpline`]); the feet are held in stance ([`super::contacts`]); the COM
-//! reference is the scaled pelvis' ground projection pulled into the support polygon of the
+//! reference is the scaled pelvis' ground projection plus the robot's own horizontal offset of
+//! its COM from its pelvis in its start posture (turned with the clip's heading: G1's COM is
+//! 4.1 cm ahead of its pelvis: held over the pelvis, its torso's orientation missed the
+//! clip's by a mean 29–43° on the shared clips, with the offset by 10–31°), pulled into the support polygon of the
 //! feet on the ground (shrunk by `com_margin`), then smoothed by two passes of a centred moving
 //! average of `com_smoothing` \[s\]; orientations come from the points: the pelvis frame from
 //! the hip axis and the vertical, the torso frame from the shoulder axis and the hips-to-
@@ -363,6 +366,10 @@ pub(crate) fn plan(
         feet[i] = pose_refs(pos, rot, s.dt);
     }
     // COM over the support polygon of the feet on the ground.
+    // The robot's COM relative to its pelvis in its start posture, horizontal: where its COM
+    // is when it stands as the captured person stands.
+    let mut com_offset = kin.com() - kin.frame_pose(robot, body.pelvis)?.translation.vector;
+    com_offset.z = 0.0;
     let mut com: Vec<Vector3<f64>> = Vec::with_capacity(ticks);
     let mut polygon = SupportPolygon::default();
     for k in 0..ticks {
@@ -379,7 +386,9 @@ pub(crate) fn plan(
                 )
             })
             .collect();
-        let p = (pelvis_x[k].x, pelvis_x[k].y);
+        let turn = UnitQuaternion::from_euler_angles(0.0, 0.0, heading[k] - heading[0]);
+        let c = pelvis_x[k] + turn * com_offset;
+        let p = (c.x, c.y);
         let (l, w) = (support.sole_length, support.sole_width);
         let q = match on.as_slice() {
             [a] => {
