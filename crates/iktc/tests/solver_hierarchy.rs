@@ -509,3 +509,90 @@ fn the_closed_form_declines_what_it_does_not_cover_and_the_block_stays_the_same(
         }
     }
 }
+
+#[test]
+fn a_square_stack_over_a_selection_solved_in_closed_form_gives_the_recursion_s_answer() {
+    // Levels over a bottom selection that completes the rank: the solve takes q̈ = J⁻¹ h
+    // without reducing any level (the `selection` module's bound on σ_min(J)). The answer,
+    // the ranks and, once the factors are asked for, every J̄_i⁺ are those of the recursion.
+    // With a row of the top level repeated, that level loses rank, M_O is singular, and the
+    // general recursion answers.
+    let mut r = rng(79);
+    for case in 0..60 {
+        let n = 6 + case % 13;
+        let m = 1 + case % (n - 1);
+        let mut levels = levels_over_a_selection(&mut r, n, m);
+        let deficient = case % 4 == 3 && levels[0].dim() >= 2;
+        if deficient {
+            let row = levels[0].jacobian.row(0).clone_owned();
+            levels[0].jacobian.set_row(1, &row);
+        }
+        let dims: Vec<usize> = levels.iter().map(|l| l.dim()).collect();
+        let mut h = Hierarchy::new(n, &dims);
+        let mut q = DVector::zeros(n);
+        h.solve(&levels, &SolverSettings::default(), &mut q)
+            .unwrap();
+        check_lexicographic(&levels, &q, 1e-7);
+        if deficient {
+            assert_eq!(h.ranks()[0], dims[0] - 1, "case {case}");
+            continue;
+        }
+        assert_eq!(h.ranks(), &dims[..], "case {case}");
+        let want = reference_solution(&levels, 0.0);
+        let err = (&q - &want).norm() / (1.0 + want.norm());
+        assert!(err < REL_TOL, "case {case}: n {n}, dims {dims:?}: {err}");
+        for (i, (l, na)) in levels.iter().zip(projectors_above(&levels)).enumerate() {
+            let want = (&l.jacobian * na).pseudo_inverse(1e-9).unwrap();
+            let got = h.pinv(i).clone();
+            assert!(
+                (&got - &want).norm() < REL_TOL * (1.0 + want.norm()),
+                "case {case} level {i}: {}",
+                (&got - &want).norm()
+            );
+        }
+        assert_eq!(h.ranks(), &dims[..], "case {case}: the deferred reductions");
+    }
+}
+
+#[test]
+fn a_badly_scaled_stack_over_a_selection_gets_the_same_answer() {
+    // The rows above scaled by 1e-6 under a rank threshold of 1e-8: the bound on σ_min of the
+    // whole stack no longer clears the threshold, the levels above are reduced, and the bottom
+    // selection (whose reduced rows do not depend on the scale) is still taken in closed form.
+    let mut r = rng(80);
+    let settings = SolverSettings {
+        rank_threshold: 1e-8,
+        ..Default::default()
+    };
+    for case in 0..40 {
+        let n = 6 + case % 13;
+        let m = 1 + case % (n - 1);
+        let mut levels = levels_over_a_selection(&mut r, n, m);
+        let nt = levels.len();
+        for l in &mut levels[..nt - 1] {
+            l.jacobian *= 1e-6;
+            l.rhs *= 1e-6;
+        }
+        let dims: Vec<usize> = levels.iter().map(|l| l.dim()).collect();
+        let mut h = Hierarchy::new(n, &dims);
+        let mut q = DVector::zeros(n);
+        h.solve(&levels, &settings, &mut q).unwrap();
+        if h.ranks() != &dims[..] {
+            // A random level above with a pivot under the threshold: not this test's case.
+            continue;
+        }
+        let want = reference_solution(&levels, 0.0);
+        let err = (&q - &want).norm() / (1.0 + want.norm());
+        assert!(err < REL_TOL, "case {case}: n {n}, dims {dims:?}: {err}");
+        let i = nt - 1;
+        let want = (&levels[i].jacobian * &projectors_above(&levels)[i])
+            .pseudo_inverse(1e-12)
+            .unwrap();
+        let got = h.pinv(i).clone();
+        assert!(
+            (&got - &want).norm() < REL_TOL * (1.0 + want.norm()),
+            "case {case}: {}",
+            (&got - &want).norm()
+        );
+    }
+}

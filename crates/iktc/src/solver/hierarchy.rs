@@ -36,6 +36,14 @@
 //! moves nothing: its rows are not reduced, its columns of G are zero and are not computed, and
 //! it has no column in IKTC's correction QP (its correction is zero at the optimum).
 //!
+//! A level that selects coordinates and completes the rank under levels of full rank (the
+//! posture level of the peer problem: the upper-body joints under feet, COM and pelvis) is
+//! solved in closed form instead: q̈ = q̈_{i−1} + g_i (h_i − J_i q̈_{i−1}) with g_i from one LU
+//! of the other coordinates' block (the `selection` module, which also bounds the reduced
+//! level's singular values from below to decide that the QR would keep all its rows). Its
+//! Householder reduction is run only if something later needs its factors
+//! ([`Hierarchy::complete`]).
+//!
 //! IKTC's correction QP (eq. 23) needs G only through the changes of h that move q̈. Level i
 //! moves q̈ through J̄_i^{λ+} = Z Q_r S_i⁻¹ R_r Πᵀ, whose row space is that of R_r Πᵀ (S_i is
 //! invertible): r_i dimensions. With R_rᵀ = V T (Householder QR, V m_i × r_i orthonormal) and
@@ -110,6 +118,17 @@ pub struct Hierarchy {
     pinv: Vec<DMatrix<f64>>,
     /// The closed form of a bottom selection level's block ([`super::selection`]).
     selection: SelectionBlock,
+    /// The block g_i (n × m_i, column-major) of the selection level `built` by the last
+    /// [`Hierarchy::solve`] ([`Hierarchy::build_closed`]), and the level whose step it took
+    /// in closed form ([`Hierarchy::solve_closed`], [`Hierarchy::solve_stack_closed`]).
+    closed: Vec<f64>,
+    built: Option<usize>,
+    closed_level: Option<usize>,
+    /// The first level whose reduction (QR, factors) has not been run, down to the closed
+    /// level: only what needs their factors runs it ([`Hierarchy::complete`]), with the
+    /// settings of the solve.
+    deferred: Option<usize>,
+    settings: SolverSettings,
 }
 
 impl Hierarchy {
@@ -147,6 +166,11 @@ impl Hierarchy {
             gc: DMatrix::zeros(n, total.max(1)),
             pinv: dims.iter().map(|&m| DMatrix::zeros(n, m)).collect(),
             selection: SelectionBlock::new(n, mmax),
+            closed: vec![0.0; n * mmax],
+            built: None,
+            closed_level: None,
+            deferred: None,
+            settings: SolverSettings::default(),
         }
     }
 
@@ -230,9 +254,22 @@ impl Hierarchy {
         }
         self.u.fill(0.0);
         self.refl.truncate(0);
+        (self.built, self.closed_level, self.deferred) = (None, None, None);
+        self.settings = *settings;
+        if self.solve_stack_closed(levels, settings, qdd) {
+            return Ok(());
+        }
         for (i, lvl) in levels.iter().enumerate() {
+            if self.closed_level.is_some() {
+                // The level solved in closed form completed the rank: no coordinate left.
+                (self.starts[i], self.ranks[i]) = (self.n, 0);
+                continue;
+            }
             let p = self.refl.len();
             self.starts[i] = p;
+            if self.solve_closed(i, levels, settings) {
+                continue;
+            }
             self.reduce_level(i, settings);
             let (m, r) = (self.dims[i], self.ranks[i]);
             if r == 0 {
@@ -255,10 +292,130 @@ impl Hierarchy {
             }
             f.apply(r, m, &self.x[..m], &mut self.u.as_mut_slice()[p..p + r]);
         }
-        // q̈ = Q u.
+        // q̈ = Q u, then the step of the level solved in closed form.
         qdd.copy_from(&self.u);
         self.refl.apply_q(qdd.as_mut_slice());
+        if let Some(i) = self.closed_level {
+            let (n, m) = (self.n, self.dims[i]);
+            self.selection.step(
+                levels[i].rhs.as_slice(),
+                &self.closed[..n * m],
+                n,
+                &mut self.res[..m],
+                qdd.as_mut_slice(),
+            );
+        }
         Ok(())
+    }
+
+    /// The whole stack in closed form ([`super::selection`], "The whole stack without QR"):
+    /// when the first level that makes the rows add up to n is a selection, M_O is regular and
+    /// the lower bound on σ_min of the stacked Jacobian exceeds 2 × the rank threshold (and
+    /// the adaptive damping's threshold), every level keeps all its rows undamped, and
+    /// q̈ = J⁻¹ h: no level is reduced ([`Hierarchy::complete`] does it on demand). False
+    /// (nothing decided) otherwise.
+    fn solve_stack_closed(
+        &mut self,
+        levels: &[TaskEquation],
+        settings: &SolverSettings,
+        qdd: &mut DVector<f64>,
+    ) -> bool {
+        let n = self.n;
+        let nt = self.dims.len();
+        let Some(i) = (0..nt).find(|&i| self.dims[i] > 0 && self.offsets[i] + self.dims[i] == n)
+        else {
+            return false;
+        };
+        let Some(floor) = undamped_floor(settings) else {
+            return false;
+        };
+        if !self.build_closed(i, levels) || !clears(self.selection.stack_sigma_lower_bound(), floor)
+        {
+            return false;
+        }
+        let (m, q) = (self.dims[i], qdd.as_mut_slice());
+        self.selection.solve_above(&levels[..i], q);
+        self.selection.step(
+            levels[i].rhs.as_slice(),
+            &self.closed[..n * m],
+            n,
+            &mut self.res[..m],
+            q,
+        );
+        for k in 0..nt {
+            let full = k <= i;
+            self.starts[k] = if full { self.offsets[k] } else { n };
+            self.ranks[k] = if full { self.dims[k] } else { 0 };
+            self.fac[k].direct = full;
+        }
+        self.closed_level = Some(i);
+        self.deferred = Some(0);
+        true
+    }
+
+    /// The closed-form block of level i into `closed` (once per solve); false when the
+    /// `selection` module does not cover it.
+    fn build_closed(&mut self, i: usize, levels: &[TaskEquation]) -> bool {
+        if self.built == Some(i) {
+            return true;
+        }
+        let (n, m) = (self.n, self.dims[i]);
+        if levels.len() != self.dims.len()
+            || !self
+                .selection
+                .build(&levels[..i], &levels[i], n, &mut self.closed[..n * m])
+        {
+            return false;
+        }
+        self.built = Some(i);
+        true
+    }
+
+    /// Level i in closed form, when it is a selection that completes the rank under levels of
+    /// full rank ([`super::selection`]): its block g_i from one LU instead of its reduction, and
+    /// its rank m_i (all its rows kept, no damping) decided by the lower bound σ_low on the
+    /// reduced level's singular values: taken only when σ_low > 2 × the rank threshold (and
+    /// × the adaptive damping's threshold), so that the QR, which is not run, would keep every
+    /// row with λ = 0 up to rounding. Its reduction is deferred ([`Hierarchy::complete`]);
+    /// [`Hierarchy::solve`] adds its step. False (nothing decided) otherwise.
+    fn solve_closed(
+        &mut self,
+        i: usize,
+        levels: &[TaskEquation],
+        settings: &SolverSettings,
+    ) -> bool {
+        let (n, m, p) = (self.n, self.dims[i], self.refl.len());
+        // p = Σ_{k<i} r_k equals Σ_{k<i} m_k only when every level above has full rank.
+        if m == 0 || p != self.offsets[i] || p + m != n {
+            return false;
+        }
+        let Some(floor) = undamped_floor(settings) else {
+            return false;
+        };
+        if !self.build_closed(i, levels) || !clears(self.selection.sigma_lower_bound(), floor) {
+            return false;
+        }
+        self.ranks[i] = m;
+        self.fac[i].direct = true;
+        self.closed_level = Some(i);
+        self.deferred = Some(i);
+        true
+    }
+
+    /// Runs the reductions that the last [`Hierarchy::solve`] deferred (the levels from
+    /// `deferred` to the one it took in closed form), for what needs their factors (the
+    /// reflectors, R, Π: the blocks of the general construction, J̄^{λ+}). The ranks they find
+    /// are the ones decided (full, by the bounds of the `selection` module).
+    fn complete(&mut self) {
+        let (Some(from), Some(to)) = (self.deferred.take(), self.closed_level) else {
+            return;
+        };
+        let settings = self.settings;
+        for k in from..=to {
+            self.starts[k] = self.refl.len();
+            self.reduce_level(k, &settings);
+            debug_assert_eq!(self.ranks[k], self.dims[k], "level {k}: closed-form rank");
+        }
     }
 
     /// Reduces level i: its rows multiplied by the reflectors of the levels above, pivoted QR
@@ -393,6 +550,7 @@ impl Hierarchy {
     }
 
     fn reduced_block_in(&mut self, i: usize, propagate: bool, in_basis: bool) -> usize {
+        self.complete();
         let (n, m, r, p) = (self.n, self.dims[i], self.ranks[i], self.starts[i]);
         let basis = in_basis && self.rank_deficient(i);
         if basis {
@@ -583,6 +741,11 @@ impl Hierarchy {
         let c0 = self.block_offset(i, in_basis);
         let target = if in_basis { &mut self.gc } else { &mut self.g };
         let out = &mut target.as_mut_slice()[c0 * n..(c0 + m) * n];
+        if self.built == Some(i) {
+            // Built by the solve already.
+            out.copy_from_slice(&self.closed[..n * m]);
+            return true;
+        }
         self.selection.build(&levels[..i], &levels[i], n, out)
     }
 
@@ -653,6 +816,26 @@ impl Hierarchy {
             out[pc] = (0..w).map(|q| f.basis[(c, q)] * z[q]).sum();
         }
     }
+}
+
+/// The floor that the closed forms' lower bounds on the reduced levels' singular values must
+/// clear (× 2, for rounding) for the QR to keep every row with λ = 0: the rank threshold, and
+/// the adaptive damping's threshold ε (λ = 0 for a last pivot ≥ ε); None for a fixed λ > 0.
+fn undamped_floor(settings: &SolverSettings) -> Option<f64> {
+    match settings.damping {
+        Damping::None => Some(settings.rank_threshold),
+        Damping::Fixed(0.0) => Some(settings.rank_threshold),
+        Damping::Fixed(_) => None,
+        Damping::Adaptive { max, threshold } if max != 0.0 => {
+            Some(settings.rank_threshold.max(threshold))
+        }
+        Damping::Adaptive { .. } => Some(settings.rank_threshold),
+    }
+}
+
+/// Whether a lower bound on singular values clears 2 × `floor` (false for NaN).
+fn clears(bound: f64, floor: f64) -> bool {
+    bound > 2.0 * floor
 }
 
 /// The factors of one level's J̄^{λ+} in reduced coordinates: out = S⁻¹ R_r Πᵀ b with

@@ -24,18 +24,60 @@
 //! ```
 //!
 //! with M_O = J_{<i}\[:, O\] square and invertible (the stacked matrix is, and it is block
-//! triangular in the order O, C). One LU factorization of M_O (partial pivoting) and m_i
-//! triangular solves cost about (2/3)(n − m_i)³ + 2(n − m_i)² m_i flops, against applying the
-//! n reflectors of the whole hierarchy to m_i columns in the general construction.
+//! triangular in the order O, C). One LU factorization of M_O (partial pivoting) costs about
+//! (2/3)(n − m_i)³ flops, against applying the n reflectors of the whole hierarchy to m_i
+//! columns in the general construction. The right-hand side B = J_{<i}\[:, C\] has non-zero
+//! rows only where a row above reaches a selected coordinate (on a humanoid: the COM rows,
+//! not the feet or the pelvis, whose Jacobians have exact zeros in the upper body's columns),
+//! so X = M_O⁻¹ B is taken as X = Y B_nz with Y = M_O⁻¹ E_nz: one triangular solve per
+//! non-zero row of B (k of them) instead of one per column (m_i), and a product of
+//! (n − m_i) k m_i.
 //!
 //! The result equals the general construction's up to rounding; when any condition fails (a
 //! row with two entries, a coordinate selected twice, a singular or non-finite pivot) the
 //! caller builds the block the general way.
+//!
+//! ## The level's step and its rank without its QR
+//!
+//! The same block gives level i's step of the prioritized solution: level i is solved exactly
+//! in the null space of the levels above, so q̈ = q̈_{i−1} + g_i (h_i − J_i q̈_{i−1})
+//! ([`SelectionBlock::step`]; J_i q̈ is s_c q̈\[C\[c\]\] row by row). Whether the hierarchy's
+//! pivoted QR would keep all m_i rows of level i follows from X = M_O⁻¹ J_{<i}\[:, C\]: the
+//! null space of the rows above is spanned by N = \[−X; I\] (coordinates O, then C), so with
+//! Z = N (NᵀN)^{−1/2} orthonormal the reduced level J_i Z = diag(s) (I + XᵀX)^{−1/2} has
+//!
+//! ```text
+//! σ_min(J_i Z) ≥ min_c |s_c| / √(1 + ‖X‖₂²) ≥ min_c |s_c| / √(1 + ‖X‖_F²) =: σ_low,
+//! ```
+//!
+//! and every pivot |R_jj| of its column-pivoted QR is at least σ_min(J_i Z) (the distance of
+//! a column from the span of the columns before it): above the rank threshold when σ_low is
+//! ([`SelectionBlock::sigma_lower_bound`]). The last pivot, which sets the adaptive damping,
+//! is at least σ_low too.
+//!
+//! ## The whole stack without QR
+//!
+//! The same holds for every level above when the whole square stack J (levels 0..=i, n × n)
+//! is far from singular: level k reduced to the null space of the rows above it has, for any
+//! y, ‖Zᵀ J_kᵀ y‖ = min_a ‖J_{≤k}ᵀ \[−a; y\]‖ ≥ σ_min(J) ‖y‖ (J_{≤k} is a subset of J's
+//! rows), so all its pivots exceed σ_min(J). In the order (O, C),
+//!
+//! ```text
+//! J = [ M_O  B ]      J⁻¹ = [ M_O⁻¹  −X S⁻¹ ]      ‖J⁻¹‖₂ ≤ ‖M_O⁻¹‖₂ + (‖X‖₂ + 1) ‖S⁻¹‖₂,
+//!     [ 0    S ],           [ 0       S⁻¹   ],
+//! ```
+//!
+//! S = diag(s), and with M_O = Pᵀ L U, ‖M_O⁻¹‖₂ ≤ √(n − m_i) ‖U⁻¹‖_∞ ‖L⁻¹‖_∞, each triangular
+//! factor bounded through its comparison matrix M(T) (|T_jj| on the diagonal, −|T_rj| off it):
+//! |T⁻¹| ≤ M(T)⁻¹ entrywise, so ‖T⁻¹‖_∞ ≤ max(M(T)⁻¹ 𝟙), one triangular solve each (Higham,
+//! *Accuracy and Stability of Numerical Algorithms*, 2nd ed., Thm. 8.12). When 1 / that bound
+//! clears the rank threshold every level keeps all its rows, and the prioritized solution of a
+//! square stack solved exactly at every level is J⁻¹ h: q̈\[O\] = M_O⁻¹ h_{<i} − X S⁻¹ h_i,
+//! q̈\[C\] = S⁻¹ h_i ([`SelectionBlock::solve_above`], then [`SelectionBlock::step`]).
 
 use nalgebra::DMatrix;
 
-use super::kernels::axpy;
-use crate::error::all_finite;
+use super::kernels::{axpy, dot};
 use crate::task::TaskEquation;
 
 /// Scratch of the closed form, sized once.
@@ -50,11 +92,19 @@ pub(crate) struct SelectionBlock {
     row_of: Vec<usize>,
     /// The coordinates O, in order.
     others: Vec<usize>,
-    /// M_O (column-major, `no` × `no`, overwritten by its LU factors) and the right-hand
-    /// sides, then solutions (column-major, `no` × m).
+    /// M_O (column-major, `no` × `no`, overwritten by its LU factors), B = J_{<i}\[:, C\]
+    /// (row-major, `no` × m), its non-zero rows nz, a unit right-hand side e and
+    /// Y = M_O⁻¹ E_nz scattered to n-long columns (column-major, n × k).
     lu: Vec<f64>,
     piv: Vec<usize>,
     rhs: Vec<f64>,
+    nz: Vec<usize>,
+    e: Vec<f64>,
+    y: Vec<f64>,
+    /// Rows m_i and ‖X‖_F² of the last successful [`SelectionBlock::build`].
+    m: usize,
+    no: usize,
+    xx: f64,
 }
 
 impl SelectionBlock {
@@ -69,6 +119,12 @@ impl SelectionBlock {
             lu: vec![0.0; n * n],
             piv: vec![0; n],
             rhs: vec![0.0; n * mmax.max(1)],
+            nz: vec![0; n],
+            e: vec![0.0; n],
+            y: vec![0.0; n * n],
+            m: 0,
+            no: 0,
+            xx: 0.0,
         }
     }
 
@@ -117,18 +173,124 @@ impl SelectionBlock {
         if !lu_factor(lu, no, &mut self.piv[..no]) {
             return false;
         }
-        lu_solve_rows(lu, no, &self.piv[..no], x, m);
-        // g[O, c] = −X[:, c] / s_c; g[C[c], c] = 1 / s_c.
+        // Y = M_O⁻¹ E_nz, one unit right-hand side per non-zero row of B, each column scattered
+        // to the coordinates O of an n-long column (zero on C): Y_j[others[o]] = (M_O⁻¹ e_r)[o].
+        let mut k = 0;
+        for r in 0..no {
+            if x[r * m..(r + 1) * m].iter().any(|v| *v != 0.0) {
+                self.nz[k] = r;
+                k += 1;
+            }
+        }
+        for (j, &r) in self.nz[..k].iter().enumerate() {
+            let e = &mut self.e[..no];
+            e.fill(0.0);
+            e[r] = 1.0;
+            lu_solve(lu, no, &self.piv[..no], e);
+            let yj = &mut self.y[j * n..(j + 1) * n];
+            yj.fill(0.0);
+            for (&t, &v) in self.others[..no].iter().zip(e.iter()) {
+                yj[t] = v;
+            }
+        }
+        // Column c of g: −(Σ_j B[nz_j, c] Y_j) / s_c, and 1 / s_c at C[c]. Its squared norm
+        // less 1 / s_c², times s_c², is ‖X[:, c]‖² (X = Y B_nz); their sum, finite only when
+        // every entry is, gives σ_low.
+        let mut xx = 0.0;
         for c in 0..m {
             let inv = 1.0 / self.scale[c];
             let col = &mut out[c * n..(c + 1) * n];
             col.fill(0.0);
-            for (o, &t) in self.others[..no].iter().enumerate() {
-                col[t] = -x[o * m + c] * inv;
+            for (j, &r) in self.nz[..k].iter().enumerate() {
+                let f = x[r * m + c];
+                if f != 0.0 {
+                    axpy(-f * inv, &self.y[j * n..(j + 1) * n], col);
+                }
             }
+            xx += (dot(col, col) * (self.scale[c] * self.scale[c]) - 1.0).max(0.0);
             col[self.coord[c]] = inv;
         }
-        all_finite(&out[..n * m])
+        (self.m, self.no, self.xx) = (m, no, xx);
+        xx.is_finite() && self.scale[..m].iter().all(|s| (1.0 / s).is_finite())
+    }
+
+    /// σ_low = min_c |s_c| / √(1 + ‖X‖_F²) of the last successful [`SelectionBlock::build`]:
+    /// a lower bound on the smallest singular value of the level's rows reduced to the null
+    /// space of the levels above \[task units per coordinate unit\] (module docs).
+    pub(crate) fn sigma_lower_bound(&self) -> f64 {
+        let smin = self.scale[..self.m]
+            .iter()
+            .fold(f64::INFINITY, |a, s| a.min(s.abs()));
+        smin / (1.0 + self.xx).sqrt()
+    }
+
+    /// A lower bound on the smallest singular value of the whole stacked Jacobian J of the
+    /// level and the levels above (n × n) for the last successful [`SelectionBlock::build`]
+    /// \[task units per coordinate unit\] (module docs): 1 / (√(n − m_i) β_L β_U +
+    /// (‖X‖_F + 1) / min_c |s_c|), β_T = max(M(T)⁻¹ 𝟙) for the triangular factors of M_O and
+    /// their comparison matrices. Allocates nothing.
+    pub(crate) fn stack_sigma_lower_bound(&mut self) -> f64 {
+        let no = self.no;
+        let (lu, z) = (&self.lu[..no * no], &mut self.e[..no]);
+        let max = |z: &[f64]| z.iter().fold(0.0_f64, |a, &v| a.max(v));
+        // M(L) z = 𝟙 (L unit lower, entries −|l_rj| off the diagonal), by columns.
+        z.fill(1.0);
+        for j in 0..no {
+            let zj = z[j];
+            for (zr, l) in z[j + 1..].iter_mut().zip(&lu[j * no + j + 1..(j + 1) * no]) {
+                *zr += l.abs() * zj;
+            }
+        }
+        let beta_l = max(z);
+        // M(U) z = 𝟙 (U upper), by columns from the last.
+        z.fill(1.0);
+        for j in (0..no).rev() {
+            let zj = z[j] / lu[j * no + j].abs();
+            z[j] = zj;
+            for (zr, u) in z[..j].iter_mut().zip(&lu[j * no..j * no + j]) {
+                *zr += u.abs() * zj;
+            }
+        }
+        let beta_u = max(z);
+        let smin = self.scale[..self.m]
+            .iter()
+            .fold(f64::INFINITY, |a, s| a.min(s.abs()));
+        1.0 / ((no as f64).sqrt() * beta_l * beta_u + (self.xx.sqrt() + 1.0) / smin)
+    }
+
+    /// q ← (M_O⁻¹ h_{<i} on the coordinates O, zero on C): with [`SelectionBlock::step`]
+    /// after it, J⁻¹ h for the square stack of the levels `above` (their right-hand sides
+    /// h_{<i}) and the level of the last successful [`SelectionBlock::build`]. Allocates
+    /// nothing.
+    pub(crate) fn solve_above(&mut self, above: &[TaskEquation], q: &mut [f64]) {
+        let no = self.no;
+        let e = &mut self.e[..no];
+        let mut r0 = 0;
+        for l in above {
+            e[r0..r0 + l.dim()].copy_from_slice(l.rhs.as_slice());
+            r0 += l.dim();
+        }
+        lu_solve(&self.lu[..no * no], no, &self.piv[..no], e);
+        q.fill(0.0);
+        for (&t, &v) in self.others[..no].iter().zip(e.iter()) {
+            q[t] = v;
+        }
+    }
+
+    /// Level i's step of the prioritized solution, q ← q + g_i (h − J_i q) with J_i q =
+    /// s_c q\[C\[c\]\] row by row, for the block `g` (n × m_i, column-major) of the last
+    /// successful [`SelectionBlock::build`] and the level's right-hand side `h` \[task units\].
+    /// `res`: scratch of m_i entries.
+    pub(crate) fn step(&self, h: &[f64], g: &[f64], n: usize, res: &mut [f64], q: &mut [f64]) {
+        let m = self.m;
+        for c in 0..m {
+            res[c] = h[c] - self.scale[c] * q[self.coord[c]];
+        }
+        for (c, col) in g.chunks_exact(n).take(m).enumerate() {
+            if res[c] != 0.0 {
+                axpy(res[c], col, q);
+            }
+        }
     }
 
     /// Finds the coordinate and entry of each row of `j` (m × n, column-major); false unless
@@ -141,14 +303,18 @@ impl SelectionBlock {
         for t in 0..n {
             let col = &js[t * m..(t + 1) * m];
             let mut hit = None;
-            for (r, &v) in col.iter().enumerate() {
-                if v != 0.0 {
-                    if hit.is_some() || self.coord[r] != usize::MAX {
-                        return false;
+            // Most columns are all zero: one branch-free pass decides (the scan below finds the
+            // row of a non-zero column).
+            if col.iter().fold(false, |a, &v| a | (v != 0.0)) {
+                for (r, &v) in col.iter().enumerate() {
+                    if v != 0.0 {
+                        if hit.is_some() || self.coord[r] != usize::MAX {
+                            return false;
+                        }
+                        hit = Some(r);
+                        self.coord[r] = t;
+                        self.scale[r] = v;
                     }
-                    hit = Some(r);
-                    self.coord[r] = t;
-                    self.scale[r] = v;
                 }
             }
             self.other_index[t] = if hit.is_some() {
@@ -203,39 +369,26 @@ fn lu_factor(a: &mut [f64], k: usize, piv: &mut [usize]) -> bool {
     true
 }
 
-/// Solves (L U) X = P B in place for the factors of [`lu_factor`] and the m right-hand sides
-/// of the row-major k × m `x`: row operations on rows of length m (one axpy each), so that all
-/// right-hand sides go through each step together.
-fn lu_solve_rows(lu: &[f64], k: usize, piv: &[usize], x: &mut [f64], m: usize) {
+/// Solves (L U) x = P b in place for the factors of [`lu_factor`] and one right-hand side
+/// `x` (length k), by columns of the factors: forward with L (unit lower), skipping the
+/// steps whose entry is zero (the leading entries of a unit right-hand side), then back with U.
+fn lu_solve(lu: &[f64], k: usize, piv: &[usize], x: &mut [f64]) {
     for (j, &p) in piv.iter().enumerate().take(k) {
-        if p != j {
-            for c in 0..m {
-                x.swap(j * m + c, p * m + c);
-            }
-        }
+        x.swap(j, p);
     }
-    // L Y = P B (unit lower): row r −= L[r, j] row j, for j < r.
+    // L y = P b: x[j + 1..] −= x_j L[j + 1.., j].
     for j in 0..k {
-        let (head, tail) = x.split_at_mut((j + 1) * m);
-        let xj = &head[j * m..];
-        for (q, row) in tail.chunks_exact_mut(m).enumerate() {
-            let l = lu[j * k + j + 1 + q];
-            if l != 0.0 {
-                axpy(-l, xj, row);
-            }
+        let xj = x[j];
+        if xj != 0.0 {
+            axpy(-xj, &lu[j * k + j + 1..(j + 1) * k], &mut x[j + 1..k]);
         }
     }
-    // U X = Y: row j /= U[j, j], then row r −= U[r, j] row j, for r < j.
+    // U x = y: x_j = y_j / U[j, j], then x[..j] −= x_j U[..j, j].
     for j in (0..k).rev() {
-        let (head, tail) = x.split_at_mut(j * m);
-        let xj = &mut tail[..m];
-        let d = 1.0 / lu[j * k + j];
-        xj.iter_mut().for_each(|v| *v *= d);
-        for (r, row) in head.chunks_exact_mut(m).enumerate() {
-            let u = lu[j * k + r];
-            if u != 0.0 {
-                axpy(-u, xj, row);
-            }
+        let xj = x[j] / lu[j * k + j];
+        x[j] = xj;
+        if xj != 0.0 {
+            axpy(-xj, &lu[j * k..j * k + j], &mut x[..j]);
         }
     }
 }
@@ -257,7 +410,7 @@ mod tests {
             let mut piv = vec![0; k];
             assert!(lu_factor(&mut lu, k, &mut piv));
             let mut x = b.as_slice().to_vec();
-            lu_solve_rows(&lu, k, &piv, &mut x, 1);
+            lu_solve(&lu, k, &piv, &mut x);
             let want = a.clone().lu().solve(&b).unwrap();
             for (got, w) in x.iter().zip(want.iter()) {
                 // Relative to the solution's size; a well-conditioned random k ≤ 18 system
@@ -273,15 +426,15 @@ mod tests {
         let mut a = vec![0.0, 1.0, 1.0, 0.0];
         let mut piv = vec![0; 2];
         assert!(lu_factor(&mut a, 2, &mut piv));
-        let mut x = vec![3.0, 5.0];
-        lu_solve_rows(&a, 2, &piv, &mut x, 1);
+        let mut x = vec![3.0_f64, 5.0];
+        lu_solve(&a, 2, &piv, &mut x);
         assert_eq!(x, vec![5.0, 3.0]);
         // A tiny pivot left in place would lose every digit of the first unknown:
         // [[1e-20, 1], [1, 1]] x = [1, 2] has x ≈ [1, 1].
         let mut a = vec![1e-20, 1.0, 1.0, 1.0];
         assert!(lu_factor(&mut a, 2, &mut piv));
-        let mut x = vec![1.0, 2.0];
-        lu_solve_rows(&a, 2, &piv, &mut x, 1);
+        let mut x = vec![1.0_f64, 2.0];
+        lu_solve(&a, 2, &piv, &mut x);
         assert!(
             (x[0] - 1.0).abs() < 1e-12 && (x[1] - 1.0).abs() < 1e-12,
             "{x:?}"
