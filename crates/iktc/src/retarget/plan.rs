@@ -796,4 +796,43 @@ mod tests {
             assert!(moved < 0.03, "{p}: moved {moved} m");
         }
     }
+
+    /// The COM reference is the pelvis' ground projection plus the robot's own COM offset from
+    /// its pelvis in the start posture, turned with the heading, wherever that lies inside the
+    /// support polygon (unsmoothed here, so it is compared tick by tick; elsewhere it is pulled
+    /// to the polygon's margin). On G1 the offset is 4.1 cm: held over the pelvis instead, the
+    /// reference would match on no tick.
+    #[test]
+    fn the_com_reference_carries_the_robots_com_offset_from_its_pelvis() {
+        let s = KeypointSettings {
+            com_smoothing: 0.0,
+            ..KeypointSettings::default()
+        };
+        let (robot, kin, body, _, free, _) = plans_with("g1", "humanoid3d_walk", &s);
+        let mut offset = kin.com()
+            - kin
+                .frame_pose(&robot, body.pelvis)
+                .unwrap()
+                .translation
+                .vector;
+        offset.z = 0.0;
+        assert!(offset.norm() > 0.03, "G1's offset: {offset}");
+        let r0 = free.pelvis[0].rotation;
+        let (mut with, mut without) = (0, 0);
+        for k in 0..free.ticks {
+            let yaw = (free.pelvis[k].rotation * r0.inverse()).euler_angles().2;
+            let turn = UnitQuaternion::from_euler_angles(0.0, 0.0, yaw);
+            let p = free.pelvis[k].position.position;
+            let c = free.com[k].position;
+            // A reference built from stored positions: equal up to rounding.
+            if (c.xy() - (p + turn * offset).xy()).norm() < 1e-9 {
+                with += 1;
+            }
+            if (c.xy() - p.xy()).norm() < 1e-9 {
+                without += 1;
+            }
+        }
+        assert!(2 * with > free.ticks, "{with} of {} ticks", free.ticks);
+        assert_eq!(without, 0);
+    }
 }
