@@ -101,6 +101,27 @@ impl Controller {
     pub fn prepare(&mut self, state: &State, dt: f64) -> Result<()> {
         self.stage = Stage::Built;
         self.kin.update(&self.robot, state)?;
+        self.prepare_tasks(state, dt)
+    }
+
+    /// [`Controller::prepare`] with the kinematics at `state` already computed in `kin`
+    /// ([`Kinematics::update`] of this controller's robot at `state`): they are swapped in
+    /// instead of computed again (`kin` receives the controller's previous ones). The same
+    /// problem bit for bit, the kinematics being a function of the robot and the state.
+    #[cfg(all(feature = "urdf", feature = "toml"))]
+    pub(crate) fn prepare_with_kinematics(
+        &mut self,
+        state: &State,
+        dt: f64,
+        kin: &mut Kinematics,
+    ) -> Result<()> {
+        self.stage = Stage::Built;
+        std::mem::swap(&mut self.kin, kin);
+        self.prepare_tasks(state, dt)
+    }
+
+    /// The steps of [`Controller::prepare`] after the kinematics.
+    fn prepare_tasks(&mut self, state: &State, dt: f64) -> Result<()> {
         self.stack
             .linearize(&self.robot, &self.kin, state, &mut self.eqs)?;
         state.dof_positions(&self.robot, &mut self.pos)?;

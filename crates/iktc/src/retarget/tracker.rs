@@ -490,7 +490,9 @@ impl KeypointController {
             }
         }
         let mut modes = [FootMode::Stance; 2];
-        if self.stance != [true; 2] {
+        // Whether `kin` holds the kinematics of the state.
+        let fresh = self.stance != [true; 2];
+        if fresh {
             // The robot's feet where they are now.
             self.kin.update(&self.robot, &self.state)?;
             let (kin, robot) = (&self.kin, &*self.robot);
@@ -568,7 +570,15 @@ impl KeypointController {
             k,
             hold,
         )?;
-        stack.ctl.prepare(&self.state, self.dt)?;
+        if fresh {
+            // The kinematics of the state, computed above for the feet: swapped in, not
+            // computed again (the fallback below computes its own).
+            stack
+                .ctl
+                .prepare_with_kinematics(&self.state, self.dt, &mut self.kin)?;
+        } else {
+            stack.ctl.prepare(&self.state, self.dt)?;
+        }
         let iktc = stack.ctl.settings().method == Method::Iktc;
         let r = stack.ctl.solve()?;
         let held = stance != 0 && r.corrected_from == Some(0);
