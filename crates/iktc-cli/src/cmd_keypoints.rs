@@ -9,8 +9,8 @@ use iktc::batch::{posture_references, Posture};
 use iktc::motion::{Keypoints, MotionFormat, BUILTIN_CLIP_NAMES, DEFAULT_MAX_GAP};
 use iktc::profile::RobotProfile;
 use iktc::retarget::{
-    builtin_motion, joint_route_quality, retarget_keypoints, KeypointRun, KeypointSettings,
-    RetargetQuality,
+    builtin_motion, joint_route_quality, retarget_keypoints, HandScaling, KeypointRun,
+    KeypointSettings, RetargetQuality,
 };
 use iktc::sim::ImitateConfig;
 
@@ -21,6 +21,17 @@ pub enum RetargetArg {
     Keypoints,
     /// The paper's joint-angle route: captured rotations decomposed onto the robot's joints.
     Joints,
+}
+
+/// Where the keypoint route places the hands' references ([`iktc::retarget::HandScaling`]).
+#[derive(clap::ValueEnum, Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum HandsArg {
+    /// From the pelvis by the leg ratio: the hands where the captured person's are relative to
+    /// the pelvis, scaled as a whole (hands that meet still meet).
+    #[default]
+    Leg,
+    /// Along the arm, each segment at the robot's length: the captured arm's direction.
+    Segments,
 }
 
 /// Options of the keypoint retargeting (`iktc imitate`, `iktc retarget`).
@@ -42,15 +53,21 @@ pub struct KeypointArgs {
     /// The motion as captured, not low-passed, on either route.
     #[arg(long)]
     pub no_smoothing: bool,
+    /// Where the keypoint route places the hands' references (default: leg).
+    #[arg(long, value_enum)]
+    pub hands: Option<HandsArg>,
 }
 
 impl KeypointArgs {
     /// Gives `cfg` the `--smoothing` (both routes use it; without it the joint route keeps
     /// `cfg`'s default, [`iktc::sim::IMITATE_SMOOTHING`], and the keypoint route none),
-    /// `--no-smoothing`, and refuses `--standing` on the joint route.
+    /// `--no-smoothing`, and refuses `--standing` and `--hands` on the joint route.
     pub fn apply(&self, route: RetargetArg, cfg: &mut ImitateConfig) -> Result<()> {
         if route == RetargetArg::Joints && self.standing {
             anyhow::bail!("--standing applies to --retarget keypoints only");
+        }
+        if route == RetargetArg::Joints && self.hands.is_some() {
+            anyhow::bail!("--hands applies to --retarget keypoints only");
         }
         cfg.smoothing = match (self.no_smoothing, self.smoothing, route) {
             (true, _, _) => None,
@@ -76,6 +93,10 @@ pub fn keypoint_settings(
         run_limits: cfg.run_limits,
         standing: k.standing,
         smoothing: if k.no_smoothing { None } else { k.smoothing },
+        hands: match k.hands.unwrap_or_default() {
+            HandsArg::Leg => HandScaling::Leg,
+            HandsArg::Segments => HandScaling::Segments,
+        },
         ..KeypointSettings::default()
     }
 }

@@ -649,3 +649,58 @@ fn standing_holds_feet_and_pelvis_and_is_part_of_the_settings() {
     assert!(!o.status.success());
     assert!(String::from_utf8_lossy(&o.stderr).contains("--retarget keypoints only"));
 }
+
+/// `--hands segments` places the hands along the arm instead of from the pelvis by the leg
+/// ratio: the robot's hands move differently (centimetres apart somewhere in the clip), the
+/// option enters the settings fingerprint (the clip is redone, not skipped), and the joint
+/// route refuses it.
+#[test]
+fn hands_option_moves_the_hands_and_is_part_of_the_settings() {
+    let dir = tmp("hands");
+    let clip = data().join("humanoid3d_punch.txt");
+    let out = dir.join("out");
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            clip.to_str().unwrap(),
+            "--robot",
+            "g1",
+            "--out",
+            out.to_str().unwrap(),
+            "--no-viewer",
+        ];
+        args.extend_from_slice(extra);
+        retarget(&args)
+    };
+    let hand = || {
+        let npz = read_npz(&std::fs::read(out.join("humanoid3d_punch/motion.npz")).unwrap());
+        let bodies = strings(&npz, "body_names");
+        let (shape, body) = floats(&npz, "body_pos_w");
+        let i = bodies
+            .iter()
+            .position(|b| b == "right_rubber_hand")
+            .unwrap();
+        let nb = shape[1];
+        (0..shape[0])
+            .map(|k| body[3 * (nb * k + i)..3 * (nb * k + i) + 3].to_vec())
+            .collect::<Vec<_>>()
+    };
+    let o = run(&[]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let leg = hand();
+    let o = run(&["--hands", "segments"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(statuses(&out)["humanoid3d_punch"], "retargeted");
+    let seg = hand();
+    assert_eq!(leg.len(), seg.len());
+    let apart = leg
+        .iter()
+        .zip(&seg)
+        .map(|(a, b)| (0..3).map(|d| (a[d] - b[d]).powi(2)).sum::<f64>().sqrt())
+        .fold(0.0, f64::max);
+    assert!(apart > 0.02, "hands at most {apart} m apart");
+    let o = run(&["--hands", "segments", "--retarget", "joints"]);
+    assert!(!o.status.success());
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("--hands applies to --retarget keypoints only")
+    );
+}

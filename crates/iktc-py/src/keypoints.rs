@@ -4,7 +4,7 @@
 
 use iktc::batch::{posture_references, Posture};
 use iktc::motion::DEFAULT_MAX_GAP;
-use iktc::retarget::{keypoint_controller, KeypointSettings};
+use iktc::retarget::{keypoint_controller, HandScaling, KeypointSettings};
 use iktc::sim::ImitateConfig;
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
@@ -40,9 +40,11 @@ pub struct PyKeypointTrajectory {
 /// `iktc::retarget::KeypointSettings::standing`). `smoothing`: cut-off [Hz] of the zero-phase
 /// low-pass applied to the body points before they are differentiated (`None`: as captured).
 /// `approach_rate` [1/s]: the soft approach to the range ends
-/// (`iktc::limits::ViableSettings::approach_rate`; 0, the default, leaves it out).
+/// (`iktc::limits::ViableSettings::approach_rate`; 0, the default, leaves it out). `hands`:
+/// `"leg"` places the hands' references from the pelvis by the leg ratio, `"segments"` along
+/// the arm at the robot's segment lengths (`iktc::retarget::HandScaling`).
 #[pyfunction]
-#[pyo3(name = "retarget_keypoints", signature = (motion, robot, *, dt=0.005, hold_feet=false, standing=false, smoothing=None, approach_rate=0.0))]
+#[pyo3(name = "retarget_keypoints", signature = (motion, robot, *, dt=0.005, hold_feet=false, standing=false, smoothing=None, approach_rate=0.0, hands="leg"))]
 #[allow(clippy::too_many_arguments)]
 pub fn py_retarget_keypoints(
     py: Python<'_>,
@@ -53,12 +55,23 @@ pub fn py_retarget_keypoints(
     standing: bool,
     smoothing: Option<f64>,
     approach_rate: f64,
+    hands: &str,
 ) -> PyResult<PyKeypointTrajectory> {
     let profile = robot.required_profile("keypoint retargeting", "feet, pelvis and hands")?;
+    let hands = match hands {
+        "leg" => HandScaling::Leg,
+        "segments" => HandScaling::Segments,
+        other => {
+            return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                "unknown hands `{other}`; expected \"leg\" or \"segments\""
+            )))
+        }
+    };
     let mut settings = KeypointSettings {
         dt,
         standing,
         smoothing,
+        hands,
         ..KeypointSettings::default()
     };
     settings.bounds = settings

@@ -89,3 +89,18 @@ def test_the_soft_approach_halves_the_plans_jerk_and_bad_rates_are_errors():
     assert rms_jerk(approach_rate=10.0) < 0.6 * rms_jerk()
     with pytest.raises(iktc.IktcError, match="approach_rate"):
         iktc.retarget_keypoints(motion, robot, approach_rate=-1.0)
+
+
+def test_hands_along_the_segments_move_the_hands_differently_and_bad_names_are_errors():
+    robot = iktc.Robot("g1")
+    motion = iktc.load_motion("humanoid3d_punch")
+
+    def hand(t):
+        return np.array([robot.frame_pose(q, "right_rubber_hand")[:3, 3] for q in t.q])
+
+    leg = hand(iktc.retarget_keypoints(motion, robot))
+    seg = hand(iktc.retarget_keypoints(motion, robot, hands="segments"))
+    assert leg.shape == seg.shape
+    assert np.linalg.norm(leg - seg, axis=1).max() > 0.02
+    with pytest.raises(ValueError, match="segments"):
+        iktc.retarget_keypoints(motion, robot, hands="elbows")

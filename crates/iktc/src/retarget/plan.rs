@@ -675,9 +675,15 @@ mod tests {
             .unwrap()
             .keypoints(crate::motion::DEFAULT_MAX_GAP)
             .unwrap();
-        let scaled =
-            super::super::scale::scale_clip(&robot, &kin, &body, &kp, cfg.support.ankle_height)
-                .unwrap();
+        let scaled = super::super::scale::scale_clip(
+            &robot,
+            &kin,
+            &body,
+            &kp,
+            cfg.support.ankle_height,
+            s.hands,
+        )
+        .unwrap();
         let free = plan(&robot, &kin, &body, &kp, &scaled, &cfg.support, s).unwrap();
         let standing = KeypointSettings {
             standing: true,

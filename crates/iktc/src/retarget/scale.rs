@@ -16,11 +16,15 @@
 //! pelvis → head, chest, neck): `p'_c = p'_p + s_pc (a(p_c) − a(p_p))` with
 //! `s_pc = |r_c − r_p| / median_t |p_c(t) − p_p(t)|`, `r` the robot's points in its start
 //! posture. A segment without robot points takes its parent segment's ratio (toe: the shank's;
-//! chest, neck: the head's, else the leg's).
+//! chest, neck: the head's, else the leg's). With [`HandScaling::Leg`] (the default) the
+//! wrists are then placed from the pelvis by the leg ratio instead, `p'_wrist = p'_pelvis +
+//! s_leg (a(p_wrist) − a(p_pelvis))`: where the hands are relative to the body is kept, not
+//! the forearm's direction.
 
 use nalgebra::{Rotation3, Vector3};
 
 use super::body::RobotBody;
+use super::HandScaling;
 use crate::error::{Error, Result};
 use crate::model::{Kinematics, Robot};
 use crate::motion::{BodyPoint, Keypoints};
@@ -82,13 +86,15 @@ fn required(kp: &Keypoints, p: BodyPoint) -> Result<usize> {
 }
 
 /// Aligns and scales `kp` onto the robot whose body points are `body` at the kinematics `kin`
-/// (start posture); `ankle_height` is the robot's ankle above its sole \[m\].
+/// (start posture); `ankle_height` is the robot's ankle above its sole \[m\]; `hands` places
+/// the wrists.
 pub(crate) fn scale_clip(
     robot: &Robot,
     kin: &Kinematics,
     body: &RobotBody,
     kp: &Keypoints,
     ankle_height: f64,
+    hands: HandScaling,
 ) -> Result<ScaledClip> {
     let n = kp.points.len();
     let frames = kp.frame_count();
@@ -185,6 +191,7 @@ pub(crate) fn scale_clip(
         (Some(l), Some(r), Some(p)) => p.z - 0.5 * (l.z + r.z),
         _ => 0.0,
     };
+    let wrists = [index(kp, B::LeftWrist), index(kp, B::RightWrist)];
     for f in 0..frames {
         let row = f * n;
         let hips = 0.5 * (aligned[row + lh] + aligned[row + rh]);
@@ -193,6 +200,12 @@ pub(crate) fn scale_clip(
         for &(pa, pb, r) in &segments {
             if let (Some(a), Some(b)) = (index(kp, pa), index(kp, pb)) {
                 scaled[row + b] = scaled[row + a] + r * (aligned[row + b] - aligned[row + a]);
+            }
+        }
+        if hands == HandScaling::Leg {
+            for w in wrists.iter().flatten() {
+                scaled[row + w] =
+                    scaled[row + pelvis] + leg * (aligned[row + w] - aligned[row + pelvis]);
             }
         }
     }
@@ -213,13 +226,9 @@ mod tests {
     use super::*;
     use crate::profile::RobotProfile;
 
-    /// Every limb segment (thigh, shank, upper arm, forearm) comes out exactly as long as the
-    /// robot's: the clip's limbs are rigid, so their median length is their length in every
-    /// frame. (Segments from the pelvis are not: the spine bends, and the pelvis is placed by
-    /// the hips' height.) The pelvis starts above the origin.
-    #[test]
-    fn scaled_segments_have_the_robots_lengths() {
-        let kp = super::super::builtin_motion("humanoid3d_punch")
+    /// G1 at its neutral posture, its body points, and the keypoints of a built-in clip.
+    fn g1_and(clip: &str) -> (Robot, Kinematics, RobotBody, Keypoints) {
+        let kp = super::super::builtin_motion(clip)
             .unwrap()
             .keypoints(crate::motion::DEFAULT_MAX_GAP)
             .unwrap();
@@ -232,7 +241,18 @@ mod tests {
         let state = crate::model::State::neutral(&robot);
         let kin = Kinematics::new(&robot, &state).unwrap();
         let body = RobotBody::find(&robot, &kin, &names).unwrap();
-        let c = scale_clip(&robot, &kin, &body, &kp, 0.035).unwrap();
+        (robot, kin, body, kp)
+    }
+
+    /// Every limb segment (thigh, shank, upper arm, forearm) comes out exactly as long as the
+    /// robot's with the segment scaling of the hands: the clip's limbs are rigid, so their
+    /// median length is their length in every frame. (Segments from the pelvis are not: the
+    /// spine bends, and the pelvis is placed by the hips' height.) The pelvis starts above the
+    /// origin.
+    #[test]
+    fn scaled_segments_have_the_robots_lengths() {
+        let (robot, kin, body, kp) = g1_and("humanoid3d_punch");
+        let c = scale_clip(&robot, &kin, &body, &kp, 0.035, HandScaling::Segments).unwrap();
         let n = kp.points.len();
         let idx = |p: BodyPoint| kp.points.iter().position(|q| *q == p).unwrap();
         let mut checked = 0;
@@ -258,5 +278,36 @@ mod tests {
         assert_eq!(checked, 8, "limb segments checked");
         let p0 = c.scaled[idx(BodyPoint::Pelvis)];
         assert!(p0.xy().norm() < 1e-12, "{p0}");
+    }
+
+    /// With the leg ratio for the hands, hands that meet in the clip meet on the robot (the
+    /// captured wrists moved onto their midpoint in every frame: a clap), while along the
+    /// arm's segments they miss each other by centimetres; every other point is placed alike
+    /// by both.
+    #[test]
+    fn hands_that_meet_in_the_clip_meet_with_the_leg_ratio() {
+        let (robot, kin, body, mut kp) = g1_and("humanoid3d_punch");
+        let n = kp.points.len();
+        let idx = |p: BodyPoint| kp.points.iter().position(|q| *q == p).unwrap();
+        let (l, r) = (idx(BodyPoint::LeftWrist), idx(BodyPoint::RightWrist));
+        for f in 0..kp.frame_count() {
+            let mid = 0.5 * (kp.positions[f * n + l] + kp.positions[f * n + r]);
+            kp.positions[f * n + l] = mid;
+            kp.positions[f * n + r] = mid;
+        }
+        let leg = scale_clip(&robot, &kin, &body, &kp, 0.035, HandScaling::Leg).unwrap();
+        let seg = scale_clip(&robot, &kin, &body, &kp, 0.035, HandScaling::Segments).unwrap();
+        // Rounding of a few additions of decimetre-sized vectors \[m\].
+        let tol = 1e-12;
+        let mut apart: f64 = 0.0;
+        for f in 0..kp.frame_count() {
+            let gap = |c: &ScaledClip| (c.scaled[f * n + l] - c.scaled[f * n + r]).norm();
+            assert!(gap(&leg) < tol, "frame {f}: {}", gap(&leg));
+            apart = apart.max(gap(&seg));
+            for k in (0..n).filter(|k| *k != l && *k != r) {
+                assert_eq!(leg.scaled[f * n + k], seg.scaled[f * n + k], "point {k}");
+            }
+        }
+        assert!(apart > 0.01, "the segments' hands at most {apart} m apart");
     }
 }
