@@ -315,16 +315,21 @@ impl TrainingTrajectory {
     /// The CSV text: [`Self::csv_header`], then one row per frame; numbers in Rust's shortest
     /// round-trip form (reading them back gives the same `f64`).
     pub fn csv(&self) -> String {
+        use std::fmt::Write;
         let mut s = self.csv_header().join(",");
         s.push('\n');
         for j in 0..self.len() {
             let row = std::iter::once(self.time[j])
                 .chain(self.base_pos[j])
                 .chain(self.base_quat_xyzw[j])
-                .chain(self.joint_pos[j].iter().copied())
-                .map(|x| x.to_string())
-                .collect::<Vec<_>>();
-            s.push_str(&row.join(","));
+                .chain(self.joint_pos[j].iter().copied());
+            for (c, x) in row.enumerate() {
+                if c > 0 {
+                    s.push(',');
+                }
+                // Writing into a String cannot fail.
+                let _ = write!(s, "{x}");
+            }
             s.push('\n');
         }
         s
