@@ -6,12 +6,7 @@
 //! 2. `swing_floor`: the feet the clip puts on the ground that have not landed yet, 6D towards
 //!    the plan's hold, and the height, roll and pitch of a swing foot near the ground: the
 //!    floor ([`super::floor`]) keeps their soles above the ground;
-//! 3. `com_xy`: the COM over the support polygon, horizontal, only while a foot is held (in
-//!    the first level): with no foot on the ground there is no polygon, and a COM level would
-//!    move the free limbs as counterweights (on the shared clips, against a COM level on every
-//!    tick: the joints' RMS jerk 14 % lower summed over G1's six clips, the deepest sole
-//!    0.14 mm below the ground instead of 0.52 mm, the mean keypoint error lower on eight
-//!    of the twelve runs; G1 `humanoid3d_dance_a` 15.3 → 17.9 cm);
+//! 3. `com_xy`: the COM over the support polygon, horizontal;
 //! 4. `pelvis`: the pelvis pose, 6D;
 //! 5. `hands_swing_feet`: the hand frames' positions and the feet in the air, 6D;
 //! 6. `elbows_head_torso`: the elbows' and the head's positions and the torso's orientation,
@@ -147,8 +142,7 @@ struct Tasks {
     feet: Vec<(usize, FrameHandle)>,
     /// Foot index and handle of the swing feet whose floor is engaged ([`super::floor`]).
     floor: Vec<(usize, FrameHandle)>,
-    /// The COM task: only while a foot is held on the ground.
-    com: Option<ComHandle>,
+    com: ComHandle,
     pelvis: FrameHandle,
     torso: Option<FrameHandle>,
     points: Vec<(FrameHandle, usize)>,
@@ -291,9 +285,7 @@ fn set_references(
     } else {
         c
     };
-    if let Some(h) = t.com {
-        ctl.set_com_reference(h, c)?;
-    }
+    ctl.set_com_reference(t.com, c)?;
     ctl.set_frame_reference(t.pelvis, p.pelvis[k].frame(hold))?;
     if let Some(h) = t.torso {
         ctl.set_frame_reference(h, p.torso[k].frame(hold))?;
@@ -359,13 +351,7 @@ fn build_stack(
             floor.push((i, b.frame(&name(body.feet[i]), axes)?));
         }
     }
-    // Without a held foot there is no support polygon to keep the COM over: a COM level would
-    // only swing the free limbs as counterweights.
-    let com = if stance.iter().any(|on| *on) {
-        Some(b.level(KEYPOINT_LEVELS[2]).com([true, true, false])?)
-    } else {
-        None
-    };
+    let com = b.level(KEYPOINT_LEVELS[2]).com([true, true, false])?;
     let pelvis = b
         .level(KEYPOINT_LEVELS[3])
         .frame(&name(body.pelvis), Axes::ALL)?;
@@ -734,41 +720,5 @@ impl KeypointController {
     /// The controller of the last tick's contact state (IKTC).
     pub fn controller(&self) -> &Controller {
         &self.stacks[self.active & 15].ctl
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::motion::DEFAULT_MAX_GAP;
-    use crate::profile::RobotProfile;
-
-    /// Of the 16 stacks (one per pair of foot modes), exactly those with a held foot have the
-    /// COM level, in both the IKTC and the GF controller, and every stack has the pelvis.
-    #[test]
-    fn the_com_level_is_in_the_stacks_with_a_held_foot_only() {
-        let profile = RobotProfile::builtin("g1").unwrap();
-        let kp = super::super::builtin_motion("humanoid3d_walk")
-            .unwrap()
-            .keypoints(DEFAULT_MAX_GAP)
-            .unwrap();
-        let c =
-            super::super::keypoint_controller(&profile, &kp, None, &KeypointSettings::default())
-                .unwrap();
-        assert_eq!(c.stacks.len(), 16);
-        let has = |ctl: &Controller, name: &str| ctl.stack().levels.iter().any(|l| l.name == name);
-        let mut with = 0;
-        for (idx, stack) in c.stacks.iter().enumerate() {
-            let modes = [FootMode::ALL[idx % 4], FootMode::ALL[idx / 4]];
-            let held = modes.contains(&FootMode::Stance);
-            for ctl in [&stack.ctl, &stack.fallback] {
-                assert_eq!(has(ctl, KEYPOINT_LEVELS[2]), held, "modes {modes:?}");
-                assert!(has(ctl, KEYPOINT_LEVELS[3]), "modes {modes:?}");
-            }
-            assert_eq!(stack.tasks.com.is_some(), held);
-            with += usize::from(held);
-        }
-        // 16 pairs less the 9 without a Stance foot.
-        assert_eq!(with, 7);
     }
 }
