@@ -650,10 +650,10 @@ fn standing_holds_feet_and_pelvis_and_is_part_of_the_settings() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("--retarget keypoints only"));
 }
 
-/// `--hands segments` places the hands along the arm instead of from the pelvis by the leg
-/// ratio: the robot's hands move differently (centimetres apart somewhere in the clip), the
-/// option enters the settings fingerprint (the clip is redone, not skipped), and the joint
-/// route refuses it.
+/// `--hands leg` places the hands from the pelvis by the leg ratio instead of along the arm:
+/// the robot's hands move differently (centimetres apart somewhere in the clip), the option
+/// enters the settings fingerprint (the clip is redone, not skipped), and the joint route
+/// refuses it.
 #[test]
 fn hands_option_moves_the_hands_and_is_part_of_the_settings() {
     let dir = tmp("hands");
@@ -686,11 +686,11 @@ fn hands_option_moves_the_hands_and_is_part_of_the_settings() {
     };
     let o = run(&[]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let leg = hand();
-    let o = run(&["--hands", "segments"]);
+    let seg = hand();
+    let o = run(&["--hands", "leg"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert_eq!(statuses(&out)["humanoid3d_punch"], "retargeted");
-    let seg = hand();
+    let leg = hand();
     assert_eq!(leg.len(), seg.len());
     let apart = leg
         .iter()
@@ -698,7 +698,7 @@ fn hands_option_moves_the_hands_and_is_part_of_the_settings() {
         .map(|(a, b)| (0..3).map(|d| (a[d] - b[d]).powi(2)).sum::<f64>().sqrt())
         .fold(0.0, f64::max);
     assert!(apart > 0.02, "hands at most {apart} m apart");
-    let o = run(&["--hands", "segments", "--retarget", "joints"]);
+    let o = run(&["--hands", "leg", "--retarget", "joints"]);
     assert!(!o.status.success());
     assert!(
         String::from_utf8_lossy(&o.stderr).contains("--hands applies to --retarget keypoints only")

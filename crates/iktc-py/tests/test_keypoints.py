@@ -91,15 +91,15 @@ def test_the_soft_approach_halves_the_plans_jerk_and_bad_rates_are_errors():
         iktc.retarget_keypoints(motion, robot, approach_rate=-1.0)
 
 
-def test_hands_along_the_segments_move_the_hands_differently_and_bad_names_are_errors():
+def test_hands_by_the_leg_ratio_move_the_hands_differently_and_bad_names_are_errors():
     robot = iktc.Robot("g1")
     motion = iktc.load_motion("humanoid3d_punch")
 
     def hand(t):
         return np.array([robot.frame_pose(q, "right_rubber_hand")[:3, 3] for q in t.q])
 
-    leg = hand(iktc.retarget_keypoints(motion, robot))
-    seg = hand(iktc.retarget_keypoints(motion, robot, hands="segments"))
+    seg = hand(iktc.retarget_keypoints(motion, robot))
+    leg = hand(iktc.retarget_keypoints(motion, robot, hands="leg"))
     assert leg.shape == seg.shape
     assert np.linalg.norm(leg - seg, axis=1).max() > 0.02
     with pytest.raises(ValueError, match="segments"):

@@ -184,12 +184,15 @@ pub struct KeypointSettings {
     /// the box. With them the level's least-squares problem is a compromise with the posture's
     /// `q̈_d + k_v (q̇_d − q̇) + k_p (q_d − q)`, which damps every joint the level moves.
     pub posture_weight: f64,
-    /// Where the hands' references are placed (default [`HandScaling::Leg`]). On the shared
-    /// clips (`tests/retarget_keypoints.rs`), against [`HandScaling::Segments`], G1's wrists
-    /// miss the captured ones by a mean 2.7–6.6 cm instead of 9.7–14.4 cm on three DeepMimic
-    /// clips and 1.3–1.4 cm instead of 7.1–9.2 cm on CMU `scaled_131_02`, about as before on
-    /// CMU 131_01 (14 cm) and `humanoid3d_dance_a` (19–20 cm); the mean keypoint error falls on
-    /// eleven of the twelve runs of G1 and JVRC-1 (G1 131_01: 11.7 → 12.7 cm).
+    /// Where the hands' references are placed (default [`HandScaling::Segments`]). On the
+    /// shared clips (`tests/retarget_keypoints.rs`) [`HandScaling::Leg`] brings G1's wrists
+    /// within a mean 2.7–6.6 cm of the captured ones instead of 9.7–14.4 cm on three DeepMimic
+    /// clips and 1.3–1.4 cm instead of 7.1–9.2 cm on CMU `scaled_131_02` (about as before on
+    /// CMU 131_01 and `humanoid3d_dance_a`), and lowers the mean keypoint error on eleven of
+    /// the twelve runs; but it stretches the arms further and faster: G1's RMS jerk rose on
+    /// three clips (e.g. `humanoid3d_dance_b` 13 600 → 18 200 rad/s³), and in MuJoCo
+    /// (`crates/iktc-py/examples/g1_sim.py`, standing imitation of `humanoid3d_dance_b`) G1's
+    /// feet slid 39 mm instead of 3.7 mm. (Measured with a COM level on every tick.)
     pub hands: HandScaling,
 }
 
@@ -231,7 +234,7 @@ impl Default for KeypointSettings {
             standing: false,
             smoothing: None,
             posture_weight: POSTURE_WEIGHT,
-            hands: HandScaling::Leg,
+            hands: HandScaling::Segments,
         }
     }
 }

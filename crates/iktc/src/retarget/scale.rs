@@ -16,7 +16,7 @@
 //! pelvis → head, chest, neck): `p'_c = p'_p + s_pc (a(p_c) − a(p_p))` with
 //! `s_pc = |r_c − r_p| / median_t |p_c(t) − p_p(t)|`, `r` the robot's points in its start
 //! posture. A segment without robot points takes its parent segment's ratio (toe: the shank's;
-//! chest, neck: the head's, else the leg's). With [`HandScaling::Leg`] (the default) the
+//! chest, neck: the head's, else the leg's). With [`HandScaling::Leg`] the
 //! wrists are then placed from the pelvis by the leg ratio instead, `p'_wrist = p'_pelvis +
 //! s_leg (a(p_wrist) − a(p_pelvis))`: where the hands are relative to the body is kept, not
 //! the forearm's direction.
