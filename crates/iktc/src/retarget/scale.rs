@@ -309,5 +309,16 @@ mod tests {
             }
         }
         assert!(apart > 0.01, "the segments' hands at most {apart} m apart");
+        // With the leg ratio, each hand is the captured hand's offset from the pelvis, scaled
+        // by the leg ratio, from the pelvis' reference.
+        let pelvis = idx(BodyPoint::Pelvis);
+        for f in 0..kp.frame_count() {
+            for w in [l, r] {
+                let a = &leg.aligned;
+                let want = leg.scaling.leg * (a[f * n + w] - a[f * n + pelvis]);
+                let got = leg.scaled[f * n + w] - leg.scaled[f * n + pelvis];
+                assert!((got - want).norm() < tol, "frame {f}: {got} vs {want}");
+            }
+        }
     }
 }
