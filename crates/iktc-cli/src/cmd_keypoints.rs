@@ -167,6 +167,8 @@ pub fn run(
         "gf_ticks": run.fallback_ticks,
         "stance_gf_ticks": run.stance_gf_ticks,
         "tick_median_us": run.tick_median_us,
+        "sacrificed": run.sacrificed,
+        "settle_sacrificed": run.settle_sacrificed,
         "standing": settings.standing,
         "smoothing_hz": settings.smoothing,
         "keypoints": run.quality,
@@ -211,6 +213,13 @@ fn print(run: &KeypointRun, joints: Option<&RetargetQuality>) -> std::io::Result
         run.fallback_ticks,
         run.stance_gf_ticks,
         run.tick_median_us
+    )?;
+    crate::outln!(
+        "levels sacrificed to the joint limits (ticks IKTC corrected from each): {} of {} ticks; while settling on the first frame: {} of {}",
+        run.sacrificed.describe(),
+        run.sacrificed.ticks,
+        run.settle_sacrificed.describe(),
+        run.settle_sacrificed.ticks
     )?;
     crate::outln!(
         "{:<16} {:>22} {:>22}",

@@ -144,6 +144,19 @@ fn g1_retargets_the_default_clip_by_keypoints_beside_the_joint_route() {
         // One error per body point the G1 has (its head frame sits at the pelvis).
         assert_eq!(q["points"].as_array().unwrap().len(), 13, "{route}");
     }
+    // Why tasks were sacrificed: every level of the keypoint stack counted, over the clip's
+    // recorded ticks and over the settling's, no level more often than there are ticks.
+    for (key, ticks) in [
+        ("sacrificed", s["keypoints"]["ticks"].as_u64().unwrap()),
+        ("settle_sacrificed", 300),
+    ] {
+        assert_eq!(s[key]["ticks"].as_u64(), Some(ticks), "{key}");
+        let levels = s[key]["levels"].as_object().unwrap();
+        assert_eq!(levels.len(), 7, "{key}");
+        let total: u64 = levels.values().map(|v| v.as_u64().unwrap()).sum();
+        assert!(total <= ticks, "{key}: {total} of {ticks}");
+    }
+    assert!(String::from_utf8_lossy(&o.stdout).contains("levels sacrificed to the joint limits"));
     let csv = std::fs::read_to_string(out.join("keypoints_trajectory.csv")).unwrap();
     assert_eq!(csv.lines().next().unwrap().split(',').count(), 1 + 29);
     let viewer = std::fs::read_to_string(out.join("viewer.html")).unwrap();

@@ -100,7 +100,8 @@ pub struct ClipOutcome {
 
 impl ClipOutcome {
     /// The run's own summary as JSON (the `summary` of `quality.json`): the keypoint route's
-    /// [`crate::retarget::RetargetQuality`] with its scaling and GF ticks, or the imitation's
+    /// [`crate::retarget::RetargetQuality`] with its scaling, GF ticks and the levels IKTC
+    /// sacrificed ([`crate::retarget::Sacrifices`]), or the imitation's
     /// [`crate::sim::ImitateSummary`].
     ///
     /// Errors: [`Error::InvalidSetting`] if a figure cannot be written as JSON.
@@ -116,6 +117,8 @@ impl ClipOutcome {
                 "leg_ratio": run.scaling.leg,
                 "gf_ticks": run.fallback_ticks,
                 "stance_gf_ticks": run.stance_gf_ticks,
+                "sacrificed": run.sacrificed,
+                "settle_sacrificed": run.settle_sacrificed,
                 "keypoints": run.quality,
             }),
             ClipRun::Joints { run, .. } => {
@@ -546,6 +549,16 @@ mod tests {
             summary["keypoints"]["ticks"].as_u64(),
             Some(run.quality.ticks as u64)
         );
+        assert_eq!(
+            summary["sacrificed"]["ticks"].as_u64(),
+            Some(run.quality.ticks as u64)
+        );
+        for (level, n) in &run.sacrificed.levels {
+            assert_eq!(
+                summary["sacrificed"]["levels"][level].as_u64(),
+                Some(*n as u64)
+            );
+        }
     }
 
     /// The posture level's references: the profile's map for the clip's format, none where

@@ -657,6 +657,17 @@ impl KeypointController {
         self.used_fallback
     }
 
+    /// The level of the keypoint stack ([`KEYPOINT_LEVELS`]) that IKTC sacrificed on the last
+    /// tick: the highest-priority level whose correction it needed to bring q̈ into the box
+    /// ([`SolveReport::corrected_from`]); `None` when the prioritized solution was inside it.
+    pub fn sacrificed_level(&self) -> Option<&str> {
+        let ctl = self.controller();
+        ctl.report()
+            .corrected_from
+            .and_then(|i| ctl.stack().levels.get(i))
+            .map(|l| l.name.as_str())
+    }
+
     /// Ticks solved by GF so far because IKTC's answer left the box.
     pub fn fallback_ticks(&self) -> usize {
         self.fallback_ticks
