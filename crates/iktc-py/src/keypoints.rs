@@ -4,10 +4,11 @@
 
 use iktc::batch::{posture_references, Posture};
 use iktc::motion::DEFAULT_MAX_GAP;
-use iktc::retarget::{keypoint_controller, HandScaling, KeypointSettings};
+use iktc::retarget::{keypoint_controller, HandScaling, KeypointSettings, Sacrifices};
 use iktc::sim::ImitateConfig;
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
 
 use crate::convert::{array, table};
 use crate::motion::PyMotion;
@@ -26,6 +27,8 @@ pub struct PyKeypointTrajectory {
     v: Vec<f64>,
     qdd: Vec<f64>,
     fallback_ticks: usize,
+    sacrificed: Sacrifices,
+    settle_sacrificed: Sacrifices,
 }
 
 /// Runs the keypoint retargeting of `motion` on `robot` (which must have a profile) as
@@ -103,8 +106,10 @@ pub fn py_retarget_keypoints(
             None => Posture::Start("the motion has no skeleton".into()),
         };
         let mut ctl = keypoint_controller(profile, &kp, posture.references(), &settings)?;
+        let mut settle_sacrificed = Sacrifices::new();
         for _ in 0..(settings.settle_time / dt).round() as usize {
             ctl.tick(0, true)?;
+            settle_sacrificed.count(ctl.sacrificed_level());
             ctl.integrate()?;
         }
         let ticks = ctl.ticks();
@@ -119,12 +124,15 @@ pub fn py_retarget_keypoints(
             v: Vec::with_capacity(ticks * nv),
             qdd: Vec::with_capacity(ticks * nv),
             fallback_ticks: 0,
+            sacrificed: Sacrifices::new(),
+            settle_sacrificed,
         };
         for k in 0..ticks {
             out.times.push(t0 + k as f64 * dt);
             out.q.extend(ctl.state().q.iter());
             out.v.extend(ctl.state().qd.iter());
             ctl.tick(k, false)?;
+            out.sacrificed.count(ctl.sacrificed_level());
             out.qdd.extend(ctl.qdd().iter());
             ctl.integrate()?;
         }
@@ -174,6 +182,20 @@ impl PyKeypointTrajectory {
         self.fallback_ticks
     }
 
+    /// Which tasks the joint limits cost: per level of the keypoint stack (in priority order),
+    /// the ticks of the clip on which IKTC sacrificed it (the highest-priority level it
+    /// corrected to keep every limit; `iktc::retarget::Sacrifices`).
+    #[getter]
+    fn sacrificed<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        levels_dict(py, &self.sacrificed)
+    }
+
+    /// The same over the settling on the clip's first frame, before the clip starts.
+    #[getter]
+    fn settle_sacrificed<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        levels_dict(py, &self.settle_sacrificed)
+    }
+
     fn __len__(&self) -> usize {
         self.times.len()
     }
@@ -183,4 +205,13 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(py_retarget_keypoints, m)?)?;
     m.add_class::<PyKeypointTrajectory>()?;
     Ok(())
+}
+
+/// `{level: ticks}` in priority order.
+fn levels_dict<'py>(py: Python<'py>, s: &Sacrifices) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    for (level, n) in &s.levels {
+        d.set_item(level, *n)?;
+    }
+    Ok(d)
 }

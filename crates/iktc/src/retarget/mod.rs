@@ -345,16 +345,25 @@ impl serde::Serialize for Sacrifices {
     }
 }
 
+impl Default for Sacrifices {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
 impl Sacrifices {
-    fn new() -> Self {
+    /// No tick counted yet, every level of [`KEYPOINT_LEVELS`] at 0.
+    pub fn new() -> Self {
         Self {
             ticks: 0,
             levels: KEYPOINT_LEVELS.iter().map(|l| (l.to_string(), 0)).collect(),
         }
     }
 
-    /// Counts one tick whose sacrificed level is `level`.
-    fn count(&mut self, level: Option<&str>) {
+    /// Counts one tick whose sacrificed level is `level` (a name of [`KEYPOINT_LEVELS`], as
+    /// [`KeypointController::sacrificed_level`] gives it; `None` or another name counts the
+    /// tick only).
+    pub fn count(&mut self, level: Option<&str>) {
         self.ticks += 1;
         if let Some(entry) = level.and_then(|n| self.levels.iter_mut().find(|(l, _)| l == n)) {
             entry.1 += 1;
