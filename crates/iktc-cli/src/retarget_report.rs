@@ -11,7 +11,7 @@ use crate::cmd_retarget::ClipStatus;
 /// The figures shown: key in `quality.json`'s `figures`, column label with its unit. A column
 /// appears when some clip has its figure (the keypoint and joint routes measure different
 /// things).
-const COLUMNS: [(&str, &str); 22] = [
+const COLUMNS: [(&str, &str); 23] = [
     ("duration", "duration [s]"),
     ("mean_keypoint_error", "mean keypoint error [m]"),
     ("max_keypoint_error", "max keypoint error [m]"),
@@ -49,6 +49,10 @@ const COLUMNS: [(&str, &str); 22] = [
         "share of ticks solved by GF for the feet [–]",
     ),
     ("leg_ratio", "leg ratio robot/person [–]"),
+    (
+        "body_sacrificed_share",
+        "share of ticks sacrificing the feet, COM or pelvis [–]",
+    ),
 ];
 
 /// The figure rows are sorted by, worst first: the first of these a clip has.

@@ -17,7 +17,7 @@ use serde::Serialize;
 use crate::error::{Error, Result};
 use crate::model::Robot;
 use crate::profile::Foot;
-use crate::retarget::{KeypointRun, RetargetQuality};
+use crate::retarget::{KeypointRun, RetargetQuality, KEYPOINT_LEVELS};
 use crate::sim::{ImitateRun, ImitateSummary};
 
 /// A sole corner deeper than this below the ground counts as penetrating in the share of frames
@@ -223,6 +223,12 @@ pub struct KeypointFigures {
     pub penetration: f64,
     /// Share of the ticks with a sole corner deeper than [`PENETRATION_TOLERANCE`] \[–\].
     pub penetration_share: f64,
+    /// Share of the ticks on which IKTC sacrificed the feet's, the COM's or the pelvis' level
+    /// (the first four of [`KEYPOINT_LEVELS`]) to keep the joint limits \[–\]: the body could
+    /// not take the clip's stance or pelvis pose ([`KeypointRun::sacrificed`]).
+    pub body_sacrificed_share: f64,
+    /// The level IKTC sacrificed on the most ticks (empty if none).
+    pub most_sacrificed: String,
 }
 
 impl KeypointFigures {
@@ -262,6 +268,18 @@ impl KeypointFigures {
             tick_median_us: run.tick_median_us,
             penetration: p.depth,
             penetration_share: p.share,
+            body_sacrificed_share: KEYPOINT_LEVELS[..4]
+                .iter()
+                .map(|l| run.sacrificed.of(l))
+                .sum::<usize>() as f64
+                / ticks,
+            most_sacrificed: run
+                .sacrificed
+                .levels
+                .iter()
+                .filter(|(_, n)| *n > 0)
+                .max_by_key(|(_, n)| *n)
+                .map_or_else(String::new, |(l, _)| l.clone()),
         }
     }
 }

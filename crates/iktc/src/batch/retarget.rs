@@ -434,6 +434,7 @@ impl BatchRetarget {
 mod tests {
     use super::*;
     use crate::batch::TrainingTrajectory;
+    use crate::retarget::KEYPOINT_LEVELS;
 
     fn batch() -> BatchRetarget {
         let profile = RobotProfile::builtin("jvrc1").unwrap();
@@ -443,6 +444,28 @@ mod tests {
     fn walk() -> std::path::PathBuf {
         std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("data/motions/deepmimic/humanoid3d_walk.txt")
+    }
+
+    /// The share of the ticks that sacrifice the feet's, COM's or pelvis' level flags the clip
+    /// the robot cannot take: JVRC-1 on `humanoid3d_dance_a`, whose first frame is out of its
+    /// reach (its pelvis level sacrificed on 226 of 324 ticks), against `humanoid3d_walk`.
+    #[test]
+    fn the_body_sacrificed_share_flags_the_clip_the_robot_cannot_take() {
+        let b = batch();
+        let share = |clip: &str| {
+            let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join(format!("data/motions/deepmimic/{clip}.txt"));
+            let o = b.retarget(&path).unwrap();
+            let ClipQuality::Keypoints(f) = &o.quality else {
+                panic!("{clip}: not the keypoint route");
+            };
+            (f.body_sacrificed_share, f.most_sacrificed.clone())
+        };
+        let (bad, bad_level) = share("humanoid3d_dance_a");
+        let (walk, _) = share("humanoid3d_walk");
+        assert!(bad > 0.5, "dance_a: {bad}");
+        assert_eq!(bad_level, "pelvis");
+        assert!(walk < 0.5 * bad, "walk {walk} against dance_a {bad}");
     }
 
     #[test]
@@ -552,6 +575,17 @@ mod tests {
         assert_eq!(
             summary["sacrificed"]["ticks"].as_u64(),
             Some(run.quality.ticks as u64)
+        );
+        let body: usize = KEYPOINT_LEVELS[..4]
+            .iter()
+            .map(|l| run.sacrificed.of(l))
+            .sum();
+        assert_eq!(
+            f.body_sacrificed_share,
+            body as f64 / run.quality.ticks as f64
+        );
+        assert!(
+            f.most_sacrificed.is_empty() || KEYPOINT_LEVELS.contains(&f.most_sacrificed.as_str())
         );
         for (level, n) in &run.sacrificed.levels {
             assert_eq!(
