@@ -74,6 +74,20 @@ fn retarget(args: &[&str]) -> Output {
         .unwrap()
 }
 
+/// `iktc retarget CLIP --robot g1 --out OUT --no-viewer` with `extra` arguments.
+fn retarget_on_g1(clip: &Path, out: &Path, extra: &[&str]) -> Output {
+    let mut args = vec![
+        clip.to_str().unwrap(),
+        "--robot",
+        "g1",
+        "--out",
+        out.to_str().unwrap(),
+        "--no-viewer",
+    ];
+    args.extend_from_slice(extra);
+    retarget(&args)
+}
+
 fn batch_json(out: &Path) -> BTreeMap<String, serde_json::Value> {
     let v: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("batch.json")).unwrap()).unwrap();
@@ -601,18 +615,7 @@ fn standing_holds_feet_and_pelvis_and_is_part_of_the_settings() {
     let dir = tmp("standing");
     let clip = data().join("humanoid3d_dance_b.txt");
     let out = dir.join("out");
-    let run = |extra: &[&str]| {
-        let mut args = vec![
-            clip.to_str().unwrap(),
-            "--robot",
-            "g1",
-            "--out",
-            out.to_str().unwrap(),
-            "--no-viewer",
-        ];
-        args.extend_from_slice(extra);
-        retarget(&args)
-    };
+    let run = |extra: &[&str]| retarget_on_g1(&clip, &out, extra);
     let o = run(&["--standing", "--smoothing", "6"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let npz = read_npz(&std::fs::read(out.join("humanoid3d_dance_b/motion.npz")).unwrap());
@@ -659,18 +662,7 @@ fn hands_option_moves_the_hands_and_is_part_of_the_settings() {
     let dir = tmp("hands");
     let clip = data().join("humanoid3d_punch.txt");
     let out = dir.join("out");
-    let run = |extra: &[&str]| {
-        let mut args = vec![
-            clip.to_str().unwrap(),
-            "--robot",
-            "g1",
-            "--out",
-            out.to_str().unwrap(),
-            "--no-viewer",
-        ];
-        args.extend_from_slice(extra);
-        retarget(&args)
-    };
+    let run = |extra: &[&str]| retarget_on_g1(&clip, &out, extra);
     let hand = || {
         let npz = read_npz(&std::fs::read(out.join("humanoid3d_punch/motion.npz")).unwrap());
         let bodies = strings(&npz, "body_names");

@@ -106,10 +106,8 @@ pub fn py_retarget_keypoints(
             None => Posture::Start("the motion has no skeleton".into()),
         };
         let mut ctl = keypoint_controller(profile, &kp, posture.references(), &settings)?;
-        let mut settle_sacrificed = Sacrifices::new();
         for _ in 0..(settings.settle_time / dt).round() as usize {
             ctl.tick(0, true)?;
-            settle_sacrificed.count(ctl.sacrificed_level());
             ctl.integrate()?;
         }
         let ticks = ctl.ticks();
@@ -124,19 +122,20 @@ pub fn py_retarget_keypoints(
             v: Vec::with_capacity(ticks * nv),
             qdd: Vec::with_capacity(ticks * nv),
             fallback_ticks: 0,
-            sacrificed: Sacrifices::new(),
-            settle_sacrificed,
+            sacrificed: Sacrifices::default(),
+            settle_sacrificed: Sacrifices::default(),
         };
         for k in 0..ticks {
             out.times.push(t0 + k as f64 * dt);
             out.q.extend(ctl.state().q.iter());
             out.v.extend(ctl.state().qd.iter());
             ctl.tick(k, false)?;
-            out.sacrificed.count(ctl.sacrificed_level());
             out.qdd.extend(ctl.qdd().iter());
             ctl.integrate()?;
         }
         out.fallback_ticks = ctl.fallback_ticks();
+        out.sacrificed = ctl.sacrificed().clone();
+        out.settle_sacrificed = ctl.settle_sacrificed().clone();
         Ok(out)
     })
     .map_err(to_py)

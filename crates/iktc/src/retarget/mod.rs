@@ -46,7 +46,7 @@ pub use body::{BodyFrameNames, RobotBody, MIN_HEAD_HEIGHT};
 pub use floor::FLOOR_ENGAGE;
 pub use quality::{OrientationError, PointError, QualityRecorder, RetargetQuality};
 pub use scale::Scaling;
-pub use tracker::{KeypointController, KEYPOINT_LEVELS, LAND_TILT};
+pub use tracker::{KeypointController, Sacrifices, KEYPOINT_LEVELS, LAND_TILT};
 pub use viewer::{keypoint_viewer, ON_LIMIT};
 
 use std::sync::Arc;
@@ -303,96 +303,10 @@ pub struct KeypointRun {
     /// Median time of one control tick (references, kinematics, box, solve, integration) \[µs\].
     pub tick_median_us: f64,
     /// Why tasks were sacrificed: per level of the keypoint stack, the recorded ticks on which
-    /// IKTC's answer was corrected from it ([`KeypointController::sacrificed_level`]).
+    /// IKTC's answer was corrected from it ([`KeypointController::sacrificed`]).
     pub sacrificed: Sacrifices,
     /// The same over the settling on the first frame, before the clip starts.
     pub settle_sacrificed: Sacrifices,
-}
-
-/// Per level of the keypoint stack ([`KEYPOINT_LEVELS`] order), the ticks on which IKTC
-/// sacrificed it: the highest-priority level it corrected to keep every joint limit
-/// ([`crate::solver::SolveReport::corrected_from`]). A level sacrificed on most ticks names the
-/// task the robot cannot follow within its limits (a foot out of reach, a pelvis pose the legs
-/// cannot hold).
-#[derive(Debug, Clone, PartialEq)]
-pub struct Sacrifices {
-    /// Ticks counted.
-    pub ticks: usize,
-    /// Level name and the ticks on which it was sacrificed, every level of [`KEYPOINT_LEVELS`].
-    pub levels: Vec<(String, usize)>,
-}
-
-/// As `{"ticks": n, "levels": {"stance_feet": n₀, …}}`, the levels in priority order.
-impl serde::Serialize for Sacrifices {
-    fn serialize<S: serde::Serializer>(
-        &self,
-        serializer: S,
-    ) -> std::result::Result<S::Ok, S::Error> {
-        use serde::ser::SerializeStruct;
-        struct Levels<'a>(&'a [(String, usize)]);
-        impl serde::Serialize for Levels<'_> {
-            fn serialize<S: serde::Serializer>(
-                &self,
-                serializer: S,
-            ) -> std::result::Result<S::Ok, S::Error> {
-                serializer.collect_map(self.0.iter().map(|(l, n)| (l, n)))
-            }
-        }
-        let mut st = serializer.serialize_struct("Sacrifices", 2)?;
-        st.serialize_field("ticks", &self.ticks)?;
-        st.serialize_field("levels", &Levels(&self.levels))?;
-        st.end()
-    }
-}
-
-impl Default for Sacrifices {
-    fn default() -> Self {
-        Self::new()
-    }
-}
-
-impl Sacrifices {
-    /// No tick counted yet, every level of [`KEYPOINT_LEVELS`] at 0.
-    pub fn new() -> Self {
-        Self {
-            ticks: 0,
-            levels: KEYPOINT_LEVELS.iter().map(|l| (l.to_string(), 0)).collect(),
-        }
-    }
-
-    /// Counts one tick whose sacrificed level is `level` (a name of [`KEYPOINT_LEVELS`], as
-    /// [`KeypointController::sacrificed_level`] gives it; `None` or another name counts the
-    /// tick only).
-    pub fn count(&mut self, level: Option<&str>) {
-        self.ticks += 1;
-        if let Some(entry) = level.and_then(|n| self.levels.iter_mut().find(|(l, _)| l == n)) {
-            entry.1 += 1;
-        }
-    }
-
-    /// The ticks on which `level` was sacrificed (0 for a name not in [`KEYPOINT_LEVELS`]).
-    pub fn of(&self, level: &str) -> usize {
-        self.levels
-            .iter()
-            .find(|(l, _)| l == level)
-            .map_or(0, |(_, n)| *n)
-    }
-
-    /// The levels sacrificed on at least one tick, as `name n` joined by commas, "none" if no
-    /// tick was corrected.
-    pub fn describe(&self) -> String {
-        let parts: Vec<String> = self
-            .levels
-            .iter()
-            .filter(|(_, n)| *n > 0)
-            .map(|(l, n)| format!("{l} {n}"))
-            .collect();
-        if parts.is_empty() {
-            "none".into()
-        } else {
-            parts.join(", ")
-        }
-    }
 }
 
 /// Everything a keypoint run needs, built once.
@@ -578,13 +492,10 @@ pub fn retarget_keypoints_on(
         scaling,
     } = setup(robot, profile, kp, posture, s)?;
     let settle = (s.settle_time / s.dt).round() as usize;
-    let mut settle_sacrificed = Sacrifices::new();
     for _ in 0..settle {
         controller.tick(0, true)?;
-        settle_sacrificed.count(controller.sacrificed_level());
         controller.integrate()?;
     }
-    let mut sacrificed = Sacrifices::new();
     let ticks = controller.ticks();
     let mut rec = QualityRecorder::new("keypoints", &body, s.dt);
     let mut trajectory = Vec::with_capacity(ticks);
@@ -598,7 +509,6 @@ pub fn retarget_keypoints_on(
         let start = Instant::now();
         controller.tick(k, false)?;
         tick_us.push(start.elapsed().as_secs_f64() * 1e6);
-        sacrificed.count(controller.sacrificed_level());
         let plan = controller.plan();
         let on = controller.stance();
         stance[0].push(on[0]);
@@ -635,8 +545,8 @@ pub fn retarget_keypoints_on(
         fallback_ticks: controller.fallback_ticks(),
         stance_gf_ticks: controller.stance_gf_ticks(),
         tick_median_us: percentile(&tick_us, 0.5),
-        sacrificed,
-        settle_sacrificed,
+        sacrificed: controller.sacrificed().clone(),
+        settle_sacrificed: controller.settle_sacrificed().clone(),
     })
 }
 

@@ -83,6 +83,90 @@ pub const KEYPOINT_LEVELS: [&str; 7] = [
     "posture",
 ];
 
+/// Per level of the keypoint stack ([`KEYPOINT_LEVELS`] order), the ticks on which IKTC
+/// sacrificed it: the highest-priority level it corrected to keep every joint limit
+/// ([`crate::solver::SolveReport::corrected_from`]). A level sacrificed on most ticks names the
+/// task the robot cannot follow within its limits (a foot out of reach, a pelvis pose the legs
+/// cannot hold).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Sacrifices {
+    /// Ticks counted.
+    pub ticks: usize,
+    /// Level name and the ticks on which it was sacrificed, every level of [`KEYPOINT_LEVELS`].
+    pub levels: Vec<(String, usize)>,
+}
+
+/// As `{"ticks": n, "levels": {"stance_feet": n₀, …}}`, the levels in priority order.
+impl serde::Serialize for Sacrifices {
+    fn serialize<S: serde::Serializer>(
+        &self,
+        serializer: S,
+    ) -> std::result::Result<S::Ok, S::Error> {
+        use serde::ser::SerializeStruct;
+        struct Levels<'a>(&'a [(String, usize)]);
+        impl serde::Serialize for Levels<'_> {
+            fn serialize<S: serde::Serializer>(
+                &self,
+                serializer: S,
+            ) -> std::result::Result<S::Ok, S::Error> {
+                serializer.collect_map(self.0.iter().map(|(l, n)| (l, n)))
+            }
+        }
+        let mut st = serializer.serialize_struct("Sacrifices", 2)?;
+        st.serialize_field("ticks", &self.ticks)?;
+        st.serialize_field("levels", &Levels(&self.levels))?;
+        st.end()
+    }
+}
+
+impl Default for Sacrifices {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Sacrifices {
+    /// No tick counted yet, every level of [`KEYPOINT_LEVELS`] at 0.
+    pub fn new() -> Self {
+        Self {
+            ticks: 0,
+            levels: KEYPOINT_LEVELS.iter().map(|l| (l.to_string(), 0)).collect(),
+        }
+    }
+
+    /// Counts one tick whose sacrificed level is `KEYPOINT_LEVELS[level]` (`None`: none).
+    fn count(&mut self, level: Option<usize>) {
+        self.ticks += 1;
+        if let Some(entry) = level.and_then(|i| self.levels.get_mut(i)) {
+            entry.1 += 1;
+        }
+    }
+
+    /// The ticks on which `level` was sacrificed (0 for a name not in [`KEYPOINT_LEVELS`]).
+    pub fn of(&self, level: &str) -> usize {
+        self.levels
+            .iter()
+            .find(|(l, _)| l == level)
+            .map_or(0, |(_, n)| *n)
+    }
+
+    /// The levels sacrificed on at least one tick, as `name n` joined by commas, "none" if no
+    /// tick was corrected.
+    pub fn describe(&self) -> String {
+        let parts: Vec<String> = self
+            .levels
+            .iter()
+            .filter(|(_, n)| *n > 0)
+            .map(|(l, n)| format!("{l} {n}"))
+            .collect();
+        if parts.is_empty() {
+            "none".into()
+        } else {
+            parts.join(", ")
+        }
+    }
+}
+
 /// The keypoint stack on a robot, its references and its state (see the module docs).
 #[derive(Debug, Clone)]
 pub struct KeypointController {
@@ -96,6 +180,10 @@ pub struct KeypointController {
     fallback_ticks: usize,
     /// Ticks solved by GF so far because it kept the stance feet better than IKTC.
     stance_gf_ticks: usize,
+    /// The levels IKTC sacrificed so far, over the ticks with moving references and over the
+    /// held ones (settling).
+    sacrificed: Sacrifices,
+    settle_sacrificed: Sacrifices,
     plan: Plan,
     state: State,
     dt: f64,
@@ -439,6 +527,8 @@ impl KeypointController {
             used_fallback: false,
             fallback_ticks: 0,
             stance_gf_ticks: 0,
+            sacrificed: Sacrifices::new(),
+            settle_sacrificed: Sacrifices::new(),
             plan,
             state,
             dt: s.dt,
@@ -584,6 +674,15 @@ impl KeypointController {
         let held = stance != 0 && r.corrected_from == Some(0);
         let stance_error = r.task_error_norms.first().copied().unwrap_or(0.0);
         let violation = r.violation;
+        let corrected = r.corrected_from;
+        let level = corrected
+            .and_then(|i| stack.ctl.stack().levels.get(i))
+            .and_then(|l| KEYPOINT_LEVELS.iter().position(|n| *n == l.name));
+        if hold {
+            self.settle_sacrificed.count(level);
+        } else {
+            self.sacrificed.count(level);
+        }
         if (violation <= tolerance && !held) || !iktc {
             return Ok(stack.ctl.report());
         }
@@ -657,15 +756,16 @@ impl KeypointController {
         self.used_fallback
     }
 
-    /// The level of the keypoint stack ([`KEYPOINT_LEVELS`]) that IKTC sacrificed on the last
-    /// tick: the highest-priority level whose correction it needed to bring q̈ into the box
-    /// ([`SolveReport::corrected_from`]); `None` when the prioritized solution was inside it.
-    pub fn sacrificed_level(&self) -> Option<&str> {
-        let ctl = self.controller();
-        ctl.report()
-            .corrected_from
-            .and_then(|i| ctl.stack().levels.get(i))
-            .map(|l| l.name.as_str())
+    /// The levels IKTC sacrificed on the ticks so far with moving references (`hold` false in
+    /// [`KeypointController::tick`]): per level, the ticks on which it was the highest-priority
+    /// level whose correction brought q̈ into the box ([`SolveReport::corrected_from`]).
+    pub fn sacrificed(&self) -> &Sacrifices {
+        &self.sacrificed
+    }
+
+    /// The same over the held ticks (the settling on the first frame).
+    pub fn settle_sacrificed(&self) -> &Sacrifices {
+        &self.settle_sacrificed
     }
 
     /// Ticks solved by GF so far because IKTC's answer left the box.
