@@ -86,10 +86,11 @@ pub enum SupportArea {
 /// Where the hands' references are placed ([`KeypointSettings::hands`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum HandScaling {
-    /// From the pelvis' reference by the leg ratio, `p'_wrist = p'_pelvis + s_leg (a(p_wrist)
-    /// − a(p_pelvis))`: the hands are where the captured person's are relative to the pelvis,
-    /// scaled as a whole, so hands that meet (a clap, hands on the hips) still meet on the
-    /// robot. The quality figures' neutral targets are placed the same way.
+    /// From the middle of the hips' reference by the leg ratio, `p'_wrist = p'_m + s_leg
+    /// (a(p_wrist) − a(m))` (`m` the middle of the hips): the
+    /// hands are where the captured person's are relative to the pelvis, scaled as a whole, so
+    /// hands that meet (a clap, hands on the hips) still meet on the robot. The quality
+    /// figures' neutral targets are placed the same way.
     Leg,
     /// Along the arm from the shoulder, each segment at the robot's own length: the arm keeps
     /// the captured arm's direction, and the hands land wherever the robot's proportions put
@@ -186,13 +187,13 @@ pub struct KeypointSettings {
     pub posture_weight: f64,
     /// Where the hands' references are placed (default [`HandScaling::Segments`]). On the
     /// shared clips (`tests/retarget_keypoints.rs`) [`HandScaling::Leg`] brings G1's wrists
-    /// within a mean 2.7–6.6 cm of the captured ones instead of 9.7–14.4 cm on three DeepMimic
-    /// clips and 1.3–1.4 cm instead of 7.1–9.2 cm on CMU `scaled_131_02` (about as before on
-    /// CMU 131_01 and `humanoid3d_dance_a`), and lowers the mean keypoint error on eleven of
-    /// the twelve runs; but it stretches the arms further and faster: G1's RMS jerk rose on
-    /// three clips (e.g. `humanoid3d_dance_b` 13 600 → 18 200 rad/s³), and in MuJoCo
-    /// (`crates/iktc-py/examples/g1_sim.py`, standing imitation of `humanoid3d_dance_b`) G1's
-    /// feet slid 39 mm instead of 3.7 mm. (Measured with a COM level on every tick.)
+    /// within a mean 2.9–5.9 cm of the captured ones instead of 5.2–7.7 cm on three DeepMimic
+    /// clips, and lowers the mean keypoint error on nine of the twelve runs (all six on
+    /// JVRC-1); but it stretches the arms further and faster: G1's RMS jerk rose on four clips
+    /// (e.g. `humanoid3d_dance_b` 13 600 → 18 000 rad/s³), G1's stance feet slipped 10 mm on
+    /// CMU 131_01 (1.8 mm with `Segments`), and in MuJoCo (`crates/iktc-py/examples/g1_sim.py`,
+    /// standing imitation of `humanoid3d_dance_b`) G1's feet slid 39 mm instead of 3.7 mm
+    /// (measured with the hands placed from the pelvis frame, 10 cm higher on G1).
     pub hands: HandScaling,
 }
 

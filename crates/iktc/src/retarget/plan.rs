@@ -101,8 +101,11 @@ pub(crate) struct Plan {
     pub torso: Vec<PoseRef>,
     /// The tracked points (hands, elbows, head) and their references per tick.
     pub points: Vec<(BodyPoint, Vec<PointRef>)>,
-    /// Per tick, per point of the robot body: `s_leg (a(p) − a(p_pelvis))` \[m\], the neutral
-    /// target relative to the robot's pelvis.
+    /// Per tick, per point of the robot body: `s_leg (a(p) − a(m))` \[m\], the neutral target
+    /// relative to the middle of the robot's hips, with `m = (p_lhip + p_rhip) / 2` the middle of
+    /// the human hips. The hip joint centres are the pelvis's anatomical landmarks both bodies
+    /// have; a rig's root and a robot's pelvis frame are not (DeepMimic's root is at hip height,
+    /// CMU's several centimetres above, G1's pelvis frame 10 cm above its hips, JVRC-1's at them).
     pub neutral: Vec<Vec<(BodyPoint, Vector3<f64>)>>,
 }
 
@@ -491,8 +494,12 @@ pub(crate) fn plan(
             }
         }
     }
-    // Neutral targets: the aligned human points scaled by the leg ratio, pelvis-aligned.
-    let pelvis_k = idx(BodyPoint::Pelvis).ok_or_else(|| missing(BodyPoint::Pelvis))?;
+    // Neutral targets: the aligned human points scaled by the leg ratio, placed at the middle
+    // of the hips (the joint centres both bodies have; see `Plan::neutral`).
+    let hip_k = [
+        idx(BodyPoint::LeftHip).ok_or_else(|| missing(BodyPoint::LeftHip))?,
+        idx(BodyPoint::RightHip).ok_or_else(|| missing(BodyPoint::RightHip))?,
+    ];
     let leg = clip.scaling.leg;
     let neutral = (0..ticks)
         .map(|k| {
@@ -501,7 +508,7 @@ pub(crate) fn plan(
                 .filter_map(|(p, _)| {
                     let i = idx(*p)?;
                     let a = aligned[i].as_ref()?[k];
-                    let o = aligned[pelvis_k].as_ref()?[k];
+                    let o = 0.5 * (aligned[hip_k[0]].as_ref()?[k] + aligned[hip_k[1]].as_ref()?[k]);
                     Some((*p, leg * (a - o)))
                 })
                 .collect()

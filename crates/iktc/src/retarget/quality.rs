@@ -1,9 +1,14 @@
 //! Quality figures of a retargeted motion, the same for the keypoint route and the joint route.
 //!
 //! Per tick `k` of the clip (after any settling), from the robot's state:
-//! * position error of each body point the robot has: `|x_k − (x_pelvis,k + s_leg (a(p_k) −
-//!   a(p_pelvis,k)))|` \[m\], the human point scaled by the leg ratio and placed at the robot's
-//!   pelvis (the aligned clip `a`, [`super::scale`]); mean and max per point, reported in cm;
+//! * position error of each body point the robot has: `|x_k − (x_m,k + s_leg (a(p_k) −
+//!   a(m_k)))|` \[m\], the human point scaled by the leg ratio and placed at the robot's pelvis
+//!   by the middle of the hips (`m` of the human hips, `x_m` of the robot's; the aligned clip
+//!   `a`, [`super::scale`]); mean and max per point, reported in cm. The hip joint centres are
+//!   the landmarks of the pelvis both bodies have, where a rig's root and a robot's pelvis
+//!   frame differ (DeepMimic's root is at its hips, CMU's above them, G1's pelvis frame 10 cm
+//!   above its hips, JVRC-1's at them): aligned at those, G1's hips missed the clip's by a
+//!   rigid 10.3 cm on the DeepMimic clips, which no motion of the robot changes;
 //! * orientation error of the pelvis and the torso frames against the references built from the
 //!   points ([`super::plan`]): the angle of `R_ref R_robotᵀ` \[rad\], mean and max, in degrees;
 //! * stance-foot slip: for each stance run of a foot (on the keypoint route the robot's stance,
@@ -132,13 +137,23 @@ impl QualityRecorder {
         qdd: &[f64],
     ) -> Result<()> {
         let pelvis = kin.frame_pose(robot, body.pelvis)?;
+        let hips = match (
+            body.frame_of(BodyPoint::LeftHip),
+            body.frame_of(BodyPoint::RightHip),
+        ) {
+            (Some(l), Some(r)) => {
+                0.5 * (kin.frame_pose(robot, l)?.translation.vector
+                    + kin.frame_pose(robot, r)?.translation.vector)
+            }
+            _ => pelvis.translation.vector,
+        };
         for ((p, sum, max), (f_p, f)) in self.sums.iter_mut().zip(&body.points) {
             debug_assert_eq!(p, f_p);
             let Some((_, rel)) = plan.neutral[k].iter().find(|(q, _)| q == p) else {
                 continue;
             };
             let x = kin.frame_pose(robot, *f)?.translation.vector;
-            let e = (x - (pelvis.translation.vector + rel)).norm();
+            let e = (x - (hips + rel)).norm();
             *sum += e;
             *max = max.max(e);
         }

@@ -17,9 +17,10 @@
 //! `s_pc = |r_c − r_p| / median_t |p_c(t) − p_p(t)|`, `r` the robot's points in its start
 //! posture. A segment without robot points takes its parent segment's ratio (toe: the shank's;
 //! chest, neck: the head's, else the leg's). With [`HandScaling::Leg`] the
-//! wrists are then placed from the pelvis by the leg ratio instead, `p'_wrist = p'_pelvis +
-//! s_leg (a(p_wrist) − a(p_pelvis))`: where the hands are relative to the body is kept, not
-//! the forearm's direction.
+//! wrists are then placed from the middle of the hips by the leg ratio instead, `p'_wrist =
+//! p'_m + s_leg (a(p_wrist) − a(m))` with `m` the middle of the human hips and `p'_m =
+//! (s_leg a(m)_xy, h_a + s_leg a(m)_z)` its scaled counterpart (so `p'_wrist = s_leg a(p_wrist)
+//! + h_a ẑ`): where the hands are relative to the body is kept, not the forearm's direction.
 
 use nalgebra::{Rotation3, Vector3};
 
@@ -203,9 +204,9 @@ pub(crate) fn scale_clip(
             }
         }
         if hands == HandScaling::Leg {
+            // p'_m + s_leg (a(p_wrist) − a(m)) with p'_m = (s_leg a(m)_xy, h_a + s_leg a(m)_z).
             for w in wrists.iter().flatten() {
-                scaled[row + w] =
-                    scaled[row + pelvis] + leg * (aligned[row + w] - aligned[row + pelvis]);
+                scaled[row + w] = leg * aligned[row + w] + Vector3::new(0.0, 0.0, ankle_height);
             }
         }
     }
@@ -309,14 +310,35 @@ mod tests {
             }
         }
         assert!(apart > 0.01, "the segments' hands at most {apart} m apart");
-        // With the leg ratio, each hand is the captured hand's offset from the pelvis, scaled
-        // by the leg ratio, from the pelvis' reference.
-        let pelvis = idx(BodyPoint::Pelvis);
+        // With the leg ratio, each hand is the captured hand's offset from the middle of the
+        // hips, scaled by the leg ratio, from the middle of the hips' reference: the pelvis'
+        // reference less the robot's pelvis height above its hips, horizontally the middle of
+        // the human hips scaled by the leg ratio.
+        let frame = |p: BodyPoint| {
+            let f = body.frame_of(p).unwrap();
+            kin.frame_pose(&robot, f).unwrap().translation.vector
+        };
+        let robot_above_hips = frame(BodyPoint::Pelvis).z
+            - 0.5 * (frame(BodyPoint::LeftHip).z + frame(BodyPoint::RightHip).z);
+        assert!(
+            robot_above_hips > 0.05,
+            "G1's pelvis frame {robot_above_hips} m above its hips"
+        );
+        let (pelvis, lh, rh) = (
+            idx(BodyPoint::Pelvis),
+            idx(BodyPoint::LeftHip),
+            idx(BodyPoint::RightHip),
+        );
         for f in 0..kp.frame_count() {
+            let a = &leg.aligned;
+            let m = 0.5 * (a[f * n + lh] + a[f * n + rh]);
+            let mut scaled_m =
+                leg.scaled[f * n + pelvis] - Vector3::new(0.0, 0.0, robot_above_hips);
+            scaled_m.x = leg.scaling.leg * m.x;
+            scaled_m.y = leg.scaling.leg * m.y;
             for w in [l, r] {
-                let a = &leg.aligned;
-                let want = leg.scaling.leg * (a[f * n + w] - a[f * n + pelvis]);
-                let got = leg.scaled[f * n + w] - leg.scaled[f * n + pelvis];
+                let want = scaled_m + leg.scaling.leg * (a[f * n + w] - m);
+                let got = leg.scaled[f * n + w];
                 assert!((got - want).norm() < tol, "frame {f}: {got} vs {want}");
             }
         }
