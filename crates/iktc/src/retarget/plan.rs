@@ -848,4 +848,68 @@ mod tests {
         assert!(2 * with > free.ticks, "{with} of {} ticks", free.ticks);
         assert_eq!(without, 0);
     }
+
+    /// The neutral targets are aligned at the middle of the hips: the two hips' targets are
+    /// opposite (their middle is the origin), and a robot whose body points sit exactly on
+    /// the targets, placed from the middle of its hips, scores zero error whichever of its
+    /// frames is taken for the pelvis; moved by 1 cm, every point scores 1 cm.
+    #[test]
+    fn the_keypoint_error_is_aligned_at_the_middle_of_the_hips() {
+        use super::super::quality::QualityRecorder;
+        let (robot, kin, body, support, free, _) = plans("g1", "humanoid3d_punch");
+        // Sums of decimetre-sized vectors, and one of 0.01 m \[m\].
+        let tol = 1e-12;
+        let k = free.ticks / 2;
+        let target = |p: BodyPoint| free.neutral[k].iter().find(|(q, _)| *q == p).unwrap().1;
+        let (l, r) = (target(BodyPoint::LeftHip), target(BodyPoint::RightHip));
+        assert!((l + r).norm() < tol, "{l} {r}");
+        assert!(l.norm() > 0.03, "half the hips' width: {l}");
+        // A plan whose tick k is the robot's own points relative to its hip middle.
+        let at = |p: BodyPoint| {
+            let f = body.frame_of(p).unwrap();
+            kin.frame_pose(&robot, f).unwrap().translation.vector
+        };
+        let middle = 0.5 * (at(BodyPoint::LeftHip) + at(BodyPoint::RightHip));
+        let mut plan = free.clone();
+        let shift = Vector3::new(0.0, 0.01, 0.0);
+        for (p, rel) in plan.neutral[k].iter_mut() {
+            *rel = at(*p) - middle
+                + if *p == BodyPoint::LeftHip || *p == BodyPoint::RightHip {
+                    Vector3::zeros()
+                } else {
+                    shift
+                };
+        }
+        let qdd = vec![0.0; robot.nv()];
+        // The state only enters the joint figures; the points are read from `kin`.
+        let state = crate::model::State::neutral(&robot);
+        for pelvis in [body.pelvis, body.torso.unwrap()] {
+            let body = RobotBody {
+                pelvis,
+                ..body.clone()
+            };
+            let mut rec = QualityRecorder::new("keypoints", &body, 0.005);
+            rec.record(
+                &robot,
+                &kin,
+                &body,
+                &plan,
+                &support,
+                (k, [false; 2]),
+                &state,
+                &qdd,
+            )
+            .unwrap();
+            let q = rec.finish(&robot);
+            for e in &q.points {
+                let want = if e.point.ends_with("_hip") { 0.0 } else { 1.0 };
+                assert!(
+                    (e.mean_cm - want).abs() < 1e-9,
+                    "{}: {} cm",
+                    e.point,
+                    e.mean_cm
+                );
+            }
+        }
+    }
 }
