@@ -106,6 +106,7 @@ pub(crate) struct Plan {
     /// the human hips. The hip joint centres are the pelvis's anatomical landmarks both bodies
     /// have; a rig's root and a robot's pelvis frame are not (DeepMimic's root is at hip height,
     /// CMU's several centimetres above, G1's pelvis frame 10 cm above its hips, JVRC-1's at them).
+    /// The pelvis point is that middle on both bodies (the alignment point: its target is 0).
     pub neutral: Vec<Vec<(BodyPoint, Vector3<f64>)>>,
 }
 
@@ -509,6 +510,8 @@ pub(crate) fn plan(
                     let i = idx(*p)?;
                     let a = aligned[i].as_ref()?[k];
                     let o = 0.5 * (aligned[hip_k[0]].as_ref()?[k] + aligned[hip_k[1]].as_ref()?[k]);
+                    // The pelvis is the alignment point itself (see `Plan::neutral`).
+                    let a = if *p == BodyPoint::Pelvis { o } else { a };
                     Some((*p, leg * (a - o)))
                 })
                 .collect()
@@ -873,6 +876,10 @@ mod tests {
         let mut plan = free.clone();
         let shift = Vector3::new(0.0, 0.01, 0.0);
         for (p, rel) in plan.neutral[k].iter_mut() {
+            if *p == BodyPoint::Pelvis {
+                assert_eq!(*rel, Vector3::zeros(), "the pelvis is the alignment point");
+                continue;
+            }
             *rel = at(*p) - middle
                 + if *p == BodyPoint::LeftHip || *p == BodyPoint::RightHip {
                     Vector3::zeros()
@@ -902,7 +909,11 @@ mod tests {
             .unwrap();
             let q = rec.finish(&robot);
             for e in &q.points {
-                let want = if e.point.ends_with("_hip") { 0.0 } else { 1.0 };
+                let want = if e.point.ends_with("_hip") || e.point == "pelvis" {
+                    0.0
+                } else {
+                    1.0
+                };
                 assert!(
                     (e.mean_cm - want).abs() < 1e-9,
                     "{}: {} cm",

@@ -8,7 +8,10 @@
 //!   the landmarks of the pelvis both bodies have, where a rig's root and a robot's pelvis
 //!   frame differ (DeepMimic's root is at its hips, CMU's above them, G1's pelvis frame 10 cm
 //!   above its hips, JVRC-1's at them): aligned at those, G1's hips missed the clip's by a
-//!   rigid 10.3 cm on the DeepMimic clips, which no motion of the robot changes;
+//!   rigid 10.3 cm on the DeepMimic clips, which no motion of the robot changes. The pelvis
+//!   point is the alignment point, the middle of the hips on both bodies: its error is 0 by
+//!   construction and it counts in the mean as such (its placement is measured by the hips,
+//!   its orientation below);
 //! * orientation error of the pelvis and the torso frames against the references built from the
 //!   points ([`super::plan`]): the angle of `R_ref R_robotᵀ` \[rad\], mean and max, in degrees;
 //! * stance-foot slip: for each stance run of a foot (on the keypoint route the robot's stance,
@@ -152,7 +155,10 @@ impl QualityRecorder {
             let Some((_, rel)) = plan.neutral[k].iter().find(|(q, _)| q == p) else {
                 continue;
             };
-            let x = kin.frame_pose(robot, *f)?.translation.vector;
+            let x = match p {
+                BodyPoint::Pelvis => hips,
+                _ => kin.frame_pose(robot, *f)?.translation.vector,
+            };
             let e = (x - (hips + rel)).norm();
             *sum += e;
             *max = max.max(e);
