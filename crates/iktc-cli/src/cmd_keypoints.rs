@@ -26,13 +26,12 @@ pub enum RetargetArg {
 /// Where the keypoint route places the hands' references ([`iktc::retarget::HandScaling`]).
 #[derive(clap::ValueEnum, Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum HandsArg {
-    /// Along the arm, each segment at the robot's length: the captured arm's direction.
+    /// From the middle of the hips by the leg ratio: the hands where the captured person's are
+    /// relative to the pelvis, scaled as a whole (hands that meet still meet).
     #[default]
-    Segments,
-    /// From the pelvis by the leg ratio: the hands where the captured person's are relative to
-    /// the pelvis, scaled as a whole (hands that meet still meet); closer to the captured
-    /// hands, but the arms move further and faster.
     Leg,
+    /// Along the arm, each segment at the robot's length: the captured arm's direction.
+    Segments,
 }
 
 /// Options of the keypoint retargeting (`iktc imitate`, `iktc retarget`).
@@ -54,7 +53,7 @@ pub struct KeypointArgs {
     /// The motion as captured, not low-passed, on either route.
     #[arg(long)]
     pub no_smoothing: bool,
-    /// Where the keypoint route places the hands' references (default: segments).
+    /// Where the keypoint route places the hands' references (default: leg).
     #[arg(long, value_enum)]
     pub hands: Option<HandsArg>,
 }

@@ -653,7 +653,7 @@ fn standing_holds_feet_and_pelvis_and_is_part_of_the_settings() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("--retarget keypoints only"));
 }
 
-/// `--hands leg` places the hands from the pelvis by the leg ratio instead of along the arm:
+/// `--hands segments` places the hands along the arm instead of by the leg ratio (the default):
 /// the robot's hands move differently (centimetres apart somewhere in the clip), the option
 /// enters the settings fingerprint (the clip is redone, not skipped), and the joint route
 /// refuses it.
@@ -678,11 +678,11 @@ fn hands_option_moves_the_hands_and_is_part_of_the_settings() {
     };
     let o = run(&[]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let seg = hand();
-    let o = run(&["--hands", "leg"]);
+    let leg = hand();
+    let o = run(&["--hands", "segments"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert_eq!(statuses(&out)["humanoid3d_punch"], "retargeted");
-    let leg = hand();
+    let seg = hand();
     assert_eq!(leg.len(), seg.len());
     let apart = leg
         .iter()

@@ -44,10 +44,11 @@ pub struct PyKeypointTrajectory {
 /// low-pass applied to the body points before they are differentiated (`None`: as captured).
 /// `approach_rate` [1/s]: the soft approach to the range ends
 /// (`iktc::limits::ViableSettings::approach_rate`; 0, the default, leaves it out). `hands`:
-/// `"segments"` (the default) places the hands' references along the arm at the robot's
-/// segment lengths, `"leg"` from the pelvis by the leg ratio (`iktc::retarget::HandScaling`).
+/// `"leg"` (the default) places the hands' references from the middle of the hips by the leg
+/// ratio, `"segments"` along the arm at the robot's segment lengths
+/// (`iktc::retarget::HandScaling`).
 #[pyfunction]
-#[pyo3(name = "retarget_keypoints", signature = (motion, robot, *, dt=0.005, hold_feet=false, standing=false, smoothing=None, approach_rate=0.0, hands="segments"))]
+#[pyo3(name = "retarget_keypoints", signature = (motion, robot, *, dt=0.005, hold_feet=false, standing=false, smoothing=None, approach_rate=0.0, hands="leg"))]
 #[allow(clippy::too_many_arguments)]
 pub fn py_retarget_keypoints(
     py: Python<'_>,

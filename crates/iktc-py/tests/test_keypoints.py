@@ -98,8 +98,8 @@ def test_hands_by_the_leg_ratio_move_the_hands_differently_and_bad_names_are_err
     def hand(t):
         return np.array([robot.frame_pose(q, "right_rubber_hand")[:3, 3] for q in t.q])
 
-    seg = hand(iktc.retarget_keypoints(motion, robot))
-    leg = hand(iktc.retarget_keypoints(motion, robot, hands="leg"))
+    seg = hand(iktc.retarget_keypoints(motion, robot, hands="segments"))
+    leg = hand(iktc.retarget_keypoints(motion, robot))
     assert leg.shape == seg.shape
     assert np.linalg.norm(leg - seg, axis=1).max() > 0.02
     with pytest.raises(ValueError, match="segments"):

@@ -199,7 +199,7 @@ def retarget_keypoints(motion: Motion, robot: Robot, *, dt: float = 0.005,
                        hold_feet: bool = False, standing: bool = False,
                        smoothing: Optional[float] = None,
                        approach_rate: float = 0.0,
-                       hands: str = "segments") -> KeypointTrajectory: ...
+                       hands: str = "leg") -> KeypointTrajectory: ...
 
 class Imitation:
     def __init__(self, robot: Robot, motion: Motion, *, map: Optional[str] = None,

@@ -140,9 +140,12 @@ pub struct KeypointSettings {
     /// Wider is smoother but lags the support changes.
     pub com_smoothing: f64,
     /// A leg is not asked to stretch beyond this fraction of its length (hip–knee plus
-    /// knee–ankle) \[–\]: the pelvis is lowered instead (default 0.85). Larger values keep the
+    /// knee–ankle) \[–\]: the pelvis is lowered instead (default 0.88). Larger values keep the
     /// pelvis height of the clip longer but bring the knees near their singularity, where the
-    /// feet's level loses rank.
+    /// feet's level loses rank: on the shared clips 0.85 crouched G1 (its ankles about 9 cm
+    /// higher under its hips than the scaled human's on CMU `scaled_131_02`), 0.88 lowered the
+    /// mean keypoint error on eleven of the twelve runs, and from 0.90 G1's feet slipped and
+    /// sank on CMU 131_01 (1.4–8.7 mm, up to 62 mm below the ground at 0.97).
     pub max_leg_extension: f64,
     /// Posture references from the joint route are kept this far inside the joint ranges
     /// \[rad\] (default 0.05 rad).
@@ -185,15 +188,12 @@ pub struct KeypointSettings {
     /// the box. With them the level's least-squares problem is a compromise with the posture's
     /// `q̈_d + k_v (q̇_d − q̇) + k_p (q_d − q)`, which damps every joint the level moves.
     pub posture_weight: f64,
-    /// Where the hands' references are placed (default [`HandScaling::Segments`]). On the
-    /// shared clips (`tests/retarget_keypoints.rs`) [`HandScaling::Leg`] brings G1's wrists
-    /// within a mean 2.9–5.9 cm of the captured ones instead of 5.2–7.7 cm on three DeepMimic
-    /// clips, and lowers the mean keypoint error on nine of the twelve runs (all six on
-    /// JVRC-1); but it stretches the arms further and faster: G1's RMS jerk rose on four clips
-    /// (e.g. `humanoid3d_dance_b` 13 600 → 18 000 rad/s³), G1's stance feet slipped 10 mm on
-    /// CMU 131_01 (1.8 mm with `Segments`), and in MuJoCo (`crates/iktc-py/examples/g1_sim.py`,
-    /// standing imitation of `humanoid3d_dance_b`) G1's feet slid 39 mm instead of 3.7 mm
-    /// (measured with the hands placed from the pelvis frame, 10 cm higher on G1).
+    /// Where the hands' references are placed (default [`HandScaling::Leg`]). On the shared
+    /// clips (`tests/retarget_keypoints.rs`) it brings G1's wrists within a mean 2.7–4.8 cm of
+    /// the captured ones instead of 5.2–6.8 cm with [`HandScaling::Segments`] on three
+    /// DeepMimic clips and lowers the mean keypoint error on all twelve runs; in MuJoCo
+    /// (`crates/iktc-py/examples/g1_sim.py`, standing imitation of `humanoid3d_dance_b`) G1's
+    /// feet slid 1.5 mm instead of 3.7 mm.
     pub hands: HandScaling,
 }
 
@@ -228,14 +228,14 @@ impl Default for KeypointSettings {
             support_area: SupportArea::BothFeet,
             com_margin: 0.02,
             com_smoothing: 0.2,
-            max_leg_extension: 0.85,
+            max_leg_extension: 0.88,
             posture_margin: 0.05,
             land_height: 0.02,
             land_speed: 0.06,
             standing: false,
             smoothing: None,
             posture_weight: POSTURE_WEIGHT,
-            hands: HandScaling::Segments,
+            hands: HandScaling::Leg,
         }
     }
 }
