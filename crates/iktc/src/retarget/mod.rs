@@ -296,10 +296,11 @@ pub struct KeypointRun {
     pub stance: [Vec<bool>; 2],
     /// Quality figures.
     pub quality: RetargetQuality,
-    /// Ticks solved by GF because IKTC's answer left the box ([`KeypointController::tick`]).
+    /// Ticks solved by GF because IKTC's answer left the box ([`KeypointController::tick`]),
+    /// over the settling and the clip.
     pub fallback_ticks: usize,
     /// Ticks solved by GF because IKTC corrected the stance feet's level and GF kept it more
-    /// exactly ([`KeypointController::tick`]).
+    /// exactly ([`KeypointController::tick`]), over the settling and the clip.
     pub stance_gf_ticks: usize,
     /// Median time of one control tick (references, kinematics, box, solve, integration) \[µs\].
     pub tick_median_us: f64,
