@@ -87,10 +87,10 @@ pub enum SupportArea {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum HandScaling {
     /// From the middle of the hips' reference by the leg ratio, `p'_wrist = p'_m + s_leg
-    /// (a(p_wrist) − a(m))` (`m` the middle of the hips): the
-    /// hands are where the captured person's are relative to the pelvis, scaled as a whole, so
-    /// hands that meet (a clap, hands on the hips) still meet on the robot. The quality
-    /// figures' neutral targets are placed the same way.
+    /// (a(p_wrist) − a(m))` (`m` the middle of the hips): the hands are where the captured
+    /// person's are relative to the pelvis, scaled as a whole, so hands that meet (a clap,
+    /// hands on the hips) still meet on the robot. The quality figures' neutral targets are
+    /// placed the same way.
     Leg,
     /// Along the arm from the shoulder, each segment at the robot's own length: the arm keeps
     /// the captured arm's direction, and the hands land wherever the robot's proportions put

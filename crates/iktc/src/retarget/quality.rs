@@ -2,8 +2,8 @@
 //!
 //! Per tick `k` of the clip (after any settling), from the robot's state:
 //! * position error of each body point the robot has: `|x_k − (x_m,k + s_leg (a(p_k) −
-//!   a(m_k)))|` \[m\], the human point scaled by the leg ratio and placed at the robot's pelvis
-//!   by the middle of the hips (`m` of the human hips, `x_m` of the robot's; the aligned clip
+//!   a(m_k)))|` \[m\], the human point scaled by the leg ratio and placed at the middle of the
+//!   robot's hips (`m` the middle of the human hips, `x_m` of the robot's; the aligned clip
 //!   `a`, [`super::scale`]); mean and max per point, reported in cm. The hip joint centres are
 //!   the landmarks of the pelvis both bodies have, where a rig's root and a robot's pelvis
 //!   frame differ (DeepMimic's root is at its hips, CMU's above them, G1's pelvis frame 10 cm
