@@ -855,7 +855,9 @@ mod tests {
     /// The neutral targets are aligned at the middle of the hips: the two hips' targets are
     /// opposite (their middle is the origin), and a robot whose body points sit exactly on
     /// the targets, placed from the middle of its hips, scores zero error whichever of its
-    /// frames is taken for the pelvis; moved by 1 cm, every point scores 1 cm.
+    /// frames is taken for the pelvis; moved by 1 cm, every point scores 1 cm. The pelvis
+    /// frame's reference turned by 0.1 rad about the vertical scores 0.1 rad, in degrees, on
+    /// each of two ticks.
     #[test]
     fn the_keypoint_error_is_aligned_at_the_middle_of_the_hips() {
         use super::super::quality::QualityRecorder;
@@ -887,27 +889,42 @@ mod tests {
                     shift
                 };
         }
+        let turn = 0.1;
+        for t in [k, k + 1] {
+            plan.neutral[t] = plan.neutral[k].clone();
+            plan.pelvis[t].rotation = UnitQuaternion::from_euler_angles(0.0, 0.0, turn)
+                * kin.frame_pose(&robot, body.pelvis).unwrap().rotation;
+        }
         let qdd = vec![0.0; robot.nv()];
         // The state only enters the joint figures; the points are read from `kin`.
         let state = crate::model::State::neutral(&robot);
+        let pelvis_frame = body.pelvis;
         for pelvis in [body.pelvis, body.torso.unwrap()] {
             let body = RobotBody {
                 pelvis,
                 ..body.clone()
             };
             let mut rec = QualityRecorder::new("keypoints", &body, 0.005);
-            rec.record(
-                &robot,
-                &kin,
-                &body,
-                &plan,
-                &support,
-                (k, [false; 2]),
-                &state,
-                &qdd,
-            )
-            .unwrap();
+            for t in [k, k + 1] {
+                rec.record(
+                    &robot,
+                    &kin,
+                    &body,
+                    &plan,
+                    &support,
+                    (t, [false; 2]),
+                    &state,
+                    &qdd,
+                )
+                .unwrap();
+            }
             let q = rec.finish(&robot);
+            if pelvis == pelvis_frame {
+                let o = &q.orientations[0];
+                assert_eq!(o.frame, "pelvis");
+                assert!((o.mean_deg - turn.to_degrees()).abs() < 1e-9, "{o:?}");
+                assert!((o.max_deg - turn.to_degrees()).abs() < 1e-9, "{o:?}");
+            }
             for e in &q.points {
                 let want = if e.point.ends_with("_hip") || e.point == "pelvis" {
                     0.0
