@@ -110,8 +110,9 @@ def test_standing_imitation_of_the_upper_body_keeps_the_feet_within_5_mm():
 
 
 def test_the_upper_body_standing_imitation_has_converged_in_the_physics_step():
-    # Halving the physics step changes the figures little (0.1 → 0.05 ms: slip 3.22 → 3.06 mm,
-    # servo error 0.026 → 0.025 rad rms); at 1 ms they were 11.3 mm and 0.41 rad.
+    # Halving the physics step changes the figures little (0.1 → 0.05 ms: slip 1.53 → 1.47 mm,
+    # servo error 0.0228 → 0.0226 rad rms, hands by the leg ratio, 2026-12-03; 3.22 → 3.06 mm
+    # and 0.026 → 0.025 rad with the hands along the arm); at 1 ms they were 11.3 mm and 0.41 rad.
     a = g1_sim.run_standing_keypoints(standing=True).summary()
     b = g1_sim.run_standing_keypoints(standing=True,
                                       physics_step=g1_sim.PHYSICS_STEP / 2).summary()
