@@ -861,7 +861,12 @@ mod tests {
     #[test]
     fn the_keypoint_error_is_aligned_at_the_middle_of_the_hips() {
         use super::super::quality::QualityRecorder;
-        let (robot, kin, body, support, free, _) = plans("g1", "humanoid3d_punch");
+        let (robot, mut kin, body, support, free, _) = plans("g1", "humanoid3d_punch");
+        // The robot turned and tilted, so that no frame is at the identity.
+        let mut state = crate::model::State::neutral(&robot);
+        let pose = Isometry3::new(Vector3::new(0.1, -0.2, 0.7), Vector3::new(0.2, -0.1, 0.6));
+        state.set_base_pose(&robot, &pose).unwrap();
+        kin.update(&robot, &state).unwrap();
         // Sums of decimetre-sized vectors, and one of 0.01 m \[m\].
         let tol = 1e-12;
         let k = free.ticks / 2;
@@ -896,8 +901,6 @@ mod tests {
                 * kin.frame_pose(&robot, body.pelvis).unwrap().rotation;
         }
         let qdd = vec![0.0; robot.nv()];
-        // The state only enters the joint figures; the points are read from `kin`.
-        let state = crate::model::State::neutral(&robot);
         let pelvis_frame = body.pelvis;
         for pelvis in [body.pelvis, body.torso.unwrap()] {
             let body = RobotBody {
