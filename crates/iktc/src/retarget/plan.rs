@@ -504,15 +504,20 @@ pub(crate) fn plan(
     let leg = clip.scaling.leg;
     let neutral = (0..ticks)
         .map(|k| {
+            let (Some(l), Some(r)) = (&aligned[hip_k[0]], &aligned[hip_k[1]]) else {
+                return Vec::new();
+            };
+            let o = 0.5 * (l[k] + r[k]);
             body.points
                 .iter()
                 .filter_map(|(p, _)| {
-                    let i = idx(*p)?;
-                    let a = aligned[i].as_ref()?[k];
-                    let o = 0.5 * (aligned[hip_k[0]].as_ref()?[k] + aligned[hip_k[1]].as_ref()?[k]);
+                    let a = aligned[idx(*p)?].as_ref()?[k];
                     // The pelvis is the alignment point itself (see `Plan::neutral`).
-                    let a = if *p == BodyPoint::Pelvis { o } else { a };
-                    Some((*p, leg * (a - o)))
+                    let rel = match p {
+                        BodyPoint::Pelvis => Vector3::zeros(),
+                        _ => leg * (a - o),
+                    };
+                    Some((*p, rel))
                 })
                 .collect()
         })
