@@ -41,6 +41,15 @@ impl RobotBody {
             .map(|(_, f)| *f)
     }
 
+    /// The robot frames of the left and right hips, if the robot has both: their middle is where
+    /// the quality figures align the robot's body with the scaled human's ([`super::RetargetQuality`]).
+    pub fn hips(&self) -> Option<[FrameId; 2]> {
+        Some([
+            self.frame_of(BodyPoint::LeftHip)?,
+            self.frame_of(BodyPoint::RightHip)?,
+        ])
+    }
+
     /// Finds the frames (see the module documentation) from the named frames of a profile;
     /// `kin` is at the start posture. Errors: an unknown frame name, a chain that does not
     /// reach the pelvis.

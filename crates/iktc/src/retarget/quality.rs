@@ -19,6 +19,7 @@
 //!   largest horizontal distance of the sole centre from where it was at the run's first tick
 //!   \[m\], in mm;
 //! * foot below the ground: the largest depth below z = 0 of any sole corner \[m\], in mm;
+//! * optionally, the static reach of the body points ([`super::reach`]);
 //! * joint jerk `(q̈_k − q̈_{k−1}) / Δt` of the active joints \[rad/s³\]: RMS over joints and
 //!   ticks, and max ([`DofSmoothness`]);
 //! * the worst limit margins ([`dof_margins`]): positive means a limit was exceeded.
@@ -85,6 +86,15 @@ pub struct RetargetQuality {
     pub velocity_margin: f64,
     /// Worst acceleration margin \[rad/s²\].
     pub acceleration_margin: f64,
+    /// The static reach, where asked for ([`super::KeypointSettings::reach`]): the least mean
+    /// body point error found per tick by a posture within the joint ranges alone, averaged
+    /// over the ticks sampled every [`super::REACH_PERIOD`] \[cm\] ([`super::reach`]). The robot's
+    /// body cannot do better than about this; the rest of [`RetargetQuality::mean_cm`] is what
+    /// the retargeting gives up for its feet, balance and smoothness.
+    pub reach_cm: Option<f64>,
+    /// The run's own mean body point error over the same sampled ticks \[cm\], beside
+    /// [`RetargetQuality::reach_cm`].
+    pub reach_run_cm: Option<f64>,
 }
 
 /// Records the ticks of a run and gives its [`RetargetQuality`]. Allocates during `record`
@@ -140,15 +150,12 @@ impl QualityRecorder {
         qdd: &[f64],
     ) -> Result<()> {
         let pelvis = kin.frame_pose(robot, body.pelvis)?;
-        let hips = match (
-            body.frame_of(BodyPoint::LeftHip),
-            body.frame_of(BodyPoint::RightHip),
-        ) {
-            (Some(l), Some(r)) => {
+        let hips = match body.hips() {
+            Some([l, r]) => {
                 0.5 * (kin.frame_pose(robot, l)?.translation.vector
                     + kin.frame_pose(robot, r)?.translation.vector)
             }
-            _ => pelvis.translation.vector,
+            None => pelvis.translation.vector,
         };
         for ((p, sum, max), (f_p, f)) in self.sums.iter_mut().zip(&body.points) {
             debug_assert_eq!(p, f_p);
@@ -267,6 +274,8 @@ impl QualityRecorder {
             position_margin: pm,
             velocity_margin: vm,
             acceleration_margin: am,
+            reach_cm: None,
+            reach_run_cm: None,
         }
     }
 }
