@@ -56,6 +56,12 @@ pub struct KeypointArgs {
     /// Where the keypoint route places the hands' references (default: leg).
     #[arg(long, value_enum)]
     pub hands: Option<HandsArg>,
+    /// Also measure the static reach: per tick sampled every 0.05 s, the least mean keypoint
+    /// error of a posture within the joint ranges alone (no feet, balance or rates), beside
+    /// the run's own on the same ticks. What the robot's body cannot do is about the reach;
+    /// the rest is what the retargeting gives up. About doubles the run's time.
+    #[arg(long)]
+    pub reach: bool,
 }
 
 impl KeypointArgs {
@@ -68,6 +74,9 @@ impl KeypointArgs {
         }
         if route == RetargetArg::Joints && self.hands.is_some() {
             anyhow::bail!("--hands applies to --retarget keypoints only");
+        }
+        if route == RetargetArg::Joints && self.reach {
+            anyhow::bail!("--reach applies to --retarget keypoints only");
         }
         cfg.smoothing = match (self.no_smoothing, self.smoothing, route) {
             (true, _, _) => None,
@@ -97,6 +106,7 @@ pub fn keypoint_settings(
             HandsArg::Leg => HandScaling::Leg,
             HandsArg::Segments => HandScaling::Segments,
         },
+        reach: k.reach,
         ..KeypointSettings::default()
     }
 }
@@ -248,6 +258,13 @@ fn print(run: &KeypointRun, joints: Option<&RetargetQuality>) -> std::io::Result
         format!("{:.2} cm", k.mean_cm),
         joints.map(|j| format!("{:.2} cm", j.mean_cm)),
     )?;
+    if let (Some(reach), Some(run)) = (k.reach_cm, k.reach_run_cm) {
+        row(
+            "static reach",
+            format!("{reach:.2} cm (run {run:.2})"),
+            None,
+        )?;
+    }
     for (i, o) in k.orientations.iter().enumerate() {
         let other = joints
             .and_then(|j| j.orientations.get(i))

@@ -11,9 +11,13 @@ use crate::cmd_retarget::ClipStatus;
 /// The figures shown: key in `quality.json`'s `figures`, column label with its unit. A column
 /// appears when some clip has its figure (the keypoint and joint routes measure different
 /// things).
-const COLUMNS: [(&str, &str); 23] = [
+const COLUMNS: [(&str, &str); 24] = [
     ("duration", "duration [s]"),
     ("mean_keypoint_error", "mean keypoint error [m]"),
+    (
+        "reach_keypoint_error",
+        "static reach: least mean keypoint error of a posture within the joint ranges [m]",
+    ),
     ("max_keypoint_error", "max keypoint error [m]"),
     (
         "max_orientation_error",

@@ -129,12 +129,21 @@ fn the_approach_and_the_low_pass_can_be_turned_off_and_bad_values_are_named() {
 fn g1_retargets_the_default_clip_by_keypoints_beside_the_joint_route() {
     let out = tmp("g1kp");
     let o = iktc()
-        .args(["imitate", "--robot", "g1", "--out"])
+        .args(["imitate", "--robot", "g1", "--reach", "--out"])
         .arg(&out)
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", stderr(&o));
     let s = json(&out.join("keypoints_summary.json"));
+    // `--reach`: the static reach of the keypoint route beside its error on the same ticks,
+    // printed; the joint route has none.
+    let (reach, run) = (&s["keypoints"]["reach_cm"], &s["keypoints"]["reach_run_cm"]);
+    assert!(
+        reach.as_f64().unwrap() <= run.as_f64().unwrap(),
+        "{reach} {run}"
+    );
+    assert!(s["joints"]["reach_cm"].is_null());
+    assert!(String::from_utf8_lossy(&o.stdout).contains("static reach"));
     for route in ["keypoints", "joints"] {
         let q = &s[route];
         for k in ["position_margin", "velocity_margin", "acceleration_margin"] {

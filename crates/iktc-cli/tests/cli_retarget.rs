@@ -696,3 +696,48 @@ fn hands_option_moves_the_hands_and_is_part_of_the_settings() {
         String::from_utf8_lossy(&o.stderr).contains("--hands applies to --retarget keypoints only")
     );
 }
+
+/// `--reach`: each clip's `quality.json` has the static reach beside the run's error on the
+/// same sampled ticks (at most it, and both in metres), the report gets its column, the motion
+/// written is the same as without it, a run without it leaves both `null`, and the joint
+/// route refuses it.
+#[test]
+fn reach_option_reports_the_static_reach() {
+    let dir = tmp("reach");
+    let clip = data().join("humanoid3d_walk.txt");
+    let out = dir.join("out");
+    let run = |extra: &[&str]| retarget_on_g1(&clip, &out, extra);
+    let figures = || -> serde_json::Value {
+        let q: serde_json::Value = serde_json::from_str(
+            &std::fs::read_to_string(out.join("humanoid3d_walk/quality.json")).unwrap(),
+        )
+        .unwrap();
+        q["figures"].clone()
+    };
+    let csv = || std::fs::read_to_string(out.join("humanoid3d_walk/motion.csv")).unwrap();
+    let o = run(&[]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let f = figures();
+    assert!(f["reach_keypoint_error"].is_null() && f["reach_run_keypoint_error"].is_null());
+    let index = std::fs::read_to_string(out.join("index.html")).unwrap();
+    assert!(!index.contains("static reach"));
+    let without = csv();
+    let o = run(&["--reach"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(statuses(&out)["humanoid3d_walk"], "retargeted");
+    let f = figures();
+    let reach = f["reach_keypoint_error"].as_f64().unwrap();
+    let sampled = f["reach_run_keypoint_error"].as_f64().unwrap();
+    let mean = f["mean_keypoint_error"].as_f64().unwrap();
+    assert!(0.0 < reach && reach <= sampled, "{reach} {sampled}");
+    // Sampled every 0.05 s, the run's error is close to its mean over every tick (metres).
+    assert!((sampled - mean).abs() < 0.1 * mean, "{sampled} {mean}");
+    assert_eq!(csv(), without);
+    let index = std::fs::read_to_string(out.join("index.html")).unwrap();
+    assert!(index.contains("static reach"));
+    let o = run(&["--reach", "--retarget", "joints"]);
+    assert!(!o.status.success());
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("--reach applies to --retarget keypoints only")
+    );
+}

@@ -229,6 +229,13 @@ pub struct KeypointFigures {
     pub body_sacrificed_share: f64,
     /// The level IKTC sacrificed on the most ticks (empty if none).
     pub most_sacrificed: String,
+    /// The static reach where it was asked for ([`crate::retarget::KeypointSettings::reach`]): the least mean
+    /// keypoint error of a posture within the joint ranges alone, over the ticks sampled
+    /// every [`crate::retarget::REACH_PERIOD`] \[m\] ([`RetargetQuality::reach_cm`]); `null` otherwise.
+    pub reach_keypoint_error: Option<f64>,
+    /// The run's mean keypoint error over the same sampled ticks \[m\]; `null` without the
+    /// reach.
+    pub reach_run_keypoint_error: Option<f64>,
 }
 
 impl KeypointFigures {
@@ -280,6 +287,8 @@ impl KeypointFigures {
                 .filter(|(_, n)| *n > 0)
                 .max_by_key(|(_, n)| *n)
                 .map_or_else(String::new, |(l, _)| l.clone()),
+            reach_keypoint_error: q.reach_cm.map(|c| c / 100.0),
+            reach_run_keypoint_error: q.reach_run_cm.map(|c| c / 100.0),
         }
     }
 }
