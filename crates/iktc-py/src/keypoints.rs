@@ -4,7 +4,9 @@
 
 use iktc::batch::{posture_references, Posture};
 use iktc::motion::DEFAULT_MAX_GAP;
-use iktc::retarget::{keypoint_controller, HandScaling, KeypointSettings, Sacrifices};
+use iktc::retarget::{
+    retarget_keypoints, HandScaling, KeypointSettings, RetargetQuality, Sacrifices,
+};
 use iktc::sim::ImitateConfig;
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
@@ -29,6 +31,7 @@ pub struct PyKeypointTrajectory {
     fallback_ticks: usize,
     sacrificed: Sacrifices,
     settle_sacrificed: Sacrifices,
+    quality: RetargetQuality,
 }
 
 /// Runs the keypoint retargeting of `motion` on `robot` (which must have a profile) as
@@ -46,9 +49,10 @@ pub struct PyKeypointTrajectory {
 /// (`iktc::limits::ViableSettings::approach_rate`; 0, the default, leaves it out). `hands`:
 /// `"leg"` (the default) places the hands' references from the middle of the hips by the leg
 /// ratio, `"segments"` along the arm at the robot's segment lengths
-/// (`iktc::retarget::HandScaling`).
+/// (`iktc::retarget::HandScaling`). `reach`: also measure the static reach of the body points
+/// (`iktc::retarget::KeypointSettings::reach`; about doubles the time), in `quality`.
 #[pyfunction]
-#[pyo3(name = "retarget_keypoints", signature = (motion, robot, *, dt=0.005, hold_feet=false, standing=false, smoothing=None, approach_rate=0.0, hands="leg"))]
+#[pyo3(name = "retarget_keypoints", signature = (motion, robot, *, dt=0.005, hold_feet=false, standing=false, smoothing=None, approach_rate=0.0, hands="leg", reach=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn py_retarget_keypoints(
     py: Python<'_>,
@@ -60,6 +64,7 @@ pub fn py_retarget_keypoints(
     smoothing: Option<f64>,
     approach_rate: f64,
     hands: &str,
+    reach: bool,
 ) -> PyResult<PyKeypointTrajectory> {
     let profile = robot.required_profile("keypoint retargeting", "feet, pelvis and hands")?;
     let hands = match hands {
@@ -76,6 +81,7 @@ pub fn py_retarget_keypoints(
         standing,
         smoothing,
         hands,
+        reach,
         ..KeypointSettings::default()
     };
     settings.bounds = settings
@@ -106,38 +112,21 @@ pub fn py_retarget_keypoints(
             )?,
             None => Posture::Start("the motion has no skeleton".into()),
         };
-        let mut ctl = keypoint_controller(profile, &kp, posture.references(), &settings)?;
-        for _ in 0..(settings.settle_time / dt).round() as usize {
-            ctl.tick(0, true)?;
-            ctl.integrate()?;
-        }
-        let ticks = ctl.ticks();
-        let (nq, nv) = (robot.robot.nq(), robot.robot.nv());
-        let t0 = kp.times.first().copied().unwrap_or(0.0);
-        let mut out = PyKeypointTrajectory {
+        let run = retarget_keypoints(profile, &kp, posture.references(), &settings)?;
+        let flat = |rows: &[Vec<f64>]| rows.iter().flatten().copied().collect::<Vec<f64>>();
+        Ok(PyKeypointTrajectory {
             dt,
-            times: Vec::with_capacity(ticks),
-            nq,
-            nv,
-            q: Vec::with_capacity(ticks * nq),
-            v: Vec::with_capacity(ticks * nv),
-            qdd: Vec::with_capacity(ticks * nv),
-            fallback_ticks: 0,
-            sacrificed: Sacrifices::default(),
-            settle_sacrificed: Sacrifices::default(),
-        };
-        for k in 0..ticks {
-            out.times.push(t0 + k as f64 * dt);
-            out.q.extend(ctl.state().q.iter());
-            out.v.extend(ctl.state().qd.iter());
-            ctl.tick(k, false)?;
-            out.qdd.extend(ctl.qdd().iter());
-            ctl.integrate()?;
-        }
-        out.fallback_ticks = ctl.fallback_ticks();
-        out.sacrificed = ctl.sacrificed().clone();
-        out.settle_sacrificed = ctl.settle_sacrificed().clone();
-        Ok(out)
+            times: run.times.clone(),
+            nq: robot.robot.nq(),
+            nv: robot.robot.nv(),
+            q: flat(&run.trajectory),
+            v: flat(&run.velocities),
+            qdd: flat(&run.accelerations),
+            fallback_ticks: run.fallback_ticks,
+            sacrificed: run.sacrificed,
+            settle_sacrificed: run.settle_sacrificed,
+            quality: run.quality,
+        })
     })
     .map_err(to_py)
 }
@@ -194,6 +183,57 @@ impl PyKeypointTrajectory {
     #[getter]
     fn settle_sacrificed<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         levels_dict(py, &self.settle_sacrificed)
+    }
+
+    /// The run's quality figures (`iktc::retarget::RetargetQuality`), as `iktc imitate` writes
+    /// them in `keypoints_summary.json`: `mean_cm`, `points` (per body point `{"point",
+    /// "mean_cm", "max_cm"}`), `orientations` (`{"frame", "mean_deg", "max_deg"}`), `slip_mm`,
+    /// `below_ground_mm`, `stance_ticks`, `jerk_rms` and `jerk_max` [rad/s³], the worst
+    /// `position_margin` [rad], `velocity_margin` [rad/s] and `acceleration_margin` [rad/s²]
+    /// (positive: a limit exceeded), and `reach_cm` and `reach_run_cm` (None unless asked for
+    /// with `reach=True`).
+    #[getter]
+    fn quality<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let q = &self.quality;
+        let d = PyDict::new(py);
+        d.set_item("route", &q.route)?;
+        d.set_item("ticks", q.ticks)?;
+        let points = q
+            .points
+            .iter()
+            .map(|p| {
+                let e = PyDict::new(py);
+                e.set_item("point", &p.point)?;
+                e.set_item("mean_cm", p.mean_cm)?;
+                e.set_item("max_cm", p.max_cm)?;
+                Ok(e)
+            })
+            .collect::<PyResult<Vec<_>>>()?;
+        d.set_item("points", points)?;
+        d.set_item("mean_cm", q.mean_cm)?;
+        let orientations = q
+            .orientations
+            .iter()
+            .map(|o| {
+                let e = PyDict::new(py);
+                e.set_item("frame", &o.frame)?;
+                e.set_item("mean_deg", o.mean_deg)?;
+                e.set_item("max_deg", o.max_deg)?;
+                Ok(e)
+            })
+            .collect::<PyResult<Vec<_>>>()?;
+        d.set_item("orientations", orientations)?;
+        d.set_item("slip_mm", q.slip_mm)?;
+        d.set_item("below_ground_mm", q.below_ground_mm)?;
+        d.set_item("stance_ticks", q.stance_ticks)?;
+        d.set_item("jerk_rms", q.jerk_rms)?;
+        d.set_item("jerk_max", q.jerk_max)?;
+        d.set_item("position_margin", q.position_margin)?;
+        d.set_item("velocity_margin", q.velocity_margin)?;
+        d.set_item("acceleration_margin", q.acceleration_margin)?;
+        d.set_item("reach_cm", q.reach_cm)?;
+        d.set_item("reach_run_cm", q.reach_run_cm)?;
+        Ok(d)
     }
 
     fn __len__(&self) -> usize {

@@ -2,6 +2,7 @@
 of the same clip (an independent path through the bindings): the keypoint route (the default)
 against `iktc.retarget_keypoints`, the joint route against `iktc.Imitation`."""
 import csv
+import json
 import os
 import subprocess
 import tempfile
@@ -74,3 +75,29 @@ def test_retarget_joints_npz_equals_the_python_imitation():
         vs.append(sim.v.copy())
         sim.tick()
     assert worst_difference(d, qs, vs) < 1e-9
+
+
+def test_the_python_quality_figures_equal_the_batch_ones():
+    """`retarget_keypoints(...).quality` holds the figures `iktc retarget` writes in the clip's
+    quality.json (in cm and mm there in m), the static reach included when asked for."""
+    out = tempfile.mkdtemp()
+    subprocess.run([iktc_binary(), "retarget", str(CLIP), "--robot", "g1", "--no-viewer",
+                    "--reach", "--out", out], check=True, stdout=subprocess.DEVNULL,
+                   stderr=subprocess.DEVNULL)
+    with open(os.path.join(out, "humanoid3d_walk", "quality.json")) as f:
+        figures = json.load(f)["figures"]
+    robot = iktc.Robot("g1")
+    motion = iktc.load_motion(str(CLIP))
+    q = iktc.retarget_keypoints(motion, robot, reach=True).quality
+    assert q["route"] == "keypoints" and len(q["points"]) == 13
+    assert abs(q["mean_cm"] / 100 - figures["mean_keypoint_error"]) < 1e-12
+    assert abs(q["slip_mm"] / 1000 - figures["foot_slip"]) < 1e-12
+    assert abs(q["reach_cm"] / 100 - figures["reach_keypoint_error"]) < 1e-12
+    assert abs(q["reach_run_cm"] / 100 - figures["reach_run_keypoint_error"]) < 1e-12
+    assert 0 < q["reach_cm"] <= q["reach_run_cm"]
+    # The per-point means average to the mean; every margin says no limit was exceeded.
+    assert abs(np.mean([p["mean_cm"] for p in q["points"]]) - q["mean_cm"]) < 1e-9
+    assert max(q["position_margin"], q["velocity_margin"], q["acceleration_margin"]) < 1e-6
+    plain = iktc.retarget_keypoints(motion, robot).quality
+    assert plain["reach_cm"] is None and plain["reach_run_cm"] is None
+    assert plain["mean_cm"] == q["mean_cm"]

@@ -1,5 +1,5 @@
 """Type stubs of the compiled module (see the package docstring)."""
-from typing import Optional, Sequence, Tuple, List, Dict
+from typing import Any, Optional, Sequence, Tuple, List, Dict
 
 import numpy as np
 import numpy.typing as npt
@@ -193,13 +193,16 @@ class KeypointTrajectory:
     def sacrificed(self) -> Dict[str, int]: ...
     @property
     def settle_sacrificed(self) -> Dict[str, int]: ...
+    @property
+    def quality(self) -> Dict[str, Any]: ...
     def __len__(self) -> int: ...
 
 def retarget_keypoints(motion: Motion, robot: Robot, *, dt: float = 0.005,
                        hold_feet: bool = False, standing: bool = False,
                        smoothing: Optional[float] = None,
                        approach_rate: float = 0.0,
-                       hands: str = "leg") -> KeypointTrajectory: ...
+                       hands: str = "leg",
+                       reach: bool = False) -> KeypointTrajectory: ...
 
 class Imitation:
     def __init__(self, robot: Robot, motion: Motion, *, map: Optional[str] = None,

@@ -301,6 +301,10 @@ pub struct KeypointRun {
     /// The robot's velocity at every recorded tick (base twist in the base's axes \[m/s,
     /// rad/s\], then joint rates \[rad/s\]).
     pub velocities: Vec<Vec<f64>>,
+    /// The acceleration q̈ applied over every recorded tick, from its configuration and
+    /// velocity to the next's (base \[m/s², rad/s²\] in the base's axes, then joints
+    /// \[rad/s²\]).
+    pub accelerations: Vec<Vec<f64>>,
     /// The clip's contacts per tick, left and right foot.
     pub contacts: [Vec<bool>; 2],
     /// The robot's stance per tick, left and right foot: the foot landed and held by the first
@@ -514,6 +518,7 @@ pub fn retarget_keypoints_on(
     let mut rec = QualityRecorder::new("keypoints", &body, s.dt);
     let mut trajectory = Vec::with_capacity(ticks);
     let mut velocities = Vec::with_capacity(ticks);
+    let mut accelerations = Vec::with_capacity(ticks);
     let mut times = Vec::with_capacity(ticks);
     let mut tick_us = Vec::with_capacity(ticks);
     let mut stance = [Vec::with_capacity(ticks), Vec::with_capacity(ticks)];
@@ -538,6 +543,7 @@ pub fn retarget_keypoints_on(
             &state,
             controller.qdd().as_slice(),
         )?;
+        accelerations.push(controller.qdd().as_slice().to_vec());
         let start = Instant::now();
         controller.integrate()?;
         if let Some(last) = tick_us.last_mut() {
@@ -560,6 +566,7 @@ pub fn retarget_keypoints_on(
         times,
         trajectory,
         velocities,
+        accelerations,
         contacts,
         stance,
         quality,
