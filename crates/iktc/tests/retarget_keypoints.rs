@@ -153,6 +153,34 @@ fn check_robot(name: &str) {
             None => eprintln!("  joints    (no joint route for this clip on {name})"),
         }
         let file = path.display().to_string();
+        // The recorded q̈ carries each tick's state to the next (the integrator, constant
+        // acceleration over the tick): v⁺ = v + Δt q̈ on every coordinate, q⁺ = q + Δt v +
+        // ½Δt² q̈ on the joints (after the base's 7 configuration and 6 velocity coordinates).
+        let (nqb, nvb) = (robot.base_nq(), robot.base_nv());
+        assert_eq!(run.accelerations.len(), run.trajectory.len(), "{file}");
+        for k in 0..run.trajectory.len().saturating_sub(1) {
+            let (v, v1, a) = (
+                &run.velocities[k],
+                &run.velocities[k + 1],
+                &run.accelerations[k],
+            );
+            let (q, q1) = (&run.trajectory[k], &run.trajectory[k + 1]);
+            for i in 0..v.len() {
+                let step = (v1[i] - v[i] - s.dt * a[i]).abs();
+                assert!(
+                    step <= 1e-12 * (1.0 + v1[i].abs()),
+                    "{file} tick {k} v[{i}]"
+                );
+            }
+            for j in 0..v.len() - nvb {
+                let (iq, iv) = (nqb + j, nvb + j);
+                let x = q[iq] + s.dt * v[iv] + 0.5 * s.dt * s.dt * a[iv];
+                assert!(
+                    (q1[iq] - x).abs() <= 1e-12 * (1.0 + x.abs()),
+                    "{file} tick {k} q[{iq}]"
+                );
+            }
+        }
         let tol = SolverSettings::default().box_tolerance;
         if q.position_margin > tol || q.velocity_margin > tol || q.acceleration_margin > tol {
             failures.push(format!("{file}: a limit exceeded"));
