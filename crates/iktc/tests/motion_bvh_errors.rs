@@ -176,9 +176,13 @@ fn bad_motion_lines() {
     assert_error(
         &replaced(20, "1 1 1 1 x 1 1 1 1"),
         20,
-        "`x` is not a number",
+        "frame 1, value 5: `x` is not a number",
     );
-    assert_error(&replaced(20, "1 1 1 1 nan 1 1 1 1"), 20, "not finite");
+    assert_error(
+        &replaced(20, "1 1 1 1 nan 1 1 1 1"),
+        20,
+        "frame 1, value 5: `nan` is not finite",
+    );
     assert_error(&replaced(17, "Frames: 0"), 17, "zero frames");
     assert_error(&replaced(17, "Frames: many"), 17, "not a frame count");
     assert_error(&replaced(17, "Frame: 2"), 17, "expected `Frames: <number>`");

@@ -98,13 +98,16 @@ impl<'a> Reader<'a> {
     }
 
     fn number(&self, token: &str, line: usize, what: &str) -> Result<f64> {
-        let v: f64 = token
-            .parse()
-            .map_err(|_| self.error(line, format!("{what}: `{token}` is not a number")))?;
-        if v.is_finite() {
-            Ok(v)
-        } else {
-            Err(self.error(line, format!("{what}: `{token}` is not finite")))
+        self.number_of(token, line, || what.to_string())
+    }
+
+    /// [`Self::number`] with the description made only for an error (a frame's values are
+    /// read by the million).
+    fn number_of(&self, token: &str, line: usize, what: impl FnOnce() -> String) -> Result<f64> {
+        match token.parse::<f64>() {
+            Ok(v) if v.is_finite() => Ok(v),
+            Ok(_) => Err(self.error(line, format!("{}: `{token}` is not finite", what()))),
+            Err(_) => Err(self.error(line, format!("{}: `{token}` is not a number", what()))),
         }
     }
 
@@ -194,7 +197,7 @@ impl<'a> Reader<'a> {
                 ));
             }
             for (k, t) in tokens.iter().enumerate() {
-                values.push(self.number(t, line, &format!("frame {read}, value {}", k + 1))?);
+                values.push(self.number_of(t, line, || format!("frame {read}, value {}", k + 1))?);
             }
             read += 1;
         }
