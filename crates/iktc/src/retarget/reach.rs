@@ -449,7 +449,10 @@ mod run_tests {
             q.mean_cm
         );
         assert!(all.reach.iter().zip(&all.run).all(|(a, b)| a <= b));
-        assert!(all.reach_mean() > 0.0);
+        let n = all.reach.len() as f64;
+        let reach = all.reach.iter().sum::<f64>() / n;
+        assert!((all.reach_mean() - reach).abs() <= f64::EPSILON * reach);
+        assert!(0.0 < reach && reach < all.run_mean());
         let asked = KeypointSettings { reach: true, ..s };
         let q = retarget_keypoints(&profile, &kp, None, &asked)
             .unwrap()
