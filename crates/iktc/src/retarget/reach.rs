@@ -388,6 +388,42 @@ mod tests {
         }
     }
 
+    /// The Jacobian rows are the derivatives of the residuals: a small step δ of every
+    /// coordinate (the base's included) changes each residual by its rows times δ, to first
+    /// order (finite differences; the second-order remainder is about |δ|² ≈ 1e-12 m).
+    #[test]
+    fn the_jacobian_rows_are_the_residuals_derivatives() {
+        let (robot, body, start) = g1();
+        let state = moved(&robot, &start, 0.3, true, 11);
+        let targets: Vec<_> = body
+            .points
+            .iter()
+            .map(|(p, _)| (*p, Vector3::zeros()))
+            .collect();
+        let mut d = Descent::new(&robot, &body, &state).unwrap();
+        let mut rng = rand::rngs::StdRng::seed_from_u64(12);
+        let h = 1e-6;
+        let delta = DVector::from_fn(robot.nv(), |_, _| h * rng.random_range(-1.0..1.0));
+        d.evaluate(&state, &targets, true).unwrap();
+        let (res, rows) = (d.res.clone(), d.rows.clone());
+        let mut moved_state = state.clone();
+        d.step(&mut moved_state, &delta).unwrap();
+        d.evaluate(&moved_state, &targets, false).unwrap();
+        let mut checked = 0;
+        for (i, (p, _)) in body.points.iter().enumerate() {
+            if *p == BodyPoint::Pelvis {
+                continue;
+            }
+            let finite = d.res[i] - res[i];
+            let linear = &rows[i] * &delta;
+            assert!(finite.norm() > 1e-8, "{p:?} did not move");
+            let gap = (finite - &linear).norm();
+            assert!(gap < 1e-4 * finite.norm(), "{p:?}: {finite} {linear}");
+            checked += 1;
+        }
+        assert!(checked >= 10);
+    }
+
     /// Targets of a posture beyond the joint ranges: the least error stays above zero, no
     /// joint leaves its range, and the descent never ends above where it started.
     #[test]
