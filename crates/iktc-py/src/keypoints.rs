@@ -202,11 +202,11 @@ impl PyKeypointTrajectory {
             .points
             .iter()
             .map(|p| {
-                let e = PyDict::new(py);
-                e.set_item("point", &p.point)?;
-                e.set_item("mean_cm", p.mean_cm)?;
-                e.set_item("max_cm", p.max_cm)?;
-                Ok(e)
+                figure_dict(
+                    py,
+                    ("point", &p.point),
+                    [("mean_cm", p.mean_cm), ("max_cm", p.max_cm)],
+                )
             })
             .collect::<PyResult<Vec<_>>>()?;
         d.set_item("points", points)?;
@@ -215,11 +215,11 @@ impl PyKeypointTrajectory {
             .orientations
             .iter()
             .map(|o| {
-                let e = PyDict::new(py);
-                e.set_item("frame", &o.frame)?;
-                e.set_item("mean_deg", o.mean_deg)?;
-                e.set_item("max_deg", o.max_deg)?;
-                Ok(e)
+                figure_dict(
+                    py,
+                    ("frame", &o.frame),
+                    [("mean_deg", o.mean_deg), ("max_deg", o.max_deg)],
+                )
             })
             .collect::<PyResult<Vec<_>>>()?;
         d.set_item("orientations", orientations)?;
@@ -245,6 +245,21 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(py_retarget_keypoints, m)?)?;
     m.add_class::<PyKeypointTrajectory>()?;
     Ok(())
+}
+
+/// A dict of one name and its mean and largest figure, e.g. `{"point": …, "mean_cm": …,
+/// "max_cm": …}`.
+fn figure_dict<'py>(
+    py: Python<'py>,
+    (key, name): (&str, &str),
+    values: [(&str, f64); 2],
+) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item(key, name)?;
+    for (k, v) in values {
+        d.set_item(k, v)?;
+    }
+    Ok(d)
 }
 
 /// `{level: ticks}` in priority order.

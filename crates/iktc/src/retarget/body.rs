@@ -50,6 +50,18 @@ impl RobotBody {
         ])
     }
 
+    /// The middle of the hips at `kin` \[m\], world; the pelvis frame's origin on a robot
+    /// without both hips ([`RobotBody::hips`]).
+    pub fn hips_middle(&self, robot: &Robot, kin: &Kinematics) -> Result<Vector3<f64>> {
+        Ok(match self.hips() {
+            Some([l, r]) => {
+                0.5 * (kin.frame_pose(robot, l)?.translation.vector
+                    + kin.frame_pose(robot, r)?.translation.vector)
+            }
+            None => kin.frame_pose(robot, self.pelvis)?.translation.vector,
+        })
+    }
+
     /// Finds the frames (see the module documentation) from the named frames of a profile;
     /// `kin` is at the start posture. Errors: an unknown frame name, a chain that does not
     /// reach the pelvis.

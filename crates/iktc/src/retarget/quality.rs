@@ -150,13 +150,7 @@ impl QualityRecorder {
         qdd: &[f64],
     ) -> Result<()> {
         let pelvis = kin.frame_pose(robot, body.pelvis)?;
-        let hips = match body.hips() {
-            Some([l, r]) => {
-                0.5 * (kin.frame_pose(robot, l)?.translation.vector
-                    + kin.frame_pose(robot, r)?.translation.vector)
-            }
-            None => pelvis.translation.vector,
-        };
+        let hips = body.hips_middle(robot, kin)?;
         for ((p, sum, max), (f_p, f)) in self.sums.iter_mut().zip(&body.points) {
             debug_assert_eq!(p, f_p);
             let Some((_, rel)) = plan.neutral[k].iter().find(|(q, _)| q == p) else {

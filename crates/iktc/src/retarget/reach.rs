@@ -137,28 +137,21 @@ impl<'a> Descent<'a> {
     ) -> Result<f64> {
         let (robot, body) = (self.robot, self.body);
         self.kin.update(robot, state)?;
-        // The middle of the hips and its Jacobian, or the pelvis frame's on a robot without
-        // both hips (as the quality figures do).
-        let mut x_m = Vector3::zeros();
-        match body.hips() {
-            Some(hips) => {
-                if jacobians {
+        // The middle of the hips and, when asked, its Jacobian (the pelvis frame's on a robot
+        // without both hips, as the quality figures do).
+        let x_m = body.hips_middle(robot, &self.kin)?;
+        if jacobians {
+            match body.hips() {
+                Some(hips) => {
                     self.hips_jac.fill(0.0);
-                }
-                for f in hips {
-                    x_m += 0.5 * self.kin.frame_pose(robot, f)?.translation.vector;
-                    if jacobians {
+                    for f in hips {
                         self.kin.frame_jacobian(robot, f, &mut self.jac)?;
                         self.hips_jac += 0.5 * &self.jac;
                     }
                 }
-            }
-            None => {
-                x_m = self.kin.frame_pose(robot, body.pelvis)?.translation.vector;
-                if jacobians {
-                    self.kin
-                        .frame_jacobian(robot, body.pelvis, &mut self.hips_jac)?;
-                }
+                None => self
+                    .kin
+                    .frame_jacobian(robot, body.pelvis, &mut self.hips_jac)?,
             }
         }
         let (mut sum, mut count) = (0.0, 0usize);
