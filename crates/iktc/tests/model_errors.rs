@@ -192,3 +192,43 @@ fn bad_per_joint_acceleration_and_jerk_limits_are_named() {
         }
     }
 }
+
+/// URDF requires a `name` on `<material>`; exporters leave it out (Unitree's H1-2 description
+/// has 55 such). The reader takes them as unnamed, with a warning that counts them, and reads
+/// the same robot as with the names written; a material with a name gives no warning.
+#[test]
+fn materials_without_a_name_are_read_as_unnamed() {
+    let visual = |material: &str| {
+        format!(
+            r#"<robot name="r">
+  <link name="a"><visual><geometry><box size="0.1 0.1 0.1"/></geometry>{material}</visual></link>
+  <link name="b"><visual><geometry><sphere radius="0.1"/></geometry>{material}</visual></link>
+  <joint name="j" type="revolute"><parent link="a"/><child link="b"/><axis xyz="0 0 1"/>
+    <origin xyz="0 0 0.3"/><limit lower="-1" upper="1" velocity="2" effort="1"/></joint>
+</robot>"#
+        )
+    };
+    let unnamed = load(&visual(
+        r#"<material><color rgba="0.1 0.1 0.1 1"/></material>"#,
+    ))
+    .unwrap();
+    let empty = load(&visual("<material/>")).unwrap();
+    let named = load(&visual(
+        r#"<material name="grey"><color rgba="0.1 0.1 0.1 1"/></material>"#,
+    ))
+    .unwrap();
+    assert!(named.warnings().is_empty(), "{:?}", named.warnings());
+    for r in [&unnamed, &empty] {
+        assert_eq!(r.nv(), named.nv());
+        assert_eq!(r.joints()[0].origin, named.joints()[0].origin);
+        let w = r.warnings().join("\n");
+        assert!(
+            w.contains("2 <material> element(s) without the `name`"),
+            "{w}"
+        );
+    }
+    // The profile guesses and the viewer's meshes read the same document.
+    let text = visual("<material><color rgba=\"0.1 0.1 0.1 1\"/></material>");
+    assert!(iktc::profile::init_profile_toml(&text, "r.urdf").is_ok());
+    assert!(iktc::mesh::urdf::meshes_from_urdf(&text, std::path::Path::new("."), 0.01).is_ok());
+}

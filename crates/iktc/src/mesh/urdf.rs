@@ -137,9 +137,7 @@ fn link_mesh(
 /// # Errors
 /// [`Error::Urdf`] when the URDF cannot be parsed; every problem with one mesh is a warning.
 pub fn meshes_from_urdf(text: &str, dir: &Path, cell: f64) -> Result<UrdfMeshes> {
-    let u = urdf_rs::read_from_string(text.trim_end_matches('\0')).map_err(|e| Error::Urdf {
-        message: format!("cannot parse the URDF: {e}"),
-    })?;
+    let (u, _) = crate::model::read_urdf(text, &crate::resources::ReadLimits::default())?;
     let mut out = UrdfMeshes::default();
     for link in &u.links {
         for v in &link.visual {

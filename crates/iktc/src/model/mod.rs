@@ -20,6 +20,9 @@ mod urdf;
 #[cfg(feature = "urdf")]
 mod urdf_check;
 
+#[cfg(feature = "urdf")]
+pub(crate) use urdf::read_urdf;
+
 pub use builtin::{builtin_robot, planar3r, BUILTIN_ROBOTS};
 #[cfg(feature = "urdf")]
 pub use builtin::{g1, jvrc1, G1_URDF, JVRC1_FINGERS, JVRC1_URDF};

@@ -6,7 +6,7 @@ use std::collections::HashMap;
 
 use super::joint::{JointKind, JointLimit};
 use super::robot::{JointSpec, Link, ModelOptions, Robot, RobotBuilder};
-use super::urdf_check::{check_raw, RawJoint};
+use super::urdf_check::{check_raw, unnamed_materials_named, RawJoint, RawUrdf};
 use crate::error::{Error, Result};
 use crate::resources::ReadLimits;
 
@@ -199,6 +199,26 @@ fn checked_limit(j: &urdf_rs::Joint, raw: &RawJoint, b: &mut RobotBuilder) -> Re
     Ok(limit)
 }
 
+/// Parses URDF `text` with `urdf-rs` after the raw pass ([`check_raw`]): a trailing NUL
+/// (some exported files carry one) is dropped and `<material>` elements without a name are
+/// read as unnamed. The one place a URDF is parsed (model, meshes, profile guesses).
+pub(crate) fn read_urdf(text: &str, limits: &ReadLimits) -> Result<(urdf_rs::Robot, RawUrdf)> {
+    // The XML parser rejects a trailing NUL, which some exported files carry.
+    let text = text.trim_end_matches('\0');
+    let raw = check_raw(text, limits)?;
+    let named;
+    let text = if raw.unnamed_materials.is_empty() {
+        text
+    } else {
+        named = unnamed_materials_named(text, &raw.unnamed_materials);
+        named.as_str()
+    };
+    let u = urdf_rs::read_from_string(text).map_err(|e| Error::Urdf {
+        message: format!("cannot parse the URDF: {e}"),
+    })?;
+    Ok((u, raw))
+}
+
 impl Robot {
     /// Reads a robot from URDF text (revolute, continuous, prismatic and fixed joints).
     ///
@@ -235,13 +255,15 @@ impl Robot {
         options: &ModelOptions,
         limits: &ReadLimits,
     ) -> Result<Robot> {
-        // The XML parser rejects a trailing NUL, which some exported files carry.
-        let text = text.trim_end_matches('\0');
-        let raw = check_raw(text, limits)?;
-        let u = urdf_rs::read_from_string(text).map_err(|e| Error::Urdf {
-            message: format!("cannot parse the URDF: {e}"),
-        })?;
-        builder_from_urdf(&u, &raw)?.build(options)
+        let (u, raw) = read_urdf(text, limits)?;
+        let mut b = builder_from_urdf(&u, &raw.joints)?;
+        if !raw.unnamed_materials.is_empty() {
+            b.warn(format!(
+                "{} <material> element(s) without the `name` URDF requires: read as unnamed",
+                raw.unnamed_materials.len()
+            ));
+        }
+        b.build(options)
     }
 
     /// Reads a robot from a URDF file.

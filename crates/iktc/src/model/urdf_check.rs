@@ -9,7 +9,11 @@
 //!   would otherwise leave a revolute joint with the range \[0, 0\]; a misspelled `<mass>` a
 //!   massless link), and the attributes of `<limit>`;
 //! * which `<limit>` attributes are written at all, so that a missing value and an explicit 0
-//!   can be told apart (the typed parse gives 0 for both).
+//!   can be told apart (the typed parse gives 0 for both);
+//! * where a `<material>` has no `name`: URDF requires one, `urdf-rs` rejects the document
+//!   without it, and exporters leave it out (Unitree's H1-2 description has 55 such
+//!   materials); the reader then names them `""` ([`unnamed_materials_named`]), which is what
+//!   a name-less material means to a kinematic reader (materials only colour the visuals).
 
 use std::collections::HashMap;
 
@@ -92,15 +96,40 @@ struct Open {
     name: String,
 }
 
-/// Streams `text` once; returns the robot's joints by name. Errors: a nesting deeper than
-/// `limits.max_xml_depth`, an element URDF does not know inside a robot's `<joint>` or
-/// `<inertial>`, an unknown `<limit>` attribute, malformed XML.
-pub(crate) fn check_raw(text: &str, limits: &ReadLimits) -> Result<HashMap<String, RawJoint>> {
+/// What the raw pass found.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub(crate) struct RawUrdf {
+    /// The robot's joints by name.
+    pub joints: HashMap<String, RawJoint>,
+    /// Byte offsets just past `<material` of every `<material>` without a `name` attribute.
+    pub unnamed_materials: Vec<usize>,
+}
+
+/// `text` with `name=""` written into each `<material` at the byte offsets `at` (ascending,
+/// each just past a `<material` tag name; see [`RawUrdf::unnamed_materials`]).
+pub(crate) fn unnamed_materials_named(text: &str, at: &[usize]) -> String {
+    let mut out = String::with_capacity(text.len() + 8 * at.len());
+    let mut from = 0;
+    for &p in at {
+        out.push_str(&text[from..p]);
+        out.push_str(" name=\"\"");
+        from = p;
+    }
+    out.push_str(&text[from..]);
+    out
+}
+
+/// Streams `text` once; returns the robot's joints by name and where `<material>` lacks a
+/// name. Errors: a nesting deeper than `limits.max_xml_depth`, an element URDF does not know
+/// inside a robot's `<joint>` or `<inertial>`, an unknown `<limit>` attribute, malformed XML.
+pub(crate) fn check_raw(text: &str, limits: &ReadLimits) -> Result<RawUrdf> {
     limits.validate()?;
     let mut reader = quick_xml::Reader::from_str(text);
     let mut stack: Vec<Open> = Vec::new();
     let mut joints: HashMap<String, RawJoint> = HashMap::new();
+    let mut unnamed_materials = Vec::new();
     loop {
+        let at = usize::try_from(reader.buffer_position()).unwrap_or(usize::MAX);
         let event = reader.read_event().map_err(|e| {
             error(format!(
                 "cannot parse the URDF at byte {}: {e}",
@@ -170,6 +199,13 @@ pub(crate) fn check_raw(text: &str, limits: &ReadLimits) -> Result<HashMap<Strin
                 "link `{link}`: <inertial> contains <{tag}>, which URDF does not define there; expected <origin>, <mass> or <inertia>"
             )));
         }
+        if tag == "material" && !attrs.iter().any(|(k, _)| k == "name") {
+            // The event starts at `at` with `<material`; found by search to be sure of it.
+            let tail = text.get(at..).unwrap_or("");
+            if let Some(i) = tail.find("<material") {
+                unnamed_materials.push(at + i + "<material".len());
+            }
+        }
         if tag == "joint" && stack.len() == 1 {
             joints.entry(name.clone()).or_default();
         }
@@ -177,5 +213,8 @@ pub(crate) fn check_raw(text: &str, limits: &ReadLimits) -> Result<HashMap<Strin
             stack.push(Open { tag, name });
         }
     }
-    Ok(joints)
+    Ok(RawUrdf {
+        joints,
+        unnamed_materials,
+    })
 }

@@ -128,9 +128,7 @@ fn quote(s: &str) -> String {
 ///
 /// Errors: a URDF that does not parse or has no single root link.
 pub fn init_profile_toml(text: &str, urdf_path: &str) -> Result<String> {
-    let u = urdf_rs::read_from_string(text.trim_end_matches('\0')).map_err(|e| Error::Urdf {
-        message: format!("cannot parse the URDF: {e}"),
-    })?;
+    let (u, _) = crate::model::read_urdf(text, &crate::resources::ReadLimits::default())?;
     let is_child = |name: &str| u.joints.iter().any(|j| j.child.link == name);
     let roots: Vec<&urdf_rs::Link> = u.links.iter().filter(|l| !is_child(&l.name)).collect();
     let [root] = roots.as_slice() else {
