@@ -3,7 +3,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
-use iktc::profile::{builtin_profile_text, init_profile_toml};
+use iktc::profile::{builtin_profile_text, init_profile_toml_at};
 
 /// Arguments of `iktc profile`.
 #[derive(clap::Args, Debug)]
@@ -64,7 +64,8 @@ pub fn run(a: &Args) -> Result<()> {
         ProfileCommand::Init { urdf, out } => {
             let text = std::fs::read_to_string(urdf)
                 .with_context(|| format!("reading {}", urdf.display()))?;
-            let toml = init_profile_toml(&text, &urdf_key(urdf, out.as_deref())?)?;
+            let toml =
+                init_profile_toml_at(&text, &urdf_key(urdf, out.as_deref())?, urdf.parent())?;
             match out {
                 Some(path) => {
                     std::fs::write(path, toml)

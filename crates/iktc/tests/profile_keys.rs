@@ -3,8 +3,8 @@
 
 use iktc::model::{jvrc1, JointRole, ModelOptions};
 use iktc::profile::{
-    builtin_profile_text, init_profile_toml, ProfileOrigin, RobotProfile, BUILTIN_PROFILES,
-    DEFAULT_PUSH_VELOCITY_CHANGE,
+    builtin_profile_text, init_profile_toml, init_profile_toml_at, ProfileOrigin, RobotProfile,
+    BUILTIN_PROFILES, DEFAULT_PUSH_VELOCITY_CHANGE,
 };
 use iktc::sim::{ImitateConfig, WalkImitateConfig};
 use iktc::Error;
@@ -481,4 +481,94 @@ fn jerk_limits_come_from_the_profile() {
     // Printed and read back, the key survives.
     let p = parse(&text).unwrap();
     assert_eq!(parse(&p.to_toml_string().unwrap()).unwrap().jerk, p.jerk);
+}
+
+/// A binary STL of the axis-aligned box `[lo, hi]` \[m\] (12 triangles).
+fn box_stl(lo: [f32; 3], hi: [f32; 3]) -> Vec<u8> {
+    let c = |i: usize| -> [f32; 3] {
+        [
+            if i & 1 == 0 { lo[0] } else { hi[0] },
+            if i & 2 == 0 { lo[1] } else { hi[1] },
+            if i & 4 == 0 { lo[2] } else { hi[2] },
+        ]
+    };
+    let faces = [
+        [0, 1, 3, 2],
+        [4, 6, 7, 5],
+        [0, 4, 5, 1],
+        [2, 3, 7, 6],
+        [0, 2, 6, 4],
+        [1, 5, 7, 3],
+    ];
+    let mut out = vec![0u8; 80];
+    out.extend_from_slice(&12u32.to_le_bytes());
+    for f in faces {
+        for t in [[f[0], f[1], f[2]], [f[0], f[2], f[3]]] {
+            out.extend_from_slice(&[0u8; 12]);
+            for i in t {
+                for x in c(i) {
+                    out.extend_from_slice(&x.to_le_bytes());
+                }
+            }
+            out.extend_from_slice(&[0u8; 2]);
+        }
+    }
+    out
+}
+
+/// Feet without collision boxes or spheres: their soles come from their meshes in the URDF's
+/// folder (the collision mesh before the visual one), to 0.1 mm; without the folder they are
+/// placeholders as before.
+#[test]
+fn init_guesses_the_soles_from_the_feet_meshes() {
+    let dir = std::env::temp_dir().join(format!("iktc-init-meshes-{}", std::process::id()));
+    std::fs::create_dir_all(dir.join("meshes")).unwrap();
+    // Visual: a 0.22 × 0.09 m foot 0.04 m below the ankle, 0.02 m ahead of it; collision: a
+    // 0.2 × 0.08 m box 0.05 m below, 0.03 m ahead (the one taken).
+    std::fs::write(
+        dir.join("meshes/visual.stl"),
+        box_stl([-0.09, -0.045, -0.04], [0.13, 0.045, 0.01]),
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("meshes/collision.stl"),
+        box_stl([-0.07, -0.04, -0.05], [0.13, 0.04, 0.0]),
+    )
+    .unwrap();
+    let foot = |side: &str, collision: bool| {
+        format!(
+            r#"<link name="{side}_foot"><visual><geometry><mesh filename="meshes/visual.stl"/></geometry></visual>{}</link>
+  <joint name="{side}_ankle" type="revolute"><parent link="pelvis"/><child link="{side}_foot"/><axis xyz="0 1 0"/>
+    <origin xyz="0 {} -0.6"/><limit lower="-1" upper="1" velocity="5" effort="10"/></joint>"#,
+            if collision {
+                r#"<collision><geometry><mesh filename="package://robot_description/meshes/collision.stl"/></geometry></collision>"#
+            } else {
+                ""
+            },
+            if side == "left" { 0.1 } else { -0.1 }
+        )
+    };
+    for collision in [true, false] {
+        let urdf = format!(
+            "<robot name=\"r\"><link name=\"pelvis\"/>{}{}</robot>",
+            foot("left", collision),
+            foot("right", collision)
+        );
+        let toml = init_profile_toml_at(&urdf, "r.urdf", Some(&dir)).unwrap();
+        let p = parse(&toml).unwrap();
+        let feet = p.feet.clone().unwrap();
+        let want = if collision {
+            (0.2, 0.08, 0.03, 0.05, "from the link's collision meshes")
+        } else {
+            (0.22, 0.09, 0.02, 0.04, "from the link's visual meshes")
+        };
+        for f in [&feet.left, &feet.right] {
+            let got = (f.sole.length, f.sole.width, f.sole.offset_x, f.ankle_height);
+            assert_eq!(got, (want.0, want.1, want.2, want.3), "{toml}");
+        }
+        assert!(toml.contains(want.4), "{toml}");
+        let bare = init_profile_toml(&urdf, "r.urdf").unwrap();
+        assert!(bare.contains("PLACEHOLDER"), "{bare}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
 }

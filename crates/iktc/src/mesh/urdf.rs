@@ -90,16 +90,16 @@ impl Format {
     }
 }
 
-/// One visual mesh read from `path`, in the link frame, decimated on `cell` \[m\]; `None`
-/// when decimation leaves nothing (a part smaller than a cell). Also returns the warnings
-/// about parts of the file left out.
-fn link_mesh(
+/// The triangle mesh of the file `path` (STL or Collada by `format`), its vertices mapped into
+/// the link frame by `p_link = R·(s ⊙ p) + t` (`s` = `scale`, `R, t` from `origin`) and its
+/// triangles turned back counter-clockwise under a mirroring scale; with the warnings about the
+/// parts of the file left out.
+fn read_in_link(
     path: &Path,
     format: Format,
     scale: [f64; 3],
     origin: &urdf_rs::Pose,
-    cell: f64,
-) -> Result<(Option<QuantizedMesh>, Vec<String>)> {
+) -> Result<(super::TriMesh, Vec<String>)> {
     let bytes = std::fs::read(path).map_err(|e| Error::Parse {
         source_name: path.display().to_string(),
         line: 0,
@@ -125,6 +125,55 @@ fn link_mesh(
             tri.swap(1, 2);
         }
     }
+    Ok((mesh, warnings))
+}
+
+/// The vertices \[m\] of the mesh geometry `geometry` of a link (a `<visual>` or
+/// `<collision>` with the `<origin>` `origin`), in the link frame, its file found from the
+/// URDF's folder `dir` as the viewer finds it. `Ok(None)` for a geometry that is not a mesh.
+///
+/// # Errors
+/// A file that cannot be found or read, in another format than STL or Collada, or malformed.
+pub fn mesh_vertices(
+    geometry: &urdf_rs::Geometry,
+    origin: &urdf_rs::Pose,
+    dir: &Path,
+) -> Result<Option<Vec<Vector3<f64>>>> {
+    let urdf_rs::Geometry::Mesh { filename, scale } = geometry else {
+        return Ok(None);
+    };
+    let path = resolve(filename, dir);
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .unwrap_or_default();
+    let format = Format::of(&ext).ok_or_else(|| Error::Parse {
+        source_name: path.display().to_string(),
+        line: 0,
+        message: "this mesh format is not supported (STL or Collada .dae only)".into(),
+    })?;
+    let s = scale.as_ref().map(|s| s.0).unwrap_or([1.0; 3]);
+    let (mesh, _) = read_in_link(&path, format, s, origin)?;
+    Ok(Some(
+        mesh.vertices
+            .iter()
+            .map(|v| Vector3::new(f64::from(v[0]), f64::from(v[1]), f64::from(v[2])))
+            .collect(),
+    ))
+}
+
+/// One visual mesh read from `path`, in the link frame, decimated on `cell` \[m\]; `None`
+/// when decimation leaves nothing (a part smaller than a cell). Also returns the warnings
+/// about parts of the file left out.
+fn link_mesh(
+    path: &Path,
+    format: Format,
+    scale: [f64; 3],
+    origin: &urdf_rs::Pose,
+    cell: f64,
+) -> Result<(Option<QuantizedMesh>, Vec<String>)> {
+    let (mesh, warnings) = read_in_link(path, format, scale, origin)?;
     let d = decimate(&mesh, cell)?;
     if d.triangles.is_empty() {
         return Ok((None, warnings));

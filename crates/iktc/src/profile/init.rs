@@ -4,7 +4,10 @@
 //! * feet: per side, the deepest link whose name contains `foot`, `ankle`, `sole` or `toe`
 //!   (the side from a `left`/`l_`/`_l` or `right`/`r_`/`_r` in its name); their sole rectangle
 //!   and ankle height from the link's collision boxes and spheres (the bounding rectangle of
-//!   their footprints, the ankle height from the lowest point), else a placeholder;
+//!   their footprints, the ankle height from the lowest point), else, when the URDF's folder is
+//!   known ([`init_profile_toml_at`]), from its collision meshes, else its visual meshes (the
+//!   ankle height from the lowest vertex, the sole the bounding rectangle of the vertices within
+//!   [`SOLE_BAND`] of it), else a placeholder;
 //! * pelvis: the first link (from the root) whose name contains `pelvis`, else the root link;
 //! * torso (`torso`, `chest`, `trunk`) and head (`head`, `neck`): the matching link nearest the
 //!   root; hands (`hand`, `palm`, `wrist`): the deepest matching link per side;
@@ -116,6 +119,64 @@ fn sole_from_collisions(link: &urdf_rs::Link) -> Option<(f64, f64, f64, f64)> {
     (l > 0.0 && w > 0.0 && zmin < 0.0).then(|| (l, w, 0.5 * (xmin + xmax), -zmin))
 }
 
+/// Vertices of a foot mesh up to this height above its lowest one make its sole \[m\]: the
+/// flat underside of a foot, not the toe's upward curve or the ankle's housing above it.
+pub const SOLE_BAND: f64 = 0.01;
+
+/// A guessed sole: `(length, width, offset_x, ankle_height)` \[m\] from the mesh vertices
+/// `v` of a foot link, in its frame (see the module documentation).
+fn sole_from_vertices(v: &[Vector3<f64>]) -> Option<(f64, f64, f64, f64)> {
+    let zmin = v.iter().map(|p| p.z).fold(f64::INFINITY, f64::min);
+    let (mut xmin, mut xmax, mut ymin, mut ymax) = (
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    );
+    for p in v.iter().filter(|p| p.z <= zmin + SOLE_BAND) {
+        xmin = xmin.min(p.x);
+        xmax = xmax.max(p.x);
+        ymin = ymin.min(p.y);
+        ymax = ymax.max(p.y);
+    }
+    let (l, w) = (xmax - xmin, ymax - ymin);
+    (l > 0.0 && w > 0.0 && zmin < 0.0).then(|| (l, w, 0.5 * (xmin + xmax), -zmin))
+}
+
+/// The sole of `link` from its collision meshes, else its visual meshes, read from the URDF's
+/// folder `dir`, with which of the two it came from. `None` when neither gives one (no mesh,
+/// a mesh that cannot be read, or one that does not reach below the link's origin).
+fn sole_from_meshes(
+    link: &urdf_rs::Link,
+    dir: &std::path::Path,
+) -> Option<((f64, f64, f64, f64), &'static str)> {
+    let read = |parts: Vec<(&urdf_rs::Geometry, &urdf_rs::Pose)>| -> Option<(f64, f64, f64, f64)> {
+        let mut all = Vec::new();
+        for (g, o) in parts {
+            all.extend(crate::mesh::urdf::mesh_vertices(g, o, dir).ok()??);
+        }
+        sole_from_vertices(&all)
+    };
+    let collision = link
+        .collision
+        .iter()
+        .map(|c| (&c.geometry, &c.origin))
+        .collect();
+    let visual = link
+        .visual
+        .iter()
+        .map(|v| (&v.geometry, &v.origin))
+        .collect();
+    read(collision)
+        .map(|s| (s, "from the link's collision meshes"))
+        .or_else(|| read(visual).map(|s| (s, "from the link's visual meshes")))
+}
+
+/// `x` \[m\] rounded to 0.1 mm.
+fn tenth_mm(x: f64) -> f64 {
+    (x * 1e4).round() / 1e4
+}
+
 fn quote(s: &str) -> String {
     // TOML basic string: escape backslashes and quotes.
     format!("\"{}\"", s.replace('\\', "\\\\").replace('"', "\\\""))
@@ -128,6 +189,16 @@ fn quote(s: &str) -> String {
 ///
 /// Errors: a URDF that does not parse or has no single root link.
 pub fn init_profile_toml(text: &str, urdf_path: &str) -> Result<String> {
+    init_profile_toml_at(text, urdf_path, None)
+}
+
+/// [`init_profile_toml`] for a URDF in the folder `dir`: a foot without collision boxes or
+/// spheres has its sole guessed from its meshes there (see the module documentation).
+pub fn init_profile_toml_at(
+    text: &str,
+    urdf_path: &str,
+    dir: Option<&std::path::Path>,
+) -> Result<String> {
     let (u, _) = crate::model::read_urdf(text, &crate::resources::ReadLimits::default())?;
     let is_child = |name: &str| u.joints.iter().any(|j| j.child.link == name);
     let roots: Vec<&urdf_rs::Link> = u.links.iter().filter(|l| !is_child(&l.name)).collect();
@@ -212,23 +283,25 @@ pub fn init_profile_toml(text: &str, urdf_path: &str) -> Result<String> {
     match feet {
         Some((l, r)) => {
             for (side, link) in [("left", l), ("right", r)] {
-                let sole = u
-                    .links
-                    .iter()
-                    .find(|x| x.name == link.name)
-                    .and_then(sole_from_collisions);
+                let urdf_link = u.links.iter().find(|x| x.name == link.name);
+                let sole = urdf_link
+                    .and_then(sole_from_collisions)
+                    .map(|s| (s, "from the link's collision boxes/spheres"))
+                    .or_else(|| urdf_link.zip(dir).and_then(|(l, d)| sole_from_meshes(l, d)));
                 out.push_str(&format!(
                     "[feet.{side}]\nframe = {} # guessed: deepest link named like a foot on the {side}\n",
                     quote(&link.name)
                 ));
                 let (len, wid, off, ankle, why) = match sole {
-                    Some((a, b, c, d)) => (a, b, c, d, "from the link's collision boxes/spheres"),
+                    // To 0.1 mm: meshes are stored in single precision.
+                    Some(((a, b, c, d), why)) => (tenth_mm(a), tenth_mm(b), tenth_mm(c), tenth_mm(d), why),
                     None => (
                         0.2,
                         0.1,
                         0.0,
                         0.1,
-                        "PLACEHOLDER, no collision box or sphere: measure the robot",
+                        "PLACEHOLDER, no collision box, sphere or readable mesh below the \
+                         link: measure the robot",
                     ),
                 };
                 out.push_str(&format!(
@@ -278,4 +351,33 @@ pub fn init_profile_toml(text: &str, urdf_path: &str) -> Result<String> {
          [imitate.maps]\n# deepmimic = \"my_deepmimic_map.toml\"\n",
     );
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A box foot 0.2 × 0.08 m whose underside is 0.05 m below the frame, centred 0.03 m ahead
+    /// of it, with a toe tip raised 0.02 m (above the sole band) reaching 0.05 m further and an
+    /// ankle housing above: the sole is the underside's rectangle.
+    #[test]
+    fn the_sole_of_a_mesh_is_its_underside() {
+        let mut v = Vec::new();
+        for x in [-0.07, 0.13] {
+            for y in [-0.04, 0.04] {
+                v.push(Vector3::new(x, y, -0.05));
+                v.push(Vector3::new(x, y, 0.0));
+            }
+        }
+        v.push(Vector3::new(0.18, 0.0, -0.05 + 2.0 * SOLE_BAND));
+        v.push(Vector3::new(0.0, 0.06, 0.1));
+        let (l, w, off, ankle) = sole_from_vertices(&v).unwrap();
+        for (got, want) in [(l, 0.2), (w, 0.08), (off, 0.03), (ankle, 0.05)] {
+            assert!((got - want).abs() < 1e-12, "{got} {want}");
+        }
+        // A mesh entirely above the frame has no sole below it.
+        let above: Vec<_> = v.iter().map(|p| p + Vector3::z()).collect();
+        assert!(sole_from_vertices(&above).is_none());
+        assert!(sole_from_vertices(&[]).is_none());
+    }
 }
