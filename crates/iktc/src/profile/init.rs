@@ -68,9 +68,12 @@ fn deepest<'a>(links: &'a [TreeLink], words: &[&str], side: Option<Side>) -> Opt
     pick(links, words, side, false)
 }
 
-/// A guessed sole: `(length, width, offset_x, ankle_height)` \[m\] from the collision boxes and
+/// A guessed sole: `(length, width, offset_x, ankle_height)` \[m\].
+type Sole = (f64, f64, f64, f64);
+
+/// A guessed sole ([`Sole`]) from the collision boxes and
 /// spheres of `link` (their footprints in the link frame, ignoring their rotation about z).
-fn sole_from_collisions(link: &urdf_rs::Link) -> Option<(f64, f64, f64, f64)> {
+fn sole_from_collisions(link: &urdf_rs::Link) -> Option<Sole> {
     let (mut xmin, mut xmax, mut ymin, mut ymax, mut zmin) = (
         f64::INFINITY,
         f64::NEG_INFINITY,
@@ -125,7 +128,7 @@ pub const SOLE_BAND: f64 = 0.01;
 
 /// A guessed sole: `(length, width, offset_x, ankle_height)` \[m\] from the mesh vertices
 /// `v` of a foot link, in its frame (see the module documentation).
-fn sole_from_vertices(v: &[Vector3<f64>]) -> Option<(f64, f64, f64, f64)> {
+fn sole_from_vertices(v: &[Vector3<f64>]) -> Option<Sole> {
     let zmin = v.iter().map(|p| p.z).fold(f64::INFINITY, f64::min);
     let (mut xmin, mut xmax, mut ymin, mut ymax) = (
         f64::INFINITY,
@@ -146,11 +149,8 @@ fn sole_from_vertices(v: &[Vector3<f64>]) -> Option<(f64, f64, f64, f64)> {
 /// The sole of `link` from its collision meshes, else its visual meshes, read from the URDF's
 /// folder `dir`, with which of the two it came from. `None` when neither gives one (no mesh,
 /// a mesh that cannot be read, or one that does not reach below the link's origin).
-fn sole_from_meshes(
-    link: &urdf_rs::Link,
-    dir: &std::path::Path,
-) -> Option<((f64, f64, f64, f64), &'static str)> {
-    let read = |parts: Vec<(&urdf_rs::Geometry, &urdf_rs::Pose)>| -> Option<(f64, f64, f64, f64)> {
+fn sole_from_meshes(link: &urdf_rs::Link, dir: &std::path::Path) -> Option<(Sole, &'static str)> {
+    let read = |parts: Vec<(&urdf_rs::Geometry, &urdf_rs::Pose)>| -> Option<Sole> {
         let mut all = Vec::new();
         for (g, o) in parts {
             all.extend(crate::mesh::urdf::mesh_vertices(g, o, dir).ok()??);
