@@ -121,6 +121,7 @@ fn base_profile(spec: &str) -> Result<(RobotProfile, String)> {
             base: BaseKind::Fixed,
             lock: Vec::new(),
             feet: None,
+            added_frames: Vec::new(),
             frames: Default::default(),
             posture: Default::default(),
             narrow: Default::default(),
@@ -284,8 +285,21 @@ fn explain(source: &str, flag_keys: &[(String, &'static str)], e: iktc::Error) -
         return anyhow::anyhow!("{flag}: {e}");
     }
     if value == MISSING {
+        // A URDF without a profile: `iktc profile init` guesses feet, soles, pelvis and hands.
+        let init = source
+            .strip_prefix("URDF ")
+            .map(|u| {
+                format!(
+                    "; or write a profile with its keys guessed from the URDF: `iktc profile init {u} --out {}`",
+                    Path::new(u).with_extension("toml").display()
+                )
+            })
+            .unwrap_or_default();
         if let Some((_, flag)) = FLAG_OF_KEY.iter().find(|(k, _)| under(k)) {
-            return anyhow::anyhow!("{source}: {e}; set the key or pass {flag}");
+            return anyhow::anyhow!("{source}: {e}; set the key or pass {flag}{init}");
+        }
+        if !init.is_empty() {
+            return anyhow::anyhow!("{source}: {e}{init}");
         }
     }
     anyhow::anyhow!("{source}: {e}")

@@ -293,6 +293,8 @@ fn a_bare_urdf_names_the_missing_flag_and_key() {
     assert!(!o.status.success());
     let e = stderr(&o);
     assert!(e.contains("--feet") && e.contains("`feet`"), "{e}");
+    // And the command that guesses every missing key into a profile.
+    assert!(e.contains(&format!("`iktc profile init {u} --out ")), "{e}");
     // With feet but no sole.
     let feet = "right_ankle_roll_link,left_ankle_roll_link";
     let o = run(&["imitate", "--robot", u, "--feet", feet]);

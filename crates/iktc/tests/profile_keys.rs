@@ -572,3 +572,130 @@ fn init_guesses_the_soles_from_the_feet_meshes() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A frame the profile adds (key `frame`) sits at its offset in its parent, for every
+/// configuration (checked against the parent's pose); the other keys can name it; a wrong
+/// parent, a taken name or a non-finite offset is an error naming the key.
+#[test]
+fn added_frames_sit_at_their_offset_and_bad_ones_name_their_key() {
+    use iktc::model::{Kinematics, State};
+    use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
+    let text = jvrc1_with(
+        "[[frame]]\nname = \"l_tip\"\nparent = \"L_ELBOW_Y_S\"\nxyz = [0.1, -0.02, -0.25]\nrpy = [0.3, -0.2, 0.1]\n\
+         [[frame]]\nname = \"l_tip2\"\nparent = \"l_tip\"\nxyz = [0.0, 0.0, 0.05]\n",
+        "[frames]\npelvis = \"PELVIS_S\"\nleft_hand = \"l_tip2\"\nright_hand = \"R_WRIST_Y_S\"",
+    );
+    let p = parse(&text).unwrap();
+    let robot = p.robot().unwrap();
+    let mut state = State::neutral(&robot);
+    for (k, q) in state.q.iter_mut().enumerate().skip(7) {
+        *q = 0.3 * ((k as f64) * 1.7).sin();
+    }
+    let kin = Kinematics::new(&robot, &state).unwrap();
+    let parent = kin
+        .frame_pose(&robot, robot.frame_id("L_ELBOW_Y_S").unwrap())
+        .unwrap();
+    let offset = Isometry3::from_parts(
+        Translation3::new(0.1, -0.02, -0.25),
+        UnitQuaternion::from_euler_angles(0.3, -0.2, 0.1),
+    );
+    let tip = kin
+        .frame_pose(&robot, robot.frame_id("l_tip").unwrap())
+        .unwrap();
+    let want = parent * offset;
+    assert!((tip.translation.vector - want.translation.vector).norm() < 1e-12);
+    assert!(tip.rotation.angle_to(&want.rotation) < 1e-12);
+    // A frame on an added frame: 5 cm along the first one's z axis.
+    let tip2 = kin
+        .frame_pose(&robot, robot.frame_id("l_tip2").unwrap())
+        .unwrap();
+    let d = tip2.translation.vector - tip.translation.vector;
+    assert!((d - tip.rotation * Vector3::new(0.0, 0.0, 0.05)).norm() < 1e-12);
+    // The hands' key takes it.
+    assert_eq!(p.frames.left_hand.as_deref(), Some("l_tip2"));
+    for (frame, key, what) in [
+        (
+            "name = \"x\"\nparent = \"NOPE\"",
+            "frame[0].parent",
+            "L_ELBOW_Y_S",
+        ),
+        (
+            "name = \"PELVIS_S\"\nparent = \"L_ELBOW_Y_S\"",
+            "frame[0].name",
+            "no link or frame",
+        ),
+        (
+            "name = \"x\"\nparent = \"L_ELBOW_Y_S\"\nxyz = [0.0, nan, 0.0]",
+            "frame[0].xyz",
+            "finite",
+        ),
+    ] {
+        let e = build_error(&jvrc1_with(&format!("[[frame]]\n{frame}\n"), "")).to_string();
+        assert!(e.contains(key) && e.contains(what), "{e}");
+    }
+}
+
+/// A robot without hand links (Unitree H1's arms end at the elbow link): `profile init` adds a
+/// hand frame at the far end of each forearm, from its mesh when the folder is known, else at
+/// twice its centre of mass; the profile builds and names them as the hands.
+#[test]
+fn init_adds_hand_frames_at_the_end_of_bare_forearms() {
+    let dir = std::env::temp_dir().join(format!("iktc-init-hands-{}", std::process::id()));
+    std::fs::create_dir_all(dir.join("meshes")).unwrap();
+    // The forearm mesh: from the elbow to 0.28 m along x, 3 cm thick.
+    std::fs::write(
+        dir.join("meshes/forearm.stl"),
+        box_stl([-0.02, -0.015, -0.015], [0.28, 0.015, 0.015]),
+    )
+    .unwrap();
+    let side = |s: &str, y: f64| {
+        format!(
+            r#"<link name="{s}_ankle_link"><collision><origin xyz="0.05 0 -0.05"/><geometry><box size="0.2 0.08 0.02"/></geometry></collision></link>
+  <joint name="{s}_ankle_joint" type="revolute"><parent link="pelvis"/><child link="{s}_ankle_link"/><axis xyz="0 1 0"/>
+    <origin xyz="0 {y} -0.8"/><limit lower="-1" upper="1" velocity="5" effort="10"/></joint>
+  <link name="{s}_elbow_link"><inertial><origin xyz="0.12 0 0"/><mass value="0.5"/><inertia ixx="0.001" ixy="0" ixz="0" iyy="0.001" iyz="0" izz="0.001"/></inertial>
+    <visual><geometry><mesh filename="meshes/forearm.stl"/></geometry></visual></link>
+  <joint name="{s}_elbow_joint" type="revolute"><parent link="torso_link"/><child link="{s}_elbow_link"/><axis xyz="0 1 0"/>
+    <origin xyz="0 {y} 0.3"/><limit lower="-1" upper="1" velocity="5" effort="10"/></joint>"#
+        )
+    };
+    let urdf = format!(
+        r#"<robot name="h"><link name="pelvis"/><link name="torso_link"/>
+  <joint name="torso_joint" type="revolute"><parent link="pelvis"/><child link="torso_link"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" velocity="5" effort="10"/></joint>{}{}</robot>"#,
+        side("left", 0.2),
+        side("right", -0.2)
+    );
+    std::fs::write(dir.join("h.urdf"), &urdf).unwrap();
+    for (folder, x, why) in [
+        (
+            Some(dir.as_path()),
+            0.28,
+            "farthest vertex of its visual meshes",
+        ),
+        (None, 0.24, "twice its centre of mass"),
+    ] {
+        let toml = init_profile_toml_at(&urdf, "h.urdf", folder).unwrap();
+        assert!(toml.contains(why), "{toml}");
+        let p = RobotProfile::from_toml_str(&toml, "init", ProfileOrigin::Directory(dir.clone()))
+            .unwrap();
+        assert_eq!(p.added_frames.len(), 2, "{toml}");
+        for (f, parent) in p
+            .added_frames
+            .iter()
+            .zip(["left_elbow_link", "right_elbow_link"])
+        {
+            assert_eq!(f.parent, parent);
+            assert!(
+                (f.xyz[0] - x).abs() < 1e-9 && f.xyz[1].abs() <= 0.015,
+                "{:?}",
+                f.xyz
+            );
+        }
+        assert_eq!(p.frames.left_hand.as_deref(), Some("left_hand"));
+        assert_eq!(p.frames.right_hand.as_deref(), Some("right_hand"));
+        let robot = p.robot().unwrap();
+        assert!(robot.frame_id("left_hand").is_ok() && robot.frame_id("right_hand").is_ok());
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -645,6 +645,30 @@ impl Robot {
         self.total_mass
     }
 
+    /// The robot with a frame added: `name`, fixed to the frame `parent` (a link or a frame)
+    /// with the pose `offset` in it (translation \[m\], rotation). For a point a URDF has no
+    /// link at, e.g. the hand at the end of a forearm link. Errors: an unknown parent (the
+    /// error lists the frames), a name a link or frame already has, a non-finite offset.
+    pub fn with_frame(mut self, name: &str, parent: &str, offset: Isometry3<f64>) -> Result<Robot> {
+        let p = self.frame_id(parent)?;
+        finite_iso(&format!("offset of the frame `{name}`"), &offset)?;
+        if self.frames.iter().any(|f| f.name == name) {
+            return Err(Error::InvalidSetting {
+                name: "frame name".into(),
+                value: name.into(),
+                expected: "a name no link or frame of the robot has".into(),
+            });
+        }
+        let parent = &self.frames[p.0];
+        let frame = Frame {
+            name: name.into(),
+            link: parent.link,
+            offset: parent.offset * offset,
+        };
+        self.frames.push(frame);
+        Ok(self)
+    }
+
     /// The frame called `name`; the error lists the valid names.
     pub fn frame_id(&self, name: &str) -> Result<FrameId> {
         self.frames

@@ -4,6 +4,8 @@
 use super::glob::glob_match;
 use super::schema::{Feet, Foot, RobotProfile};
 use crate::error::{Error, Result};
+use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
+
 use crate::model::{JointKind, ModelOptions, Robot};
 use crate::motion::RetargetMap;
 use crate::sim::imitate::SupportSettings;
@@ -71,6 +73,18 @@ impl RobotProfile {
     pub fn check_values(&self) -> Result<()> {
         for (i, l) in self.lock.iter().enumerate() {
             check_number(&format!("lock[{i}].value"), l.value, true, "a finite value")?;
+        }
+        for (i, f) in self.added_frames.iter().enumerate() {
+            for (key, v) in [("xyz", f.xyz), ("rpy", f.rpy)] {
+                for x in v {
+                    check_number(
+                        &format!("frame[{i}].{key}"),
+                        x,
+                        true,
+                        "three finite numbers ([m] for xyz, [rad] for rpy)",
+                    )?;
+                }
+            }
         }
         if let Some(feet) = &self.feet {
             check_foot("left", &feet.left)?;
@@ -196,8 +210,23 @@ impl RobotProfile {
             jerk_per_acceleration: self.jerk.per_acceleration.unwrap_or(f64::INFINITY),
             ..ModelOptions::default()
         };
-        let robot = Robot::from_urdf_str(&text, &options)
+        let mut robot = Robot::from_urdf_str(&text, &options)
             .map_err(|e| profile_error("urdf", &self.urdf, e.to_string()))?;
+        for (i, f) in self.added_frames.iter().enumerate() {
+            let offset = Isometry3::from_parts(
+                Translation3::from(Vector3::from(f.xyz)),
+                UnitQuaternion::from_euler_angles(f.rpy[0], f.rpy[1], f.rpy[2]),
+            );
+            robot = robot.with_frame(&f.name, &f.parent, offset).map_err(|e| {
+                let key = match e {
+                    Error::UnknownName { .. } => "parent",
+                    Error::InvalidSetting { .. } => "name",
+                    _ => "xyz",
+                };
+                let value = if key == "parent" { &f.parent } else { &f.name };
+                profile_error(&format!("frame[{i}].{key}"), value, e.to_string())
+            })?;
+        }
         self.check_robot(&robot)?;
         Ok(robot)
     }

@@ -10,7 +10,9 @@
 //!   [`SOLE_BAND`] of it), else a placeholder;
 //! * pelvis: the first link (from the root) whose name contains `pelvis`, else the root link;
 //! * torso (`torso`, `chest`, `trunk`) and head (`head`, `neck`): the matching link nearest the
-//!   root; hands (`hand`, `palm`, `wrist`): the deepest matching link per side;
+//!   root; hands (`hand`, `palm`, `wrist`): the deepest matching link per side; a side without
+//!   one gets a frame added (key `frame`) at the far end of its deepest `elbow`/`forearm` link
+//!   (the farthest vertex of its meshes from the elbow, else twice its centre of mass);
 //! * base: floating when both feet were found, else fixed;
 //! * locks: movable joints whose names contain `finger`, `thumb`, `index`, `middle`, `ring`,
 //!   `little` or `pinky`, as one glob pattern each.
@@ -172,6 +174,48 @@ fn sole_from_meshes(link: &urdf_rs::Link, dir: &std::path::Path) -> Option<(Sole
         .or_else(|| read(visual).map(|s| (s, "from the link's visual meshes")))
 }
 
+/// Links shorter than this from their origin to their far end \[m\] give no hand point.
+const MIN_FOREARM: f64 = 0.05;
+
+/// The far end of a forearm link without a hand link below it, in its frame \[m\], and where
+/// it came from: the vertex of its visual (else collision) meshes in `dir` farthest from its
+/// origin (the elbow), else twice its centre of mass (the end of a uniform rod from the
+/// elbow). `None` when neither reaches [`MIN_FOREARM`].
+fn hand_point(
+    link: &urdf_rs::Link,
+    dir: Option<&std::path::Path>,
+) -> Option<(Vector3<f64>, &'static str)> {
+    let far = |parts: Vec<(&urdf_rs::Geometry, &urdf_rs::Pose)>| -> Option<Vector3<f64>> {
+        let d = dir?;
+        let mut best: Option<Vector3<f64>> = None;
+        for (g, o) in parts {
+            for v in crate::mesh::urdf::mesh_vertices(g, o, d).ok()?? {
+                if best.is_none_or(|b| v.norm() > b.norm()) {
+                    best = Some(v);
+                }
+            }
+        }
+        best.filter(|b| b.norm() >= MIN_FOREARM)
+    };
+    let visual = link
+        .visual
+        .iter()
+        .map(|v| (&v.geometry, &v.origin))
+        .collect();
+    let collision = link
+        .collision
+        .iter()
+        .map(|c| (&c.geometry, &c.origin))
+        .collect();
+    far(visual)
+        .map(|p| (p, "the farthest vertex of its visual meshes"))
+        .or_else(|| far(collision).map(|p| (p, "the farthest vertex of its collision meshes")))
+        .or_else(|| {
+            let c = 2.0 * Vector3::from(link.inertial.origin.xyz.0);
+            (c.norm() >= MIN_FOREARM).then_some((c, "twice its centre of mass"))
+        })
+}
+
 /// `x` \[m\] rounded to 0.1 mm.
 fn tenth_mm(x: f64) -> f64 {
     (x * 1e4).round() / 1e4
@@ -248,6 +292,19 @@ pub fn init_profile_toml_at(
     let hand_words = ["hand", "palm", "wrist"];
     let left_hand = deepest(&links, &hand_words, Some(Side::Left));
     let right_hand = deepest(&links, &hand_words, Some(Side::Right));
+    // A side without a hand link: a frame added at the far end of its forearm.
+    let forearm_words = ["elbow", "forearm", "lower_arm", "lowerarm"];
+    let hand_end = |side: Side, found: Option<&TreeLink>| {
+        if found.is_some() {
+            return None;
+        }
+        let forearm = deepest(&links, &forearm_words, Some(side))?;
+        let link = u.links.iter().find(|l| l.name == forearm.name)?;
+        let (xyz, why) = hand_point(link, dir)?;
+        Some((forearm.name.clone(), xyz, why))
+    };
+    let left_end = hand_end(Side::Left, left_hand);
+    let right_end = hand_end(Side::Right, right_hand);
 
     let mut out = String::new();
     let name = if u.name.is_empty() { "robot" } else { &u.name };
@@ -315,6 +372,19 @@ pub fn init_profile_toml_at(
              # add [feet.left] and [feet.right] (frame, ankle_height, sole) for a standing robot.\n\n",
         ),
     }
+    for (key, end) in [("left_hand", &left_end), ("right_hand", &right_end)] {
+        if let Some((parent, xyz, why)) = end {
+            out.push_str(&format!(
+                "[[frame]] # guessed: no hand link; the far end of the forearm ({why})\n\
+                 name = {}\nparent = {}\nxyz = [{:?}, {:?}, {:?}]\n\n",
+                quote(key),
+                quote(parent),
+                tenth_mm(xyz.x),
+                tenth_mm(xyz.y),
+                tenth_mm(xyz.z),
+            ));
+        }
+    }
     out.push_str("[frames]\n");
     out.push_str(&format!(
         "pelvis = {} # guessed: {}\n",
@@ -331,12 +401,21 @@ pub fn init_profile_toml_at(
         ("left_hand", left_hand),
         ("right_hand", right_hand),
     ] {
-        match found {
-            Some(l) => out.push_str(&format!(
+        let end = match key {
+            "left_hand" => left_end.as_ref(),
+            "right_hand" => right_end.as_ref(),
+            _ => None,
+        };
+        match (found, end) {
+            (Some(l), _) => out.push_str(&format!(
                 "{key} = {} # guessed: a link named like it\n",
                 quote(&l.name)
             )),
-            None => out.push_str(&format!("# {key} = \"...\" # not found\n")),
+            (None, Some((parent, _, _))) => out.push_str(&format!(
+                "{key} = {} # guessed: the frame added at the end of `{parent}` above\n",
+                quote(key)
+            )),
+            (None, None) => out.push_str(&format!("# {key} = \"...\" # not found\n")),
         }
     }
     out.push_str(

@@ -19,6 +19,11 @@
 //! ankle_height = 0.035
 //! sole = { length = 0.17, width = 0.05, offset_x = 0.035 }
 //!
+//! [[frame]]                                      # frames added to the robot (optional)
+//! name = "left_hand_tip"                         # a point the URDF has no link at
+//! parent = "left_elbow_link"                     # the link or frame it is fixed to
+//! xyz = [0.3, 0.0, 0.0]                          # [m] in the parent; rpy = [...] [rad]
+//!
 //! [frames]                                       # all optional
 //! pelvis = "pelvis"
 //! torso = "torso_link"
@@ -82,7 +87,7 @@ pub use glob::glob_match;
 pub use init::{init_profile_toml, init_profile_toml_at, SOLE_BAND};
 pub use load::{builtin_profile_text, BUILTIN_PROFILES};
 pub use schema::{
-    AccelerationProfile, BodyFrames, Feet, Foot, ImitateProfile, JerkProfile, LockRule,
+    AccelerationProfile, AddedFrame, BodyFrames, Feet, Foot, ImitateProfile, JerkProfile, LockRule,
     ProfileOrigin, PushProfile, RobotProfile, Sole, WalkProfile, DEFAULT_ACCELERATION_PER_VELOCITY,
 };
 pub use walk::DEFAULT_PUSH_VELOCITY_CHANGE;

@@ -24,6 +24,10 @@ pub struct RobotProfile {
     /// The two feet (key `feet`); absent for a robot that does not stand.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub feet: Option<Feet>,
+    /// Frames added to the robot (key `frame`, an array of tables), for points the URDF has
+    /// no link at; the other keys may name them like any link.
+    #[serde(default, rename = "frame", skip_serializing_if = "Vec::is_empty")]
+    pub added_frames: Vec<AddedFrame>,
     /// Named body frames (key `frames`).
     #[serde(default)]
     pub frames: BodyFrames,
@@ -122,7 +126,25 @@ pub struct Foot {
     pub sole: Sole,
 }
 
-/// Named body frames (key `frames`); each a link or frame of the URDF.
+/// A frame added to the robot (key `frame`): fixed to a link or frame of the URDF.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AddedFrame {
+    /// Its name (key `frame[i].name`), one no link or frame has.
+    pub name: String,
+    /// The link or frame it is fixed to (key `frame[i].parent`).
+    pub parent: String,
+    /// Its position in the parent \[m\] (key `frame[i].xyz`; default 0).
+    #[serde(default)]
+    pub xyz: [f64; 3],
+    /// Its orientation in the parent, roll, pitch, yaw as in URDF \[rad\] (key
+    /// `frame[i].rpy`; default 0).
+    #[serde(default)]
+    pub rpy: [f64; 3],
+}
+
+/// Named body frames (key `frames`); each a link or frame of the URDF, or a frame the profile
+/// adds (key `frame`).
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BodyFrames {
