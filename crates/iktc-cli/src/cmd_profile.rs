@@ -1,9 +1,9 @@
 //! `iktc profile`: print a built-in robot profile, or write a starting one for a URDF.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use anyhow::{Context, Result};
-use iktc::profile::{builtin_profile_text, init_profile_toml_at};
+use iktc::profile::{builtin_profile_text, init_profile_toml_at, urdf_key};
 
 /// Arguments of `iktc profile`.
 #[derive(clap::Args, Debug)]
@@ -30,28 +30,6 @@ pub enum ProfileCommand {
         #[arg(long)]
         out: Option<PathBuf>,
     },
-}
-
-/// The URDF's path as the profile at `out` should name it: relative to the profile's directory
-/// when the URDF lies under it, else absolute.
-fn urdf_key(urdf: &Path, out: Option<&Path>) -> Result<String> {
-    let Some(out) = out else {
-        return Ok(urdf.display().to_string());
-    };
-    let dir = out
-        .parent()
-        .filter(|d| !d.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    let abs_urdf = urdf
-        .canonicalize()
-        .with_context(|| format!("reading {}", urdf.display()))?;
-    let abs_dir = dir
-        .canonicalize()
-        .with_context(|| format!("the output directory {}", dir.display()))?;
-    Ok(match abs_urdf.strip_prefix(&abs_dir) {
-        Ok(rel) => rel.display().to_string(),
-        Err(_) => abs_urdf.display().to_string(),
-    })
 }
 
 /// Runs `iktc profile`.

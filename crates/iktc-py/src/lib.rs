@@ -43,6 +43,7 @@ fn _iktc(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<controller::PySolveReport>()?;
     m.add_class::<imitate::PyImitation>()?;
     m.add_class::<walk::PyWalking>()?;
+    m.add_function(wrap_pyfunction!(robot::profile_init, m)?)?;
     motion::register(m)?;
     keypoints::register(m)?;
     balance::register(m)?;

@@ -274,9 +274,28 @@ impl PyRobot {
     pub(crate) fn required_profile(&self, what: &str, parts: &str) -> PyResult<&RobotProfile> {
         self.profile.as_deref().ok_or_else(|| {
             crate::IktcError::new_err(format!(
-                "robot `{}` has no profile: {what} needs its {parts} (load it by a built-in name or a profile file)",
+                "robot `{}` has no profile: {what} needs its {parts} (load it by a built-in name or a profile file; `iktc.profile_init(URDF, out=PROFILE)` writes one with its keys guessed from the URDF)",
                 self.robot.name()
             ))
         })
     }
+}
+
+/// A starting robot profile for the URDF file `urdf` (TOML text, every guess marked
+/// `# guessed`), as `iktc profile init` writes it: feet and soles (from collision shapes or
+/// meshes), pelvis, torso, head and hands (a frame at the end of a bare forearm), finger locks.
+/// With `out` the profile is also written there, its `urdf` key relative to `out`'s folder.
+#[pyfunction]
+#[pyo3(signature = (urdf, *, out=None))]
+pub fn profile_init(urdf: &str, out: Option<&str>) -> PyResult<String> {
+    let path = Path::new(urdf);
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| crate::IktcError::new_err(format!("cannot read {urdf}: {e}")))?;
+    let key = iktc::profile::urdf_key(path, out.map(Path::new)).map_err(to_py)?;
+    let toml = iktc::profile::init_profile_toml_at(&text, &key, path.parent()).map_err(to_py)?;
+    if let Some(o) = out {
+        std::fs::write(o, &toml)
+            .map_err(|e| crate::IktcError::new_err(format!("cannot write {o}: {e}")))?;
+    }
+    Ok(toml)
 }

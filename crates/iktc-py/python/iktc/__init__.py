@@ -43,6 +43,7 @@ from ._iktc import (
     retarget,
     retarget_keypoints,
     KeypointTrajectory,
+    profile_init,
 )
 
 __all__ = [
@@ -68,4 +69,5 @@ __all__ = [
     "retarget",
     "retarget_keypoints",
     "KeypointTrajectory",
+    "profile_init",
 ]

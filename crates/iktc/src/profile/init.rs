@@ -226,6 +226,30 @@ fn quote(s: &str) -> String {
     format!("\"{}\"", s.replace('\\', "\\\\").replace('"', "\\\""))
 }
 
+/// The `urdf` key of a profile written to `profile` for the URDF file `urdf`: its path
+/// relative to the profile's folder when it lies under it, else absolute; `urdf` as given
+/// without a profile file. Errors: a URDF or a folder that does not exist.
+pub fn urdf_key(urdf: &std::path::Path, profile: Option<&std::path::Path>) -> Result<String> {
+    let Some(profile) = profile else {
+        return Ok(urdf.display().to_string());
+    };
+    let dir = profile
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(std::path::Path::new("."));
+    let canonical = |p: &std::path::Path, what: &str| {
+        p.canonicalize().map_err(|e| Error::Urdf {
+            message: format!("{what} {}: {e}", p.display()),
+        })
+    };
+    let abs_urdf = canonical(urdf, "cannot read")?;
+    let abs_dir = canonical(dir, "cannot find the profile's folder")?;
+    Ok(match abs_urdf.strip_prefix(&abs_dir) {
+        Ok(rel) => rel.display().to_string(),
+        Err(_) => abs_urdf.display().to_string(),
+    })
+}
+
 /// Writes a starting profile for the URDF `text`, whose path relative to where the profile
 /// will be written is `urdf_path`. Every guessed value is marked `# guessed`; the result parses
 /// as a [`RobotProfile`](super::RobotProfile) (keys it could not guess are left out or
