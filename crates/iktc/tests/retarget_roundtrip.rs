@@ -273,3 +273,32 @@ fn spline_is_c2_and_interpolates() {
     assert!(CubicSpline::new(&[0.0, 0.0], &[1.0, 2.0]).is_err());
     assert!(CubicSpline::new(&[], &[]).is_err());
 }
+
+/// `values_at` equals `eval(t)[0]` bit for bit at ascending times inside, at and outside the
+/// knots (seeded), and at times that step back.
+#[test]
+fn spline_values_at_ascending_times_equal_eval() {
+    let mut rng = ChaCha8Rng::seed_from_u64(5);
+    let mut t = vec![0.0];
+    for _ in 0..40 {
+        let last = *t.last().unwrap();
+        t.push(last + rng.random_range(0.01..0.2));
+    }
+    let y: Vec<f64> = t.iter().map(|_| rng.random_range(-1.0..1.0)).collect();
+    let s = CubicSpline::new(&t, &y).unwrap();
+    let (a, b) = s.span();
+    let mut times: Vec<f64> = (0..500)
+        .map(|_| rng.random_range(a - 0.3..b + 0.3))
+        .collect();
+    times.extend_from_slice(&t);
+    times.sort_by(f64::total_cmp);
+    // Steps back and a NaN, as `eval` takes them.
+    times.extend_from_slice(&[0.5 * (a + b), a, f64::NAN, b]);
+    let mut out = vec![0.0; times.len()];
+    s.values_at(&times, &mut out).unwrap();
+    for (t, v) in times.iter().zip(&out) {
+        let e = s.eval(*t)[0];
+        assert!(e.to_bits() == v.to_bits(), "t = {t}: {v} against {e}");
+    }
+    assert!(s.values_at(&times, &mut out[1..]).is_err());
+}

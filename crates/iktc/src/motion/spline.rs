@@ -102,6 +102,11 @@ impl CubicSpline {
             return [self.y.last().copied().unwrap_or(0.0), 0.0, 0.0];
         }
         let i = self.t.partition_point(|&x| x <= t).clamp(1, n - 1) - 1;
+        self.eval_in(i, t)
+    }
+
+    /// Value, first and second derivative at `t` in the interval `[t_i, t_{i+1}]`.
+    fn eval_in(&self, i: usize, t: f64) -> [f64; 3] {
         let (t0, t1) = (self.t[i], self.t[i + 1]);
         let (y0, y1) = (self.y[i], self.y[i + 1]);
         let (m0, m1) = (self.m[i], self.m[i + 1]);
@@ -113,5 +118,34 @@ impl CubicSpline {
             (y1 - y0) / h - (3.0 * a * a - 1.0) / 6.0 * h * m0 + (3.0 * b * b - 1.0) / 6.0 * h * m1;
         let ydd = a * m0 + b * m1;
         [y, yd, ydd]
+    }
+
+    /// The values at the ascending times `times` into `out` (same length), equal to
+    /// `eval(t)[0]` at each: the interval is found by walking forward from the last one instead
+    /// of a search per time (the plan samples every spline at every tick). Times that do not
+    /// ascend are searched as by `eval`. Errors: `out` of another length than `times`.
+    pub fn values_at(&self, times: &[f64], out: &mut [f64]) -> Result<()> {
+        check_dim("spline output", times.len(), out.len())?;
+        let n = self.t.len();
+        let (first, last) = self.span();
+        let mut i = 0;
+        let mut previous = f64::NEG_INFINITY;
+        for (o, &t) in out.iter_mut().zip(times) {
+            if n == 1 || !t.is_finite() || t < first || t > last || t < previous {
+                *o = self.eval(t)[0];
+                previous = if t.is_finite() { t } else { f64::NEG_INFINITY };
+                continue;
+            }
+            // The i of `eval`: the last knot at or before t, at most n − 2.
+            while i + 2 < n && self.t[i + 1] <= t {
+                i += 1;
+            }
+            while i > 0 && self.t[i] > t {
+                i -= 1;
+            }
+            *o = self.eval_in(i, t)[0];
+            previous = t;
+        }
+        Ok(())
     }
 }

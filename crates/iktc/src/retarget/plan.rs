@@ -245,6 +245,7 @@ pub(crate) fn plan(
     // Splines through the scaled (low-passed, when asked) and aligned points.
     let sample = |data: &[Vector3<f64>], k: usize, smooth: bool| -> Result<Vec<Vector3<f64>>> {
         let mut out = vec![Vector3::zeros(); ticks];
+        let mut column = vec![0.0; ticks];
         if frames == 1 {
             out.iter_mut().for_each(|o| *o = data[k]);
             return Ok(out);
@@ -254,9 +255,9 @@ pub(crate) fn plan(
             if let (true, Some(fc)) = (smooth, s.smoothing) {
                 y = lowpass_track(&y, &kp.times, fc)?;
             }
-            let spline = CubicSpline::new(&kp.times, &y)?;
-            for (o, t) in out.iter_mut().zip(&times) {
-                o[axis] = spline.eval(*t)[0];
+            CubicSpline::new(&kp.times, &y)?.values_at(&times, &mut column)?;
+            for (o, v) in out.iter_mut().zip(&column) {
+                o[axis] = *v;
             }
         }
         Ok(out)
