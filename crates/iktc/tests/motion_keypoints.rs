@@ -461,3 +461,102 @@ fn the_deepmimic_character_is_recognised_and_stands_about_human_height() {
         assert!(z(BodyPoint::Pelvis) > z(BodyPoint::LeftAnkle) + 0.6);
     }
 }
+
+/// A rig that lies along +X at rest and writes every joint's whole local translation into six
+/// channels (as Bandai Namco's motion dataset does): SMALL with every offset turned by
+/// Rz(−90°) (+Y to +X), position channels repeating the turned offsets, and the root turned back
+/// up by Rz(+90°) in every frame. Its keypoints equal SMALL's with the same motion; the up axis is
+/// decided from the first frame (the rest pose does not stand), the units from its height.
+#[test]
+fn a_rig_lying_at_rest_with_offsets_in_its_channels_reads_as_standing() {
+    use iktc::motion::Measured;
+    let turn = |x: f64, y: f64, z: f64| (y, -x, z);
+    let mut lying = String::new();
+    for line in SMALL.lines() {
+        let t = line.trim_start();
+        let indent = &line[..line.len() - t.len()];
+        if let Some(rest) = t.strip_prefix("OFFSET ") {
+            let v: Vec<f64> = rest
+                .split_whitespace()
+                .map(|x| x.parse().unwrap())
+                .collect();
+            let (x, y, z) = turn(v[0], v[1], v[2]);
+            lying += &format!("{indent}OFFSET {x} {y} {z}\n");
+        } else if t == "CHANNELS 3 Zrotation Xrotation Yrotation" {
+            lying += &format!(
+                "{indent}CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation\n"
+            );
+        } else {
+            lying += line;
+            lying += "\n";
+        }
+    }
+    // The turned offsets of the joints with channels, in file order (End Site offsets follow
+    // their joint's CHANNELS line, so keep only those read before a CHANNELS line).
+    let mut channel_offsets = Vec::new();
+    let mut last = None;
+    for line in lying.lines() {
+        let t = line.trim_start();
+        if let Some(rest) = t.strip_prefix("OFFSET ") {
+            let v: Vec<f64> = rest
+                .split_whitespace()
+                .map(|x| x.parse().unwrap())
+                .collect();
+            last = Some((v[0], v[1], v[2]));
+        } else if t.starts_with("CHANNELS 6 Xposition") {
+            channel_offsets.push(last.take().unwrap());
+        }
+    }
+    let joints = 22;
+    assert_eq!(channel_offsets.len(), joints, "{lying}");
+    // Frames: root at (0|10, 95, 0) cm; frame 1 bends the left forearm 90° about z.
+    let forearm = 7; // the 8th joint
+    let frame = |x: f64, bend: f64, standing: bool| -> Vec<f64> {
+        let mut v = vec![x, 95.0, 0.0, if standing { 0.0 } else { 90.0 }, 0.0, 0.0];
+        for (j, o) in channel_offsets.iter().enumerate().skip(1) {
+            if !standing {
+                v.extend([o.0, o.1, o.2]);
+            }
+            v.extend([if j == forearm { bend } else { 0.0 }, 0.0, 0.0]);
+        }
+        v
+    };
+    let line = |v: Vec<f64>| {
+        v.iter()
+            .map(|x| x.to_string())
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    let standing = format!(
+        "{SMALL}{}\n{}\n",
+        line(frame(0.0, 0.0, true)),
+        line(frame(10.0, 90.0, true))
+    );
+    let lying = format!(
+        "{lying}{}\n{}\n",
+        line(frame(0.0, 0.0, false)),
+        line(frame(10.0, 90.0, false))
+    );
+    let a = from_text(&standing, "standing.bvh", &MotionOptions::default()).unwrap();
+    let b = from_text(&lying, "lying.bvh", &MotionOptions::default()).unwrap();
+    assert_eq!(a.up.measured_on, Measured::RestPose);
+    assert_eq!(b.up.measured_on, Measured::FirstFrame);
+    assert!(b.up.to_string().contains("first frame"), "{}", b.up);
+    let (ka, kb) = (a.keypoints(0.1).unwrap(), b.keypoints(0.1).unwrap());
+    assert_eq!(ka.units.unit, LengthUnit::Centimetres);
+    assert_eq!(kb.units.unit, LengthUnit::Centimetres);
+    assert!((kb.units.standing_height.unwrap() - 177.0).abs() < 1e-9);
+    for f in 0..2 {
+        for p in [
+            BodyPoint::Pelvis,
+            BodyPoint::Head,
+            BodyPoint::LeftWrist,
+            BodyPoint::LeftElbow,
+            BodyPoint::RightAnkle,
+            BodyPoint::LeftToe,
+        ] {
+            let (x, y) = (ka.position(f, p).unwrap(), kb.position(f, p).unwrap());
+            assert!(close(x, y, 1e-9), "frame {f} {p}: {x:?} against {y:?}");
+        }
+    }
+}

@@ -19,7 +19,8 @@ use super::keypoints::{clip_keypoints, marker_keypoints, Keypoints};
 use super::markers::{MarkerSet, DEFAULT_MAX_GAP};
 use super::recognise::{recognise_markers, recognise_skeleton};
 use super::units::{
-    decide_units, decide_up, extent_along, Units, UnitsDecision, UpChoice, UpDecision,
+    decide_units, decide_up, extent_along, stands, Measured, Units, UnitsDecision, UpChoice,
+    UpDecision,
 };
 use super::{BodyPoint, BvhReadOptions, Clip, LengthUnit, Pose, Skeleton, SkeletonJoint, UpAxis};
 use crate::error::{Error, Result};
@@ -393,23 +394,41 @@ fn ankles_to_head(at: impl Fn(BodyPoint) -> Option<Vector3<f64>>) -> Option<Vect
     Some(at(BodyPoint::Head)? - (at(BodyPoint::LeftAnkle)? + at(BodyPoint::RightAnkle)?) / 2.0)
 }
 
-/// The ankles-to-head vector (if the body map gives them) and all rest points.
-type RestMeasure = (Option<Vector3<f64>>, Vec<Vector3<f64>>);
+/// The ankles-to-head vector (if the body map gives them) and all points \[file units\].
+type Points = (Option<Vector3<f64>>, Vec<Vector3<f64>>);
 
-/// Rest measurements for the automatic decisions: the ankles-to-head vector and all rest
-/// points \[file units\].
+/// [`Points`] and the posture they were measured on.
+type RestMeasure = (Option<Vector3<f64>>, Vec<Vector3<f64>>, Measured);
+
+/// Measurements for the automatic decisions: the ankles-to-head vector and all points
+/// \[file units\] of a skeleton's rest pose, or of its first frame when the rest pose does not
+/// stand along +Y or +Z and the first frame does (some rigs lie along +X at rest and are
+/// rotated upright in every frame: Bandai Namco's motion dataset); of a marker file's most
+/// complete frame.
 fn rest_measure(content: &MotionContent, map: Option<&BodyMap>) -> Result<RestMeasure> {
     match content {
         MotionContent::Skeleton(clip) => {
             let skeleton = clip.skeleton();
-            let mut world = vec![Isometry3::identity(); skeleton.len()];
-            skeleton.world_transforms(&skeleton.rest_pose(), &mut world)?;
-            let all: Vec<Vector3<f64>> = world.iter().map(|t| t.translation.vector).collect();
-            let at = |p: BodyPoint| match map.and_then(|m| m.get(p)) {
-                Some(PointSource::Joint(name)) => skeleton.index_of(name).ok().map(|j| all[j]),
-                _ => None,
+            let measure = |pose: &Pose| -> Result<Points> {
+                let mut world = vec![Isometry3::identity(); skeleton.len()];
+                skeleton.world_transforms(pose, &mut world)?;
+                let all: Vec<Vector3<f64>> = world.iter().map(|t| t.translation.vector).collect();
+                let at = |p: BodyPoint| match map.and_then(|m| m.get(p)) {
+                    Some(PointSource::Joint(name)) => skeleton.index_of(name).ok().map(|j| all[j]),
+                    _ => None,
+                };
+                Ok((ankles_to_head(at), all))
             };
-            Ok((ankles_to_head(at), all))
+            let (v, all) = measure(&skeleton.rest_pose())?;
+            if v.as_ref().is_some_and(|v| !stands(v)) {
+                if let Some(first) = clip.frame(0) {
+                    let (f, all_f) = measure(first)?;
+                    if f.as_ref().is_some_and(stands) {
+                        return Ok((f, all_f, Measured::FirstFrame));
+                    }
+                }
+            }
+            Ok((v, all, Measured::RestPose))
         }
         MotionContent::Markers(m) => {
             let f = m.most_complete_frame();
@@ -430,7 +449,7 @@ fn rest_measure(content: &MotionContent, map: Option<&BodyMap>) -> Result<RestMe
                     .collect();
                 (!pts.is_empty()).then(|| pts.iter().sum::<Vector3<f64>>() / pts.len() as f64)
             };
-            Ok((ankles_to_head(at), all))
+            Ok((ankles_to_head(at), all, Measured::MostCompleteFrame))
         }
     }
 }
@@ -449,12 +468,12 @@ pub fn motion_from_content(
             MotionContent::Markers(m) => recognise_markers(&m.names, &source),
         },
     };
-    let (ankles_to_head, rest) = rest_measure(&content, body_map.as_ref().ok())?;
+    let (ankles_to_head, rest, measured_on) = rest_measure(&content, body_map.as_ref().ok())?;
     if options.up == UpChoice::Auto && ankles_to_head.is_none() {
         // The recognition error says what is missing and how to write a map.
         body_map.clone()?;
     }
-    let up = decide_up(options.up, ankles_to_head, &source)?;
+    let up = decide_up(options.up, ankles_to_head, measured_on, &source)?;
     let units = decide_units(options.units, extent_along(&rest, up.up), &source)?;
     Ok(Motion {
         source,

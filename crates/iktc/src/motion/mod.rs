@@ -73,8 +73,8 @@ pub use asf::{read_asf, Asf, AsfBone, AsfDof};
 pub use body_map::{BodyMap, FoundBy, MappedPoint, PointSource};
 pub use body_point::{BodyPoint, Side};
 pub use bvh::{
-    bvh_rotation, read_bvh, write_bvh, write_clip_bvh, BvhChannel, BvhClip, BvhExportOptions,
-    BvhJoint, BvhReadOptions, BvhWriteOptions, LengthUnit, RotationOrder,
+    bvh_rotation, read_bvh, repeats_offsets, write_bvh, write_clip_bvh, BvhChannel, BvhClip,
+    BvhExportOptions, BvhJoint, BvhReadOptions, BvhWriteOptions, LengthUnit, RotationOrder,
 };
 pub use c3d::read_c3d;
 pub use clip::{y_up_to_z_up, Clip, Pose, UpAxis};
@@ -106,6 +106,6 @@ pub use shape::MIN_LIMB_JOINTS;
 pub use skeleton::{JointKind, Skeleton, SkeletonJoint};
 pub use spline::CubicSpline;
 pub use units::{
-    decide_units, decide_up, to_z_up, unit_name, Units, UnitsDecision, UpChoice, UpDecision,
-    CMU_METRES_PER_UNIT, HUMAN_HEIGHT_MAX, HUMAN_HEIGHT_MIN,
+    decide_units, decide_up, stands, to_z_up, unit_name, Measured, Units, UnitsDecision, UpChoice,
+    UpDecision, CMU_METRES_PER_UNIT, HUMAN_HEIGHT_MAX, HUMAN_HEIGHT_MIN,
 };

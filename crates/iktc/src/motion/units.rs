@@ -146,6 +146,21 @@ pub struct UpDecision {
     pub up: UpAxis,
     /// Whether it was decided automatically.
     pub automatic: bool,
+    /// What an automatic decision was measured on: the skeleton's rest pose, else (a rest pose
+    /// that does not stand along +Y or +Z, e.g. a rig lying along +X at rest) its first frame,
+    /// or a marker file's most complete frame.
+    pub measured_on: Measured,
+}
+
+/// The posture the automatic units and up axis were measured on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Measured {
+    /// The skeleton's rest pose (zero rotations and translations).
+    RestPose,
+    /// The clip's first frame (the rest pose does not stand).
+    FirstFrame,
+    /// The marker file's frame with the most markers.
+    MostCompleteFrame,
 }
 
 impl std::fmt::Display for UpDecision {
@@ -154,10 +169,15 @@ impl std::fmt::Display for UpDecision {
             UpAxis::Y => "+Y",
             UpAxis::Z => "+Z",
         };
-        let how = if self.automatic {
-            "decided from the rest pose (ankles to head)"
-        } else {
-            "given"
+        let how = match (self.automatic, self.measured_on) {
+            (false, _) => "given",
+            (true, Measured::RestPose) => "decided from the rest pose (ankles to head)",
+            (true, Measured::FirstFrame) => {
+                "decided from the first frame (ankles to head; the rest pose does not stand)"
+            }
+            (true, Measured::MostCompleteFrame) => {
+                "decided from the most complete frame (ankles to head)"
+            }
         };
         write!(f, "{axis}, {how}")
     }
@@ -213,17 +233,26 @@ pub fn decide_units(
     }
 }
 
+/// Whether the ankles-to-head vector `v` \[file units\] is mostly along +Y or +Z: a subject
+/// standing in a supported up axis.
+pub fn stands(v: &Vector3<f64>) -> bool {
+    let k = v.iamax();
+    k > 0 && v[k] > 0.0
+}
+
 /// Decides the up axis (see the module documentation) from the vector from the ankles to the
-/// head \[file units\] (needed for `Auto` only).
+/// head \[file units\] (needed for `Auto` only) measured on `measured_on`.
 pub fn decide_up(
     up: UpChoice,
     ankles_to_head: Option<Vector3<f64>>,
+    measured_on: Measured,
     source: &str,
 ) -> Result<UpDecision> {
     match up {
         UpChoice::Fixed(up) => Ok(UpDecision {
             up,
             automatic: false,
+            measured_on,
         }),
         UpChoice::Auto => {
             let v = ankles_to_head.ok_or_else(|| Error::InsufficientData {
@@ -231,7 +260,7 @@ pub fn decide_up(
                 message: "no head and ankles were found; give the up axis".to_string(),
             })?;
             let k = v.iamax();
-            let up = match (k, v[k] > 0.0) {
+            let up = match (k, stands(&v)) {
                 (1, true) => UpAxis::Y,
                 (2, true) => UpAxis::Z,
                 _ => {
@@ -250,6 +279,7 @@ pub fn decide_up(
             Ok(UpDecision {
                 up,
                 automatic: true,
+                measured_on,
             })
         }
     }

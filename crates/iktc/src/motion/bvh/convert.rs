@@ -32,6 +32,34 @@ fn bvh_translation(channels: &[BvhChannel], values: &[f64]) -> Vector3<f64> {
         .sum()
 }
 
+/// Whether the non-root position channels of `clip` hold the joints' whole local translations
+/// rather than additions to their offsets: over the non-root joints with position channels and
+/// an offset longer than 1e-9 file units, the median of `|t − OFFSET| / |OFFSET|` at the first
+/// frame is below 1/2 (additions are near 0, so their ratio is near 1; repeated offsets give
+/// near 0). `false` without such joints or frames.
+pub fn repeats_offsets(clip: &BvhClip) -> bool {
+    let Some(values) = clip.frame(0) else {
+        return false;
+    };
+    let mut ratios: Vec<f64> = clip
+        .joints()
+        .iter()
+        .enumerate()
+        .skip(1)
+        .filter(|(_, j)| j.channels.iter().any(|c| !c.is_rotation()) && j.offset.norm() > 1e-9)
+        .filter_map(|(i, j)| {
+            let start = clip.channel_start(i)?;
+            let v = values.get(start..start + j.channels.len())?;
+            Some((bvh_translation(&j.channels, v) - j.offset).norm() / j.offset.norm())
+        })
+        .collect();
+    if ratios.is_empty() {
+        return false;
+    }
+    ratios.sort_by(f64::total_cmp);
+    ratios[ratios.len() / 2] < 0.5
+}
+
 impl BvhClip {
     /// The clip as poses on a skeleton.
     ///
@@ -40,7 +68,13 @@ impl BvhClip {
     /// Local rotations follow [`bvh_rotation`]. Position channels add to the offset (Meredith &
     /// Maddock, "Motion capture file formats explained", 2001): the root is at
     /// `OFFSET + (Xposition, Yposition, Zposition)` in the world, and a non-root joint with position
-    /// channels at `OFFSET + translation` in its parent's frame. Frame `k` is at `k · frame_time`.
+    /// channels at `OFFSET + translation` in its parent's frame. Some exporters write instead
+    /// the whole local translation into every joint's position channels (Bandai Namco's motion
+    /// dataset: six channels per joint, their first frame repeating each `OFFSET`): when the
+    /// first frame's non-root position channels lie within half their offset of it for most
+    /// such joints ([`repeats_offsets`]), a non-root joint is at its channels' translation in
+    /// its parent's frame, not at `OFFSET` plus it (which doubled every bone). Frame `k` is at
+    /// `k · frame_time`.
     pub fn to_clip(&self) -> Result<Clip> {
         let joints: Vec<SkeletonJoint> = self
             .joints()
@@ -71,6 +105,7 @@ impl BvhClip {
             .collect();
         let skeleton = Skeleton::new(joints)?;
         let n = self.joints().len();
+        let absolute = repeats_offsets(self);
         let mut times = Vec::with_capacity(self.frame_count());
         let mut poses = Vec::with_capacity(self.frame_count());
         for f in 0..self.frame_count() {
@@ -94,7 +129,12 @@ impl BvhClip {
                     pose.root_orientation = rotation;
                 } else {
                     pose.rotations[i] = rotation;
-                    pose.translations[i] = translation;
+                    let has_position = j.channels.iter().any(|c| !c.is_rotation());
+                    pose.translations[i] = if absolute && has_position {
+                        translation - j.offset
+                    } else {
+                        translation
+                    };
                 }
             }
             times.push(f as f64 * self.frame_time());

@@ -9,7 +9,7 @@ mod read;
 mod types;
 mod write;
 
-pub use convert::bvh_rotation;
+pub use convert::{bvh_rotation, repeats_offsets};
 pub use read::read_bvh;
 pub use types::{
     BvhChannel, BvhClip, BvhExportOptions, BvhJoint, BvhReadOptions, BvhWriteOptions, LengthUnit,
