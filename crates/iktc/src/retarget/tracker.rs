@@ -30,7 +30,13 @@
 //! A foot is in the first level only once it has landed, and in the second only while it
 //! lands or its floor is engaged: one stack per pair of foot modes ([`FootMode`]: stance,
 //! swing, swing with its floor, landing; 16 stacks) is built once, and each tick is solved by
-//! the stack of its modes. A swing foot that the robot cannot follow (a kick faster than its
+//! the stack of its modes. The floor engages from the foot's own height and speed; a swing
+//! foot rising off the ground does not engage it, and a correction of the level it shares
+//! with the hands could then pull it below the ground within the tick (18 mm on a clip of
+//! Bandai Namco's dataset). So after each solve the lowest sole corner of a swing foot is
+//! predicted at the end of the tick (its second-order expansion, [`super::floor`]); a corner
+//! below the ground has the tick solved again with that foot's floor engaged
+//! ([`KeypointController::dip_ticks`]). A swing foot that the robot cannot follow (a kick faster than its
 //! joint limits allow) then costs the hands' level accuracy, never the stance foot's hold.
 //!
 //! The hold is closed-loop. A foot the clip puts on the ground is first brought to the plan's
@@ -56,7 +62,7 @@ use nalgebra::{DVector, Point3, UnitQuaternion, Vector3};
 
 use super::body::RobotBody;
 use super::drift::StanceDrift;
-use super::floor::{engaged, floor_acceleration, lowest_corner, sole_corners};
+use super::floor::{engaged, floor_acceleration, lowest_after, lowest_corner, sole_corners};
 use super::plan::Plan;
 use super::KeypointSettings;
 use crate::controller::{
@@ -207,11 +213,15 @@ pub struct KeypointController {
     gains: Gains,
     /// Ticks with a swing foot's floor engaged so far.
     floor_ticks: usize,
+    /// Ticks solved again with a swing foot's floor engaged (it would have dipped).
+    dip_ticks: usize,
     robot: Arc<Robot>,
     posture_track: Vec<[Vec<f64>; 3]>,
     posture_ref: [Vec<f64>; 3],
     /// The held feet's compensation of the integration's drift ([`super::drift`]).
     drift: StanceDrift,
+    /// Scratch: a foot frame's Jacobian (6 × nv), for the dip check.
+    dip_jac: nalgebra::DMatrix<f64>,
 }
 
 /// The controllers of one contact state: IKTC, and GF for the ticks where IKTC's answer leaves
@@ -540,13 +550,42 @@ impl KeypointController {
             sole,
             gains: s.gains,
             floor_ticks: 0,
+            dip_ticks: 0,
             robot: robot.clone(),
             stance: [true; 2],
             landing: (s.land_height, s.land_speed),
             posture_track: posture.1,
             posture_ref: [vec![0.0; m], vec![0.0; m], vec![0.0; m]],
             drift: StanceDrift::new(robot.nv()),
+            dip_jac: nalgebra::DMatrix::zeros(6, robot.nv()),
         })
+    }
+
+    /// The floor of swing foot `i` at `pose` moving with `v`, with the bound `a_min`
+    /// \[m/s²\], in `mode` (`Floor` or `Landing`).
+    #[allow(clippy::too_many_arguments)]
+    fn floor_of(
+        &self,
+        i: usize,
+        k: usize,
+        hold: bool,
+        pose: &nalgebra::Isometry3<f64>,
+        v: &nalgebra::Vector6<f64>,
+        a_min: f64,
+        mode: FootMode,
+    ) -> Floor {
+        let r = foot_reference(&self.plan, i, k, hold, self.latch[i]);
+        let (z, z_dot) = (pose.translation.vector.z, v[2]);
+        let a_ref = r.acceleration[2]
+            + self.gains.kv * (r.velocity[2] - z_dot)
+            + self.gains.kp * (r.pose.translation.vector.z - z);
+        let p = pose.translation.vector;
+        Floor {
+            z,
+            z_dot,
+            acceleration: a_ref.max(a_min),
+            stop: (mode == FootMode::Landing).then_some([p.x, p.y]),
+        }
     }
 
     /// Number of ticks of the clip.
@@ -624,18 +663,7 @@ impl KeypointController {
                     (_, false) => FootMode::Swing,
                 };
                 if modes[i] != FootMode::Swing {
-                    let r = foot_reference(&self.plan, i, k, hold, self.latch[i]);
-                    let (z, z_dot) = (pose.translation.vector.z, v[2]);
-                    let a_ref = r.acceleration[2]
-                        + self.gains.kv * (r.velocity[2] - z_dot)
-                        + self.gains.kp * (r.pose.translation.vector.z - z);
-                    let p = pose.translation.vector;
-                    self.floor[i] = Floor {
-                        z,
-                        z_dot,
-                        acceleration: a_ref.max(a_min),
-                        stop: (modes[i] == FootMode::Landing).then_some([p.x, p.y]),
-                    };
+                    self.floor[i] = self.floor_of(i, k, hold, &pose, &v, a_min, modes[i]);
                 }
             }
         }
@@ -670,7 +698,60 @@ impl KeypointController {
             stack.ctl.prepare(&self.state, self.dt)?;
         }
         let iktc = stack.ctl.settings().method == Method::Iktc;
-        let r = stack.ctl.solve()?;
+        stack.ctl.solve()?;
+        if fresh {
+            // A swing foot whose floor is not engaged and which this tick's q̈ would take below
+            // the ground (a correction of the level it shares with the hands can pull it down
+            // at hundreds of m/s²): the tick is solved again with its floor engaged.
+            let mut again = false;
+            for i in 0..2 {
+                if modes[i] != FootMode::Swing {
+                    continue;
+                }
+                let ctl = &self.stacks[self.active & 15].ctl;
+                let (kin, robot) = (ctl.kinematics(), &*self.robot);
+                let pose = kin.frame_pose(robot, self.feet[i])?;
+                let v = kin.frame_velocity(robot, self.feet[i])?;
+                kin.frame_jacobian(robot, self.feet[i], &mut self.dip_jac)?;
+                let mut a = kin.frame_drift(robot, self.feet[i])?;
+                a.gemv(1.0, &self.dip_jac, ctl.qdd(), 1.0);
+                if lowest_after(&pose, &v, &a, &self.corners, self.dt) < 0.0 {
+                    let (e, e_dot) = lowest_corner(&pose, &v, &self.corners);
+                    let a_min = floor_acceleration(e, e_dot, &self.gains);
+                    modes[i] = if on[i] {
+                        FootMode::Landing
+                    } else {
+                        FootMode::Floor
+                    };
+                    self.floor[i] = self.floor_of(i, k, hold, &pose, &v, a_min, modes[i]);
+                    again = true;
+                }
+            }
+            if again {
+                self.dip_ticks += 1;
+                self.active = modes[0].index() + 4 * modes[1].index();
+                let stack = &mut self.stacks[self.active & 15];
+                let (p, l, fl, pt) = (&self.plan, &self.latch, &self.floor, &self.posture_track);
+                set_references(
+                    &mut stack.ctl,
+                    &stack.tasks,
+                    p,
+                    l,
+                    &self.drift,
+                    fl,
+                    pt,
+                    &mut self.posture_ref,
+                    k,
+                    hold,
+                )?;
+                stack.ctl.prepare(&self.state, self.dt)?;
+                stack.ctl.solve()?;
+            }
+        }
+        let stack = &mut self.stacks[self.active & 15];
+        let (p, l, fl, pt) = (&self.plan, &self.latch, &self.floor, &self.posture_track);
+        let dr = &self.drift;
+        let r = stack.ctl.report();
         let held = stance != 0 && r.corrected_from == Some(0);
         let stance_error = r.task_error_norms.first().copied().unwrap_or(0.0);
         let violation = r.violation;
@@ -777,6 +858,13 @@ impl KeypointController {
     /// more exactly ([`KeypointController::tick`]).
     pub fn stance_gf_ticks(&self) -> usize {
         self.stance_gf_ticks
+    }
+
+    /// Ticks so far solved a second time with a swing foot's floor engaged because the first
+    /// q̈ would have taken a sole corner of that foot, its floor not engaged, below the ground
+    /// within the tick ([`super::floor`]).
+    pub fn dip_ticks(&self) -> usize {
+        self.dip_ticks
     }
 
     /// Ticks so far with a swing foot's floor engaged in the `swing_floor` level (landing feet
