@@ -862,7 +862,7 @@ impl KeypointController {
 
     /// Ticks so far solved a second time with a swing foot's floor engaged because the first
     /// q̈ would have taken a sole corner of that foot, its floor not engaged, below the ground
-    /// within the tick ([`super::floor`]).
+    /// within the tick (see the module documentation).
     pub fn dip_ticks(&self) -> usize {
         self.dip_ticks
     }
