@@ -478,9 +478,23 @@ mod tests {
         for (got, want) in [(l, 0.2), (w, 0.08), (off, 0.03), (ankle, 0.05)] {
             assert!((got - want).abs() < 1e-12, "{got} {want}");
         }
-        // A mesh entirely above the frame has no sole below it.
+        // A mesh entirely above the frame has no sole below it, nor one whose lowest vertex is
+        // at the frame's height (an ankle height of 0).
         let above: Vec<_> = v.iter().map(|p| p + Vector3::z()).collect();
         assert!(sole_from_vertices(&above).is_none());
+        let level: Vec<_> = v.iter().map(|p| p + 0.05 * Vector3::z()).collect();
+        assert!(sole_from_vertices(&level).is_none());
         assert!(sole_from_vertices(&[]).is_none());
+        // An underside that is a line (no width) or a point across (no length) is no sole.
+        let line = [
+            Vector3::new(-0.07, 0.0, -0.05),
+            Vector3::new(0.13, 0.0, -0.05),
+        ];
+        assert!(sole_from_vertices(&line).is_none());
+        let across = [
+            Vector3::new(0.0, -0.04, -0.05),
+            Vector3::new(0.0, 0.04, -0.05),
+        ];
+        assert!(sole_from_vertices(&across).is_none());
     }
 }
