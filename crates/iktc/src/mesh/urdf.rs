@@ -81,10 +81,15 @@ enum Format {
 }
 
 impl Format {
-    fn of(ext: &str) -> Option<Format> {
-        match ext {
-            "stl" => Some(Format::Stl),
-            "dae" => Some(Format::Collada),
+    /// The format of the file `path`, by its lower-case extension.
+    fn of(path: &Path) -> Option<Format> {
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        match ext.as_deref() {
+            Some("stl") => Some(Format::Stl),
+            Some("dae") => Some(Format::Collada),
             _ => None,
         }
     }
@@ -143,12 +148,7 @@ pub fn mesh_vertices(
         return Ok(None);
     };
     let path = resolve(filename, dir);
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase)
-        .unwrap_or_default();
-    let format = Format::of(&ext).ok_or_else(|| Error::Parse {
+    let format = Format::of(&path).ok_or_else(|| Error::Parse {
         source_name: path.display().to_string(),
         line: 0,
         message: "this mesh format is not supported (STL or Collada .dae only)".into(),
@@ -194,12 +194,7 @@ pub fn meshes_from_urdf(text: &str, dir: &Path, cell: f64) -> Result<UrdfMeshes>
                 continue;
             };
             let path = resolve(filename, dir);
-            let ext = path
-                .extension()
-                .and_then(|e| e.to_str())
-                .map(str::to_ascii_lowercase)
-                .unwrap_or_default();
-            let Some(format) = Format::of(&ext) else {
+            let Some(format) = Format::of(&path) else {
                 out.warnings.push(format!(
                     "link `{}`: mesh {filename}: this format is not supported (STL or Collada \
                      .dae only); the link is drawn without it",
