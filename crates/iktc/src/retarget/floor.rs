@@ -42,6 +42,28 @@ pub(crate) fn sole_corners(support: &crate::sim::imitate::SupportSettings) -> [V
     })
 }
 
+/// The linear and angular parts of a twist or acceleration (world axes).
+fn parts(x: &Vector6<f64>) -> (Vector3<f64>, Vector3<f64>) {
+    (
+        x.fixed_rows::<3>(0).into_owned(),
+        x.fixed_rows::<3>(3).into_owned(),
+    )
+}
+
+/// Corner `c` (foot frame) of a foot at `pose` whose origin moves at `v` \[m/s\] and which
+/// turns at `w` \[rad/s\]: its arm `r = R c` (world axes) \[m\], height \[m\] and vertical
+/// speed `v_z + (ω × r)_z` \[m/s\].
+fn corner_state(
+    pose: &Isometry3<f64>,
+    v: &Vector3<f64>,
+    w: &Vector3<f64>,
+    c: &Vector3<f64>,
+) -> (Vector3<f64>, f64, f64) {
+    let r = pose.rotation * c;
+    let z = (pose * Point3::from(*c)).z;
+    (r, z, v.z + w.cross(&r).z)
+}
+
 /// The lowest corner's height \[m\] and vertical speed \[m/s\] of a foot at `pose` moving with
 /// the twist `velocity` (linear velocity of the frame's origin \[m/s\], angular velocity
 /// \[rad/s\], world axes).
@@ -50,16 +72,12 @@ pub(crate) fn lowest_corner(
     velocity: &Vector6<f64>,
     corners: &[Vector3<f64>; 4],
 ) -> (f64, f64) {
-    let (v, w) = (
-        velocity.fixed_rows::<3>(0).into_owned(),
-        velocity.fixed_rows::<3>(3).into_owned(),
-    );
+    let (v, w) = parts(velocity);
     let mut best = (f64::INFINITY, 0.0);
     for c in corners {
-        let r = pose.rotation * c;
-        let z = (pose * Point3::from(*c)).z;
+        let (_, z, z_dot) = corner_state(pose, &v, &w, c);
         if z < best.0 {
-            best = (z, v.z + w.cross(&r).z);
+            best = (z, z_dot);
         }
     }
     best
@@ -89,20 +107,11 @@ pub(crate) fn lowest_after(
     corners: &[Vector3<f64>; 4],
     dt: f64,
 ) -> f64 {
-    let (v, w) = (
-        velocity.fixed_rows::<3>(0).into_owned(),
-        velocity.fixed_rows::<3>(3).into_owned(),
-    );
-    let (a, al) = (
-        acceleration.fixed_rows::<3>(0).into_owned(),
-        acceleration.fixed_rows::<3>(3).into_owned(),
-    );
+    let ((v, w), (a, al)) = (parts(velocity), parts(acceleration));
     corners
         .iter()
         .map(|c| {
-            let r = pose.rotation * c;
-            let z = (pose * Point3::from(*c)).z;
-            let z_dot = v.z + w.cross(&r).z;
+            let (r, z, z_dot) = corner_state(pose, &v, &w, c);
             let z_ddot = a.z + (al.cross(&r) + w.cross(&w.cross(&r))).z;
             z + z_dot * dt + 0.5 * z_ddot * dt * dt
         })
