@@ -73,72 +73,17 @@ fn deepest<'a>(links: &'a [TreeLink], words: &[&str], side: Option<Side>) -> Opt
 /// A guessed sole: `(length, width, offset_x, ankle_height)` \[m\].
 type Sole = (f64, f64, f64, f64);
 
-/// A guessed sole ([`Sole`]) from the collision boxes and
-/// spheres of `link` (their footprints in the link frame, ignoring their rotation about z).
-fn sole_from_collisions(link: &urdf_rs::Link) -> Option<Sole> {
-    let (mut xmin, mut xmax, mut ymin, mut ymax, mut zmin) = (
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-        f64::INFINITY,
-    );
-    for c in &link.collision {
-        let o = Isometry3::from_parts(
-            Translation3::new(c.origin.xyz[0], c.origin.xyz[1], c.origin.xyz[2]),
-            UnitQuaternion::from_euler_angles(c.origin.rpy[0], c.origin.rpy[1], c.origin.rpy[2]),
-        );
-        let corners: Vec<Vector3<f64>> = match &c.geometry {
-            urdf_rs::Geometry::Sphere { radius } => {
-                let p = o.translation.vector;
-                // The footprint is the contact point; the sphere reaches `radius` lower.
-                vec![p - Vector3::z() * *radius]
-            }
-            urdf_rs::Geometry::Box { size } => {
-                let h = Vector3::new(size[0], size[1], size[2]) * 0.5;
-                let mut v = Vec::new();
-                for sx in [-1.0, 1.0] {
-                    for sy in [-1.0, 1.0] {
-                        for sz in [-1.0, 1.0] {
-                            v.push(
-                                o * nalgebra::Point3::from(
-                                    h.component_mul(&Vector3::new(sx, sy, sz)),
-                                ),
-                            );
-                        }
-                    }
-                }
-                v.into_iter().map(|p| p.coords).collect()
-            }
-            _ => continue,
-        };
-        for p in corners {
-            xmin = xmin.min(p.x);
-            xmax = xmax.max(p.x);
-            ymin = ymin.min(p.y);
-            ymax = ymax.max(p.y);
-            zmin = zmin.min(p.z);
-        }
-    }
-    let (l, w) = (xmax - xmin, ymax - ymin);
-    (l > 0.0 && w > 0.0 && zmin < 0.0).then(|| (l, w, 0.5 * (xmin + xmax), -zmin))
-}
-
-/// Vertices of a foot mesh up to this height above its lowest one make its sole \[m\]: the
-/// flat underside of a foot, not the toe's upward curve or the ankle's housing above it.
-pub const SOLE_BAND: f64 = 0.01;
-
-/// A guessed sole: `(length, width, offset_x, ankle_height)` \[m\] from the mesh vertices
-/// `v` of a foot link, in its frame (see the module documentation).
-fn sole_from_vertices(v: &[Vector3<f64>]) -> Option<Sole> {
-    let zmin = v.iter().map(|p| p.z).fold(f64::INFINITY, f64::min);
+/// The sole over the footprint points `footprint` (link frame) \[m\]: their bounding rectangle
+/// in x and y, the ankle height `−zmin` from the lowest point `zmin` \[m\] below the link's
+/// origin. `None` for a rectangle without length or width, or `zmin ≥ 0`.
+fn rectangle<'a>(footprint: impl Iterator<Item = &'a Vector3<f64>>, zmin: f64) -> Option<Sole> {
     let (mut xmin, mut xmax, mut ymin, mut ymax) = (
         f64::INFINITY,
         f64::NEG_INFINITY,
         f64::INFINITY,
         f64::NEG_INFINITY,
     );
-    for p in v.iter().filter(|p| p.z <= zmin + SOLE_BAND) {
+    for p in footprint {
         xmin = xmin.min(p.x);
         xmax = xmax.max(p.x);
         ymin = ymin.min(p.y);
@@ -148,30 +93,87 @@ fn sole_from_vertices(v: &[Vector3<f64>]) -> Option<Sole> {
     (l > 0.0 && w > 0.0 && zmin < 0.0).then(|| (l, w, 0.5 * (xmin + xmax), -zmin))
 }
 
+/// The lowest height of `points` \[m\] (`+∞` for none).
+fn lowest(points: &[Vector3<f64>]) -> f64 {
+    points.iter().map(|p| p.z).fold(f64::INFINITY, f64::min)
+}
+
+/// A guessed sole ([`Sole`]) from the collision boxes and spheres of `link` (their footprints
+/// in the link frame, ignoring their rotation about z).
+fn sole_from_collisions(link: &urdf_rs::Link) -> Option<Sole> {
+    let mut points = Vec::new();
+    for c in &link.collision {
+        let o = Isometry3::from_parts(
+            Translation3::new(c.origin.xyz[0], c.origin.xyz[1], c.origin.xyz[2]),
+            UnitQuaternion::from_euler_angles(c.origin.rpy[0], c.origin.rpy[1], c.origin.rpy[2]),
+        );
+        match &c.geometry {
+            urdf_rs::Geometry::Sphere { radius } => {
+                // The footprint is the contact point; the sphere reaches `radius` lower.
+                points.push(o.translation.vector - Vector3::z() * *radius);
+            }
+            urdf_rs::Geometry::Box { size } => {
+                let h = Vector3::new(size[0], size[1], size[2]) * 0.5;
+                for sx in [-1.0, 1.0] {
+                    for sy in [-1.0, 1.0] {
+                        for sz in [-1.0, 1.0] {
+                            let corner = h.component_mul(&Vector3::new(sx, sy, sz));
+                            points.push((o * nalgebra::Point3::from(corner)).coords);
+                        }
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    rectangle(points.iter(), lowest(&points))
+}
+
+/// Vertices of a foot mesh up to this height above its lowest one make its sole \[m\]: the
+/// flat underside of a foot, not the toe's upward curve or the ankle's housing above it.
+pub const SOLE_BAND: f64 = 0.01;
+
+/// A guessed sole ([`Sole`]) from the mesh vertices `v` of a foot link, in its frame (see the
+/// module documentation).
+fn sole_from_vertices(v: &[Vector3<f64>]) -> Option<Sole> {
+    let zmin = lowest(v);
+    rectangle(v.iter().filter(|p| p.z <= zmin + SOLE_BAND), zmin)
+}
+
+/// The vertices \[m\] of every collision (`collision`) or visual mesh of `link`, in its frame,
+/// read from the URDF's folder `dir`; `None` when one of those shapes is not a mesh or cannot
+/// be read.
+fn link_vertices(
+    link: &urdf_rs::Link,
+    collision: bool,
+    dir: &std::path::Path,
+) -> Option<Vec<Vector3<f64>>> {
+    let parts: Vec<(&urdf_rs::Geometry, &urdf_rs::Pose)> = if collision {
+        link.collision
+            .iter()
+            .map(|c| (&c.geometry, &c.origin))
+            .collect()
+    } else {
+        link.visual
+            .iter()
+            .map(|v| (&v.geometry, &v.origin))
+            .collect()
+    };
+    let mut all = Vec::new();
+    for (g, o) in parts {
+        all.extend(crate::mesh::urdf::mesh_vertices(g, o, dir).ok()??);
+    }
+    Some(all)
+}
+
 /// The sole of `link` from its collision meshes, else its visual meshes, read from the URDF's
 /// folder `dir`, with which of the two it came from. `None` when neither gives one (no mesh,
 /// a mesh that cannot be read, or one that does not reach below the link's origin).
 fn sole_from_meshes(link: &urdf_rs::Link, dir: &std::path::Path) -> Option<(Sole, &'static str)> {
-    let read = |parts: Vec<(&urdf_rs::Geometry, &urdf_rs::Pose)>| -> Option<Sole> {
-        let mut all = Vec::new();
-        for (g, o) in parts {
-            all.extend(crate::mesh::urdf::mesh_vertices(g, o, dir).ok()??);
-        }
-        sole_from_vertices(&all)
-    };
-    let collision = link
-        .collision
-        .iter()
-        .map(|c| (&c.geometry, &c.origin))
-        .collect();
-    let visual = link
-        .visual
-        .iter()
-        .map(|v| (&v.geometry, &v.origin))
-        .collect();
-    read(collision)
+    let sole = |collision| sole_from_vertices(&link_vertices(link, collision, dir)?);
+    sole(true)
         .map(|s| (s, "from the link's collision meshes"))
-        .or_else(|| read(visual).map(|s| (s, "from the link's visual meshes")))
+        .or_else(|| sole(false).map(|s| (s, "from the link's visual meshes")))
 }
 
 /// Links shorter than this from their origin to their far end \[m\] give no hand point.
@@ -185,31 +187,18 @@ fn hand_point(
     link: &urdf_rs::Link,
     dir: Option<&std::path::Path>,
 ) -> Option<(Vector3<f64>, &'static str)> {
-    let far = |parts: Vec<(&urdf_rs::Geometry, &urdf_rs::Pose)>| -> Option<Vector3<f64>> {
-        let d = dir?;
+    let far = |collision| -> Option<Vector3<f64>> {
         let mut best: Option<Vector3<f64>> = None;
-        for (g, o) in parts {
-            for v in crate::mesh::urdf::mesh_vertices(g, o, d).ok()?? {
-                if best.is_none_or(|b| v.norm() > b.norm()) {
-                    best = Some(v);
-                }
+        for v in link_vertices(link, collision, dir?)? {
+            if best.is_none_or(|b| v.norm() > b.norm()) {
+                best = Some(v);
             }
         }
         best.filter(|b| b.norm() >= MIN_FOREARM)
     };
-    let visual = link
-        .visual
-        .iter()
-        .map(|v| (&v.geometry, &v.origin))
-        .collect();
-    let collision = link
-        .collision
-        .iter()
-        .map(|c| (&c.geometry, &c.origin))
-        .collect();
-    far(visual)
+    far(false)
         .map(|p| (p, "the farthest vertex of its visual meshes"))
-        .or_else(|| far(collision).map(|p| (p, "the farthest vertex of its collision meshes")))
+        .or_else(|| far(true).map(|p| (p, "the farthest vertex of its collision meshes")))
         .or_else(|| {
             let c = 2.0 * Vector3::from(link.inertial.origin.xyz.0);
             (c.norm() >= MIN_FOREARM).then_some((c, "twice its centre of mass"))
