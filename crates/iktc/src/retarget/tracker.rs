@@ -561,6 +561,28 @@ impl KeypointController {
         })
     }
 
+    /// Sets the references of tick `k` on the active stack's IKTC controller, or with
+    /// `fallback` on its GF one ([`set_references`]).
+    fn refer(&mut self, fallback: bool, k: usize, hold: bool) -> Result<()> {
+        let Stack {
+            ctl,
+            fallback: gf,
+            tasks,
+        } = &mut self.stacks[self.active & 15];
+        set_references(
+            if fallback { gf } else { ctl },
+            tasks,
+            &self.plan,
+            &self.latch,
+            &self.drift,
+            &self.floor,
+            &self.posture_track,
+            &mut self.posture_ref,
+            k,
+            hold,
+        )
+    }
+
     /// The floor of swing foot `i` at `pose` moving with `v`, with the bound `a_min`
     /// \[m/s²\], in `mode` (`Floor` or `Landing`).
     #[allow(clippy::too_many_arguments)]
@@ -672,22 +694,9 @@ impl KeypointController {
         }
         let stance = usize::from(self.stance[0]) + 2 * usize::from(self.stance[1]);
         self.active = modes[0].index() + 4 * modes[1].index();
+        self.refer(false, k, hold)?;
         let stack = &mut self.stacks[self.active & 15];
         let tolerance = stack.ctl.settings().solver.box_tolerance;
-        let (p, l, fl, pt) = (&self.plan, &self.latch, &self.floor, &self.posture_track);
-        let dr = &self.drift;
-        set_references(
-            &mut stack.ctl,
-            &stack.tasks,
-            p,
-            l,
-            dr,
-            fl,
-            pt,
-            &mut self.posture_ref,
-            k,
-            hold,
-        )?;
         if fresh {
             // The kinematics of the state, computed above for the feet: swapped in, not
             // computed again (the fallback below computes its own).
@@ -730,27 +739,13 @@ impl KeypointController {
             if again {
                 self.dip_ticks += 1;
                 self.active = modes[0].index() + 4 * modes[1].index();
-                let stack = &mut self.stacks[self.active & 15];
-                let (p, l, fl, pt) = (&self.plan, &self.latch, &self.floor, &self.posture_track);
-                set_references(
-                    &mut stack.ctl,
-                    &stack.tasks,
-                    p,
-                    l,
-                    &self.drift,
-                    fl,
-                    pt,
-                    &mut self.posture_ref,
-                    k,
-                    hold,
-                )?;
-                stack.ctl.prepare(&self.state, self.dt)?;
-                stack.ctl.solve()?;
+                self.refer(false, k, hold)?;
+                let ctl = &mut self.stacks[self.active & 15].ctl;
+                ctl.prepare(&self.state, self.dt)?;
+                ctl.solve()?;
             }
         }
-        let stack = &mut self.stacks[self.active & 15];
-        let (p, l, fl, pt) = (&self.plan, &self.latch, &self.floor, &self.posture_track);
-        let dr = &self.drift;
+        let stack = &self.stacks[self.active & 15];
         let r = stack.ctl.report();
         let held = stance != 0 && r.corrected_from == Some(0);
         let stance_error = r.task_error_norms.first().copied().unwrap_or(0.0);
@@ -765,21 +760,11 @@ impl KeypointController {
             self.sacrificed.count(level);
         }
         if (violation <= tolerance && !held) || !iktc {
-            return Ok(stack.ctl.report());
+            return Ok(self.stacks[self.active & 15].ctl.report());
         }
+        self.refer(true, k, hold)?;
+        let stack = &mut self.stacks[self.active & 15];
         let f = &mut stack.fallback;
-        set_references(
-            f,
-            &stack.tasks,
-            p,
-            l,
-            dr,
-            fl,
-            pt,
-            &mut self.posture_ref,
-            k,
-            hold,
-        )?;
         f.prepare(&self.state, self.dt)?;
         let g = f.solve()?;
         let gf_error = g.task_error_norms.first().copied().unwrap_or(0.0);
