@@ -147,7 +147,15 @@ pub fn run(a: &Args) -> Result<()> {
             crate::cmd_keypoints::RetargetArg::Joints => RetargetMethod::Joints,
         },
     };
-    let (clips, mut statuses) = discover(&a.inputs);
+    let (clips, mut statuses, outputs) = discover(&a.inputs, Some(&a.out));
+    if !outputs.is_empty() {
+        let names: Vec<String> = outputs.iter().map(|p| p.display().to_string()).collect();
+        eprintln!(
+            "not searched: {} folder(s) of iktc output ({})",
+            outputs.len(),
+            names.join(", ")
+        );
+    }
     std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
     remove_temporaries(&a.out)?;
     let hash = batch.settings_hash();
@@ -366,15 +374,39 @@ fn is_motion_file(p: &Path) -> bool {
         .is_some_and(|e| MOTION_EXTENSIONS.contains(&e.to_ascii_lowercase().as_str()))
 }
 
-/// Every file under `dir`, sorted, recursively.
-fn walk(dir: &Path, out: &mut Vec<PathBuf>) -> std::io::Result<()> {
+/// Whether `dir` holds what `iktc retarget` writes: the batch's `--out` folder (`out`), or a
+/// folder of an earlier batch (its `batch.json`) or of one of its clips (its settings marker).
+/// Its files (`quality.json`, trajectories) are not motion to retarget, wherever the output
+/// went, so a batch whose `--out` lies inside its input folder can run again.
+fn is_output_folder(dir: &Path, out: Option<&Path>) -> bool {
+    let same = |a: &Path, b: &Path| match (a.canonicalize(), b.canonicalize()) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    };
+    out.is_some_and(|o| same(dir, o))
+        || dir.join("batch.json").is_file()
+        || dir.join(SETTINGS_FILE).is_file()
+}
+
+/// Every file under `dir`, sorted, recursively, leaving out the folders of iktc's output
+/// ([`is_output_folder`]), which are counted in `skipped`.
+fn walk(
+    dir: &Path,
+    out_dir: Option<&Path>,
+    out: &mut Vec<PathBuf>,
+    skipped: &mut Vec<PathBuf>,
+) -> std::io::Result<()> {
     let mut entries: Vec<PathBuf> = std::fs::read_dir(dir)?
         .map(|e| e.map(|e| e.path()))
         .collect::<std::io::Result<_>>()?;
     entries.sort();
     for p in entries {
         if p.is_dir() {
-            walk(&p, out)?;
+            if is_output_folder(&p, out_dir) {
+                skipped.push(p);
+            } else {
+                walk(&p, out_dir, out, skipped)?;
+            }
         } else {
             out.push(p);
         }
@@ -392,8 +424,14 @@ fn clip_name(path: &Path, base: &Path) -> String {
 }
 
 /// The clips the inputs name, and an error entry for every input that names none (or a clip
-/// whose output name another input already took).
-pub fn discover(inputs: &[String]) -> (Vec<ClipInput>, Vec<ClipStatus>) {
+/// whose output name another input already took). Folders and globs are searched without the
+/// folders of iktc's output (`out`, the batch's `--out`, and those of earlier batches), which
+/// are listed in the third value.
+pub fn discover(
+    inputs: &[String],
+    out: Option<&Path>,
+) -> (Vec<ClipInput>, Vec<ClipStatus>, Vec<PathBuf>) {
+    let mut outputs = Vec::new();
     let mut clips: Vec<ClipInput> = Vec::new();
     let mut errors = Vec::new();
     let mut bad = |input: &str, error: String| {
@@ -416,7 +454,7 @@ pub fn discover(inputs: &[String]) -> (Vec<ClipInput>, Vec<ClipStatus>) {
             }]
         } else if p.is_dir() {
             let mut files = Vec::new();
-            if let Err(e) = walk(p, &mut files) {
+            if let Err(e) = walk(p, out, &mut files, &mut outputs) {
                 bad(input, format!("reading folder: {e}"));
                 continue;
             }
@@ -440,7 +478,7 @@ pub fn discover(inputs: &[String]) -> (Vec<ClipInput>, Vec<ClipStatus>) {
                 base.clone()
             };
             let mut files = Vec::new();
-            if let Err(e) = walk(&root, &mut files) {
+            if let Err(e) = walk(&root, out, &mut files, &mut outputs) {
                 bad(input, format!("reading folder {}: {e}", root.display()));
                 continue;
             }
@@ -486,7 +524,7 @@ pub fn discover(inputs: &[String]) -> (Vec<ClipInput>, Vec<ClipStatus>) {
             clips.push(c);
         }
     }
-    (clips, errors)
+    (clips, errors, outputs)
 }
 
 /// Progress on standard error: a bar redrawn in place with the ETA on a terminal, a log line

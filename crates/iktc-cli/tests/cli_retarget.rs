@@ -741,3 +741,35 @@ fn reach_option_reports_the_static_reach() {
         String::from_utf8_lossy(&o.stderr).contains("--reach applies to --retarget keypoints only")
     );
 }
+
+/// A batch whose `--out` lies inside its input folder, beside the output of an earlier batch
+/// there: neither output folder is searched for motion (their `quality.json` files are not
+/// clips), not even an `--out` that an interrupted run left without `batch.json` and without
+/// a clip's settings marker, so the same command runs again, skips the clip as up to date and
+/// succeeds.
+#[test]
+fn output_folders_inside_the_input_folder_are_not_searched() {
+    let dir = tmp("inside");
+    let input = dir.join("in");
+    std::fs::create_dir_all(&input).unwrap();
+    std::fs::copy(
+        data().join("humanoid3d_walk.txt"),
+        input.join("humanoid3d_walk.txt"),
+    )
+    .unwrap();
+    let (out, earlier) = (input.join("out"), input.join("earlier"));
+    let o = retarget_on_g1(&input, &earlier, &[]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    std::fs::create_dir_all(out.join("humanoid3d_walk")).unwrap();
+    std::fs::write(out.join("humanoid3d_walk/quality.json"), "{}").unwrap();
+    for (pass, folders) in [("retargeted", 2), ("skipped", 2)] {
+        let o = retarget_on_g1(&input, &out, &[]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(o.status.success(), "{err}");
+        let s = statuses(&out);
+        assert_eq!(s.len(), 1, "{s:?}");
+        assert_eq!(s["humanoid3d_walk"], pass);
+        let note = format!("not searched: {folders} folder(s) of iktc output");
+        assert!(err.contains(&note), "{err}");
+    }
+}
