@@ -286,6 +286,11 @@ fn print(run: &KeypointRun, joints: Option<&RetargetQuality>) -> std::io::Result
         joints.map(|j| format!("{:.2} mm", j.below_ground_mm)),
     )?;
     row(
+        "foot floating (max, share > 1 cm)",
+        format!("{:.1} mm, {:.1} %", k.float_mm, 100.0 * k.float_share),
+        joints.map(|j| format!("{:.1} mm, {:.1} %", j.float_mm, 100.0 * j.float_share)),
+    )?;
+    row(
         "jerk RMS / max",
         format!("{:.0} / {:.0}", k.jerk_rms, k.jerk_max),
         joints.map(|j| format!("{:.0} / {:.0}", j.jerk_rms, j.jerk_max)),

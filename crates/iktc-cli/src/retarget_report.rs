@@ -11,7 +11,7 @@ use crate::cmd_retarget::ClipStatus;
 /// The figures shown: key in `quality.json`'s `figures`, column label with its unit. A column
 /// appears when some clip has its figure (the keypoint and joint routes measure different
 /// things).
-const COLUMNS: [(&str, &str); 24] = [
+const COLUMNS: [(&str, &str); 26] = [
     ("duration", "duration [s]"),
     ("mean_keypoint_error", "mean keypoint error [m]"),
     (
@@ -32,6 +32,14 @@ const COLUMNS: [(&str, &str); 24] = [
     ("rms_error_pelvis_height", "pelvis height RMS error [m]"),
     ("rms_error_com", "COM RMS error [m]"),
     ("foot_slip", "foot slip [m]"),
+    (
+        "foot_float",
+        "highest a foot floats while the clip has it on the ground [m]",
+    ),
+    (
+        "foot_float_share",
+        "share of the clip's foot-contact ticks with the foot more than 1 cm up [–]",
+    ),
     ("penetration", "sole penetration [m]"),
     (
         "penetration_share",

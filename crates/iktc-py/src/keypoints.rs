@@ -188,7 +188,7 @@ impl PyKeypointTrajectory {
     /// The run's quality figures (`iktc::retarget::RetargetQuality`), as `iktc imitate` writes
     /// them in `keypoints_summary.json`: `mean_cm`, `points` (per body point `{"point",
     /// "mean_cm", "max_cm"}`), `orientations` (`{"frame", "mean_deg", "max_deg"}`), `slip_mm`,
-    /// `below_ground_mm`, `stance_ticks`, `jerk_rms` and `jerk_max` [rad/s³], the worst
+    /// `below_ground_mm`, `float_mm` (highest a foot the clip has on the ground floats) and `float_share` (share of those foot-ticks above 1 cm), `stance_ticks`, `jerk_rms` and `jerk_max` [rad/s³], the worst
     /// `position_margin` [rad], `velocity_margin` [rad/s] and `acceleration_margin` [rad/s²]
     /// (positive: a limit exceeded), and `reach_cm` and `reach_run_cm` (None unless asked for
     /// with `reach=True`).
@@ -225,6 +225,8 @@ impl PyKeypointTrajectory {
         d.set_item("orientations", orientations)?;
         d.set_item("slip_mm", q.slip_mm)?;
         d.set_item("below_ground_mm", q.below_ground_mm)?;
+        d.set_item("float_mm", q.float_mm)?;
+        d.set_item("float_share", q.float_share)?;
         d.set_item("stance_ticks", q.stance_ticks)?;
         d.set_item("jerk_rms", q.jerk_rms)?;
         d.set_item("jerk_max", q.jerk_max)?;

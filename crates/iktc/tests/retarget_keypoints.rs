@@ -70,8 +70,8 @@ fn format_key(m: &Motion) -> &'static str {
 
 fn print(q: &RetargetQuality) {
     eprintln!(
-        "  {:9} mean {:5.2} cm | slip {:6.2} mm | below {:5.2} mm | jerk rms {:8.1} max {:9.1} rad/s³ | margins pos {:+.2e} vel {:+.2e} acc {:+.2e}",
-        q.route, q.mean_cm, q.slip_mm, q.below_ground_mm, q.jerk_rms, q.jerk_max,
+        "  {:9} mean {:5.2} cm | slip {:6.2} mm | below {:5.2} mm | float {:6.1} mm {:4.1} % | jerk rms {:8.1} max {:9.1} rad/s³ | margins pos {:+.2e} vel {:+.2e} acc {:+.2e}",
+        q.route, q.mean_cm, q.slip_mm, q.below_ground_mm, q.float_mm, 100.0 * q.float_share, q.jerk_rms, q.jerk_max,
         q.position_margin, q.velocity_margin, q.acceleration_margin
     );
     if let (Some(reach), Some(run)) = (q.reach_cm, q.reach_run_cm) {
@@ -407,4 +407,78 @@ fn jvrc1_names_the_level_it_cannot_follow_on_dance_a() {
         "{}",
         settle.describe()
     );
+}
+
+/// The floating figures (`float_mm`, `float_share`) recomputed from the run's own trajectory
+/// and contacts by the forward kinematics of each recorded configuration: on every tick the
+/// clip has a foot on the ground, that foot's lowest sole corner (the profile's sole
+/// rectangle and ankle height); the largest height and the share above
+/// [`iktc::retarget::FLOAT_HEIGHT`]. CMU 131_01 on G1 has feet the robot does not bring down
+/// (both figures non-zero), DeepMimic `humanoid3d_dance_b` none (both zero).
+#[test]
+fn floating_feet_are_the_contact_ticks_lowest_corners() {
+    use iktc::model::{Kinematics, State};
+    use nalgebra::Point3;
+    let profile = RobotProfile::builtin("g1").unwrap();
+    let robot = profile.robot().unwrap();
+    let feet = profile.feet.as_ref().unwrap();
+    let feet = [&feet.left, &feet.right];
+    let ids: Vec<_> = feet
+        .iter()
+        .map(|f| robot.frame_id(&f.frame).unwrap())
+        .collect();
+    // Recomputed and recorded figures agree to the rounding of two kinematics passes [m].
+    const ROUNDING: f64 = 1e-9;
+    for clip in [
+        "tests/data/motions/cmu/131_01.bvh",
+        "data/motions/deepmimic/humanoid3d_dance_b.txt",
+    ] {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(clip);
+        let kp = load_motion(&path, &MotionOptions::default())
+            .unwrap()
+            .keypoints(DEFAULT_MAX_GAP)
+            .unwrap();
+        let run = retarget_keypoints(&profile, &kp, None, &KeypointSettings::default()).unwrap();
+        let mut state = State::neutral(&robot);
+        let (mut high, mut n, mut up) = (0.0_f64, 0usize, 0usize);
+        for (k, q) in run.trajectory.iter().enumerate() {
+            state.q.copy_from_slice(q);
+            let kin = Kinematics::new(&robot, &state).unwrap();
+            for (i, foot) in feet.iter().enumerate() {
+                if !run.contacts[i][k] {
+                    continue;
+                }
+                let pose = kin.frame_pose(&robot, ids[i]).unwrap();
+                let s = &foot.sole;
+                let lowest = [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)]
+                    .iter()
+                    .map(|(dx, dy)| {
+                        (pose
+                            * Point3::new(
+                                s.offset_x + dx * s.length / 2.0,
+                                dy * s.width / 2.0,
+                                -foot.ankle_height,
+                            ))
+                        .z
+                    })
+                    .fold(f64::INFINITY, f64::min);
+                high = high.max(lowest);
+                n += 1;
+                up += usize::from(lowest > iktc::retarget::FLOAT_HEIGHT);
+            }
+        }
+        let q = &run.quality;
+        eprintln!(
+            "{clip}: float {:.1} mm, {:.1} % of {n} foot-contact ticks",
+            q.float_mm,
+            100.0 * q.float_share
+        );
+        assert!(n > 0, "{clip}: no contact");
+        assert!(
+            (q.float_mm / 1000.0 - high).abs() < ROUNDING,
+            "{clip}: {} mm against {high} m",
+            q.float_mm
+        );
+        assert_eq!(q.float_share, up as f64 / n as f64, "{clip}");
+    }
 }

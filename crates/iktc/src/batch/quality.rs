@@ -219,6 +219,12 @@ pub struct KeypointFigures {
     pub leg_ratio: f64,
     /// Median tick time \[µs\] (wall clock, noisy).
     pub tick_median_us: f64,
+    /// Highest a foot floats while the clip has it on the ground \[m\]
+    /// ([`RetargetQuality::float_mm`]).
+    pub foot_float: f64,
+    /// Share of the clip's foot-contact ticks with the foot's lowest sole corner more than
+    /// [`crate::retarget::FLOAT_HEIGHT`] above the ground \[–\] ([`RetargetQuality::float_share`]).
+    pub foot_float_share: f64,
     /// Deepest sole corner below the ground \[m\] ([`sole_penetration`]).
     pub penetration: f64,
     /// Share of the ticks with a sole corner deeper than [`PENETRATION_TOLERANCE`] \[–\].
@@ -264,6 +270,8 @@ impl KeypointFigures {
                 .fold(0.0, f64::max)
                 .to_radians(),
             foot_slip: q.slip_mm / 1000.0,
+            foot_float: q.float_mm / 1000.0,
+            foot_float_share: q.float_share,
             worst_position_margin: q.position_margin,
             worst_velocity_margin: q.velocity_margin,
             worst_acceleration_margin: q.acceleration_margin,

@@ -558,6 +558,8 @@ mod tests {
         assert_eq!(f.ticks, run.quality.ticks);
         assert_eq!(f.mean_keypoint_error, run.quality.mean_cm / 100.0);
         assert_eq!(f.foot_slip, run.quality.slip_mm / 1000.0);
+        assert_eq!(f.foot_float, run.quality.float_mm / 1000.0);
+        assert_eq!(f.foot_float_share, run.quality.float_share);
         assert_eq!(f.leg_ratio, run.scaling.leg);
         assert!(f.healthy, "{f:?}");
         let feet = b.profile.feet.as_ref().unwrap();

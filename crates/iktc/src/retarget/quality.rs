@@ -19,6 +19,9 @@
 //!   largest horizontal distance of the sole centre from where it was at the run's first tick
 //!   \[m\], in mm;
 //! * foot below the ground: the largest depth below z = 0 of any sole corner \[m\], in mm;
+//! * foot floating: over the ticks on which the clip has a foot on the ground, the largest
+//!   height of that foot's lowest sole corner above z = 0, in mm, and the share of those
+//!   foot-ticks on which it is above [`FLOAT_HEIGHT`];
 //! * optionally, the static reach of the body points ([`super::reach`]);
 //! * joint jerk `(q̈_k − q̈_{k−1}) / Δt` of the active joints \[rad/s³\]: RMS over joints and
 //!   ticks, and max ([`DofSmoothness`]);
@@ -57,6 +60,11 @@ pub struct OrientationError {
     pub max_deg: f64,
 }
 
+/// A foot the clip has on the ground counts as floating in [`RetargetQuality::float_share`] when
+/// its lowest sole corner is higher than this above the ground \[m\] (1 cm: ten times the
+/// landing rule's rounding, half its `land_height`).
+pub const FLOAT_HEIGHT: f64 = 0.01;
+
 /// The quality figures of one run (see the module documentation).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct RetargetQuality {
@@ -74,6 +82,13 @@ pub struct RetargetQuality {
     pub slip_mm: f64,
     /// Deepest sole corner below the ground \[mm\] (0 if never below).
     pub below_ground_mm: f64,
+    /// Highest a foot floats while the clip has it on the ground: the largest height of its
+    /// lowest sole corner above z = 0 over the clip's foot-contact ticks \[mm\] (0 if it never
+    /// rises; a foot the robot cannot bring down, or does not land, shows here).
+    pub float_mm: f64,
+    /// Share of the clip's foot-contact ticks (per foot) on which the foot's lowest sole corner
+    /// is more than [`FLOAT_HEIGHT`] above the ground \[–\].
+    pub float_share: f64,
     /// Ticks with at least one foot on the ground (per the clip's contacts).
     pub stance_ticks: usize,
     /// RMS joint jerk \[rad/s³\].
@@ -107,6 +122,8 @@ pub struct QualityRecorder {
     orient: [(f64, f64); 2],
     slip: f64,
     below: f64,
+    /// Highest lowest-corner over contact ticks \[m\], contact foot-ticks, floating ones.
+    float: (f64, usize, usize),
     stance_start: [Option<Vector3<f64>>; 2],
     stance_ticks: usize,
     ticks: usize,
@@ -125,6 +142,7 @@ impl QualityRecorder {
             orient: [(0.0, 0.0); 2],
             slip: 0.0,
             below: 0.0,
+            float: (0.0, 0, 0),
             stance_start: [None, None],
             stance_ticks: 0,
             ticks: 0,
@@ -176,6 +194,7 @@ impl QualityRecorder {
         for (i, (held, f)) in stance.iter().zip(body.feet).enumerate() {
             let foot = kin.frame_pose(robot, f)?;
             let (hl, hw) = (0.5 * support.sole_length, 0.5 * support.sole_width);
+            let mut lowest = f64::INFINITY;
             for (sx, sy) in [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)] {
                 let c = foot
                     * Point3::new(
@@ -184,6 +203,12 @@ impl QualityRecorder {
                         -support.ankle_height,
                     );
                 self.below = self.below.max(-c.z);
+                lowest = lowest.min(c.z);
+            }
+            if plan.contact[i].get(k).copied().unwrap_or(false) {
+                self.float.0 = self.float.0.max(lowest);
+                self.float.1 += 1;
+                self.float.2 += usize::from(lowest > FLOAT_HEIGHT);
             }
             let centre =
                 (foot * Point3::new(support.sole_offset_x, 0.0, -support.ankle_height)).coords;
@@ -262,6 +287,8 @@ impl QualityRecorder {
             orientations,
             slip_mm: 1000.0 * self.slip,
             below_ground_mm: 1000.0 * self.below.max(0.0),
+            float_mm: 1000.0 * self.float.0,
+            float_share: self.float.2 as f64 / self.float.1.max(1) as f64,
             stance_ticks: self.stance_ticks,
             jerk_rms: (sum_sq / count.max(1) as f64).sqrt(),
             jerk_max,
