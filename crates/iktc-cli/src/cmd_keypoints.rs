@@ -265,6 +265,13 @@ fn print(run: &KeypointRun, joints: Option<&RetargetQuality>) -> std::io::Result
             None,
         )?;
     }
+    if let Some(balanced) = k.balanced_reach_cm {
+        row(
+            "balanced reach (feet, COM kept)",
+            format!("{balanced:.2} cm"),
+            None,
+        )?;
+    }
     for (i, o) in k.orientations.iter().enumerate() {
         let other = joints
             .and_then(|j| j.orientations.get(i))

@@ -11,12 +11,16 @@ use crate::cmd_retarget::ClipStatus;
 /// The figures shown: key in `quality.json`'s `figures`, column label with its unit. A column
 /// appears when some clip has its figure (the keypoint and joint routes measure different
 /// things).
-const COLUMNS: [(&str, &str); 26] = [
+const COLUMNS: [(&str, &str); 27] = [
     ("duration", "duration [s]"),
     ("mean_keypoint_error", "mean keypoint error [m]"),
     (
         "reach_keypoint_error",
         "static reach: least mean keypoint error of a posture within the joint ranges [m]",
+    ),
+    (
+        "balanced_reach_keypoint_error",
+        "balanced reach: the same, keeping the clip's feet and the COM over them [m]",
     ),
     ("max_keypoint_error", "max keypoint error [m]"),
     (

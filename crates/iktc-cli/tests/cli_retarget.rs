@@ -719,6 +719,7 @@ fn reach_option_reports_the_static_reach() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let f = figures();
     assert!(f["reach_keypoint_error"].is_null() && f["reach_run_keypoint_error"].is_null());
+    assert!(f["balanced_reach_keypoint_error"].is_null());
     let index = std::fs::read_to_string(out.join("index.html")).unwrap();
     assert!(!index.contains("static reach"));
     let without = csv();
@@ -730,11 +731,18 @@ fn reach_option_reports_the_static_reach() {
     let sampled = f["reach_run_keypoint_error"].as_f64().unwrap();
     let mean = f["mean_keypoint_error"].as_f64().unwrap();
     assert!(0.0 < reach && reach <= sampled, "{reach} {sampled}");
+    // Keeping the feet and the balance, a posture comes no closer than within the ranges
+    // alone on this clip (both descents start at the run's posture).
+    let balanced = f["balanced_reach_keypoint_error"].as_f64().unwrap();
+    assert!(
+        reach <= balanced && balanced < mean,
+        "{reach} {balanced} {mean}"
+    );
     // Sampled every 0.05 s, the run's error is close to its mean over every tick (metres).
     assert!((sampled - mean).abs() < 0.1 * mean, "{sampled} {mean}");
     assert_eq!(csv(), without);
     let index = std::fs::read_to_string(out.join("index.html")).unwrap();
-    assert!(index.contains("static reach"));
+    assert!(index.contains("static reach") && index.contains("balanced reach"));
     let o = run(&["--reach", "--retarget", "joints"]);
     assert!(!o.status.success());
     assert!(

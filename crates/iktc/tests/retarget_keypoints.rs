@@ -75,7 +75,10 @@ fn print(q: &RetargetQuality) {
         q.position_margin, q.velocity_margin, q.acceleration_margin
     );
     if let (Some(reach), Some(run)) = (q.reach_cm, q.reach_run_cm) {
-        eprintln!("    static reach {reach:.2} cm (the run {run:.2} cm on the same ticks)");
+        eprintln!(
+            "    static reach {reach:.2} cm, balanced {:.2} cm (the run {run:.2} cm on the same ticks)",
+            q.balanced_reach_cm.unwrap_or(f64::NAN)
+        );
     }
     let pts: Vec<String> = q
         .points

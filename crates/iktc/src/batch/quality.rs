@@ -239,6 +239,10 @@ pub struct KeypointFigures {
     /// keypoint error of a posture within the joint ranges alone, over the ticks sampled
     /// every [`crate::retarget::REACH_PERIOD`] \[m\] ([`RetargetQuality::reach_cm`]); `null` otherwise.
     pub reach_keypoint_error: Option<f64>,
+    /// The balanced reach beside the static reach: the least mean keypoint error of a posture
+    /// that also keeps the clip's feet where the run has them and the COM over their soles
+    /// \[m\] ([`RetargetQuality::balanced_reach_cm`]); `null` without the reach.
+    pub balanced_reach_keypoint_error: Option<f64>,
     /// The run's mean keypoint error over the same sampled ticks \[m\]; `null` without the
     /// reach.
     pub reach_run_keypoint_error: Option<f64>,
@@ -296,6 +300,7 @@ impl KeypointFigures {
                 .max_by_key(|(_, n)| *n)
                 .map_or_else(String::new, |(l, _)| l.clone()),
             reach_keypoint_error: q.reach_cm.map(|c| c / 100.0),
+            balanced_reach_keypoint_error: q.balanced_reach_cm.map(|c| c / 100.0),
             reach_run_keypoint_error: q.reach_run_cm.map(|c| c / 100.0),
         }
     }

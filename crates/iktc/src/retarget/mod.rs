@@ -557,8 +557,17 @@ pub fn retarget_keypoints_on(
     let mut quality = rec.finish(&robot);
     if s.reach {
         let stride = ((REACH_PERIOD / s.dt).round() as usize).max(1);
-        let r = reach::static_reach(&robot, &body, controller.plan(), &trajectory, stride)?;
+        let balance = (&support, s.com_margin);
+        let r = reach::static_reach(
+            &robot,
+            &body,
+            controller.plan(),
+            &trajectory,
+            stride,
+            balance,
+        )?;
         quality.reach_cm = Some(100.0 * r.reach_mean());
+        quality.balanced_reach_cm = Some(100.0 * r.balanced_mean());
         quality.reach_run_cm = Some(100.0 * r.run_mean());
     }
     Ok(KeypointRun {

@@ -107,6 +107,12 @@ pub struct RetargetQuality {
     /// body cannot do better than about this; the rest of [`RetargetQuality::mean_cm`] is what
     /// the retargeting gives up for its feet, balance and smoothness.
     pub reach_cm: Option<f64>,
+    /// The balanced reach, where asked for with the static reach: the same descent keeping
+    /// the feet the clip has on the ground where the run has them and the COM over their
+    /// soles, averaged over the same ticks \[cm\] ([`super::reach`], balanced reach). The rest
+    /// of [`RetargetQuality::mean_cm`] is what the run gives up to its rates, priorities and
+    /// references.
+    pub balanced_reach_cm: Option<f64>,
     /// The run's own mean body point error over the same sampled ticks \[cm\], beside
     /// [`RetargetQuality::reach_cm`].
     pub reach_run_cm: Option<f64>,
@@ -296,6 +302,7 @@ impl QualityRecorder {
             velocity_margin: vm,
             acceleration_margin: am,
             reach_cm: None,
+            balanced_reach_cm: None,
             reach_run_cm: None,
         }
     }

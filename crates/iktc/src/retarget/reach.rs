@@ -33,14 +33,32 @@
 //! On the shared clips (`tests/retarget_keypoints.rs`, 2026-12-03) the reach is 1.4–2.3 cm
 //! on G1 and 2.3–4.7 cm on JVRC-1, against the runs' 6.3–14.0 and 7.8–33.3 cm: the bodies
 //! are not what keeps the error above a few centimetres.
+//!
+//! ## Balanced reach
+//!
+//! The same descent, from the same posture, also with what a retargeting must keep at a
+//! standstill: every foot the clip has on the ground stays where the run has it at that tick
+//! (its pose, 6D), and the COM stays over the soles of those feet, at least the keypoint
+//! settings' `com_margin` inside their support polygon. Both enter the sum as penalties,
+//! `K Σ_c ‖r_c‖` with [`HOLD_WEIGHT`] `K` (per unit of the mean error), by the same reweighting:
+//! r_c is a held foot's position error and its rotation error `log(R R_heldᵀ)` times
+//! [`ROTATION_LENGTH`] (6 rows, `J_c` its frame Jacobian, the angular rows scaled alike), and
+//! the COM's horizontal distance from the shrunk polygon (2 rows, `J_c` the COM Jacobian's; 0
+//! inside). What is left between this figure and the run's is what the run gives up to the
+//! rates of its motion, its priorities and its references (the pelvis pose, the torso's
+//! orientation, the lowering of the pelvis for the legs), not to its feet or balance. On the
+//! shared clips (2026-12-03) G1's balanced reach is 1.8–6.2 cm (4.4 cm on
+//! `humanoid3d_dance_a`, whose run gives 14.0 cm), JVRC-1's 2.9–21.0 cm.
 
-use nalgebra::{DMatrix, DVector, Vector3};
+use nalgebra::{DMatrix, DVector, Isometry3, Vector3};
 
 use super::body::RobotBody;
 use super::plan::Plan;
 use crate::error::{check_dim, Result};
-use crate::model::{Kinematics, Robot, State};
+use crate::model::{FrameId, Kinematics, Robot, State};
 use crate::motion::BodyPoint;
+use crate::sim::imitate::{sole_pose, SupportSettings};
+use crate::walk::SupportPolygon;
 
 /// Smallest residual a weight is taken at \[m\]: points closer than 1 mm weigh as if 1 mm
 /// away, so that a point on its target does not take the whole step.
@@ -52,6 +70,18 @@ const MU_START: f64 = 1e-3;
 
 /// Largest μ tried before a tick's descent stops \[m/rad²\].
 const MU_MAX: f64 = 1e3;
+
+/// Weight of the balanced reach's penalties \[–\]: a metre of a held foot's or the COM's
+/// residual costs as much as 30 m of mean body point error, which holds them to about a
+/// millimetre where the points pull (the descent stops at gains of 0.01 mm).
+pub(crate) const HOLD_WEIGHT: f64 = 30.0;
+
+/// Smallest residual a penalty's weight is taken at \[m\] (0.1 mm).
+const HOLD_FLOOR: f64 = 1e-4;
+
+/// Length a held foot's rotation error is counted at \[m/rad\]: a radian of it as 10 cm
+/// (about a sole's half length) of position error.
+pub(crate) const ROTATION_LENGTH: f64 = 0.1;
 
 /// Iterations per tick at most.
 const MAX_ITERATIONS: usize = 60;
@@ -74,6 +104,57 @@ pub(crate) struct Reach {
     /// The least mean error found at each sampled tick, by a posture within the joint ranges
     /// \[m\]; at most `run`.
     pub(crate) reach: Vec<f64>,
+    /// The same, by a posture that also keeps the clip's feet and the COM over them (see the
+    /// module documentation, balanced reach) \[m\].
+    pub(crate) balanced: Vec<f64>,
+}
+
+/// What the balanced reach keeps at one tick: the feet the clip has on the ground at the
+/// poses the run has them in, and the COM inside their support polygon shrunk by `margin`.
+#[derive(Debug, Clone)]
+struct Balance {
+    feet: Vec<(FrameId, Isometry3<f64>)>,
+    /// `None` without a foot on the ground.
+    polygon: Option<SupportPolygon>,
+    margin: f64,
+}
+
+impl Balance {
+    /// The balance of tick `k` of `plan`, with `kin` at the run's posture of that tick.
+    fn of_tick(
+        robot: &Robot,
+        body: &RobotBody,
+        plan: &Plan,
+        k: usize,
+        kin: &Kinematics,
+        (support, margin): (&SupportSettings, f64),
+    ) -> Result<Self> {
+        let mut feet = Vec::with_capacity(2);
+        for (i, f) in body.feet.iter().enumerate() {
+            if plan.contact[i].get(k).copied().unwrap_or(false) {
+                feet.push((*f, kin.frame_pose(robot, *f)?));
+            }
+        }
+        let soles: Vec<_> = feet.iter().map(|(_, p)| sole_pose(p, support)).collect();
+        let (l, w) = (support.sole_length, support.sole_width);
+        let mut polygon = SupportPolygon::default();
+        let polygon = match soles.as_slice() {
+            [a] => {
+                polygon.set_sole(a, l, w);
+                Some(polygon)
+            }
+            [a, b] => {
+                polygon.set_hull_of_soles(a, b, l, w);
+                Some(polygon)
+            }
+            _ => None,
+        };
+        Ok(Self {
+            feet,
+            polygon,
+            margin,
+        })
+    }
 }
 
 impl Reach {
@@ -85,6 +166,11 @@ impl Reach {
     /// Mean of the least errors over the sampled ticks \[m\].
     pub(crate) fn reach_mean(&self) -> f64 {
         mean(&self.reach)
+    }
+
+    /// Mean of the least errors of balanced postures over the sampled ticks \[m\].
+    pub(crate) fn balanced_mean(&self) -> f64 {
+        mean(&self.balanced)
     }
 }
 
@@ -104,6 +190,15 @@ struct Descent<'a> {
     res: Vec<Vector3<f64>>,
     /// Position range of each active joint \[rad or m\].
     range: Vec<(f64, f64)>,
+    /// What a balanced descent keeps (none for the reach within the ranges alone).
+    balance: Option<Balance>,
+    /// The penalties' rows and residuals ([`Balance`]; the module documentation).
+    held_rows: Vec<DMatrix<f64>>,
+    held_res: Vec<DVector<f64>>,
+    com_jac: DMatrix<f64>,
+    /// Body points measured and their mean error at the last evaluation \[m\].
+    count: usize,
+    points: f64,
 }
 
 impl<'a> Descent<'a> {
@@ -124,11 +219,19 @@ impl<'a> Descent<'a> {
             rows: body.points.iter().map(|_| DMatrix::zeros(3, nv)).collect(),
             res: vec![Vector3::zeros(); body.points.len()],
             range,
+            balance: None,
+            held_rows: Vec::new(),
+            held_res: Vec::new(),
+            com_jac: DMatrix::zeros(3, nv),
+            count: 0,
+            points: 0.0,
         })
     }
 
-    /// The mean error of `state` against `targets` \[m\], with the residuals in `res` (and,
-    /// with `jacobians`, their Jacobians in `rows`).
+    /// The descent's objective at `state`: the mean error against `targets` \[m\] (kept in
+    /// `points`), plus the balance's penalties `HOLD_WEIGHT Σ ‖r_c‖` when there is a balance,
+    /// with the residuals in `res` and `held_res` (and, with `jacobians`, their Jacobians in
+    /// `rows` and `held_rows`).
     fn evaluate(
         &mut self,
         state: &State,
@@ -173,11 +276,59 @@ impl<'a> Descent<'a> {
                 self.rows[i].copy_from(&d);
             }
         }
-        Ok(sum / count.max(1) as f64)
+        self.count = count;
+        self.points = sum / count.max(1) as f64;
+        Ok(self.points + HOLD_WEIGHT * self.penalties(jacobians)?)
+    }
+
+    /// The balance's residuals (and, with `jacobians`, their rows) and the sum of their norms
+    /// \[m\]; 0 without a balance.
+    fn penalties(&mut self, jacobians: bool) -> Result<f64> {
+        let (robot, kin) = (self.robot, &self.kin);
+        self.held_res.clear();
+        if jacobians {
+            self.held_rows.clear();
+        }
+        let Some(balance) = &self.balance else {
+            return Ok(0.0);
+        };
+        let mut sum = 0.0;
+        for (f, held) in &balance.feet {
+            let pose = kin.frame_pose(robot, *f)?;
+            let dp = pose.translation.vector - held.translation.vector;
+            let dr = (pose.rotation * held.rotation.inverse()).scaled_axis() * ROTATION_LENGTH;
+            let r = DVector::from_iterator(6, dp.iter().chain(dr.iter()).copied());
+            sum += r.norm();
+            self.held_res.push(r);
+            if jacobians {
+                kin.frame_jacobian(robot, *f, &mut self.jac)?;
+                let mut j = self.jac.clone();
+                j.rows_mut(3, 3).scale_mut(ROTATION_LENGTH);
+                self.held_rows.push(j);
+            }
+        }
+        if let Some(polygon) = &balance.polygon {
+            let c = kin.com();
+            let v = polygon.vertices();
+            let n = v.len().max(1) as f64;
+            let centre = v
+                .iter()
+                .fold((0.0, 0.0), |a, q| (a.0 + q.0 / n, a.1 + q.1 / n));
+            let inside = polygon.pull_towards((c.x, c.y), centre, balance.margin);
+            let r = DVector::from_vec(vec![c.x - inside.0, c.y - inside.1]);
+            sum += r.norm();
+            self.held_res.push(r);
+            if jacobians {
+                kin.com_jacobian(robot, &mut self.com_jac)?;
+                self.held_rows.push(self.com_jac.rows(0, 2).into_owned());
+            }
+        }
+        Ok(sum)
     }
 
     /// Descends from `state` (changed in place) on the targets of one tick; returns the
-    /// mean error at the start and at the end \[m\].
+    /// mean error at the start and at the end \[m\] (the points' alone: a balanced descent's
+    /// penalties are not in them).
     fn run(
         &mut self,
         state: &mut State,
@@ -185,6 +336,7 @@ impl<'a> Descent<'a> {
     ) -> Result<(f64, f64)> {
         let nv = self.robot.nv();
         let start = self.evaluate(state, targets, true)?;
+        let start_points = self.points;
         let mut best = start;
         let mut mu = MU_START;
         let mut h = DMatrix::zeros(nv, nv);
@@ -199,6 +351,12 @@ impl<'a> Descent<'a> {
                     continue;
                 }
                 let w = 1.0 / r.norm().max(WEIGHT_FLOOR);
+                h.gemm_tr(w, rows, rows, 1.0);
+                g.gemv_tr(w, rows, r, 1.0);
+            }
+            // The penalties, on the scale of the points' sum (the mean times their count).
+            for (rows, r) in self.held_rows.iter().zip(&self.held_res) {
+                let w = self.count as f64 * HOLD_WEIGHT / r.norm().max(HOLD_FLOOR);
                 h.gemm_tr(w, rows, rows, 1.0);
                 g.gemv_tr(w, rows, r, 1.0);
             }
@@ -243,7 +401,9 @@ impl<'a> Descent<'a> {
             }
             self.evaluate(state, targets, true)?;
         }
-        Ok((start, best))
+        // The points' error at the state kept (the objective's `best` there).
+        self.evaluate(state, targets, false)?;
+        Ok((start_points, self.points))
     }
 
     /// Moves `state` by the velocity-coordinate step `delta` and puts every joint back into
@@ -263,13 +423,15 @@ impl<'a> Descent<'a> {
 
 /// The static reach of a run of `plan` on `robot`: `trajectory` holds the configuration q at
 /// the start of each tick, and every `stride`-th tick is sampled (see the module
-/// documentation). Errors: a configuration of the wrong length.
+/// documentation); the balanced reach keeps the COM `com_margin` \[m\] inside the soles of
+/// `support`. Errors: a configuration of the wrong length.
 pub(crate) fn static_reach(
     robot: &Robot,
     body: &RobotBody,
     plan: &Plan,
     trajectory: &[Vec<f64>],
     stride: usize,
+    (support, com_margin): (&SupportSettings, f64),
 ) -> Result<Reach> {
     let mut state = State::neutral(robot);
     let mut descent = Descent::new(robot, body, &state)?;
@@ -277,15 +439,23 @@ pub(crate) fn static_reach(
         ticks: Vec::new(),
         run: Vec::new(),
         reach: Vec::new(),
+        balanced: Vec::new(),
     };
     for k in (0..trajectory.len().min(plan.ticks)).step_by(stride.max(1)) {
         check_dim("configuration", robot.nq(), trajectory[k].len())?;
         state.q.copy_from_slice(&trajectory[k]);
         state.qd.fill(0.0);
+        descent.balance = None;
         let (run, reach) = descent.run(&mut state, &plan.neutral[k])?;
+        state.q.copy_from_slice(&trajectory[k]);
+        let kin = Kinematics::new(robot, &state)?;
+        let balance = Balance::of_tick(robot, body, plan, k, &kin, (support, com_margin))?;
+        descent.balance = Some(balance);
+        let (_, balanced) = descent.run(&mut state, &plan.neutral[k])?;
         out.ticks.push(k);
         out.run.push(run);
         out.reach.push(reach);
+        out.balanced.push(balanced);
     }
     Ok(out)
 }
@@ -300,6 +470,7 @@ mod tests {
     use crate::motion::DEFAULT_MAX_GAP;
     use crate::profile::RobotProfile;
     use crate::retarget::{builtin_motion, setup, KeypointSettings, Setup};
+    use crate::sim::imitate::sole_pose;
 
     /// G1 and its body frames, from the keypoint setup of a built-in clip.
     fn g1() -> (Arc<Robot>, RobotBody, State) {
@@ -417,6 +588,118 @@ mod tests {
         assert!(checked >= 10);
     }
 
+    /// G1's sole settings and a balance holding both feet where `state` has them, the COM
+    /// `margin` inside their soles.
+    fn both_feet(robot: &Robot, body: &RobotBody, state: &State, margin: f64) -> Balance {
+        let support = RobotProfile::builtin("g1")
+            .unwrap()
+            .imitate_config(Default::default())
+            .unwrap()
+            .support;
+        let kin = Kinematics::new(robot, state).unwrap();
+        let feet: Vec<_> = body
+            .feet
+            .iter()
+            .map(|f| (*f, kin.frame_pose(robot, *f).unwrap()))
+            .collect();
+        let (a, b) = (
+            sole_pose(&feet[0].1, &support),
+            sole_pose(&feet[1].1, &support),
+        );
+        let mut polygon = SupportPolygon::default();
+        polygon.set_hull_of_soles(&a, &b, support.sole_length, support.sole_width);
+        Balance {
+            feet,
+            polygon: Some(polygon),
+            margin,
+        }
+    }
+
+    /// The balanced descent towards a posture with the arms and legs moved keeps both feet
+    /// where they stood (within a millimetre and 0.1°, the penalties' weight against the
+    /// points' pull) and the COM inside the soles' polygon, and still lowers the points'
+    /// error; a balance with no foot on the ground is the reach within the ranges alone, to
+    /// the bit.
+    #[test]
+    fn the_balanced_reach_keeps_the_feet_and_the_com() {
+        let (robot, body, start) = g1();
+        let margin = 0.02;
+        for seed in 0..3 {
+            let goal = moved(&robot, &start, 0.4, true, 20 + seed);
+            let targets = targets_of(&robot, &body, &goal);
+            let mut d = Descent::new(&robot, &body, &start).unwrap();
+            d.balance = Some(both_feet(&robot, &body, &start, margin));
+            let mut state = start.clone();
+            let (first, last) = d.run(&mut state, &targets).unwrap();
+            assert!(last < 0.8 * first, "seed {seed}: {first} -> {last}");
+            let held = d.balance.clone().unwrap();
+            let kin = Kinematics::new(&robot, &state).unwrap();
+            for (f, pose) in &held.feet {
+                let now = kin.frame_pose(&robot, *f).unwrap();
+                let moved_by = (now.translation.vector - pose.translation.vector).norm();
+                let turned = (now.rotation * pose.rotation.inverse()).angle();
+                assert!(moved_by < 1e-3, "seed {seed}: foot moved {moved_by} m");
+                assert!(
+                    turned < 0.1f64.to_radians(),
+                    "seed {seed}: foot turned {turned} rad"
+                );
+            }
+            let c = kin.com();
+            let inside = held.polygon.as_ref().unwrap().margin((c.x, c.y));
+            assert!(inside > margin - 1e-3, "seed {seed}: COM {inside} m inside");
+            assert!(in_range(&robot, &state));
+            // No foot on the ground: nothing kept, the same descent as without a balance.
+            let mut free = start.clone();
+            d.balance = None;
+            let without = d.run(&mut free, &targets).unwrap();
+            let mut idle = start.clone();
+            d.balance = Some(Balance {
+                feet: Vec::new(),
+                polygon: None,
+                margin,
+            });
+            assert_eq!(d.run(&mut idle, &targets).unwrap(), without);
+            assert_eq!(idle.q, free.q);
+        }
+    }
+
+    /// The penalties' rows are the derivatives of their residuals (finite differences, as
+    /// for the points): a held foot's 6 rows and the COM's 2 rows once it is outside. The
+    /// rotation rows are the foot's angular velocity, the derivative of `log(R R_heldᵀ)` to
+    /// first order in the rotation error θ (the descent starts at θ = 0): with the feet held
+    /// about 0.01 rad from the posture, they agree to θ.
+    #[test]
+    fn the_penalty_rows_are_the_residuals_derivatives() {
+        let (robot, body, start) = g1();
+        let state = moved(&robot, &start, 0.3, true, 31);
+        let near = moved(&robot, &state, 0.002, true, 33);
+        // Feet held where `near` has them and a polygon the COM of `state` is outside of:
+        // a margin wider than the soles' hull.
+        let mut d = Descent::new(&robot, &body, &state).unwrap();
+        d.balance = Some(both_feet(&robot, &body, &near, 0.5));
+        let targets: Vec<_> = body
+            .points
+            .iter()
+            .map(|(p, _)| (*p, Vector3::zeros()))
+            .collect();
+        d.evaluate(&state, &targets, true).unwrap();
+        let (res, rows) = (d.held_res.clone(), d.held_rows.clone());
+        assert_eq!(res.len(), 3, "two feet and the COM");
+        let mut rng = rand::rngs::StdRng::seed_from_u64(32);
+        let h = 1e-6;
+        let delta = DVector::from_fn(robot.nv(), |_, _| h * rng.random_range(-1.0..1.0));
+        let mut moved_state = state.clone();
+        d.step(&mut moved_state, &delta).unwrap();
+        d.evaluate(&moved_state, &targets, false).unwrap();
+        for (i, (r0, j)) in res.iter().zip(&rows).enumerate() {
+            let finite = &d.held_res[i] - r0;
+            let linear = j * &delta;
+            assert!(finite.norm() > 1e-8, "penalty {i} did not move");
+            let gap = (&finite - &linear).norm();
+            assert!(gap < 1e-2 * finite.norm(), "penalty {i}: {finite} {linear}");
+        }
+    }
+
     /// Targets of a posture beyond the joint ranges: the least error stays above zero, no
     /// joint leaves its range, and the descent never ends above where it started.
     #[test]
@@ -460,6 +743,7 @@ mod run_tests {
         let s = KeypointSettings::default();
         let run = retarget_keypoints(&profile, &kp, None, &s).unwrap();
         assert_eq!(run.quality.reach_cm, None);
+        assert_eq!(run.quality.balanced_reach_cm, None);
         assert_eq!(run.quality.reach_run_cm, None);
         let robot = Arc::new(profile.robot().unwrap());
         let Setup {
@@ -468,7 +752,17 @@ mod run_tests {
             controller,
             ..
         } = setup(robot, &profile, &kp, None, &s).unwrap();
-        let all = static_reach(&robot, &body, controller.plan(), &run.trajectory, 1).unwrap();
+        let support = &profile.imitate_config(Default::default()).unwrap().support;
+        let balance = (support, s.com_margin);
+        let all = static_reach(
+            &robot,
+            &body,
+            controller.plan(),
+            &run.trajectory,
+            1,
+            balance,
+        );
+        let all = all.unwrap();
         assert_eq!(all.ticks.len(), run.trajectory.len());
         let mean = 100.0 * all.run_mean();
         let q = &run.quality;
@@ -487,9 +781,17 @@ mod run_tests {
             .unwrap()
             .quality;
         let stride = (crate::retarget::REACH_PERIOD / s.dt).round() as usize;
-        let sampled = static_reach(&robot, &body, controller.plan(), &run.trajectory, stride);
+        let sampled = static_reach(
+            &robot,
+            &body,
+            controller.plan(),
+            &run.trajectory,
+            stride,
+            balance,
+        );
         let sampled = sampled.unwrap();
         assert_eq!(q.reach_cm, Some(100.0 * sampled.reach_mean()));
+        assert_eq!(q.balanced_reach_cm, Some(100.0 * sampled.balanced_mean()));
         assert_eq!(q.reach_run_cm, Some(100.0 * sampled.run_mean()));
     }
 }
