@@ -40,9 +40,9 @@
 //! standstill: every foot the clip has on the ground stays where the run has it at that tick
 //! (its pose, 6D), and the COM stays over the soles of those feet, at least the keypoint
 //! settings' `com_margin` inside their support polygon. Both enter the sum as penalties,
-//! `K Σ_c ‖r_c‖` with [`HOLD_WEIGHT`] `K` (per unit of the mean error), by the same reweighting:
+//! `K Σ_c ‖r_c‖` with `K` = 30 (`HOLD_WEIGHT`, per unit of the mean error), by the same reweighting:
 //! r_c is a held foot's position error and its rotation error `log(R R_heldᵀ)` times
-//! [`ROTATION_LENGTH`] (6 rows, `J_c` its frame Jacobian, the angular rows scaled alike), and
+//! 0.1 m (`ROTATION_LENGTH`; 6 rows, `J_c` its frame Jacobian, the angular rows scaled alike), and
 //! the COM's horizontal distance from the shrunk polygon (2 rows, `J_c` the COM Jacobian's; 0
 //! inside). What is left between this figure and the run's is what the run gives up to the
 //! rates of its motion, its priorities and its references (the pelvis pose, the torso's
