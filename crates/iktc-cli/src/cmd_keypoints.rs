@@ -216,7 +216,7 @@ pub fn run(
 fn print(run: &KeypointRun, joints: Option<&RetargetQuality>) -> std::io::Result<()> {
     let k = &run.quality;
     crate::outln!(
-        "keypoint retargeting: {} ticks, leg ratio {:.3}, {} ticks solved by GF (+{} for the stance feet), tick median {:.1} µs",
+        "keypoint retargeting: {} ticks, leg ratio {:.3}, {} ticks solved by GF (+{} for the feet), tick median {:.1} µs",
         k.ticks,
         run.scaling.leg,
         run.fallback_ticks,

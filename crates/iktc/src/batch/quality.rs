@@ -213,7 +213,8 @@ pub struct KeypointFigures {
     pub max_jerk: f64,
     /// Share of the ticks solved by GF because IKTC's answer left the box \[–\].
     pub fallback_share: f64,
-    /// Share of the ticks solved by GF to keep the stance feet more exactly \[–\].
+    /// Share of the ticks solved by GF to keep the feet's levels (stance, floor) more exactly
+    /// \[–\].
     pub stance_gf_share: f64,
     /// Ratio of the robot's leg length to the captured person's \[–\].
     pub leg_ratio: f64,

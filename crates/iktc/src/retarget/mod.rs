@@ -315,8 +315,9 @@ pub struct KeypointRun {
     /// Ticks solved by GF because IKTC's answer left the box ([`KeypointController::tick`]),
     /// over the settling and the clip.
     pub fallback_ticks: usize,
-    /// Ticks solved by GF because IKTC corrected the stance feet's level and GF kept it more
-    /// exactly ([`KeypointController::tick`]), over the settling and the clip.
+    /// Ticks solved by GF because IKTC corrected the feet's levels while a foot was held (the
+    /// stance feet's level, or the floor's below it) and GF kept them more exactly
+    /// ([`KeypointController::tick`]), over the settling and the clip.
     pub stance_gf_ticks: usize,
     /// Median time of one control tick (references, kinematics, box, solve, integration) \[µs\].
     pub tick_median_us: f64,
