@@ -95,6 +95,8 @@ def test_the_python_quality_figures_equal_the_batch_ones():
     assert abs(q["reach_cm"] / 100 - figures["reach_keypoint_error"]) < 1e-12
     assert abs(q["reach_run_cm"] / 100 - figures["reach_run_keypoint_error"]) < 1e-12
     assert abs(q["balanced_reach_cm"] / 100 - figures["balanced_reach_keypoint_error"]) < 1e-12
+    assert abs(q["float_mm"] / 1000 - figures["foot_float"]) < 1e-12
+    assert q["float_share"] == figures["foot_float_share"] and 0 <= q["float_share"] <= 1
     assert 0 < q["reach_cm"] <= q["reach_run_cm"]
     # The per-point means average to the mean; every margin says no limit was exceeded.
     assert abs(np.mean([p["mean_cm"] for p in q["points"]]) - q["mean_cm"]) < 1e-9
