@@ -725,10 +725,12 @@ mod tests {
 mod run_tests {
     use std::sync::Arc;
 
-    use super::static_reach;
+    use super::{static_reach, Balance};
+    use crate::model::Kinematics;
     use crate::motion::DEFAULT_MAX_GAP;
     use crate::profile::RobotProfile;
     use crate::retarget::{builtin_motion, retarget_keypoints, setup, KeypointSettings, Setup};
+    use crate::sim::imitate::sole_pose;
 
     /// Sampling every tick, the run's figure is the quality figures' mean error (computed by
     /// other code), and the reach is at most that; a run asked for the reach reports it on
@@ -775,6 +777,10 @@ mod run_tests {
         let n = all.reach.len() as f64;
         let reach = all.reach.iter().sum::<f64>() / n;
         assert!((all.reach_mean() - reach).abs() <= f64::EPSILON * reach);
+        assert_eq!(all.balanced.len(), all.reach.len());
+        let balanced = all.balanced.iter().sum::<f64>() / n;
+        assert!((all.balanced_mean() - balanced).abs() <= f64::EPSILON * balanced);
+        assert!(balanced > 0.0);
         assert!(0.0 < reach && reach < all.run_mean());
         let asked = KeypointSettings { reach: true, ..s };
         let q = retarget_keypoints(&profile, &kp, None, &asked)
@@ -793,5 +799,53 @@ mod run_tests {
         assert_eq!(q.reach_cm, Some(100.0 * sampled.reach_mean()));
         assert_eq!(q.balanced_reach_cm, Some(100.0 * sampled.balanced_mean()));
         assert_eq!(q.reach_run_cm, Some(100.0 * sampled.run_mean()));
+    }
+
+    /// A tick's balance holds the feet the clip has on the ground, and its polygon (none
+    /// without a foot) is that of their soles: each held sole's centre lies inside it by at
+    /// least half the sole's width. The walk has ticks on one foot and on none, the punch on
+    /// both.
+    #[test]
+    fn a_ticks_balance_holds_its_contact_feet_over_their_soles() {
+        let mut seen = [false; 3];
+        for clip in ["humanoid3d_walk", "humanoid3d_punch"] {
+            balances_of(clip, &mut seen);
+        }
+        assert!(seen.iter().all(|s| *s), "{seen:?}");
+    }
+
+    fn balances_of(clip: &str, seen: &mut [bool; 3]) {
+        let profile = RobotProfile::builtin("g1").unwrap();
+        let kp = builtin_motion(clip)
+            .unwrap()
+            .keypoints(DEFAULT_MAX_GAP)
+            .unwrap();
+        let s = KeypointSettings::default();
+        let robot = Arc::new(profile.robot().unwrap());
+        let Setup {
+            robot,
+            body,
+            controller,
+            support,
+            ..
+        } = setup(robot, &profile, &kp, None, &s).unwrap();
+        let plan = controller.plan();
+        let kin = Kinematics::new(&robot, controller.state()).unwrap();
+        // Half a sole's width, less its rounding [m].
+        let inside = 0.5 * support.sole_width - 1e-9;
+        for k in 0..plan.ticks {
+            let on: Vec<usize> = (0..2).filter(|i| plan.contact[*i][k]).collect();
+            let b = Balance::of_tick(&robot, &body, plan, k, &kin, (&support, 0.02)).unwrap();
+            seen[on.len()] = true;
+            assert_eq!(b.feet.len(), on.len(), "tick {k}");
+            for ((f, pose), i) in b.feet.iter().zip(&on) {
+                assert_eq!(*f, body.feet[*i]);
+                let sole = sole_pose(pose, &support);
+                let m = b.polygon.as_ref().unwrap().margin((sole.x, sole.y));
+                assert!(m >= inside, "tick {k}: sole centre {m} m inside");
+            }
+            assert_eq!(b.polygon.is_none(), on.is_empty(), "tick {k}");
+            assert_eq!(b.margin, 0.02);
+        }
     }
 }
