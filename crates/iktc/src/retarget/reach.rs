@@ -685,6 +685,27 @@ mod tests {
         d.evaluate(&state, &targets, true).unwrap();
         let (res, rows) = (d.held_res.clone(), d.held_rows.clone());
         assert_eq!(res.len(), 3, "two feet and the COM");
+        // The COM's residual: from the point of the polygon `margin` inside on the way from the
+        // COM to the soles' centroid (the polygon's vertex centroid), to the COM. No point of
+        // the soles' hull is 0.5 m inside it, so that point is the centroid itself.
+        let polygon = d.balance.as_ref().unwrap().polygon.clone().unwrap();
+        let c = d.kin.com();
+        let v = polygon.vertices();
+        let n = v.len() as f64;
+        let centroid = v
+            .iter()
+            .fold((0.0, 0.0), |a, q| (a.0 + q.0 / n, a.1 + q.1 / n));
+        let r = &res[2];
+        let at = (c.x - r[0], c.y - r[1]);
+        // Bisection's resolution and rounding [m].
+        const ON_THE_WAY: f64 = 1e-6;
+        assert!(r.norm() > 0.01, "COM {} m outside", r.norm());
+        assert!(polygon.margin(centroid) < 0.5);
+        let off = (at.0 - centroid.0).hypot(at.1 - centroid.1);
+        assert!(
+            off < ON_THE_WAY,
+            "pulled to {at:?}, the centroid {centroid:?}"
+        );
         let mut rng = rand::rngs::StdRng::seed_from_u64(32);
         let h = 1e-6;
         let delta = DVector::from_fn(robot.nv(), |_, _| h * rng.random_range(-1.0..1.0));
