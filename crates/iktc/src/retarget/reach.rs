@@ -663,6 +663,47 @@ mod tests {
         }
     }
 
+    /// A COM that starts outside the polygon is brought inside it, the feet held: the polygon
+    /// of soles 12 cm ahead of the feet (half a G1 sole's length past the front ones'
+    /// centres), the COM about 2 cm behind it at the start.
+    #[test]
+    fn the_balanced_reach_brings_the_com_over_the_soles() {
+        let (robot, body, start) = g1();
+        let support = RobotProfile::builtin("g1")
+            .unwrap()
+            .imitate_config(Default::default())
+            .unwrap()
+            .support;
+        let mut balance = both_feet(&robot, &body, &start, 0.0);
+        let ahead = |pose: &Isometry3<f64>| {
+            let mut p = *pose;
+            p.translation.vector.x += 0.12;
+            sole_pose(&p, &support)
+        };
+        let (a, b) = (ahead(&balance.feet[0].1), ahead(&balance.feet[1].1));
+        let mut polygon = SupportPolygon::default();
+        polygon.set_hull_of_soles(&a, &b, support.sole_length, support.sole_width);
+        balance.polygon = Some(polygon);
+        let c = Kinematics::new(&robot, &start).unwrap().com();
+        let before = polygon.margin((c.x, c.y));
+        assert!(before < -0.005, "COM {before} m inside at the start");
+        let targets = targets_of(&robot, &body, &start);
+        let mut d = Descent::new(&robot, &body, &start).unwrap();
+        d.balance = Some(balance.clone());
+        let mut state = start.clone();
+        d.run(&mut state, &targets).unwrap();
+        let kin = Kinematics::new(&robot, &state).unwrap();
+        let c = kin.com();
+        let now = polygon.margin((c.x, c.y));
+        assert!(now > -1e-3, "COM {now} m inside (from {before})");
+        for (f, pose) in &balance.feet {
+            let moved = (kin.frame_pose(&robot, *f).unwrap().translation.vector
+                - pose.translation.vector)
+                .norm();
+            assert!(moved < 1e-3, "foot moved {moved} m");
+        }
+    }
+
     /// The penalties' rows are the derivatives of their residuals (finite differences, as
     /// for the points): a held foot's 6 rows and the COM's 2 rows once it is outside. The
     /// rotation rows are the foot's angular velocity, the derivative of `log(R R_heldᵀ)` to
@@ -688,7 +729,7 @@ mod tests {
         // The COM's residual: from the point of the polygon `margin` inside on the way from the
         // COM to the soles' centroid (the polygon's vertex centroid), to the COM. No point of
         // the soles' hull is 0.5 m inside it, so that point is the centroid itself.
-        let polygon = d.balance.as_ref().unwrap().polygon.clone().unwrap();
+        let polygon = d.balance.as_ref().unwrap().polygon.unwrap();
         let c = d.kin.com();
         let v = polygon.vertices();
         let n = v.len() as f64;
