@@ -416,7 +416,8 @@ fn jvrc1_names_the_level_it_cannot_follow_on_dance_a() {
     );
 }
 
-/// The floating figures (`float_mm`, `float_share`) recomputed from the run's own trajectory
+/// The floating figures (`float_mm`, `float_share`) and the depth below the ground
+/// (`below_ground_mm`, every tick) recomputed from the run's own trajectory
 /// and contacts by the forward kinematics of each recorded configuration: on every tick the
 /// clip has a foot on the ground, that foot's lowest sole corner (the profile's sole
 /// rectangle and ankle height); the largest height and the share above
@@ -448,13 +449,11 @@ fn floating_feet_are_the_contact_ticks_lowest_corners() {
         let run = retarget_keypoints(&profile, &kp, None, &KeypointSettings::default()).unwrap();
         let mut state = State::neutral(&robot);
         let (mut high, mut n, mut up) = (0.0_f64, 0usize, 0usize);
+        let mut deepest = 0.0_f64;
         for (k, q) in run.trajectory.iter().enumerate() {
             state.q.copy_from_slice(q);
             let kin = Kinematics::new(&robot, &state).unwrap();
             for (i, foot) in feet.iter().enumerate() {
-                if !run.contacts[i][k] {
-                    continue;
-                }
                 let pose = kin.frame_pose(&robot, ids[i]).unwrap();
                 let s = &foot.sole;
                 let lowest = [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)]
@@ -469,6 +468,11 @@ fn floating_feet_are_the_contact_ticks_lowest_corners() {
                         .z
                     })
                     .fold(f64::INFINITY, f64::min);
+                // Every tick for the depth below the ground, the contact ticks for the float.
+                deepest = deepest.max(-lowest);
+                if !run.contacts[i][k] {
+                    continue;
+                }
                 high = high.max(lowest);
                 n += 1;
                 up += usize::from(lowest > iktc::retarget::FLOAT_HEIGHT);
@@ -487,6 +491,11 @@ fn floating_feet_are_the_contact_ticks_lowest_corners() {
             q.float_mm
         );
         assert_eq!(q.float_share, up as f64 / n as f64, "{clip}");
+        assert!(
+            (q.below_ground_mm / 1000.0 - deepest).abs() < ROUNDING,
+            "{clip}: below {} mm against {deepest} m",
+            q.below_ground_mm
+        );
     }
 }
 
