@@ -374,10 +374,11 @@ fn is_motion_file(p: &Path) -> bool {
         .is_some_and(|e| MOTION_EXTENSIONS.contains(&e.to_ascii_lowercase().as_str()))
 }
 
-/// Whether `dir` holds what `iktc retarget` writes: the batch's `--out` folder (`out`), or a
-/// folder of an earlier batch (its `batch.json`) or of one of its clips (its settings marker).
-/// Its files (`quality.json`, trajectories) are not motion to retarget, wherever the output
-/// went, so a batch whose `--out` lies inside its input folder can run again.
+/// Whether `dir` holds what iktc writes: the batch's `--out` folder (`out`), a folder of an
+/// earlier batch (its `batch.json`) or of one of its clips (its settings marker), or the
+/// output of `iktc imitate` (its `keypoints_summary.json`). Their files (`quality.json`,
+/// summaries, trajectories) are not motion to retarget, wherever the output went, so a batch
+/// whose `--out` lies inside its input folder can run again.
 fn is_output_folder(dir: &Path, out: Option<&Path>) -> bool {
     let same = |a: &Path, b: &Path| match (a.canonicalize(), b.canonicalize()) {
         (Ok(a), Ok(b)) => a == b,
@@ -386,6 +387,7 @@ fn is_output_folder(dir: &Path, out: Option<&Path>) -> bool {
     out.is_some_and(|o| same(dir, o))
         || dir.join("batch.json").is_file()
         || dir.join(SETTINGS_FILE).is_file()
+        || dir.join("keypoints_summary.json").is_file()
 }
 
 /// Every file under `dir`, sorted, recursively, leaving out the folders of iktc's output

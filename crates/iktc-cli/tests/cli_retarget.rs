@@ -751,7 +751,7 @@ fn reach_option_reports_the_static_reach() {
 }
 
 /// A batch whose `--out` lies inside its input folder, beside the output of an earlier batch
-/// there: neither output folder is searched for motion (their `quality.json` files are not
+/// and of `iktc imitate` there: no output folder is searched for motion (their `quality.json` files are not
 /// clips), not even an `--out` that an interrupted run left without `batch.json` and without
 /// a clip's settings marker, so the same command runs again, skips the clip as up to date and
 /// succeeds.
@@ -770,7 +770,11 @@ fn output_folders_inside_the_input_folder_are_not_searched() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     std::fs::create_dir_all(out.join("humanoid3d_walk")).unwrap();
     std::fs::write(out.join("humanoid3d_walk/quality.json"), "{}").unwrap();
-    for (pass, folders) in [("retargeted", 2), ("skipped", 2)] {
+    // What `iktc imitate --out` writes (its summary is JSON, not a clip).
+    let imitated = input.join("imitated");
+    std::fs::create_dir_all(&imitated).unwrap();
+    std::fs::write(imitated.join("keypoints_summary.json"), "{}").unwrap();
+    for (pass, folders) in [("retargeted", 3), ("skipped", 3)] {
         let o = retarget_on_g1(&input, &out, &[]);
         let err = String::from_utf8_lossy(&o.stderr);
         assert!(o.status.success(), "{err}");
