@@ -184,18 +184,23 @@ mod tests {
         assert!(engaged(floor_acceleration(0.3, -2.0, &GAINS)));
     }
 
+    /// The corners of a 0.2 × 0.1 m sole 0.05 m below its ankle, its centre `offset_x` \[m\]
+    /// ahead of it.
+    fn corners_of(offset_x: f64) -> [Vector3<f64>; 4] {
+        sole_corners(&crate::sim::imitate::SupportSettings {
+            sole_length: 0.2,
+            sole_width: 0.1,
+            sole_offset_x: offset_x,
+            ankle_height: 0.05,
+        })
+    }
+
     /// The second-order prediction against the corner's exact motion: a foot turning about
     /// y at constant angular acceleration from a constant-acceleration translation, its lowest
     /// corner integrated in fine steps; the difference is third order in `dt`.
     #[test]
     fn the_lowest_corner_after_a_tick_is_its_second_order_expansion() {
-        let s = crate::sim::imitate::SupportSettings {
-            sole_length: 0.2,
-            sole_width: 0.1,
-            sole_offset_x: 0.03,
-            ankle_height: 0.05,
-        };
-        let corners = sole_corners(&s);
+        let corners = corners_of(0.03);
         let (z0, vz, az) = (0.06, -0.8, 30.0);
         let (th0, w0, al) = (0.05, 2.0, -40.0);
         let pose_at = |t: f64| {
@@ -237,13 +242,7 @@ mod tests {
         // A foot pitched 0.1 rad nose down (about +y), its ankle 0.1 m up, turning at 1 rad/s
         // about +y: the front corners are lowest, at 0.1 − 0.1 sin θ − 0.05 cos θ, and drop
         // at (ω × R c)_z, compared with the finite difference of the height.
-        let s = crate::sim::imitate::SupportSettings {
-            sole_length: 0.2,
-            sole_width: 0.1,
-            sole_offset_x: 0.0,
-            ankle_height: 0.05,
-        };
-        let corners = sole_corners(&s);
+        let corners = corners_of(0.0);
         let pose =
             |th: f64| Isometry3::new(Vector3::new(0.0, 0.0, 0.1), Vector3::new(0.0, th, 0.0));
         let twist = Vector6::new(0.0, 0.0, 0.0, 0.0, 1.0, 0.0);

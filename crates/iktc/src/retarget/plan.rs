@@ -31,7 +31,7 @@ use crate::model::{Kinematics, Robot};
 use crate::motion::{lowpass_track, BodyPoint, CubicSpline, Keypoints};
 use crate::sim::imitate::{sole_pose, SupportSettings};
 use crate::task::{ComReference, FrameReference};
-use crate::walk::SupportPolygon;
+use crate::walk::{Pose2, SupportPolygon};
 
 /// References of one tick.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -200,9 +200,21 @@ fn torso_frame(
     frame_from(ls - rs, 0.5 * (ls + rs) - 0.5 * (lh + rh))
 }
 
+/// The support polygon of `soles` (sole centres and headings, each `length` × `width` \[m\]):
+/// one sole's rectangle or the hull of two; `None` without a sole.
+pub(crate) fn soles_polygon(soles: &[Pose2], length: f64, width: f64) -> Option<SupportPolygon> {
+    let mut polygon = SupportPolygon::default();
+    match soles {
+        [a] => polygon.set_sole(a, length, width),
+        [a, b] => polygon.set_hull_of_soles(a, b, length, width),
+        _ => return None,
+    }
+    Some(polygon)
+}
+
 /// Pulls `p` into `polygon` until its margin is at least `margin` \[m\], along the segment to the
 /// polygon's vertex centroid (bisection).
-fn pull_inside(polygon: &SupportPolygon, p: (f64, f64), margin: f64) -> (f64, f64) {
+pub(crate) fn pull_inside(polygon: &SupportPolygon, p: (f64, f64), margin: f64) -> (f64, f64) {
     let v = polygon.vertices();
     let n = v.len().max(1) as f64;
     let c = v
@@ -376,7 +388,6 @@ pub(crate) fn plan(
     let mut com_offset = kin.com() - kin.frame_pose(robot, body.pelvis)?.translation.vector;
     com_offset.z = 0.0;
     let mut com: Vec<Vector3<f64>> = Vec::with_capacity(ticks);
-    let mut polygon = SupportPolygon::default();
     for k in 0..ticks {
         let any = contact[0][k] || contact[1][k];
         let on: Vec<Isometry3<f64>> = (0..2)
@@ -395,16 +406,10 @@ pub(crate) fn plan(
         let c = pelvis_x[k] + turn * com_offset;
         let p = (c.x, c.y);
         let (l, w) = (support.sole_length, support.sole_width);
-        let q = match on.as_slice() {
-            [a] => {
-                polygon.set_sole(&sole_pose(a, support), l, w);
-                pull_inside(&polygon, p, s.com_margin)
-            }
-            [a, b] => {
-                polygon.set_hull_of_soles(&sole_pose(a, support), &sole_pose(b, support), l, w);
-                pull_inside(&polygon, p, s.com_margin)
-            }
-            _ => p,
+        let soles: Vec<Pose2> = on.iter().map(|a| sole_pose(a, support)).collect();
+        let q = match soles_polygon(&soles, l, w) {
+            Some(polygon) => pull_inside(&polygon, p, s.com_margin),
+            None => p,
         };
         com.push(Vector3::new(q.0, q.1, 0.0));
     }

@@ -53,7 +53,7 @@
 use nalgebra::{DMatrix, DVector, Isometry3, Vector3};
 
 use super::body::RobotBody;
-use super::plan::Plan;
+use super::plan::{pull_inside, soles_polygon, Plan};
 use crate::error::{check_dim, Result};
 use crate::model::{FrameId, Kinematics, Robot, State};
 use crate::motion::BodyPoint;
@@ -136,19 +136,7 @@ impl Balance {
             }
         }
         let soles: Vec<_> = feet.iter().map(|(_, p)| sole_pose(p, support)).collect();
-        let (l, w) = (support.sole_length, support.sole_width);
-        let mut polygon = SupportPolygon::default();
-        let polygon = match soles.as_slice() {
-            [a] => {
-                polygon.set_sole(a, l, w);
-                Some(polygon)
-            }
-            [a, b] => {
-                polygon.set_hull_of_soles(a, b, l, w);
-                Some(polygon)
-            }
-            _ => None,
-        };
+        let polygon = soles_polygon(&soles, support.sole_length, support.sole_width);
         Ok(Self {
             feet,
             polygon,
@@ -309,12 +297,7 @@ impl<'a> Descent<'a> {
         }
         if let Some(polygon) = &balance.polygon {
             let c = kin.com();
-            let v = polygon.vertices();
-            let n = v.len().max(1) as f64;
-            let centre = v
-                .iter()
-                .fold((0.0, 0.0), |a, q| (a.0 + q.0 / n, a.1 + q.1 / n));
-            let inside = polygon.pull_towards((c.x, c.y), centre, balance.margin);
+            let inside = pull_inside(polygon, (c.x, c.y), balance.margin);
             let r = DVector::from_vec(vec![c.x - inside.0, c.y - inside.1]);
             sum += r.norm();
             self.held_res.push(r);

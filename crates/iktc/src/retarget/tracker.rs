@@ -231,6 +231,9 @@ struct Stack {
     ctl: Controller,
     fallback: Controller,
     tasks: Tasks,
+    /// Number of feet's levels leading the stack: the stance feet's, then the floor's (feet
+    /// landing, swing feet near the ground).
+    feet_levels: usize,
 }
 
 /// The handles of a stack's tasks.
@@ -493,9 +496,17 @@ fn build_stack(
         bounds: s.bounds,
         solver: s.solver,
     });
+    let ctl = b.build()?;
+    let feet_levels = ctl
+        .stack()
+        .levels
+        .iter()
+        .take_while(|l| l.name == KEYPOINT_LEVELS[0] || l.name == KEYPOINT_LEVELS[1])
+        .count();
     Ok(Stack {
-        ctl: b.build()?,
+        ctl,
         fallback: gf.build()?,
+        feet_levels,
         tasks: Tasks {
             feet,
             floor,
@@ -568,6 +579,7 @@ impl KeypointController {
             ctl,
             fallback: gf,
             tasks,
+            ..
         } = &mut self.stacks[self.active & 15];
         set_references(
             if fallback { gf } else { ctl },
@@ -750,15 +762,7 @@ impl KeypointController {
         }
         let stack = &self.stacks[self.active & 15];
         let r = stack.ctl.report();
-        // The feet's levels lead the stack: the stance feet's, then the floor's (feet landing,
-        // swing feet near the ground).
-        let feet_levels = stack
-            .ctl
-            .stack()
-            .levels
-            .iter()
-            .take_while(|l| l.name == KEYPOINT_LEVELS[0] || l.name == KEYPOINT_LEVELS[1])
-            .count();
+        let feet_levels = stack.feet_levels;
         let stance = self.stance.contains(&true);
         let held = stance && matches!(r.corrected_from, Some(c) if c < feet_levels);
         let feet_error: f64 = r.task_error_norms.iter().take(feet_levels).sum();
