@@ -499,7 +499,7 @@ fn floating_feet_are_the_contact_ticks_lowest_corners() {
     }
 }
 
-/// The feet's levels under a held foot: on CMU 131_01 JVRC-1 has a landing foot's floor
+/// The feet's levels under a held foot: on CMU 131_01 G1 has a landing foot's floor
 /// corrected by IKTC while the other foot is held (the floor level under the stance level),
 /// and GF's answer keeps the feet's levels more exactly on some of those ticks, which the run
 /// then takes ([`iktc::retarget::KeypointController::tick`]); its soles stay above the ground
@@ -511,7 +511,7 @@ fn gf_keeps_the_floor_under_a_held_foot() {
         .unwrap()
         .keypoints(DEFAULT_MAX_GAP)
         .unwrap();
-    let profile = RobotProfile::builtin("jvrc1").unwrap();
+    let profile = RobotProfile::builtin("g1").unwrap();
     let run = retarget_keypoints(&profile, &kp, None, &KeypointSettings::default()).unwrap();
     let floor =
         run.sacrificed.of(KEYPOINT_LEVELS[1]) + run.settle_sacrificed.of(KEYPOINT_LEVELS[1]);
