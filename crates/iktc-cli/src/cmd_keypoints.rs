@@ -213,6 +213,9 @@ pub fn run(
     Ok(())
 }
 
+/// The summary lists this many joints on a position limit, the most often first.
+const ON_LIMIT_LISTED: usize = 3;
+
 fn print(run: &KeypointRun, joints: Option<&RetargetQuality>) -> std::io::Result<()> {
     let k = &run.quality;
     crate::outln!(
@@ -296,6 +299,22 @@ fn print(run: &KeypointRun, joints: Option<&RetargetQuality>) -> std::io::Result
         "foot floating (max, share > 1 cm)",
         format!("{:.1} mm, {:.1} %", k.float_mm, 100.0 * k.float_share),
         joints.map(|j| format!("{:.1} mm, {:.1} %", j.float_mm, 100.0 * j.float_share)),
+    )?;
+    let on_limit = |q: &RetargetQuality| -> String {
+        if q.on_limit.is_empty() {
+            return "none".into();
+        }
+        q.on_limit
+            .iter()
+            .take(ON_LIMIT_LISTED)
+            .map(|j| format!("{} {:.0} %", j.joint, 100.0 * j.share))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    row(
+        "on a position limit (ticks)",
+        on_limit(k),
+        joints.map(on_limit),
     )?;
     row(
         "jerk RMS / max",

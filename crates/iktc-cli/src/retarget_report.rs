@@ -11,7 +11,7 @@ use crate::cmd_retarget::ClipStatus;
 /// The figures shown: key in `quality.json`'s `figures`, column label with its unit. A column
 /// appears when some clip has its figure (the keypoint and joint routes measure different
 /// things).
-const COLUMNS: [(&str, &str); 27] = [
+const COLUMNS: [(&str, &str); 28] = [
     ("duration", "duration [s]"),
     ("mean_keypoint_error", "mean keypoint error [m]"),
     (
@@ -68,6 +68,10 @@ const COLUMNS: [(&str, &str); 27] = [
     (
         "body_sacrificed_share",
         "share of ticks sacrificing the feet, COM or pelvis [–]",
+    ),
+    (
+        "most_on_limit_share",
+        "largest share of ticks a joint spends on a position limit [–]",
     ),
 ];
 

@@ -190,7 +190,8 @@ impl PyKeypointTrajectory {
     /// "mean_cm", "max_cm"}`), `orientations` (`{"frame", "mean_deg", "max_deg"}`), `slip_mm`,
     /// `below_ground_mm`, `float_mm` (highest a foot the clip has on the ground floats) and `float_share` (share of those foot-ticks above 1 cm), `stance_ticks`, `jerk_rms` and `jerk_max` [rad/s³], the worst
     /// `position_margin` [rad], `velocity_margin` [rad/s] and `acceleration_margin` [rad/s²]
-    /// (positive: a limit exceeded), and `reach_cm`, `balanced_reach_cm` (the reach keeping
+    /// (positive: a limit exceeded), `on_limit` (`(joint, share)` pairs: the joints on a
+    /// position limit on some ticks and the share of the ticks, the most often first), and `reach_cm`, `balanced_reach_cm` (the reach keeping
     /// the clip's feet and the COM over them) and `reach_run_cm` (None unless asked for
     /// with `reach=True`).
     #[getter]
@@ -234,6 +235,12 @@ impl PyKeypointTrajectory {
         d.set_item("position_margin", q.position_margin)?;
         d.set_item("velocity_margin", q.velocity_margin)?;
         d.set_item("acceleration_margin", q.acceleration_margin)?;
+        let on_limit = q
+            .on_limit
+            .iter()
+            .map(|j| (j.joint.as_str(), j.share))
+            .collect::<Vec<_>>();
+        d.set_item("on_limit", on_limit)?;
         d.set_item("reach_cm", q.reach_cm)?;
         d.set_item("reach_run_cm", q.reach_run_cm)?;
         d.set_item("balanced_reach_cm", q.balanced_reach_cm)?;

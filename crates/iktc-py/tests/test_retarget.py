@@ -97,6 +97,11 @@ def test_the_python_quality_figures_equal_the_batch_ones():
     assert abs(q["balanced_reach_cm"] / 100 - figures["balanced_reach_keypoint_error"]) < 1e-12
     assert abs(q["float_mm"] / 1000 - figures["foot_float"]) < 1e-12
     assert q["float_share"] == figures["foot_float_share"] and 0 <= q["float_share"] <= 1
+    # The joints on a position limit, most often first; the first is the report's.
+    shares = [share for _, share in q["on_limit"]]
+    assert shares == sorted(shares, reverse=True) and all(0 < s <= 1 for s in shares)
+    first = q["on_limit"][0] if q["on_limit"] else ("", 0.0)
+    assert first[0] == figures["most_on_limit"] and first[1] == figures["most_on_limit_share"]
     assert 0 < q["reach_cm"] <= q["reach_run_cm"]
     # The per-point means average to the mean; every margin says no limit was exceeded.
     assert abs(np.mean([p["mean_cm"] for p in q["points"]]) - q["mean_cm"]) < 1e-9

@@ -527,3 +527,43 @@ fn gf_keeps_the_floor_under_a_held_foot() {
         "{q:?}"
     );
 }
+
+/// The joints on a position limit (`on_limit`) recomputed from the run's own configurations:
+/// per active joint, the ticks on which its position is within
+/// [`iktc::retarget::LIMIT_BAND`] of a limit of the URDF; every joint with such a tick, the
+/// most often first. G1 on `humanoid3d_dance_a` has joints riding their limits.
+#[test]
+fn joints_on_a_limit_are_counted_from_the_trajectory() {
+    use iktc::retarget::LIMIT_BAND;
+    let profile = RobotProfile::builtin("g1").unwrap();
+    let robot = profile.robot().unwrap();
+    let kp = iktc::retarget::builtin_motion("humanoid3d_dance_a")
+        .unwrap()
+        .keypoints(DEFAULT_MAX_GAP)
+        .unwrap();
+    let run = retarget_keypoints(&profile, &kp, None, &KeypointSettings::default()).unwrap();
+    let ticks = run.trajectory.len() as f64;
+    let mut expected = Vec::new();
+    for j in robot.active_joints() {
+        let i = robot.joint_q_index(&j.name).unwrap();
+        let (lo, hi) = (j.limit.lower, j.limit.upper);
+        let on = run
+            .trajectory
+            .iter()
+            .filter(|q| q[i] <= lo + LIMIT_BAND || q[i] >= hi - LIMIT_BAND)
+            .count();
+        if on > 0 {
+            expected.push((j.name.clone(), on as f64 / ticks));
+        }
+    }
+    expected.sort_by(|a, b| b.1.total_cmp(&a.1));
+    let got: Vec<(String, f64)> = run
+        .quality
+        .on_limit
+        .iter()
+        .map(|j| (j.joint.clone(), j.share))
+        .collect();
+    eprintln!("{got:?}");
+    assert!(!got.is_empty());
+    assert_eq!(got, expected);
+}

@@ -236,6 +236,11 @@ pub struct KeypointFigures {
     pub body_sacrificed_share: f64,
     /// The level IKTC sacrificed on the most ticks (empty if none).
     pub most_sacrificed: String,
+    /// The joint on a position limit on the most ticks (empty if none touches one;
+    /// [`RetargetQuality::on_limit`]).
+    pub most_on_limit: String,
+    /// The share of the ticks that joint is on its limit \[–\] (0 if none).
+    pub most_on_limit_share: f64,
     /// The static reach where it was asked for ([`crate::retarget::KeypointSettings::reach`]): the least mean
     /// keypoint error of a posture within the joint ranges alone, over the ticks sampled
     /// every [`crate::retarget::REACH_PERIOD`] \[m\] ([`RetargetQuality::reach_cm`]); `null` otherwise.
@@ -300,6 +305,11 @@ impl KeypointFigures {
                 .filter(|(_, n)| *n > 0)
                 .max_by_key(|(_, n)| *n)
                 .map_or_else(String::new, |(l, _)| l.clone()),
+            most_on_limit: q
+                .on_limit
+                .first()
+                .map_or_else(String::new, |j| j.joint.clone()),
+            most_on_limit_share: q.on_limit.first().map_or(0.0, |j| j.share),
             reach_keypoint_error: q.reach_cm.map(|c| c / 100.0),
             balanced_reach_keypoint_error: q.balanced_reach_cm.map(|c| c / 100.0),
             reach_run_keypoint_error: q.reach_run_cm.map(|c| c / 100.0),

@@ -45,7 +45,10 @@ mod viewer;
 
 pub use body::{BodyFrameNames, RobotBody, MIN_HEAD_HEIGHT};
 pub use floor::FLOOR_ENGAGE;
-pub use quality::{OrientationError, PointError, QualityRecorder, RetargetQuality, FLOAT_HEIGHT};
+pub use quality::{
+    JointOnLimit, OrientationError, PointError, QualityRecorder, RetargetQuality, FLOAT_HEIGHT,
+    LIMIT_BAND,
+};
 pub use scale::Scaling;
 pub use tracker::{KeypointController, Sacrifices, KEYPOINT_LEVELS, LAND_TILT};
 pub use viewer::{keypoint_viewer, ON_LIMIT};

@@ -60,6 +60,21 @@ pub struct OrientationError {
     pub max_deg: f64,
 }
 
+/// A joint counts as on a position limit in [`RetargetQuality::on_limit`] within this of it
+/// \[rad\] or \[m\] (1 mrad, 0.06°): the viable bounds bring a joint to its limit along a
+/// braking curve, so it spends ticks a hair's breadth short of it rather than exactly on it.
+pub const LIMIT_BAND: f64 = 1e-3;
+
+/// A joint that spends ticks on one of its position limits.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct JointOnLimit {
+    /// The joint's name.
+    pub joint: String,
+    /// Share of the ticks on which its position is within [`LIMIT_BAND`] of its lower or upper
+    /// limit \[–\].
+    pub share: f64,
+}
+
 /// A foot the clip has on the ground counts as floating in [`RetargetQuality::float_share`] when
 /// its lowest sole corner is higher than this above the ground \[m\] (1 cm: ten times the
 /// landing rule's rounding, half its `land_height`).
@@ -101,6 +116,11 @@ pub struct RetargetQuality {
     pub velocity_margin: f64,
     /// Worst acceleration margin \[rad/s²\].
     pub acceleration_margin: f64,
+    /// The joints on a position limit on at least one tick, the most often first (ties in the
+    /// robot's joint order). A joint that rides its limit through much of a clip is where the
+    /// robot's body stops following the captured one, and a long stay on a limit of a leg's yaw
+    /// or roll is a leg on a branch the person's was not.
+    pub on_limit: Vec<JointOnLimit>,
     /// The static reach, where asked for ([`super::KeypointSettings::reach`]): the least mean
     /// body point error found per tick by a posture within the joint ranges alone, averaged
     /// over the ticks sampled every [`super::REACH_PERIOD`] \[cm\] ([`super::reach`]). The robot's
@@ -268,6 +288,7 @@ impl QualityRecorder {
         let joints = robot.n_active();
         let (mut sum_sq, mut count, mut jerk_max) = (0.0, 0usize, 0.0_f64);
         let (mut pm, mut vm, mut am) = (f64::NEG_INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY);
+        let mut on_limit = Vec::new();
         for (j, joint) in robot.active_joints().enumerate().take(joints) {
             let col = |rows: &[Vec<f64>]| -> Vec<f64> {
                 rows.iter()
@@ -280,11 +301,24 @@ impl QualityRecorder {
             sum_sq += sm.rms_jerk * sm.rms_jerk * steps as f64;
             count += steps;
             jerk_max = jerk_max.max(sm.max_jerk);
+            let (lo, hi) = (joint.limit.lower, joint.limit.upper);
+            let on = q
+                .iter()
+                .filter(|x| **x <= lo + LIMIT_BAND || **x >= hi - LIMIT_BAND)
+                .count();
+            if on > 0 {
+                on_limit.push(JointOnLimit {
+                    joint: joint.name.clone(),
+                    share: on as f64 / q.len().max(1) as f64,
+                });
+            }
             let m = dof_margins(j, &q, &qd, &qdd, self.dt, &joint.limit);
             pm = pm.max(m.position);
             vm = vm.max(m.velocity);
             am = am.max(m.acceleration);
         }
+        // Stable: ties keep the robot's joint order.
+        on_limit.sort_by(|a, b| b.share.total_cmp(&a.share));
         RetargetQuality {
             route: self.route.clone(),
             ticks: self.ticks,
@@ -301,6 +335,7 @@ impl QualityRecorder {
             position_margin: pm,
             velocity_margin: vm,
             acceleration_margin: am,
+            on_limit,
             reach_cm: None,
             balanced_reach_cm: None,
             reach_run_cm: None,
