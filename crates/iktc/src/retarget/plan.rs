@@ -1014,6 +1014,8 @@ mod tests {
         dirs[4] = -level(4, 10.0) + Vector3::new(0.0, 0.0, -0.4); // backwards
         dirs[7] = -level(7, 30.0) + Vector3::new(0.0, 0.0, -0.4); // backwards
         dirs[5] = level(5, 40.0);
+        // A foot's length: the share of the horizontal part, not its length, decides.
+        let dirs: Vec<Vector3<f64>> = dirs.iter().map(|d| 0.15 * d).collect();
         let yaw = foot_yaw(&dirs, &heading).unwrap();
         let twist: Vec<f64> = yaw
             .iter()
