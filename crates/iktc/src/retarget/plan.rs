@@ -351,16 +351,14 @@ pub(crate) fn plan(
     for (i, (a, t)) in sides.iter().enumerate() {
         let ankle = get(*a)?;
         let foot0 = kin.frame_pose(robot, body.feet[i])?;
-        let yaw: Vec<f64> = match track(*t) {
-            Some(toe) => {
+        // The toe's yaw where it gives one, else the heading; relative to the first tick.
+        let raw = track(*t)
+            .and_then(|toe| {
                 let dirs: Vec<Vector3<f64>> = (0..ticks).map(|k| toe[k] - ankle[k]).collect();
-                match foot_yaw(&dirs, &heading) {
-                    Some(raw) => raw.iter().map(|y| y - raw[0]).collect(),
-                    None => heading.iter().map(|y| y - heading[0]).collect(),
-                }
-            }
-            None => heading.iter().map(|y| y - heading[0]).collect(),
-        };
+                foot_yaw(&dirs, &heading)
+            })
+            .unwrap_or_else(|| heading.clone());
+        let yaw: Vec<f64> = raw.iter().map(|y| y - raw[0]).collect();
         let mut x: Vec<f64> = ankle.iter().map(|p| p.x).collect();
         let mut y: Vec<f64> = ankle.iter().map(|p| p.y).collect();
         let mut z: Vec<f64> = ankle.iter().map(|p| p.z).collect();
