@@ -157,8 +157,10 @@ pub struct KeypointSettings {
     /// A foot the clip puts on the ground lands (is held by the first level) once its lowest
     /// sole corner is within this height of the ground \[m\] (default 0.02 m) ...
     pub land_height: f64,
-    /// ... its ankle slower than this \[m/s\] (default 0.06 m/s), and its sole tilted less
-    /// than [`LAND_TILT`]. A held foot decelerates under the first level's gains: a foot
+    /// ... every corner of its sole slower than this \[m/s\] (default 0.06 m/s; the corners,
+    /// not the ankle: a foot pivoting about a slow ankle turns its sole, and the held foot's
+    /// yaw then overshoots about the ankle), and its sole tilted less than [`LAND_TILT`]. A
+    /// held foot decelerates under the first level's gains: a foot
     /// landing at speed `v` slides about `v / (e ω)` (`ω` = 20 rad/s, the held feet's
     /// gains), about 1.1 mm at the default; faster landings slide more, slower ones land later
     /// and hold the feet for less of the clip's stance (measured before the held feet's drift

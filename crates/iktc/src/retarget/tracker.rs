@@ -41,8 +41,8 @@
 //!
 //! The hold is closed-loop. A foot the clip puts on the ground is first brought to the plan's
 //! hold in the second level (its height under the floor); it lands (moves to the first level)
-//! once its lowest sole corner is within `land_height` of the ground, its ankle slower than
-//! `land_speed` ([`KeypointSettings`]) and its sole tilted less than [`LAND_TILT`]; a foot
+//! once its lowest sole corner is within `land_height` of the ground, every sole corner
+//! slower than `land_speed` ([`KeypointSettings`]) and its sole tilted less than [`LAND_TILT`]; a foot
 //! that does not get there is not held (landing it at speed, or in the air, would make it
 //! slide or stamp). At landing the offset `δ = (x, y, ψ)_robot − (x, y, ψ)_plan` of the
 //! robot's foot from the plan's hold (horizontal position of the sole's centre \[m\] and yaw
@@ -62,7 +62,10 @@ use nalgebra::{DVector, Point3, UnitQuaternion, Vector3};
 
 use super::body::RobotBody;
 use super::drift::StanceDrift;
-use super::floor::{engaged, floor_acceleration, lowest_after, lowest_corner, sole_corners};
+use super::floor::{
+    engaged, fastest_corner, floor_acceleration, lowest_after, lowest_corner,
+    origin_floor_acceleration, sole_corners,
+};
 use super::plan::Plan;
 use super::KeypointSettings;
 use crate::controller::{
@@ -613,6 +616,19 @@ impl KeypointController {
         let a_ref = r.acceleration[2]
             + self.gains.kv * (r.velocity[2] - z_dot)
             + self.gains.kp * (r.pose.translation.vector.z - z);
+        // The angular acceleration the level asks of the foot (the frame task's law, world
+        // axes): its roll and pitch rows turn the corners about the origin.
+        let er = (r.pose.rotation * pose.rotation.inverse()).scaled_axis();
+        let alpha = r.acceleration.fixed_rows::<3>(3)
+            + self.gains.kv * (r.velocity.fixed_rows::<3>(3) - v.fixed_rows::<3>(3))
+            + self.gains.kp * er;
+        let a_min = a_min.max(origin_floor_acceleration(
+            pose,
+            v,
+            &alpha,
+            &self.corners,
+            &self.gains,
+        ));
         let p = pose.translation.vector;
         Floor {
             z,
@@ -674,7 +690,7 @@ impl KeypointController {
                 if on[i] {
                     let plan = &self.plan.feet[i][k];
                     let low = e <= height;
-                    let slow = v.fixed_rows::<3>(0).norm() <= speed;
+                    let slow = fastest_corner(&pose, &v, &self.corners) <= speed;
                     let flat = (pose.rotation * Vector3::z()).z >= LAND_TILT.cos();
                     if low && slow && flat {
                         // The offset of the sole centre from the plan's (the plan's foot turned
