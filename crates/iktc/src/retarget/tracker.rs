@@ -202,6 +202,9 @@ pub struct KeypointController {
     latch: [(Vector3<f64>, f64); 2],
     /// Whether each foot has landed (is in the first level).
     stance: [bool; 2],
+    /// Whether each foot's floor was in the stack at the last tick (`Floor` or `Landing`): its
+    /// drift is measured as a held foot's ([`super::drift`]).
+    floored: [bool; 2],
     /// Landing thresholds: height \[m\], speed \[m/s\].
     landing: (f64, f64),
     /// Kinematics of the state, updated while a foot is in the air.
@@ -371,7 +374,9 @@ fn set_references(
         // speed (the row's feedback terms vanish).
         r.pose.translation.vector.z = f.z;
         r.velocity[2] = f.z_dot;
-        r.acceleration[2] = f.acceleration;
+        // With the vertical part of the drift's compensation, so that the floor's bound holds
+        // over the tick, not only at its start ([`super::drift`]).
+        r.acceleration[2] = f.acceleration + drift.compensation(*i)[2];
         if let Some([x, y]) = f.stop {
             // Landing: the horizontal motion is damped out where the foot is (ẍ = −k_v ẋ).
             r.pose.translation.vector.x = x;
@@ -567,6 +572,7 @@ impl KeypointController {
             dip_ticks: 0,
             robot: robot.clone(),
             stance: [true; 2],
+            floored: [false; 2],
             landing: (s.land_height, s.land_speed),
             posture_track: posture.1,
             posture_ref: [vec![0.0; m], vec![0.0; m], vec![0.0; m]],
@@ -673,52 +679,50 @@ impl KeypointController {
             }
         }
         let mut modes = [FootMode::Stance; 2];
-        // Whether `kin` holds the kinematics of the state.
-        let fresh = self.stance != [true; 2];
-        if fresh {
-            // The robot's feet where they are now.
-            self.kin.update(&self.robot, &self.state)?;
-            let (kin, robot) = (&self.kin, &*self.robot);
-            let (height, speed) = self.landing;
-            for i in 0..2 {
-                if self.stance[i] {
+        // The robot's feet where they are now, and the held feet's drift over the last tick.
+        self.kin.update(&self.robot, &self.state)?;
+        self.drift
+            .measure(&self.robot, &self.kin, &self.feet, self.dt)?;
+        let (kin, robot) = (&self.kin, &*self.robot);
+        let (height, speed) = self.landing;
+        for i in 0..2 {
+            if self.stance[i] {
+                continue;
+            }
+            let pose = kin.frame_pose(robot, self.feet[i])?;
+            let v = kin.frame_velocity(robot, self.feet[i])?;
+            let (e, e_dot) = lowest_corner(&pose, &v, &self.corners);
+            if on[i] {
+                let plan = &self.plan.feet[i][k];
+                let low = e <= height;
+                let slow = fastest_corner(&pose, &v, &self.corners) <= speed;
+                let flat = (pose.rotation * Vector3::z()).z >= LAND_TILT.cos();
+                if low && slow && flat {
+                    // The offset of the sole centre from the plan's (the plan's foot turned
+                    // by the latched yaw): the first level then flattens the foot about
+                    // where its sole touched, not about the ankle, which would slide the
+                    // sole by `ankle_height · sin θ` (3 mm on JVRC-1 at LAND_TILT).
+                    let x = (pose.rotation * plan.rotation.inverse()) * Vector3::x();
+                    let yaw = x.y.atan2(x.x);
+                    let turned =
+                        UnitQuaternion::from_axis_angle(&Vector3::z_axis(), yaw) * plan.rotation;
+                    let mut d = pose * Point3::from(self.sole)
+                        - (plan.position.position + turned * self.sole);
+                    d.z = 0.0;
+                    self.latch[i] = (d.coords, yaw);
+                    self.stance[i] = true;
                     continue;
                 }
-                let pose = kin.frame_pose(robot, self.feet[i])?;
-                let v = kin.frame_velocity(robot, self.feet[i])?;
-                let (e, e_dot) = lowest_corner(&pose, &v, &self.corners);
-                if on[i] {
-                    let plan = &self.plan.feet[i][k];
-                    let low = e <= height;
-                    let slow = fastest_corner(&pose, &v, &self.corners) <= speed;
-                    let flat = (pose.rotation * Vector3::z()).z >= LAND_TILT.cos();
-                    if low && slow && flat {
-                        // The offset of the sole centre from the plan's (the plan's foot turned
-                        // by the latched yaw): the first level then flattens the foot about
-                        // where its sole touched, not about the ankle, which would slide the
-                        // sole by `ankle_height · sin θ` (3 mm on JVRC-1 at LAND_TILT).
-                        let x = (pose.rotation * plan.rotation.inverse()) * Vector3::x();
-                        let yaw = x.y.atan2(x.x);
-                        let turned = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), yaw)
-                            * plan.rotation;
-                        let mut d = pose * Point3::from(self.sole)
-                            - (plan.position.position + turned * self.sole);
-                        d.z = 0.0;
-                        self.latch[i] = (d.coords, yaw);
-                        self.stance[i] = true;
-                        continue;
-                    }
-                }
-                let a_min = floor_acceleration(e, e_dot, &self.gains);
-                modes[i] = match (on[i], engaged(a_min)) {
-                    (true, true) => FootMode::Landing,
-                    (false, true) => FootMode::Floor,
-                    // Far above the ground a foot is brought down to its hold as in a swing.
-                    (_, false) => FootMode::Swing,
-                };
-                if modes[i] != FootMode::Swing {
-                    self.floor[i] = self.floor_of(i, k, hold, &pose, &v, a_min, modes[i]);
-                }
+            }
+            let a_min = floor_acceleration(e, e_dot, &self.gains);
+            modes[i] = match (on[i], engaged(a_min)) {
+                (true, true) => FootMode::Landing,
+                (false, true) => FootMode::Floor,
+                // Far above the ground a foot is brought down to its hold as in a swing.
+                (_, false) => FootMode::Swing,
+            };
+            if modes[i] != FootMode::Swing {
+                self.floor[i] = self.floor_of(i, k, hold, &pose, &v, a_min, modes[i]);
             }
         }
         if modes.contains(&FootMode::Floor) {
@@ -728,54 +732,49 @@ impl KeypointController {
         self.refer(false, k, hold)?;
         let stack = &mut self.stacks[self.active & 15];
         let tolerance = stack.ctl.settings().solver.box_tolerance;
-        if fresh {
-            // The kinematics of the state, computed above for the feet: swapped in, not
-            // computed again (the fallback below computes its own).
-            stack
-                .ctl
-                .prepare_with_kinematics(&self.state, self.dt, &mut self.kin)?;
-        } else {
-            stack.ctl.prepare(&self.state, self.dt)?;
-        }
+        // The kinematics of the state, computed above for the feet: swapped in, not
+        // computed again (the fallback below computes its own).
+        stack
+            .ctl
+            .prepare_with_kinematics(&self.state, self.dt, &mut self.kin)?;
         let iktc = stack.ctl.settings().method == Method::Iktc;
         stack.ctl.solve()?;
-        if fresh {
-            // A swing foot whose floor is not engaged and which this tick's q̈ would take below
-            // the ground (a correction of the level it shares with the hands can pull it down
-            // at hundreds of m/s²): the tick is solved again with its floor engaged.
-            let mut again = false;
-            for i in 0..2 {
-                if modes[i] != FootMode::Swing {
-                    continue;
-                }
-                let ctl = &self.stacks[self.active & 15].ctl;
-                let (kin, robot) = (ctl.kinematics(), &*self.robot);
-                let pose = kin.frame_pose(robot, self.feet[i])?;
-                let v = kin.frame_velocity(robot, self.feet[i])?;
-                kin.frame_jacobian(robot, self.feet[i], &mut self.dip_jac)?;
-                let mut a = kin.frame_drift(robot, self.feet[i])?;
-                a.gemv(1.0, &self.dip_jac, ctl.qdd(), 1.0);
-                if lowest_after(&pose, &v, &a, &self.corners, self.dt) < 0.0 {
-                    let (e, e_dot) = lowest_corner(&pose, &v, &self.corners);
-                    let a_min = floor_acceleration(e, e_dot, &self.gains);
-                    modes[i] = if on[i] {
-                        FootMode::Landing
-                    } else {
-                        FootMode::Floor
-                    };
-                    self.floor[i] = self.floor_of(i, k, hold, &pose, &v, a_min, modes[i]);
-                    again = true;
-                }
+        // A swing foot whose floor is not engaged and which this tick's q̈ would take below
+        // the ground (a correction of the level it shares with the hands can pull it down
+        // at hundreds of m/s²): the tick is solved again with its floor engaged.
+        let mut again = false;
+        for i in 0..2 {
+            if modes[i] != FootMode::Swing {
+                continue;
             }
-            if again {
-                self.dip_ticks += 1;
-                self.active = modes[0].index() + 4 * modes[1].index();
-                self.refer(false, k, hold)?;
-                let ctl = &mut self.stacks[self.active & 15].ctl;
-                ctl.prepare(&self.state, self.dt)?;
-                ctl.solve()?;
+            let ctl = &self.stacks[self.active & 15].ctl;
+            let (kin, robot) = (ctl.kinematics(), &*self.robot);
+            let pose = kin.frame_pose(robot, self.feet[i])?;
+            let v = kin.frame_velocity(robot, self.feet[i])?;
+            kin.frame_jacobian(robot, self.feet[i], &mut self.dip_jac)?;
+            let mut a = kin.frame_drift(robot, self.feet[i])?;
+            a.gemv(1.0, &self.dip_jac, ctl.qdd(), 1.0);
+            if lowest_after(&pose, &v, &a, &self.corners, self.dt) < 0.0 {
+                let (e, e_dot) = lowest_corner(&pose, &v, &self.corners);
+                let a_min = floor_acceleration(e, e_dot, &self.gains);
+                modes[i] = if on[i] {
+                    FootMode::Landing
+                } else {
+                    FootMode::Floor
+                };
+                self.floor[i] = self.floor_of(i, k, hold, &pose, &v, a_min, modes[i]);
+                again = true;
             }
         }
+        if again {
+            self.dip_ticks += 1;
+            self.active = modes[0].index() + 4 * modes[1].index();
+            self.refer(false, k, hold)?;
+            let ctl = &mut self.stacks[self.active & 15].ctl;
+            ctl.prepare(&self.state, self.dt)?;
+            ctl.solve()?;
+        }
+        self.floored = modes.map(|m| matches!(m, FootMode::Floor | FootMode::Landing));
         let stack = &self.stacks[self.active & 15];
         let r = stack.ctl.report();
         let feet_levels = stack.feet_levels;
@@ -904,9 +903,8 @@ impl KeypointController {
             &self.robot,
             ctl.kinematics(),
             &self.feet,
-            self.stance,
+            [0, 1].map(|i| self.stance[i] || self.floored[i]),
             ctl.qdd(),
-            self.dt,
         )?;
         if self.used_fallback {
             s.fallback.integrate(&mut self.state)
