@@ -302,6 +302,24 @@ mod tests {
         assert!((hd - fd).abs() < 1e-6, "{hd} {fd}");
     }
 
+    /// A foot at a seeded random pose, its origin `height ± 0.05` m up and tilted up to `tilt`
+    /// \[rad\] about x and y, with a random twist (origin's linear velocity up to 1 m/s,
+    /// angular velocity up to 4 rad/s).
+    fn random_foot(
+        rng: &mut rand::rngs::StdRng,
+        height: f64,
+        tilt: f64,
+    ) -> (Isometry3<f64>, Vector6<f64>) {
+        use rand::Rng;
+        let mut u = |r: f64| rng.random_range(-r..r);
+        let pose = Isometry3::new(
+            Vector3::new(u(0.5), u(0.5), height + u(0.05)),
+            Vector3::new(u(tilt), u(tilt), u(3.0)),
+        );
+        let v = Vector6::new(u(1.0), u(1.0), u(0.5), u(2.0), u(2.0), u(4.0));
+        (pose, v)
+    }
+
     /// The origin's bound against each corner's motion computed independently: the foot moved
     /// at constant linear and angular acceleration (`R(t) = exp([ω t + ½ α t²]×) R₀`), each
     /// corner's height differentiated twice by central differences. At the origin's bound every
@@ -314,18 +332,11 @@ mod tests {
         // Finite-difference step [s] and the agreement it allows [m/s²] (error O(h²)).
         let (h, tol) = (1e-4, 1e-4);
         for _ in 0..200 {
+            let (pose, v) = random_foot(&mut rng, 0.15, 0.2);
             let mut u = |r: f64| rng.random_range(-r..r);
-            let pose = Isometry3::new(
-                Vector3::new(u(0.5), u(0.5), 0.15 + u(0.05)),
-                Vector3::new(u(0.2), u(0.2), u(3.0)),
-            );
-            let v = Vector6::new(u(1.0), u(1.0), u(0.5), u(2.0), u(2.0), u(4.0));
             let alpha = Vector3::new(u(50.0), u(50.0), u(50.0));
             let a_z = origin_floor_acceleration(&pose, &v, &alpha, &corners, &GAINS);
-            let (lin, w) = (
-                v.fixed_rows::<3>(0).into_owned(),
-                v.fixed_rows::<3>(3).into_owned(),
-            );
+            let (lin, w) = parts(&v);
             let a = Vector3::new(u(5.0), u(5.0), a_z);
             let height = |c: &Vector3<f64>, t: f64| {
                 let turn = nalgebra::UnitQuaternion::from_scaled_axis(w * t + 0.5 * alpha * t * t);
@@ -349,22 +360,14 @@ mod tests {
     /// foot pivoting about its still ankle is fast at its corners.
     #[test]
     fn the_fastest_corner_is_the_largest_corner_speed() {
-        use rand::{Rng, SeedableRng};
+        use rand::SeedableRng;
         let corners = corners_of(0.03);
         let mut rng = rand::rngs::StdRng::seed_from_u64(29);
         // Finite-difference step [s] and the agreement it allows [m/s] (error O(h²)).
         let (h, tol) = (1e-5, 1e-8);
         for _ in 0..100 {
-            let mut u = |r: f64| rng.random_range(-r..r);
-            let pose = Isometry3::new(
-                Vector3::new(u(0.5), u(0.5), 0.1 + u(0.05)),
-                Vector3::new(u(0.3), u(0.3), u(3.0)),
-            );
-            let v = Vector6::new(u(1.0), u(1.0), u(0.5), u(2.0), u(2.0), u(4.0));
-            let (lin, w) = (
-                v.fixed_rows::<3>(0).into_owned(),
-                v.fixed_rows::<3>(3).into_owned(),
-            );
+            let (pose, v) = random_foot(&mut rng, 0.1, 0.3);
+            let (lin, w) = parts(&v);
             let at = |c: &Vector3<f64>, t: f64| {
                 let turn = nalgebra::UnitQuaternion::from_scaled_axis(w * t);
                 pose.translation.vector + lin * t + turn * (pose.rotation * c)

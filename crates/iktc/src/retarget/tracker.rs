@@ -619,15 +619,11 @@ impl KeypointController {
     ) -> Floor {
         let r = foot_reference(&self.plan, i, k, hold, self.latch[i]);
         let (z, z_dot) = (pose.translation.vector.z, v[2]);
-        let a_ref = r.acceleration[2]
-            + self.gains.kv * (r.velocity[2] - z_dot)
-            + self.gains.kp * (r.pose.translation.vector.z - z);
-        // The angular acceleration the level asks of the foot (the frame task's law, world
-        // axes): its roll and pitch rows turn the corners about the origin.
-        let er = (r.pose.rotation * pose.rotation.inverse()).scaled_axis();
-        let alpha = r.acceleration.fixed_rows::<3>(3)
-            + self.gains.kv * (r.velocity.fixed_rows::<3>(3) - v.fixed_rows::<3>(3))
-            + self.gains.kp * er;
+        // What the level asks of the foot by the frame task's law (world axes): its height's
+        // own reference, and the angular acceleration with which its roll and pitch rows turn
+        // the corners about the origin.
+        let asked = r.desired_acceleration(pose, v, &self.gains);
+        let (a_ref, alpha) = (asked[2], asked.fixed_rows::<3>(3).into_owned());
         let a_min = a_min.max(origin_floor_acceleration(
             pose,
             v,

@@ -38,6 +38,26 @@ pub struct FrameReference {
 }
 
 impl FrameReference {
+    /// The error of a frame at `pose` from this reference, world axes: the position error
+    /// `p_d − p` \[m\], then the orientation error `log(R_d Rᵀ)` as a rotation vector \[rad\].
+    pub(crate) fn pose_error(&self, pose: &Isometry3<f64>) -> Vector6<f64> {
+        let ep = self.pose.translation.vector - pose.translation.vector;
+        let er = (self.pose.rotation * pose.rotation.inverse()).scaled_axis();
+        Vector6::new(ep.x, ep.y, ep.z, er.x, er.y, er.z)
+    }
+
+    /// The acceleration a frame task with `gains` asks of a frame at `pose` moving with
+    /// `velocity` (world axes, \[m/s\] then \[rad/s\]): `ẍ_d + k_v(ẋ_d − ẋ) + k_p e`
+    /// \[m/s², rad/s²\], its rows' right-hand side before `J̇q̇` is taken off.
+    pub(crate) fn desired_acceleration(
+        &self,
+        pose: &Isometry3<f64>,
+        velocity: &Vector6<f64>,
+        gains: &Gains,
+    ) -> Vector6<f64> {
+        self.acceleration + gains.kv * (self.velocity - velocity) + gains.kp * self.pose_error(pose)
+    }
+
     /// A pose held still.
     pub fn hold(pose: Isometry3<f64>) -> Self {
         Self {
@@ -140,9 +160,7 @@ impl FrameTask {
         let pose = kin.frame_pose(robot, self.frame)?;
         let vel = kin.frame_velocity(robot, self.frame)?;
         let drift = kin.frame_drift(robot, self.frame)?;
-        let ep = self.reference.pose.translation.vector - pose.translation.vector;
-        let er = (self.reference.pose.rotation * pose.rotation.inverse()).scaled_axis();
-        let e = Vector6::new(ep.x, ep.y, ep.z, er.x, er.y, er.z);
+        let e = self.reference.pose_error(&pose);
         let edot = self.reference.velocity - vel;
         let mut r = offset;
         for k in 0..6 {
