@@ -363,6 +363,33 @@ fn g1_slows_down_on_a_held_frame_with_the_posture_rows() {
     }
 }
 
+/// Largest joint speed \[rad/s\] at which a joint counts as at rest on a held frame: 0.01
+/// rad/s moves a 0.3 m arm by 3 mm/s, below what a position servo resolves.
+const REST_SPEED: f64 = 0.01;
+
+/// The target of a held frame: the references stand still, so should the robot. Not met in
+/// 0.2.0 (hence ignored): between 2 s and 6 s G1's fastest joint moves at a median 0.24 rad/s
+/// on `humanoid3d_dance_b` and 1.8 rad/s on `humanoid3d_punch`. Measured on 51 clips of
+/// Bandai Namco's motion dataset (not shipped): at the end of the 1.5 s settling on the first
+/// frame the fastest joint moves at 1.0 rad/s (median over clips), an elbow swinging by about
+/// ±0.15 rad at about 2 Hz; the swing stays with fixed damping (λ = 0, 0.01, 0.05), other
+/// gains (k_v 10 or 40 s⁻¹, k_p 25 s⁻²), the posture rows weighted 0.03–1, the COM reference
+/// moved onto the robot's own COM, and without the elbows' and the torso's rows; with the hands
+/// placed along the arm's segments (`HandScaling::Segments`) the same median is 0.004 rad/s.
+#[test]
+#[ignore = "target not met: G1's arms do not come to rest on a held frame"]
+fn g1_comes_to_rest_on_a_held_frame() {
+    let mut moving = Vec::new();
+    for clip in ["humanoid3d_dance_b", "humanoid3d_punch"] {
+        let speed = held_frame_speed(clip, KeypointSettings::default().posture_weight, (2.0, 6.0));
+        eprintln!("{clip}: median {speed:.4} rad/s");
+        if speed >= REST_SPEED {
+            moving.push(format!("{clip}: {speed:.4} rad/s"));
+        }
+    }
+    assert!(moving.is_empty(), "{}", moving.join(", "));
+}
+
 /// The wrists' mean error (against the human wrist scaled by the leg ratio from the middle of
 /// the robot's hips, [`iktc::retarget::RetargetQuality`]) of G1 with the hands placed by the
 /// leg ratio (the default) and along the arm's segments, both wrists' mean, without posture
