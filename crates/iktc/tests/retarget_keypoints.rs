@@ -373,7 +373,7 @@ const REST_SPEED: f64 = 0.01;
 /// Bandai Namco's motion dataset (not shipped): at the end of the 1.5 s settling on the first
 /// frame the fastest joint moves at 1.0 rad/s (median over clips), an elbow swinging by about
 /// ±0.15 rad at about 2 Hz; the swing stays with fixed damping (λ = 0, 0.01, 0.05), other
-/// gains (k_v 10 or 40 s⁻¹, k_p 25 s⁻²), the posture rows weighted 0.03–1, the COM reference
+/// gains (k_v 10 or 40 s⁻¹, k_p 25 s⁻²), the posture rows weighted 1 or in a level of their own, the COM reference
 /// moved onto the robot's own COM, and without the elbows' and the torso's rows; with the hands
 /// placed along the arm's segments (`HandScaling::Segments`) the same median is 0.004 rad/s.
 #[test]
