@@ -14,7 +14,7 @@ static A: counting_alloc::Counting = counting_alloc::Counting;
 
 #[test]
 fn the_keypoint_tick_allocates_nothing_on_jvrc1_and_g1() {
-    let kp = builtin_motion("humanoid3d_dance_b")
+    let kp = builtin_motion("humanoid3d_dance_a")
         .unwrap()
         .keypoints(iktc::motion::DEFAULT_MAX_GAP)
         .unwrap();

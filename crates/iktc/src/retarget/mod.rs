@@ -187,16 +187,17 @@ pub struct KeypointSettings {
     /// joints' RMS jerk from 5 940 to 5 070 rad/s³ and 6 Hz to 4 610. The quality figures
     /// still compare the robot with the captured points.
     pub smoothing: Option<f64>,
-    /// Weight of the posture rows in the `elbows_head_torso` level \[–\] (default
-    /// [`POSTURE_WEIGHT`]; 0 puts them in a seventh level of their own, below all tracking, as
-    /// before 0.2.0): a joint's acceleration 1 rad/s² off its posture
-    /// reference costs as much there as an elbow's `weight` m/s² off its reference. The levels
-    /// above the posture level can take every coordinate (on G1 all 35), and each is then
-    /// solved exactly in what the levels above leave it, however ill-conditioned, with no
-    /// damping of a joint's velocity but the tasks' own: without these rows G1's arms never
-    /// come to rest on a held frame (9–26 rad/s after 3 s) and its joints' accelerations ride
-    /// the box. With them the level's least-squares problem is a compromise with the posture's
-    /// `q̈_d + k_v (q̇_d − q̇) + k_p (q_d − q)`, which damps every joint the level moves.
+    /// Weight of the posture rows in the `hands_swing_feet` level \[–\] (default
+    /// [`POSTURE_WEIGHT`]; 0 puts them in a seventh level of their own, below all tracking):
+    /// a joint's acceleration 1 rad/s² off its posture reference costs as much there as a
+    /// hand's `weight` m/s² off its reference. The levels above the posture level can take
+    /// every coordinate (on G1 all 35), and each is then solved exactly in what the levels
+    /// above leave it, however ill-conditioned, with no damping of a joint's velocity but the
+    /// tasks' own: without these rows G1's arms never come to rest on a held frame (9–26 rad/s
+    /// after 3 s) and its joints' accelerations ride the box. With them the hands' level is a
+    /// least-squares compromise with the posture's `q̈_d + k_v (q̇_d − q̇) + k_p (q_d − q)`,
+    /// which holds and damps the motion of an arm that leaves its hand in place (and the
+    /// level takes every coordinate, so the `elbows_head_torso` level below it moves nothing).
     pub posture_weight: f64,
     /// Where the hands' references are placed (default [`HandScaling::Leg`]). On the shared
     /// clips (`tests/retarget_keypoints.rs`) it brings G1's wrists within a mean 2.7–4.8 cm of
@@ -217,11 +218,16 @@ pub struct KeypointSettings {
 /// Sample period of the static reach ([`KeypointSettings::reach`]) \[s\].
 pub const REACH_PERIOD: f64 = 0.05;
 
-/// Default [`KeypointSettings::posture_weight`] \[–\]: 0.3 rad/s² of a joint against 1 m/s² of
-/// an elbow. On the shared clips (`tests/retarget_keypoints.rs`) it lowers the joints' RMS jerk
-/// by 9–42 % on G1 and by up to 25 % on JVRC-1 and the worst sole penetration from 0.81 to
-/// 0.35 mm, and raises the mean keypoint errors by up to 2.9 cm.
-pub const POSTURE_WEIGHT: f64 = 0.3;
+/// Default [`KeypointSettings::posture_weight`] \[–\]: 0.1 rad/s² of a joint against 1 m/s² of
+/// a hand. Against the same rows weighted 0.3 in the level below (`elbows_head_torso`, before
+/// 0.2.0), on 51 Bandai Namco clips (`iktc retarget`, the joint route's posture references):
+/// G1 comes to rest on the held first frame (fastest joint at the end of the settling, median
+/// over clips, 1.1 → 0.0002 rad/s; JVRC-1 1.0 → 0.00003 rad/s), its joints' RMS jerk falls
+/// (median 3 570 → 1 080 rad/s³; JVRC-1 2 850 → 2 080), the worst clip's mean keypoint error
+/// falls (12.1 → 9.9 cm; JVRC-1 15.7 → 14.2) and the median clip's rises (6.22 → 6.87 cm;
+/// JVRC-1 9.91 → 10.26). Weights 0.05 and 0.07 kept more of the median (6.60 cm) but put a
+/// sole 0.46–0.59 mm below the ground on G1 CMU 131_01; 0.15 and 0.2 raised it to 7.4–8.0 cm.
+pub const POSTURE_WEIGHT: f64 = 0.1;
 
 impl Default for KeypointSettings {
     fn default() -> Self {

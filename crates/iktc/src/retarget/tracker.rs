@@ -8,24 +8,30 @@
 //!    floor ([`super::floor`]) keeps their soles above the ground;
 //! 3. `com_xy`: the COM over the support polygon, horizontal;
 //! 4. `pelvis`: the pelvis pose, 6D;
-//! 5. `hands_swing_feet`: the hand frames' positions and the feet in the air, 6D;
-//! 6. `elbows_head_torso`: the elbows' and the head's positions and the torso's orientation,
-//!    and every active joint at its posture reference with its rows weighted by
+//! 5. `hands_swing_feet`: the hand frames' positions and the positions of the feet in the
+//!    air, and every active joint at its posture reference with its rows weighted by
 //!    [`KeypointSettings::posture_weight`] (a regulariser, see below);
+//! 6. `elbows_head_torso`: the elbows' and the head's positions, the torso's orientation and
+//!    the orientations of the feet in the air; with weighted posture rows in the fifth level
+//!    it has no coordinate left (rank 0) and moves nothing, and only its errors are reported;
 //! 7. `posture`: only with a posture weight of 0, every active joint at its posture reference
 //!    in a level of its own (below the weighted rows such a level could only move what they
 //!    already move: it would have rank 0).
 //!
 //! The levels above the last can take every coordinate (on G1 the feet, COM, pelvis, hands,
-//! elbows and torso take all 35, leaving the posture level rank 0): each level is then solved
-//! exactly in what its betters leave it, however ill-conditioned that is, and nothing damps a
-//! joint's velocity but the tasks' own. Without the regulariser G1's arms never come to rest
-//! on a held frame (9–26 rad/s after 3 s on `humanoid3d_dance_b`, `_walk`, `_punch`), its
-//! joints' accelerations ride the box (RMS jerk 17 000–33 000 rad/s³ over the shared clips),
-//! and in MuJoCo its servos trail the arms' set points by 0.67 rad rms. In the sixth level the
-//! posture rows make the level's least-squares problem a compromise between the elbows, head
-//! and torso and the posture's `q̈_d + k_v (q̇_d − q̇) + k_p (q_d − q)`, which damps every joint
-//! that level moves.
+//! elbows and torso take all 35): each level is then solved exactly in what its betters leave
+//! it, however ill-conditioned that is, and nothing damps a joint's velocity but the tasks'
+//! own. Without the regulariser G1's arms never come to rest on a held frame (9–26 rad/s after
+//! 3 s on `humanoid3d_dance_b`, `_walk`, `_punch`), its joints' accelerations ride the box
+//! (RMS jerk 17 000–33 000 rad/s³ over the shared clips), and in MuJoCo its servos trail the
+//! arms' set points by 0.67 rad rms. In the fifth level the posture rows make the level's
+//! least-squares problem a compromise between the hands and the posture's `q̈_d + k_v (q̇_d −
+//! q̇) + k_p (q_d − q)`, which holds and damps the hands' null space: the motion of an arm
+//! that leaves its hand where it is. With the posture rows one level lower (before 0.2.0),
+//! the hands' level pushed a hand towards a reference the arm could not quite reach through
+//! a nearly singular Jacobian, and the elbow and wrist swung against each other in that null
+//! space (G1 on 51 Bandai Namco clips: the fastest joint at the end of the settling at 1.0
+//! rad/s, median over clips; now 2 · 10⁻⁴ rad/s).
 //!
 //! A foot is in the first level only once it has landed, and in the second only while it
 //! lands or its floor is engaged: one stack per pair of foot modes ([`FootMode`]: stance,
@@ -469,18 +475,40 @@ fn build_stack(
     for i in (0..2).filter(|i| swing[*i]) {
         feet.push((i, b.frame(&name(body.feet[i]), Axes::POSITION)?));
     }
-    let mut level = 4;
-    for (i, (p, _)) in plan.points.iter().enumerate() {
-        if level == 4 && !matches!(p, BodyPoint::LeftWrist | BodyPoint::RightWrist) {
-            b.level(KEYPOINT_LEVELS[5]);
-            level = 5;
-        }
+    let hand = |p: &BodyPoint| matches!(p, BodyPoint::LeftWrist | BodyPoint::RightWrist);
+    for (i, (p, _)) in plan.points.iter().enumerate().filter(|(_, (p, _))| hand(p)) {
         if let Some(f) = body.frame_of(*p) {
             points.push((b.frame(&name(f), Axes::POSITION)?, i));
         }
     }
-    if level == 4 {
+    let names: Vec<&str> = posture.iter().map(String::as_str).collect();
+    // Weighted into the fifth level, or (weight 0) a level of its own below the sixth: never
+    // both, as a posture level below the weighted rows could only move what they already move.
+    let weighted = if s.posture_weight > 0.0 {
+        Some(b.weighted_joints(&names, s.posture_weight)?)
+    } else {
+        None
+    };
+    // The sixth level only with a task in it (a robot without elbows, head or torso frames
+    // standing on both feet has none).
+    let sixth = body.torso.is_some()
+        || swing.contains(&true)
+        || plan
+            .points
+            .iter()
+            .any(|(p, _)| !hand(p) && body.frame_of(*p).is_some());
+    if sixth {
         b.level(KEYPOINT_LEVELS[5]);
+    }
+    for (i, (p, _)) in plan
+        .points
+        .iter()
+        .enumerate()
+        .filter(|(_, (p, _))| !hand(p))
+    {
+        if let Some(f) = body.frame_of(*p) {
+            points.push((b.frame(&name(f), Axes::POSITION)?, i));
+        }
     }
     let torso = match body.torso {
         Some(f) => Some(b.frame(&name(f), Axes::ORIENTATION)?),
@@ -489,13 +517,9 @@ fn build_stack(
     for i in (0..2).filter(|i| swing[*i]) {
         feet.push((i, b.frame(&name(body.feet[i]), Axes::ORIENTATION)?));
     }
-    let names: Vec<&str> = posture.iter().map(String::as_str).collect();
-    // Weighted into the sixth level, or (weight 0) a level of its own: never both, as a
-    // posture level below the weighted rows could only move what they already move.
-    let posture = if s.posture_weight > 0.0 {
-        b.weighted_joints(&names, s.posture_weight)?
-    } else {
-        b.level(KEYPOINT_LEVELS[6]).joints(&names)?
+    let posture = match weighted {
+        Some(h) => h,
+        None => b.level(KEYPOINT_LEVELS[6]).joints(&names)?,
     };
     // The clone keeps the builder's identity: the handles address both controllers.
     let mut gf = b.clone();
