@@ -226,7 +226,10 @@ pub const REACH_PERIOD: f64 = 0.05;
 /// (median 3 570 → 1 080 rad/s³; JVRC-1 2 850 → 2 080), the worst clip's mean keypoint error
 /// falls (12.1 → 9.9 cm; JVRC-1 15.7 → 14.2) and the median clip's rises (6.22 → 6.87 cm;
 /// JVRC-1 9.91 → 10.26). Weights 0.05 and 0.07 kept more of the median (6.60 cm) but put a
-/// sole 0.46–0.59 mm below the ground on G1 CMU 131_01; 0.15 and 0.2 raised it to 7.4–8.0 cm.
+/// sole 0.46–0.59 mm below the ground on G1 CMU 131_01; 0.15, 0.2 and 0.3 raised it to 7.4,
+/// 8.0 and 9.0 cm. In MuJoCo's standing imitation (`mujoco_g1.py standing --plan upper-body`)
+/// 0.3 keeps the plan's ZMP inside the soles on every tick, 0.1 lets it out by up to 18 mm on
+/// 3 of 508 (G1 stays up, the measured ZMP at least 44 mm inside).
 pub const POSTURE_WEIGHT: f64 = 0.1;
 
 impl Default for KeypointSettings {
