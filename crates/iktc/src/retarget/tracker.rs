@@ -957,3 +957,137 @@ impl KeypointController {
         &self.stacks[self.active & 15].ctl
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::profile::RobotProfile;
+
+    /// G1 set up on `humanoid3d_dance_b` with `s`: its robot, start state, body, the
+    /// controller (for its plan) and the posture's joint names.
+    fn g1(
+        s: &KeypointSettings,
+    ) -> (
+        Arc<Robot>,
+        State,
+        RobotBody,
+        KeypointController,
+        Vec<String>,
+    ) {
+        let profile = RobotProfile::builtin("g1").unwrap();
+        let kp = super::super::builtin_motion("humanoid3d_dance_b")
+            .unwrap()
+            .keypoints(crate::motion::DEFAULT_MAX_GAP)
+            .unwrap();
+        let robot = Arc::new(profile.robot().unwrap());
+        let set = super::super::setup(robot.clone(), &profile, &kp, None, s).unwrap();
+        let names = robot.active_joints().map(|j| j.name.clone()).collect();
+        let state = set.controller.state().clone();
+        (robot, state, set.body, set.controller, names)
+    }
+
+    /// The levels of a stack, as (name, rows).
+    fn levels(stack: &Stack) -> Vec<(String, usize)> {
+        let levels = &stack.ctl.stack().levels;
+        levels.iter().map(|l| (l.name.clone(), l.dim())).collect()
+    }
+
+    fn named(v: &[(&str, usize)]) -> Vec<(String, usize)> {
+        v.iter().map(|(n, m)| (n.to_string(), *m)).collect()
+    }
+
+    /// With a posture weight the posture rows (one per active joint, 29 on G1) follow the
+    /// hands' positions (3 rows each) in the fifth level; the elbows (3 rows each) and the
+    /// torso's orientation (3) make the sixth. With a weight of 0 the posture has a level of
+    /// its own, last.
+    #[test]
+    fn the_posture_rows_share_the_hands_level() {
+        let stance = [FootMode::Stance, FootMode::Stance];
+        let s = KeypointSettings::default();
+        let (robot, state, body, c, names) = g1(&s);
+        assert_eq!(names.len(), 29);
+        let stack = build_stack(&robot, &state, &body, c.plan(), &names, &s, stance).unwrap();
+        let want = [
+            ("stance_feet", 12),
+            ("com_xy", 2),
+            ("pelvis", 6),
+            ("hands_swing_feet", 6 + 29),
+            ("elbows_head_torso", 6 + 3),
+        ];
+        assert_eq!(levels(&stack), named(&want));
+        let s0 = KeypointSettings {
+            posture_weight: 0.0,
+            ..s
+        };
+        let stack = build_stack(&robot, &state, &body, c.plan(), &names, &s0, stance).unwrap();
+        let want = [
+            ("stance_feet", 12),
+            ("com_xy", 2),
+            ("pelvis", 6),
+            ("hands_swing_feet", 6),
+            ("elbows_head_torso", 6 + 3),
+            ("posture", 29),
+        ];
+        assert_eq!(levels(&stack), named(&want));
+    }
+
+    /// A body without elbows, head or torso frames has no sixth level while both feet are
+    /// held (an empty level is an error), and one with the swing foot's orientation otherwise;
+    /// a body with only a torso, or only elbows, has it.
+    #[test]
+    fn the_sixth_level_is_there_only_with_a_task() {
+        let s = KeypointSettings::default();
+        let (robot, state, body, c, names) = g1(&s);
+        let hands_only = RobotBody {
+            torso: None,
+            points: body
+                .points
+                .iter()
+                .filter(|(p, _)| {
+                    !matches!(
+                        p,
+                        BodyPoint::LeftElbow | BodyPoint::RightElbow | BodyPoint::Head
+                    )
+                })
+                .copied()
+                .collect(),
+            ..body.clone()
+        };
+        let stance = [FootMode::Stance, FootMode::Stance];
+        let swing = [FootMode::Swing, FootMode::Stance];
+        let stack = build_stack(&robot, &state, &hands_only, c.plan(), &names, &s, stance).unwrap();
+        let names_of =
+            |st: &Stack| -> Vec<String> { levels(st).into_iter().map(|l| l.0).collect() };
+        assert!(!names_of(&stack).iter().any(|n| n == KEYPOINT_LEVELS[5]));
+        let stack = build_stack(&robot, &state, &hands_only, c.plan(), &names, &s, swing).unwrap();
+        assert_eq!(
+            levels(&stack).last().unwrap(),
+            &(KEYPOINT_LEVELS[5].to_string(), 3)
+        );
+        let torso_only = RobotBody {
+            torso: body.torso,
+            ..hands_only.clone()
+        };
+        let stack = build_stack(&robot, &state, &torso_only, c.plan(), &names, &s, stance).unwrap();
+        assert_eq!(
+            levels(&stack).last().unwrap(),
+            &(KEYPOINT_LEVELS[5].to_string(), 3)
+        );
+        let elbows_only = RobotBody {
+            torso: None,
+            points: body
+                .points
+                .iter()
+                .filter(|(p, _)| *p != BodyPoint::Head)
+                .copied()
+                .collect(),
+            ..body.clone()
+        };
+        let stack =
+            build_stack(&robot, &state, &elbows_only, c.plan(), &names, &s, stance).unwrap();
+        assert_eq!(
+            levels(&stack).last().unwrap(),
+            &(KEYPOINT_LEVELS[5].to_string(), 6)
+        );
+    }
+}
