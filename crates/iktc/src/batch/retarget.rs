@@ -448,8 +448,9 @@ mod tests {
 
     /// The share of the ticks that sacrifice the feet's, COM's or pelvis' level flags the clip
     /// the robot cannot take: JVRC-1 on `humanoid3d_dance_a`, whose first frame is out of its
-    /// reach (0.2.0: its pelvis level sacrificed on 151 of 324 ticks, a share of 0.49),
-    /// against `humanoid3d_walk` (0.02).
+    /// reach (0.2.0: a body level sacrificed on 118 of 324 ticks, a share of 0.36; 0.49
+    /// before its feet pivoted with the dancer), more than a quarter of its ticks, against
+    /// `humanoid3d_walk` (0.02).
     #[test]
     fn the_body_sacrificed_share_flags_the_clip_the_robot_cannot_take() {
         let b = batch();
@@ -464,7 +465,7 @@ mod tests {
         };
         let (bad, bad_level) = share("humanoid3d_dance_a");
         let (walk, _) = share("humanoid3d_walk");
-        assert!(bad > 0.4, "dance_a: {bad}");
+        assert!(bad > 0.25, "dance_a: {bad}");
         assert!(KEYPOINT_LEVELS.contains(&bad_level.as_str()), "{bad_level}");
         assert!(walk < 0.1 * bad, "walk {walk} against dance_a {bad}");
     }

@@ -20,6 +20,12 @@
 //! mid-swing it follows the captured foot (its lift, its path). Before the first stance and
 //! after the last one the track is shifted onto the hold, its departure faded in the same way
 //! over the first (last) `r` of the free run.
+//!
+//! A foot's yaw is held the same way, except over a stance in which the captured foot turns
+//! by more than [`PIVOT_TURN`]: there the foot pivots, its yaw following the captured one
+//! (averaged over [`PIVOT_SMOOTHING`], at most [`PIVOT_RATE`]), and `H₁`, `H₂` are the yaws at
+//! the stance's ends ([`hold_turning`]). The feet's x and y are held at the sole's centre, so
+//! a pivoting foot turns about it ([`super::plan`]).
 
 /// Contact detection per source frame for one foot (see the module documentation); `ankle`
 /// and `toe` are positions per frame \[m\], `times` the frame times \[s\].
@@ -106,33 +112,108 @@ fn fade(tau: f64) -> f64 {
 /// documentation); `stance_value`, if given, replaces the run mean (the sole on the ground).
 pub(crate) fn hold(track: &mut [f64], contact: &[bool], stance_value: Option<f64>) {
     let stances = runs(contact);
+    let values = stances
+        .iter()
+        .map(|&(s, e)| {
+            let h = stance_value.unwrap_or(track[s..e].iter().sum::<f64>() / (e - s) as f64);
+            vec![h; e - s]
+        })
+        .collect();
+    shape(track, &stances, values);
+}
+
+/// Smallest turn of a foot over one of its stances for the foot to pivot \[rad\]: a foot whose
+/// captured yaw spans less over a stance is held at the stance's mean yaw (the captured yaw's
+/// jitter, a few degrees, would twist the held foot for nothing); one that spans more turns
+/// with it, about its sole's centre (a dancer spinning on a foot: DeepMimic's
+/// `humanoid3d_dance_a` turns a full circle in 1.6 s, its left foot 4.9 rad over one stance).
+pub const PIVOT_TURN: f64 = 0.35;
+
+/// Window of the moving average of a pivoting foot's yaw \[s\]: the captured toe's direction
+/// jitters by a few degrees from frame to frame.
+pub const PIVOT_SMOOTHING: f64 = 0.1;
+
+/// Fastest a pivoting foot's reference turns \[rad/s\]: the captured turn is followed at this
+/// rate at most and caught up with when it slows. Turning a held foot as fast as a dancer
+/// does (CMU 131_01: 4.6–4.9 rad/s) takes more of the legs' joint box than balance leaves:
+/// the held foot's level is corrected and its sole dips below the ground (unlimited: 0.19 mm,
+/// JVRC-1 on `scaled_131_02`). Turning it much slower than the dancer twists the legs under
+/// the spinning body: at 2.5 rad/s JVRC-1's other foot, landing on `humanoid3d_dance_a`, is
+/// dragged 29 mm into the ground. Deepest sole over the shared clips that pivot (131_01,
+/// `scaled_131_02`, `humanoid3d_dance_a`, `humanoid3d_punch`; G1 and JVRC-1) at 2.5 / 3 /
+/// 3.5 / 4 / 4.5 / 5 / 6 rad/s: 29.4 / 0.075 / 0.053 / 0.070 / 0.067 / 0.111 / 0.13 mm.
+pub const PIVOT_RATE: f64 = 4.0;
+
+/// Holds a foot's yaw `track` \[rad\] in the stance runs of `contact` as [`hold`] does, except
+/// that a stance over which the track spans more than `min_turn` \[rad\] follows it (the foot
+/// pivots): averaged over `2 half + 1` ticks within the stance, and from the stance's first
+/// tick on changing by at most `max_step` \[rad\] per tick.
+pub(crate) fn hold_turning(
+    track: &mut [f64],
+    contact: &[bool],
+    min_turn: f64,
+    half: usize,
+    max_step: f64,
+) {
+    let stances = runs(contact);
+    let values = stances
+        .iter()
+        .map(|&(s, e)| {
+            let run = &track[s..e];
+            let (lo, hi) = run
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+                    (a.min(*x), b.max(*x))
+                });
+            let n = run.len();
+            if hi - lo <= min_turn {
+                return vec![run.iter().sum::<f64>() / n as f64; n];
+            }
+            let mut out: Vec<f64> = (0..n)
+                .map(|k| {
+                    let (a, b) = (k.saturating_sub(half), (k + half).min(n - 1));
+                    run[a..=b].iter().sum::<f64>() / (b - a + 1) as f64
+                })
+                .collect();
+            for k in 1..n {
+                out[k] = out[k - 1] + (out[k] - out[k - 1]).clamp(-max_step, max_step);
+            }
+            out
+        })
+        .collect();
+    shape(track, &stances, values);
+}
+
+/// Puts `values[i]` into stance run `stances[i]` of `track` and shapes the free runs between
+/// and around them (the module documentation, with `H₁` the value at the end of the stance
+/// before and `H₂` the one at the start of the stance after).
+fn shape(track: &mut [f64], stances: &[(usize, usize)], values: Vec<Vec<f64>>) {
     if stances.is_empty() {
         return;
     }
     let raw = track.to_vec();
-    let holds: Vec<f64> = stances
-        .iter()
-        .map(|&(s, e)| stance_value.unwrap_or(raw[s..e].iter().sum::<f64>() / (e - s) as f64))
-        .collect();
+    let first = |i: usize| values[i][0];
+    let last = |i: usize| values[i][values[i].len() - 1];
     for (i, &(s, e)) in stances.iter().enumerate() {
-        track[s..e].iter_mut().for_each(|x| *x = holds[i]);
+        track[s..e].copy_from_slice(&values[i]);
         // The swing after this stance, up to the next one (or the end).
         let a = e - 1;
         match stances.get(i + 1) {
             Some(&(b, _)) => {
                 let span = (b - a) as f64;
+                let (h1, h2) = (last(i), first(i + 1));
                 for k in e..b {
                     let tau = (k - a) as f64 / span;
                     let q = quintic(tau);
                     let departure = raw[k] - raw[a] - (raw[b] - raw[a]) * q;
-                    track[k] = holds[i] + (holds[i + 1] - holds[i]) * q + fade(tau) * departure;
+                    track[k] = h1 + (h2 - h1) * q + fade(tau) * departure;
                 }
             }
             None => {
                 let span = (track.len() - a) as f64;
                 for k in e..track.len() {
                     let w = quintic((k - a) as f64 / (SWING_FADE * span));
-                    track[k] = holds[i] + w * (raw[k] - raw[a]);
+                    track[k] = last(i) + w * (raw[k] - raw[a]);
                 }
             }
         }
@@ -142,7 +223,7 @@ pub(crate) fn hold(track: &mut [f64], contact: &[bool], stance_value: Option<f64
     let span = (b + 1) as f64;
     for k in 0..b {
         let w = quintic((b - k) as f64 / (SWING_FADE * span));
-        track[k] = holds[0] + w * (raw[k] - raw[b]);
+        track[k] = first(0) + w * (raw[k] - raw[b]);
     }
 }
 
@@ -182,6 +263,43 @@ mod tests {
         }
         let (first, last) = (t[20] - t[19], t[40] - t[39]);
         assert!(first < 0.001 && last < 0.001, "{first} {last}");
+    }
+
+    /// A stance whose yaw turns by 2 rad (at 4 rad/s) is followed no faster than the step
+    /// allowed, monotonically, and reaches the turn before the stance ends; one whose yaw
+    /// jitters by ±0.1 rad is held at its mean; the swing between starts from where the
+    /// first stance ended, at rest.
+    #[test]
+    fn a_turning_stance_is_followed_at_a_bounded_rate_and_a_jittery_one_held() {
+        let (n, dt) = (400, 0.005);
+        let contact: Vec<bool> = (0..n).map(|k| !(200..260).contains(&k)).collect();
+        let mut rng = rand::rngs::StdRng::seed_from_u64(5);
+        use rand::{Rng, SeedableRng};
+        let raw: Vec<f64> = (0..n)
+            .map(|k| {
+                if k < 200 {
+                    // 4 rad/s from tick 20 to tick 120, then still.
+                    (4.0 * dt * (k as f64 - 20.0)).clamp(0.0, 2.0)
+                } else {
+                    2.0 + rng.random_range(-0.1..0.1)
+                }
+            })
+            .collect();
+        let mut t = raw.clone();
+        let max_step = 2.5 * dt;
+        hold_turning(&mut t, &contact, PIVOT_TURN, 10, max_step);
+        for k in 1..200 {
+            let step = t[k] - t[k - 1];
+            assert!((0.0..=max_step + 1e-15).contains(&step), "{k}: {step}");
+        }
+        assert!((t[199] - 2.0).abs() < 1e-12, "{}", t[199]);
+        let m = raw[260..].iter().sum::<f64>() / (n - 260) as f64;
+        assert!(t[260..].iter().all(|x| (x - m).abs() < 1e-15));
+        assert!(
+            (t[200] - t[199]).abs() < 0.1 * max_step,
+            "{}",
+            t[200] - t[199]
+        );
     }
 
     #[test]

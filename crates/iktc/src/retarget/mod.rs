@@ -44,6 +44,7 @@ mod tracker;
 mod viewer;
 
 pub use body::{BodyFrameNames, RobotBody, MIN_HEAD_HEIGHT};
+pub use contacts::{PIVOT_RATE, PIVOT_SMOOTHING, PIVOT_TURN};
 pub use floor::FLOOR_ENGAGE;
 pub use quality::{
     JointOnLimit, OrientationError, PointError, QualityRecorder, RetargetQuality, FLOAT_HEIGHT,

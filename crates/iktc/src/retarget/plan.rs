@@ -23,7 +23,10 @@
 use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, UnitQuaternion, Vector3, Vector6};
 
 use super::body::RobotBody;
-use super::contacts::{detect, hold, quintic, remove_short, runs};
+use super::contacts::{
+    detect, hold, hold_turning, quintic, remove_short, runs, PIVOT_RATE, PIVOT_SMOOTHING,
+    PIVOT_TURN,
+};
 use super::scale::ScaledClip;
 use super::{KeypointSettings, SupportArea};
 use crate::error::{Error, Result};
@@ -335,7 +338,8 @@ pub(crate) fn plan(
         remove_short(&mut c, true, min_len);
         contact[i] = times.iter().map(|t| c[frame_of_tick(*t)]).collect();
     }
-    // Feet: x, y, yaw held in stance, z on the ground in stance.
+    // Feet: x, y (of the sole's centre) and yaw held in stance (the yaw followed where the foot
+    // pivots), z on the ground in stance.
     let h_a = support.ankle_height;
     let pelvis_x = get(BodyPoint::Pelvis)?;
     let (lh, rh) = (get(BodyPoint::LeftHip)?, get(BodyPoint::RightHip)?);
@@ -348,6 +352,7 @@ pub(crate) fn plan(
             .collect(),
     );
     let mut feet: [Vec<PoseRef>; 2] = [Vec::new(), Vec::new()];
+    let pivot_half = (0.5 * PIVOT_SMOOTHING / s.dt).round() as usize;
     for (i, (a, t)) in sides.iter().enumerate() {
         let ankle = get(*a)?;
         let foot0 = kin.frame_pose(robot, body.feet[i])?;
@@ -359,16 +364,30 @@ pub(crate) fn plan(
             })
             .unwrap_or_else(|| heading.clone());
         let yaw: Vec<f64> = raw.iter().map(|y| y - raw[0]).collect();
-        let mut x: Vec<f64> = ankle.iter().map(|p| p.x).collect();
-        let mut y: Vec<f64> = ankle.iter().map(|p| p.y).collect();
+        // The sole's centre is held (x, y), and a pivoting foot turns about it: the ankle's
+        // track is carried to the sole's centre with the captured yaw and back with the
+        // held one.
+        let mut w = yaw.clone();
+        hold_turning(
+            &mut w,
+            &contact[i],
+            PIVOT_TURN,
+            pivot_half,
+            PIVOT_RATE * s.dt,
+        );
+        let s0 = foot0.rotation * Vector3::new(support.sole_offset_x, 0.0, 0.0);
+        let sole = |psi: f64| UnitQuaternion::from_euler_angles(0.0, 0.0, psi) * s0;
+        let mut x: Vec<f64> = (0..ticks).map(|k| ankle[k].x + sole(yaw[k]).x).collect();
+        let mut y: Vec<f64> = (0..ticks).map(|k| ankle[k].y + sole(yaw[k]).y).collect();
         let mut z: Vec<f64> = ankle.iter().map(|p| p.z).collect();
-        let mut w = yaw;
         hold(&mut x, &contact[i], None);
         hold(&mut y, &contact[i], None);
         hold(&mut z, &contact[i], Some(h_a));
-        hold(&mut w, &contact[i], None);
         let pos: Vec<Vector3<f64>> = (0..ticks)
-            .map(|k| Vector3::new(x[k], y[k], z[k].max(h_a)))
+            .map(|k| {
+                let s = sole(w[k]);
+                Vector3::new(x[k] - s.x, y[k] - s.y, z[k].max(h_a))
+            })
             .collect();
         let rot: Vec<UnitQuaternion<f64>> = w
             .iter()

@@ -48,7 +48,10 @@
 //! The hold is closed-loop. A foot the clip puts on the ground is first brought to the plan's
 //! hold in the second level (its height under the floor); it lands (moves to the first level)
 //! once its lowest sole corner is within `land_height` of the ground, every sole corner
-//! slower than `land_speed` ([`KeypointSettings`]) and its sole tilted less than [`LAND_TILT`]; a foot
+//! slower than `land_speed` ([`KeypointSettings`]) against its reference (a foot the plan
+//! pivots lands while it turns with it; a still reference leaves the corners' own speed), and
+//! its sole tilted less than [`LAND_TILT`]; while it lands its sole's centre is brought to rest
+//! horizontally as the foot turns about it; a foot
 //! that does not get there is not held (landing it at speed, or in the air, would make it
 //! slide or stamp). At landing the offset `δ = (x, y, ψ)_robot − (x, y, ψ)_plan` of the
 //! robot's foot from the plan's hold (horizontal position of the sole's centre \[m\] and yaw
@@ -317,35 +320,51 @@ struct Floor {
     z_dot: f64,
     /// The vertical acceleration asked of it, `max(a_ref, a_min)` \[m/s²\].
     acceleration: f64,
-    /// While landing, its horizontal position \[m\]: its horizontal motion is damped out there
-    /// rather than carried on to the plan's hold (where the foot lands is latched anyway).
+    /// While landing, its horizontal position \[m\]: its sole centre's horizontal motion is
+    /// damped out where it is rather than carried on to the plan's hold (where the foot lands
+    /// is latched anyway), while the foot turns about that centre as its reference does.
     stop: Option<[f64; 2]>,
+    /// From the sole's centre to the foot frame's origin, world axes \[m\].
+    arm: Vector3<f64>,
 }
 
 /// The reference of foot `i` at tick `k` with the latched offset `(d, yaw)` (see the module
-/// documentation).
+/// documentation), `sole` the sole's centre in the foot frame \[m\]. The offset moves the
+/// plan's sole centre by `w d` and turns the foot about it by `w ψ`: with the plan's foot at
+/// `(p, R)` and `r = R s`, the reference is `R' = R_z(w ψ) R`, `p' = p + r + w d − R' s`, so a
+/// held foot whose plan pivots about its sole's centre pivots about the same point. Its
+/// velocity and acceleration are those of `p + r` and of `−R' s` (`ω × r`, `α × r + ω × (ω ×
+/// r)` of each rotating vector) plus the latch weight's rates times `d` and `ψ`.
 fn foot_reference(
     p: &Plan,
     i: usize,
     k: usize,
     hold: bool,
     latch: (Vector3<f64>, f64),
+    sole: &Vector3<f64>,
 ) -> FrameReference {
     let mut r = p.feet[i][k].frame(hold);
     let [w, wd, wdd] = p.latch_weight[i][k];
     let (d, yaw) = latch;
     let turn = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), w * yaw);
-    r.pose.translation.vector += w * d;
+    let r_plan = r.pose.rotation * sole;
     r.pose.rotation = turn * r.pose.rotation;
+    let r_ref = r.pose.rotation * sole;
+    r.pose.translation.vector += r_plan + w * d - r_ref;
     if !hold {
-        let (v, om) = (
-            r.velocity.fixed_rows::<3>(0) + wd * d,
-            turn * r.velocity.fixed_rows::<3>(3) + wd * yaw * Vector3::z(),
+        let (om_p, al_p) = (
+            r.velocity.fixed_rows::<3>(3).into_owned(),
+            r.acceleration.fixed_rows::<3>(3).into_owned(),
         );
-        let (a, al) = (
-            r.acceleration.fixed_rows::<3>(0) + wdd * d,
-            turn * r.acceleration.fixed_rows::<3>(3) + wdd * yaw * Vector3::z(),
-        );
+        let om = turn * om_p + wd * yaw * Vector3::z();
+        let al = turn * al_p + wdd * yaw * Vector3::z();
+        let v = r.velocity.fixed_rows::<3>(0) + om_p.cross(&r_plan) - om.cross(&r_ref) + wd * d;
+        let a = r.acceleration.fixed_rows::<3>(0)
+            + al_p.cross(&r_plan)
+            + om_p.cross(&om_p.cross(&r_plan))
+            - al.cross(&r_ref)
+            - om.cross(&om.cross(&r_ref))
+            + wdd * d;
         r.velocity.fixed_rows_mut::<3>(0).copy_from(&v);
         r.velocity.fixed_rows_mut::<3>(3).copy_from(&om);
         r.acceleration.fixed_rows_mut::<3>(0).copy_from(&a);
@@ -361,6 +380,7 @@ fn set_references(
     t: &Tasks,
     p: &Plan,
     latch: &[(Vector3<f64>, f64); 2],
+    sole: &Vector3<f64>,
     drift: &StanceDrift,
     floor: &[Floor; 2],
     posture_track: &[[Vec<f64>; 3]],
@@ -369,12 +389,12 @@ fn set_references(
     hold: bool,
 ) -> Result<()> {
     for (i, h) in &t.feet {
-        let mut r = foot_reference(p, *i, k, hold, latch[*i]);
+        let mut r = foot_reference(p, *i, k, hold, latch[*i], sole);
         r.acceleration += drift.compensation(*i);
         ctl.set_frame_reference(*h, r)?;
     }
     for (i, h) in &t.floor {
-        let mut r = foot_reference(p, *i, k, hold, latch[*i]);
+        let mut r = foot_reference(p, *i, k, hold, latch[*i], sole);
         let f = &floor[*i];
         // z̈ = max(a_ref, a_min) as the reference's feed-forward at the current height and
         // speed (the row's feedback terms vanish).
@@ -384,12 +404,18 @@ fn set_references(
         // over the tick, not only at its start ([`super::drift`]).
         r.acceleration[2] = f.acceleration + drift.compensation(*i)[2];
         if let Some([x, y]) = f.stop {
-            // Landing: the horizontal motion is damped out where the foot is (ẍ = −k_v ẋ).
+            // Landing: the sole centre's horizontal motion is damped out where it is (ẍ = −k_v
+            // ẋ without a turn), and the origin moves as the foot's turn at the reference's
+            // rate about that centre carries it: `ω × a`, `α × a + ω × (ω × a)`.
+            let w = r.velocity.fixed_rows::<3>(3).into_owned();
+            let al = r.acceleration.fixed_rows::<3>(3).into_owned();
+            let v = w.cross(&f.arm);
+            let acc = al.cross(&f.arm) + w.cross(&w.cross(&f.arm));
             r.pose.translation.vector.x = x;
             r.pose.translation.vector.y = y;
             for a in 0..2 {
-                r.velocity[a] = 0.0;
-                r.acceleration[a] = 0.0;
+                r.velocity[a] = v[a];
+                r.acceleration[a] = acc[a];
             }
         }
         ctl.set_frame_reference(*h, r)?;
@@ -619,6 +645,7 @@ impl KeypointController {
             tasks,
             &self.plan,
             &self.latch,
+            &self.sole,
             &self.drift,
             &self.floor,
             &self.posture_track,
@@ -641,7 +668,7 @@ impl KeypointController {
         a_min: f64,
         mode: FootMode,
     ) -> Floor {
-        let r = foot_reference(&self.plan, i, k, hold, self.latch[i]);
+        let r = foot_reference(&self.plan, i, k, hold, self.latch[i], &self.sole);
         let (z, z_dot) = (pose.translation.vector.z, v[2]);
         // What the level asks of the foot by the frame task's law (world axes): its height's
         // own reference, and the angular acceleration with which its roll and pitch rows turn
@@ -661,6 +688,7 @@ impl KeypointController {
             z_dot,
             acceleration: a_ref.max(a_min),
             stop: (mode == FootMode::Landing).then_some([p.x, p.y]),
+            arm: -(pose.rotation * self.sole),
         }
     }
 
@@ -715,19 +743,21 @@ impl KeypointController {
             if on[i] {
                 let plan = &self.plan.feet[i][k];
                 let low = e <= height;
-                let slow = fastest_corner(&pose, &v, &self.corners) <= speed;
+                // Slow against its reference: a foot the plan pivots lands while it turns
+                // with it (a still reference leaves the foot's own speed).
+                let r = foot_reference(&self.plan, i, k, hold, self.latch[i], &self.sole);
+                let slow = fastest_corner(&pose, &(v - r.velocity), &self.corners) <= speed;
                 let flat = (pose.rotation * Vector3::z()).z >= LAND_TILT.cos();
                 if low && slow && flat {
-                    // The offset of the sole centre from the plan's (the plan's foot turned
-                    // by the latched yaw): the first level then flattens the foot about
-                    // where its sole touched, not about the ankle, which would slide the
-                    // sole by `ankle_height · sin θ` (3 mm on JVRC-1 at LAND_TILT).
+                    // The offset of the sole centre from the plan's, and the yaw from the
+                    // plan's: the first level then flattens the foot about where its sole
+                    // touched, not about the ankle, which would slide the sole by
+                    // `ankle_height · sin θ` (3 mm on JVRC-1 at LAND_TILT), and turns it
+                    // about there ([`foot_reference`]).
                     let x = (pose.rotation * plan.rotation.inverse()) * Vector3::x();
                     let yaw = x.y.atan2(x.x);
-                    let turned =
-                        UnitQuaternion::from_axis_angle(&Vector3::z_axis(), yaw) * plan.rotation;
                     let mut d = pose * Point3::from(self.sole)
-                        - (plan.position.position + turned * self.sole);
+                        - (plan.position.position + plan.rotation * self.sole);
                     d.z = 0.0;
                     self.latch[i] = (d.coords, yaw);
                     self.stance[i] = true;
@@ -838,7 +868,7 @@ impl KeypointController {
         let k = k.min(self.plan.ticks.saturating_sub(1));
         let p = &self.plan;
         let foot = |i: usize| {
-            foot_reference(p, i, k, false, self.latch[i])
+            foot_reference(p, i, k, false, self.latch[i], &self.sole)
                 .pose
                 .translation
                 .vector
@@ -984,6 +1014,96 @@ mod tests {
         let names = robot.active_joints().map(|j| j.name.clone()).collect();
         let state = set.controller.state().clone();
         (robot, state, set.body, set.controller, names)
+    }
+
+    /// A foot whose plan pivots about its sole's centre `c` (yaw `ψ(t) = sin t`, the ankle
+    /// at `c − R_z(ψ) s`): with the latch at full weight (in stance) the reference keeps the
+    /// sole's centre at `c + d`, turned by the latched yaw, and with any weight (here
+    /// `w(t) = (1 − cos t)/2`, fading as in a swing) its velocity and acceleration are the
+    /// central differences of its pose.
+    #[test]
+    fn a_held_foot_pivots_about_its_sole_centre() {
+        use super::super::plan::{PointRef, PoseRef};
+        let s = KeypointSettings::default();
+        let (_, _, _, c, _) = g1(&s);
+        let mut p = c.plan().clone();
+        // Sample spacing of the synthetic plan [s]: central differences err by O(h²).
+        let h = 1e-4;
+        let n = 3000;
+        let sole = Vector3::new(0.035, 0.01, -0.035);
+        let centre = Vector3::new(0.3, -0.1, 0.035);
+        let pose = |t: f64| {
+            let (psi, om, al) = (t.sin(), t.cos(), -t.sin());
+            let rot = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), psi);
+            let (w, a) = (om * Vector3::z(), al * Vector3::z());
+            let r = rot * sole;
+            PoseRef {
+                position: PointRef {
+                    position: centre - r,
+                    velocity: -w.cross(&r),
+                    acceleration: -(a.cross(&r) + w.cross(&w.cross(&r))),
+                },
+                rotation: rot,
+                angular_velocity: w,
+                angular_acceleration: a,
+            }
+        };
+        let times: Vec<f64> = (0..n).map(|k| k as f64 * h).collect();
+        p.feet[0] = times.iter().map(|t| pose(*t)).collect();
+        let latch = (Vector3::new(0.004, -0.003, 0.0), 0.2);
+        // Held: the sole's centre stays where the latch put it.
+        p.latch_weight[0] = vec![[1.0, 0.0, 0.0]; n];
+        for k in (0..n).step_by(100) {
+            let r = foot_reference(&p, 0, k, false, latch, &sole);
+            let centre_now = r.pose.translation.vector + r.pose.rotation * sole;
+            assert!((centre_now - (centre + latch.0)).norm() < 1e-12, "{k}");
+            let yaw = (r.pose.rotation * p.feet[0][k].rotation.inverse()).angle();
+            assert!((yaw - latch.1).abs() < 1e-12, "{k}: {yaw}");
+        }
+        // Fading: the rates are the pose's.
+        p.latch_weight[0] = times
+            .iter()
+            .map(|t| [0.5 * (1.0 - t.cos()), 0.5 * t.sin(), 0.5 * t.cos()])
+            .collect();
+        let refs: Vec<_> = (0..n)
+            .map(|k| foot_reference(&p, 0, k, false, latch, &sole))
+            .collect();
+        // Largest difference from the central differences [m/s, m/s², rad/s, rad/s²]: O(h²)
+        // times third derivatives of order 1.
+        let tol = 1e-6;
+        for k in 1..n - 1 {
+            let (a, r, b) = (&refs[k - 1], &refs[k], &refs[k + 1]);
+            let v = (b.pose.translation.vector - a.pose.translation.vector) / (2.0 * h);
+            let acc = (b.velocity - a.velocity) / (2.0 * h);
+            let om = (b.pose.rotation * a.pose.rotation.inverse()).scaled_axis() / (2.0 * h);
+            assert!((v - r.velocity.fixed_rows::<3>(0)).norm() < tol, "{k}: v");
+            assert!((om - r.velocity.fixed_rows::<3>(3)).norm() < tol, "{k}: ω");
+            assert!((acc - r.acceleration).norm() < tol, "{k}: a");
+        }
+    }
+
+    /// The feet's levels of a stack (what GF takes over when IKTC corrects them under a held
+    /// foot) are its leading `stance_feet` and `swing_floor` levels, whichever it has.
+    #[test]
+    fn the_feet_levels_are_the_leading_stance_and_floor_levels() {
+        use FootMode::{Floor, Landing, Stance, Swing};
+        let s = KeypointSettings::default();
+        let (robot, state, body, c, names) = g1(&s);
+        for (modes, want) in [
+            ([Stance, Stance], 1),
+            ([Stance, Swing], 1),
+            ([Stance, Landing], 2),
+            ([Swing, Floor], 1),
+            ([Swing, Swing], 0),
+        ] {
+            let stack = build_stack(&robot, &state, &body, c.plan(), &names, &s, modes).unwrap();
+            let lead = levels(&stack)
+                .iter()
+                .take_while(|l| l.0 == KEYPOINT_LEVELS[0] || l.0 == KEYPOINT_LEVELS[1])
+                .count();
+            assert_eq!(lead, want, "{modes:?}");
+            assert_eq!(stack.feet_levels, want, "{modes:?}");
+        }
     }
 
     /// The levels of a stack, as (name, rows).
