@@ -77,7 +77,7 @@ def test_smoothing_is_checked_and_keeps_the_shapes():
 
 def test_the_soft_approach_halves_the_plans_jerk_and_bad_rates_are_errors():
     # G1, humanoid3d_punch: the joints' RMS jerk of the plan (q̈'s change over a tick, per
-    # second) is 15 200 rad/s³ with the viable bounds alone and 7 150 with the soft approach to
+    # second) is 13 550 rad/s³ with the viable bounds alone and 6 560 with the soft approach to
     # the range ends at 10 /s (not the route's default: on CMU 131_01 G1's sole then dipped
     # 8.7 mm below the ground). On humanoid3d_dance_b, whose joints keep off their limits, 5 000
     # and 4 100.
@@ -118,7 +118,7 @@ def test_the_run_says_which_levels_the_joint_limits_cost(runs):
         assert sum(counts.values()) <= ticks
     # JVRC-1 cannot take humanoid3d_dance_a's first frame (in the air, a foot crossed behind
     # the other): while it settles there, the level of the hands and swing feet gives way, and
-    # no other (on 70 of 300 ticks).
+    # no other (on 144 of 300 ticks).
     jvrc = iktc.retarget_keypoints(iktc.load_motion("humanoid3d_dance_a"), iktc.Robot("jvrc1"))
     settle = jvrc.settle_sacrificed
     assert settle["hands_swing_feet"] > 0, settle
