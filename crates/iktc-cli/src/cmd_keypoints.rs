@@ -62,12 +62,17 @@ pub struct KeypointArgs {
     /// the rest is what the retargeting gives up. About doubles the run's time.
     #[arg(long)]
     pub reach: bool,
+    /// Hold every stance foot at its yaw: a foot the captured person turns on (more than 0.35
+    /// rad over a stance) does not pivot about its sole's centre, the legs take the turn.
+    #[arg(long)]
+    pub no_pivot: bool,
 }
 
 impl KeypointArgs {
     /// Gives `cfg` the `--smoothing` (both routes use it; without it the joint route keeps
     /// `cfg`'s default, [`iktc::sim::IMITATE_SMOOTHING`], and the keypoint route none),
-    /// `--no-smoothing`, and refuses `--standing` and `--hands` on the joint route.
+    /// `--no-smoothing`, and refuses `--standing`, `--hands`, `--reach` and `--no-pivot` on the
+    /// joint route.
     pub fn apply(&self, route: RetargetArg, cfg: &mut ImitateConfig) -> Result<()> {
         if route == RetargetArg::Joints && self.standing {
             anyhow::bail!("--standing applies to --retarget keypoints only");
@@ -77,6 +82,9 @@ impl KeypointArgs {
         }
         if route == RetargetArg::Joints && self.reach {
             anyhow::bail!("--reach applies to --retarget keypoints only");
+        }
+        if route == RetargetArg::Joints && self.no_pivot {
+            anyhow::bail!("--no-pivot applies to --retarget keypoints only");
         }
         cfg.smoothing = match (self.no_smoothing, self.smoothing, route) {
             (true, _, _) => None,
@@ -107,6 +115,11 @@ pub fn keypoint_settings(
             HandsArg::Segments => HandScaling::Segments,
         },
         reach: k.reach,
+        pivot_turn: if k.no_pivot {
+            None
+        } else {
+            KeypointSettings::default().pivot_turn
+        },
         ..KeypointSettings::default()
     }
 }

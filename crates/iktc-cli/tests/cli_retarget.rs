@@ -750,6 +750,35 @@ fn reach_option_reports_the_static_reach() {
     );
 }
 
+/// `--no-pivot`: on `humanoid3d_dance_a`, which spins on its feet, the feet keep their yaw
+/// over every stance, so the motion differs from the default run's (and the changed setting
+/// redoes the clip rather than skipping it); a clip without a turning stance
+/// (`humanoid3d_dance_b`) is the same either way; the joint route refuses it.
+#[test]
+fn no_pivot_holds_the_feet_of_a_spinning_clip() {
+    let dir = tmp("no-pivot");
+    let out = dir.join("out");
+    for (clip, spins) in [("humanoid3d_dance_a", true), ("humanoid3d_dance_b", false)] {
+        let path = data().join(format!("{clip}.txt"));
+        let csv = || std::fs::read_to_string(out.join(format!("{clip}/motion.csv"))).unwrap();
+        let o = retarget_on_g1(&path, &out, &[]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let pivoting = csv();
+        let o = retarget_on_g1(&path, &out, &["--no-pivot"]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        assert_eq!(statuses(&out)[clip], "retargeted");
+        assert_eq!(csv() != pivoting, spins, "{clip}");
+    }
+    let o = retarget_on_g1(
+        &data().join("humanoid3d_walk.txt"),
+        &out,
+        &["--no-pivot", "--retarget", "joints"],
+    );
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr)
+        .contains("--no-pivot applies to --retarget keypoints only"));
+}
+
 /// A batch whose `--out` lies inside its input folder, beside the output of an earlier batch
 /// and of `iktc imitate` there: no output folder is searched for motion (their `quality.json` files are not
 /// clips), not even an `--out` that an interrupted run left without `batch.json` and without

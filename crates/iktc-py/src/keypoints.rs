@@ -40,8 +40,8 @@ pub struct PyKeypointTrajectory {
 /// keypoint stack solved by IKTC under the viable bounds, integrated with constant acceleration
 /// over `dt` [s]; the posture level follows the joint route's references where the profile has
 /// a map for the motion's format. `hold_feet`: every frame counts as stance, so both feet are
-/// held where they stand for the whole clip (a standing imitation) instead of stepping where
-/// the clip's feet leave the ground. `standing`: the feet and the pelvis held at the robot's
+/// held where they stand for the whole clip (a standing imitation), at their yaw, instead of
+/// stepping where the clip's feet leave the ground or pivoting where they turn. `standing`: the feet and the pelvis held at the robot's
 /// start pose and only the clip's upper body imitated, relative to its pelvis (see
 /// `iktc::retarget::KeypointSettings::standing`). `smoothing`: cut-off [Hz] of the zero-phase
 /// low-pass applied to the body points before they are differentiated (`None`: as captured).
@@ -92,6 +92,8 @@ pub fn py_retarget_keypoints(
         // Any height above the clip's lowest ankle and any speed count as on the ground.
         settings.contact_height = f64::MAX;
         settings.contact_speed = f64::MAX;
+        // Planted: no pivots (the whole clip is one stance, over which the feet turn).
+        settings.pivot_turn = None;
     }
     py.detach(|| -> iktc::Result<PyKeypointTrajectory> {
         let kp = motion.motion.keypoints(DEFAULT_MAX_GAP)?;

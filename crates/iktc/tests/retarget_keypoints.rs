@@ -598,3 +598,26 @@ fn joints_on_a_limit_are_counted_from_the_trajectory() {
     assert!(!got.is_empty());
     assert_eq!(got, expected);
 }
+
+/// A pivot threshold that is not a finite angle >= 0 is an error naming the setting; `None`
+/// (no pivots) and 0 (every turning stance pivots) are accepted.
+#[test]
+fn a_bad_pivot_turn_is_an_error() {
+    for bad in [f64::NAN, -0.1, f64::INFINITY] {
+        let s = KeypointSettings {
+            pivot_turn: Some(bad),
+            ..KeypointSettings::default()
+        };
+        match s.validate() {
+            Err(iktc::Error::InvalidSetting { name, .. }) => assert_eq!(name, "pivot_turn"),
+            other => panic!("{bad}: {other:?}"),
+        }
+    }
+    for good in [None, Some(0.0), Some(iktc::retarget::PIVOT_TURN)] {
+        let s = KeypointSettings {
+            pivot_turn: good,
+            ..KeypointSettings::default()
+        };
+        assert!(s.validate().is_ok(), "{good:?}");
+    }
+}

@@ -214,6 +214,11 @@ pub struct KeypointSettings {
     /// smoothness. Costs about as much again as the run (G1, `131_01`: 0.11 s for 1 656
     /// ticks).
     pub reach: bool,
+    /// Smallest turn of a foot over one of the clip's stances for the foot to pivot there
+    /// \[rad\] (default `Some(`[`PIVOT_TURN`]`)`; see [`PIVOT_RATE`]): the foot's yaw then follows
+    /// the captured one about its sole's centre instead of being held at the stance's mean.
+    /// `None` holds every stance's yaw (both feet planted, as `hold_feet` in Python asks).
+    pub pivot_turn: Option<f64>,
 }
 
 /// Sample period of the static reach ([`KeypointSettings::reach`]) \[s\].
@@ -267,6 +272,7 @@ impl Default for KeypointSettings {
             posture_weight: POSTURE_WEIGHT,
             hands: HandScaling::Leg,
             reach: false,
+            pivot_turn: Some(PIVOT_TURN),
         }
     }
 }
@@ -297,6 +303,15 @@ impl KeypointSettings {
                     name: name.into(),
                     value: v.to_string(),
                     expected: format!("a finite {what}"),
+                });
+            }
+        }
+        if let Some(t) = self.pivot_turn {
+            if !(t.is_finite() && t >= 0.0) {
+                return Err(Error::InvalidSetting {
+                    name: "pivot_turn".into(),
+                    value: t.to_string(),
+                    expected: "a finite angle >= 0 [rad], or none".into(),
                 });
             }
         }

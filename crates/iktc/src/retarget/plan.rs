@@ -25,7 +25,6 @@ use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, UnitQuaternion, Vect
 use super::body::RobotBody;
 use super::contacts::{
     detect, hold, hold_turning, quintic, remove_short, runs, PIVOT_RATE, PIVOT_SMOOTHING,
-    PIVOT_TURN,
 };
 use super::scale::ScaledClip;
 use super::{KeypointSettings, SupportArea};
@@ -368,13 +367,10 @@ pub(crate) fn plan(
         // track is carried to the sole's centre with the captured yaw and back with the
         // held one.
         let mut w = yaw.clone();
-        hold_turning(
-            &mut w,
-            &contact[i],
-            PIVOT_TURN,
-            pivot_half,
-            PIVOT_RATE * s.dt,
-        );
+        match s.pivot_turn {
+            Some(turn) => hold_turning(&mut w, &contact[i], turn, pivot_half, PIVOT_RATE * s.dt),
+            None => hold(&mut w, &contact[i], None),
+        }
         let s0 = foot0.rotation * Vector3::new(support.sole_offset_x, 0.0, 0.0);
         let sole = |psi: f64| UnitQuaternion::from_euler_angles(0.0, 0.0, psi) * s0;
         let mut x: Vec<f64> = (0..ticks).map(|k| ankle[k].x + sole(yaw[k]).x).collect();
@@ -770,6 +766,56 @@ mod tests {
         };
         let held = plan(&robot, &kin, &body, &kp, &scaled, &cfg.support, &standing).unwrap();
         (robot, kin, body, cfg.support, free, held)
+    }
+
+    /// `humanoid3d_dance_a` spins on its feet: with the default a foot's yaw turns by more
+    /// than a radian over one of its stances, about its sole's centre, which stays where the
+    /// stance holds it; with `pivot_turn: None` every stance holds the foot's yaw. Either way
+    /// the sole's centre is constant in every stance, and a pivoting foot turns no faster
+    /// than [`PIVOT_RATE`] there.
+    #[test]
+    fn a_spinning_foot_pivots_about_its_sole_centre_unless_asked_to_hold() {
+        let planted = KeypointSettings {
+            pivot_turn: None,
+            ..KeypointSettings::default()
+        };
+        let (.., support, free, _) = plans("g1", "humanoid3d_dance_a");
+        let (.., held, _) = plans_with("g1", "humanoid3d_dance_a", &planted);
+        let s = Vector3::new(support.sole_offset_x, 0.0, -support.ankle_height);
+        let centre = |f: &PoseRef| f.position.position + f.rotation * s;
+        let yaw = |f: &PoseRef| {
+            (f.rotation * Vector3::x())
+                .y
+                .atan2((f.rotation * Vector3::x()).x)
+        };
+        // Rounding of a held value carried through a rotation and back [m], [rad].
+        let tol = 1e-12;
+        let dt = KeypointSettings::default().dt;
+        let mut largest_turn: f64 = 0.0;
+        for (plan, pivots) in [(&free, true), (&held, false)] {
+            for i in 0..2 {
+                for (a, b) in runs(&plan.contact[i]) {
+                    let f = &plan.feet[i];
+                    for k in a + 1..b {
+                        assert!((centre(&f[k]) - centre(&f[a])).norm() < tol, "{i} {k}");
+                        let step = f[k].rotation.angle_to(&f[k - 1].rotation);
+                        if pivots {
+                            assert!(step <= PIVOT_RATE * dt + tol, "{i} {k}: {step}");
+                        } else {
+                            assert!(step < tol, "{i} {k}: {step}");
+                        }
+                    }
+                    if pivots {
+                        let turn = f[a..b]
+                            .iter()
+                            .map(|p| (yaw(p) - yaw(&f[a])).abs())
+                            .fold(0.0, f64::max);
+                        largest_turn = largest_turn.max(turn);
+                    }
+                }
+            }
+        }
+        assert!(largest_turn > 1.0, "{largest_turn}");
     }
 
     /// Standing: feet, pelvis and COM are constant at the robot's start, both feet on the ground
