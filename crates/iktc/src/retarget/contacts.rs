@@ -300,6 +300,15 @@ mod tests {
             "{}",
             t[200] - t[199]
         );
+        // A slow turn (1 rad/s, within the rate): inside the stance, a window's length from
+        // its ends, the centred average of a ramp is the ramp itself.
+        let contact = vec![true; n];
+        let raw: Vec<f64> = (0..n).map(|k| dt * k as f64).collect();
+        let mut t = raw.clone();
+        hold_turning(&mut t, &contact, PIVOT_TURN, 10, max_step);
+        for k in 10..n - 10 {
+            assert!((t[k] - raw[k]).abs() < 1e-12, "{k}: {} {}", t[k], raw[k]);
+        }
     }
 
     #[test]
