@@ -169,12 +169,8 @@ pub(crate) fn hold_turning(
             if hi - lo <= min_turn {
                 return vec![run.iter().sum::<f64>() / n as f64; n];
             }
-            let mut out: Vec<f64> = (0..n)
-                .map(|k| {
-                    let (a, b) = (k.saturating_sub(half), (k + half).min(n - 1));
-                    run[a..=b].iter().sum::<f64>() / (b - a + 1) as f64
-                })
-                .collect();
+            let mut out = run.to_vec();
+            moving_average(&mut out, half);
             for k in 1..n {
                 out[k] = out[k - 1] + (out[k] - out[k - 1]).clamp(-max_step, max_step);
             }
@@ -182,6 +178,23 @@ pub(crate) fn hold_turning(
         })
         .collect();
     shape(track, &stances, values);
+}
+
+/// Replaces each sample of `x` by the mean of the samples within `half` of it (the window
+/// shrinks at the ends).
+pub(crate) fn moving_average<T>(x: &mut [T], half: usize)
+where
+    T: Copy + std::iter::Sum + std::ops::Div<f64, Output = T>,
+{
+    if half == 0 || x.len() < 2 {
+        return;
+    }
+    let src = x.to_vec();
+    let n = src.len();
+    for (k, out) in x.iter_mut().enumerate() {
+        let (a, b) = (k.saturating_sub(half), (k + half).min(n - 1));
+        *out = src[a..=b].iter().copied().sum::<T>() / (b - a + 1) as f64;
+    }
 }
 
 /// Puts `values[i]` into stance run `stances[i]` of `track` and shapes the free runs between

@@ -24,7 +24,8 @@ use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, UnitQuaternion, Vect
 
 use super::body::RobotBody;
 use super::contacts::{
-    detect, hold, hold_turning, quintic, remove_short, runs, PIVOT_RATE, PIVOT_SMOOTHING,
+    detect, hold, hold_turning, moving_average, quintic, remove_short, runs, PIVOT_RATE,
+    PIVOT_SMOOTHING,
 };
 use super::scale::ScaledClip;
 use super::{KeypointSettings, SupportArea};
@@ -223,18 +224,6 @@ pub(crate) fn pull_inside(polygon: &SupportPolygon, p: (f64, f64), margin: f64) 
         .iter()
         .fold((0.0, 0.0), |a, q| (a.0 + q.0 / n, a.1 + q.1 / n));
     polygon.pull_towards(p, c, margin)
-}
-
-fn moving_average(x: &mut [Vector3<f64>], half: usize) {
-    if half == 0 || x.len() < 2 {
-        return;
-    }
-    let src = x.to_vec();
-    let n = src.len();
-    for (k, out) in x.iter_mut().enumerate() {
-        let (a, b) = (k.saturating_sub(half), (k + half).min(n - 1));
-        *out = src[a..=b].iter().sum::<Vector3<f64>>() / (b - a + 1) as f64;
-    }
 }
 
 /// The plan of a run (see the module documentation). `kin` is at the start posture.

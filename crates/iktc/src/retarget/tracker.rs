@@ -655,20 +655,17 @@ impl KeypointController {
         )
     }
 
-    /// The floor of swing foot `i` at `pose` moving with `v`, with the bound `a_min`
-    /// \[m/s²\], in `mode` (`Floor` or `Landing`).
-    #[allow(clippy::too_many_arguments)]
+    /// The floor of a swing foot at `pose` moving with `v` under its reference `r`
+    /// ([`foot_reference`]), with the bound `a_min` \[m/s²\], in `mode` (`Floor` or
+    /// `Landing`).
     fn floor_of(
         &self,
-        i: usize,
-        k: usize,
-        hold: bool,
+        r: &FrameReference,
         pose: &nalgebra::Isometry3<f64>,
         v: &nalgebra::Vector6<f64>,
         a_min: f64,
         mode: FootMode,
     ) -> Floor {
-        let r = foot_reference(&self.plan, i, k, hold, self.latch[i], &self.sole);
         let (z, z_dot) = (pose.translation.vector.z, v[2]);
         // What the level asks of the foot by the frame task's law (world axes): its height's
         // own reference, and the angular acceleration with which its roll and pitch rows turn
@@ -740,12 +737,12 @@ impl KeypointController {
             let pose = kin.frame_pose(robot, self.feet[i])?;
             let v = kin.frame_velocity(robot, self.feet[i])?;
             let (e, e_dot) = lowest_corner(&pose, &v, &self.corners);
+            let r = foot_reference(&self.plan, i, k, hold, self.latch[i], &self.sole);
             if on[i] {
                 let plan = &self.plan.feet[i][k];
                 let low = e <= height;
                 // Slow against its reference: a foot the plan pivots lands while it turns
                 // with it (a still reference leaves the foot's own speed).
-                let r = foot_reference(&self.plan, i, k, hold, self.latch[i], &self.sole);
                 let slow = fastest_corner(&pose, &(v - r.velocity), &self.corners) <= speed;
                 let flat = (pose.rotation * Vector3::z()).z >= LAND_TILT.cos();
                 if low && slow && flat {
@@ -772,7 +769,7 @@ impl KeypointController {
                 (_, false) => FootMode::Swing,
             };
             if modes[i] != FootMode::Swing {
-                self.floor[i] = self.floor_of(i, k, hold, &pose, &v, a_min, modes[i]);
+                self.floor[i] = self.floor_of(&r, &pose, &v, a_min, modes[i]);
             }
         }
         if modes.contains(&FootMode::Floor) {
@@ -812,7 +809,8 @@ impl KeypointController {
                 } else {
                     FootMode::Floor
                 };
-                self.floor[i] = self.floor_of(i, k, hold, &pose, &v, a_min, modes[i]);
+                let r = foot_reference(&self.plan, i, k, hold, self.latch[i], &self.sole);
+                self.floor[i] = self.floor_of(&r, &pose, &v, a_min, modes[i]);
                 again = true;
             }
         }
