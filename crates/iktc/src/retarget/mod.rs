@@ -390,16 +390,50 @@ pub const SETTLE_SPEED: f64 = 0.01;
 /// ticks run.
 fn settle(controller: &mut KeypointController, s: &KeypointSettings) -> Result<usize> {
     let most = (s.settle_time / s.dt).round() as usize;
-    let (v_rest, a_rest) = (s.settle_speed, s.settle_speed * s.gains.kv);
     for k in 0..most {
         controller.tick(0, true)?;
         controller.integrate()?;
-        let at_rest = controller.state().qd.amax() < v_rest && controller.qdd().amax() < a_rest;
-        if at_rest {
+        if at_rest(
+            controller.state().qd.as_slice(),
+            controller.qdd().as_slice(),
+            s,
+        ) {
             return Ok(k + 1);
         }
     }
     Ok(most)
+}
+
+/// Whether a state moving with `qd` under `qdd` is at rest by `s.settle_speed`: every
+/// velocity coordinate below it \[rad/s or m/s\] and every acceleration below it times the
+/// gains' `k_v` \[rad/s² or m/s²\] (a slow state whose errors still pull it, at the turn of an
+/// oscillation, is not at rest).
+fn at_rest(qd: &[f64], qdd: &[f64], s: &KeypointSettings) -> bool {
+    let fastest = |x: &[f64]| x.iter().fold(0.0, |m: f64, v| m.max(v.abs()));
+    fastest(qd) < s.settle_speed && fastest(qdd) < s.settle_speed * s.gains.kv
+}
+
+#[cfg(test)]
+mod rest_tests {
+    use super::*;
+
+    /// At rest needs both: slow, and not pulled (the acceleration bound is `settle_speed ·
+    /// k_v`, 0.2 rad/s² with the defaults); a settle speed of 0 is never met.
+    #[test]
+    fn at_rest_needs_slow_rates_and_small_accelerations() {
+        let s = KeypointSettings::default();
+        let (v, a) = (s.settle_speed, s.settle_speed * s.gains.kv);
+        assert_eq!(a, 0.01 * 20.0);
+        assert!(at_rest(&[0.0, 0.5 * v], &[0.0, -0.5 * a], &s));
+        assert!(!at_rest(&[0.0, -1.5 * v], &[0.0, 0.0], &s), "too fast");
+        assert!(!at_rest(&[0.0, 0.0], &[0.0, 1.5 * a], &s), "pulled");
+        assert!(!at_rest(&[v, 0.0], &[0.0, 0.0], &s), "the bound is strict");
+        let never = KeypointSettings {
+            settle_speed: 0.0,
+            ..s
+        };
+        assert!(!at_rest(&[0.0], &[0.0], &never));
+    }
 }
 
 /// Everything a keypoint run needs, built once.
