@@ -413,29 +413,6 @@ fn at_rest(qd: &[f64], qdd: &[f64], s: &KeypointSettings) -> bool {
     fastest(qd) < s.settle_speed && fastest(qdd) < s.settle_speed * s.gains.kv
 }
 
-#[cfg(test)]
-mod rest_tests {
-    use super::*;
-
-    /// At rest needs both: slow, and not pulled (the acceleration bound is `settle_speed ·
-    /// k_v`, 0.2 rad/s² with the defaults); a settle speed of 0 is never met.
-    #[test]
-    fn at_rest_needs_slow_rates_and_small_accelerations() {
-        let s = KeypointSettings::default();
-        let (v, a) = (s.settle_speed, s.settle_speed * s.gains.kv);
-        assert_eq!(a, 0.01 * 20.0);
-        assert!(at_rest(&[0.0, 0.5 * v], &[0.0, -0.5 * a], &s));
-        assert!(!at_rest(&[0.0, -1.5 * v], &[0.0, 0.0], &s), "too fast");
-        assert!(!at_rest(&[0.0, 0.0], &[0.0, 1.5 * a], &s), "pulled");
-        assert!(!at_rest(&[v, 0.0], &[0.0, 0.0], &s), "the bound is strict");
-        let never = KeypointSettings {
-            settle_speed: 0.0,
-            ..s
-        };
-        assert!(!at_rest(&[0.0], &[0.0], &never));
-    }
-}
-
 /// Everything a keypoint run needs, built once.
 struct Setup {
     robot: Arc<Robot>,
@@ -737,4 +714,27 @@ pub fn joint_route_quality(
         ctl.integrate(robot)?;
     }
     Ok(rec.finish(robot))
+}
+
+#[cfg(test)]
+mod rest_tests {
+    use super::*;
+
+    /// At rest needs both: slow, and not pulled (the acceleration bound is `settle_speed ·
+    /// k_v`, 0.2 rad/s² with the defaults); a settle speed of 0 is never met.
+    #[test]
+    fn at_rest_needs_slow_rates_and_small_accelerations() {
+        let s = KeypointSettings::default();
+        let (v, a) = (s.settle_speed, s.settle_speed * s.gains.kv);
+        assert_eq!(a, 0.01 * 20.0);
+        assert!(at_rest(&[0.0, 0.5 * v], &[0.0, -0.5 * a], &s));
+        assert!(!at_rest(&[0.0, -1.5 * v], &[0.0, 0.0], &s), "too fast");
+        assert!(!at_rest(&[0.0, 0.0], &[0.0, 1.5 * a], &s), "pulled");
+        assert!(!at_rest(&[v, 0.0], &[0.0, 0.0], &s), "the bound is strict");
+        let never = KeypointSettings {
+            settle_speed: 0.0,
+            ..s
+        };
+        assert!(!at_rest(&[0.0], &[0.0], &never));
+    }
 }
