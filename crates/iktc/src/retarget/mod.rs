@@ -730,7 +730,14 @@ mod rest_tests {
         assert!(at_rest(&[0.0, 0.5 * v], &[0.0, -0.5 * a], &s));
         assert!(!at_rest(&[0.0, -1.5 * v], &[0.0, 0.0], &s), "too fast");
         assert!(!at_rest(&[0.0, 0.0], &[0.0, 1.5 * a], &s), "pulled");
-        assert!(!at_rest(&[v, 0.0], &[0.0, 0.0], &s), "the bound is strict");
+        assert!(
+            !at_rest(&[v, 0.0], &[0.0, 0.0], &s),
+            "the rate bound is strict"
+        );
+        assert!(
+            !at_rest(&[0.0], &[a], &s),
+            "the acceleration bound is strict"
+        );
         let never = KeypointSettings {
             settle_speed: 0.0,
             ..s
