@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use iktc::motion::{load_motion, Motion, MotionOptions, DEFAULT_MAX_GAP};
+use iktc::motion::{load_motion, Keypoints, Motion, MotionOptions, DEFAULT_MAX_GAP};
 use iktc::profile::RobotProfile;
 use iktc::retarget::{
     joint_route_quality, retarget_keypoints, HandScaling, KeypointSettings, RetargetQuality,
@@ -12,6 +12,19 @@ use iktc::retarget::{
 };
 use iktc::sim::{imitation_references, ImitateConfig};
 use iktc::solver::SolverSettings;
+
+/// The body keypoints of a built-in DeepMimic clip.
+fn builtin_keypoints(clip: &str) -> Keypoints {
+    iktc::retarget::builtin_motion(clip)
+        .unwrap()
+        .keypoints(DEFAULT_MAX_GAP)
+        .unwrap()
+}
+
+/// The largest magnitude among `x` (0 for none).
+fn fastest(x: &[f64]) -> f64 {
+    x.iter().fold(0.0, |m: f64, v| m.max(v.abs()))
+}
 
 /// Largest pelvis orientation error on the CMU clips \[deg\] (0.2.0: 60°, from a twist the robot
 /// follows with its feet held; 154° when the base spun).
@@ -199,11 +212,9 @@ fn check_robot(name: &str) {
         let most = (s.settle_time / s.dt).round() as usize;
         assert_eq!(settle.ticks, run.settle_ticks, "{file}");
         assert!(run.settle_ticks >= 1 && run.settle_ticks <= most, "{file}");
-        let fastest = run.velocities[0]
-            .iter()
-            .fold(0.0, |a: f64, v| a.max(v.abs()));
+        let start = fastest(&run.velocities[0]);
         if run.settle_ticks < most {
-            assert!(fastest < s.settle_speed, "{file}: {fastest} at the start");
+            assert!(start < s.settle_speed, "{file}: {start} at the start");
         }
         for c in [sac, settle] {
             assert_eq!(c.levels.len(), KEYPOINT_LEVELS.len(), "{file}");
@@ -324,10 +335,7 @@ fn soles_stay_above_ground() {
 fn held_frame_speed(clip: &str, posture_weight: f64, (from, to): (f64, f64)) -> f64 {
     let profile = RobotProfile::builtin("g1").unwrap();
     let robot = profile.robot().unwrap();
-    let kp = iktc::retarget::builtin_motion(clip)
-        .unwrap()
-        .keypoints(DEFAULT_MAX_GAP)
-        .unwrap();
+    let kp = builtin_keypoints(clip);
     let s = KeypointSettings {
         posture_weight,
         ..KeypointSettings::default()
@@ -339,10 +347,7 @@ fn held_frame_speed(clip: &str, posture_weight: f64, (from, to): (f64, f64)) -> 
         c.tick(0, true).unwrap();
         c.integrate().unwrap();
         if k as f64 * s.dt >= from {
-            let v = c.state().qd.as_slice()[base..]
-                .iter()
-                .fold(0.0, |m: f64, v| m.max(v.abs()));
-            speeds.push(v);
+            speeds.push(fastest(&c.state().qd.as_slice()[base..]));
         }
     }
     speeds.sort_by(f64::total_cmp);
@@ -400,10 +405,7 @@ fn g1_comes_to_rest_on_a_held_frame() {
 #[test]
 fn the_settling_ends_once_the_robot_is_at_rest() {
     let profile = RobotProfile::builtin("g1").unwrap();
-    let kp = iktc::retarget::builtin_motion("humanoid3d_punch")
-        .unwrap()
-        .keypoints(DEFAULT_MAX_GAP)
-        .unwrap();
+    let kp = builtin_keypoints("humanoid3d_punch");
     let early = KeypointSettings::default();
     let full = KeypointSettings {
         settle_speed: 0.0,
@@ -416,8 +418,8 @@ fn the_settling_ends_once_the_robot_is_at_rest() {
     assert!(a.settle_ticks < most, "{} ticks", a.settle_ticks);
     assert_eq!(b.settle_ticks, most);
     assert_eq!(a.trajectory.len(), b.trajectory.len());
-    let fastest = a.velocities[0].iter().fold(0.0, |m: f64, v| m.max(v.abs()));
-    assert!(fastest < early.settle_speed, "{fastest}");
+    let start = fastest(&a.velocities[0]);
+    assert!(start < early.settle_speed, "{start}");
     let (qa, qb) = (&a.trajectory[0], &b.trajectory[0]);
     for i in 0..qa.len() {
         // Base position [m] (0..3), quaternion (3..7), joints [rad].
@@ -440,10 +442,7 @@ fn the_settling_ends_once_the_robot_is_at_rest() {
 fn g1_hands_by_the_leg_ratio_follow_the_captured_wrists_closer() {
     let profile = RobotProfile::builtin("g1").unwrap();
     let wrists = |s: &KeypointSettings, clip: &str| -> f64 {
-        let kp = iktc::retarget::builtin_motion(clip)
-            .unwrap()
-            .keypoints(DEFAULT_MAX_GAP)
-            .unwrap();
+        let kp = builtin_keypoints(clip);
         let q = retarget_keypoints(&profile, &kp, None, s).unwrap().quality;
         let w: Vec<f64> = q
             .points
@@ -478,10 +477,7 @@ fn g1_hands_by_the_leg_ratio_follow_the_captured_wrists_closer() {
 #[test]
 fn jvrc1_names_the_level_it_cannot_follow_on_dance_a() {
     let profile = RobotProfile::builtin("jvrc1").unwrap();
-    let kp = iktc::retarget::builtin_motion("humanoid3d_dance_a")
-        .unwrap()
-        .keypoints(DEFAULT_MAX_GAP)
-        .unwrap();
+    let kp = builtin_keypoints("humanoid3d_dance_a");
     let run = retarget_keypoints(&profile, &kp, None, &KeypointSettings::default()).unwrap();
     let settle = &run.settle_sacrificed;
     eprintln!("settling: {} of {}", settle.describe(), settle.ticks);
@@ -613,10 +609,7 @@ fn joints_on_a_limit_are_counted_from_the_trajectory() {
     use iktc::retarget::LIMIT_BAND;
     let profile = RobotProfile::builtin("g1").unwrap();
     let robot = profile.robot().unwrap();
-    let kp = iktc::retarget::builtin_motion("humanoid3d_dance_a")
-        .unwrap()
-        .keypoints(DEFAULT_MAX_GAP)
-        .unwrap();
+    let kp = builtin_keypoints("humanoid3d_dance_a");
     let run = retarget_keypoints(&profile, &kp, None, &KeypointSettings::default()).unwrap();
     let ticks = run.trajectory.len() as f64;
     let mut expected = Vec::new();
@@ -644,8 +637,7 @@ fn joints_on_a_limit_are_counted_from_the_trajectory() {
     assert_eq!(got, expected);
 }
 
-/// A pivot threshold that is not a finite angle >= 0 is an error naming the setting; `None`
-/// (no pivots) and 0 (every turning stance pivots) are accepted.
+/// A settle speed that is not a finite speed >= 0 is an error naming the setting.
 #[test]
 fn a_bad_settle_speed_is_an_error() {
     for bad in [f64::NAN, -0.01, f64::INFINITY] {
@@ -660,6 +652,8 @@ fn a_bad_settle_speed_is_an_error() {
     }
 }
 
+/// A pivot threshold that is not a finite angle >= 0 is an error naming the setting; `None`
+/// (no pivots) and 0 (every turning stance pivots) are accepted.
 #[test]
 fn a_bad_pivot_turn_is_an_error() {
     for bad in [f64::NAN, -0.1, f64::INFINITY] {

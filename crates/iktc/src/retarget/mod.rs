@@ -57,6 +57,8 @@ pub use viewer::{keypoint_viewer, ON_LIMIT};
 use std::sync::Arc;
 use std::time::Instant;
 
+use nalgebra::DVector;
+
 use crate::error::{Error, Result};
 use crate::limits::BoundMethod;
 use crate::model::{Kinematics, Robot, State};
@@ -393,11 +395,7 @@ fn settle(controller: &mut KeypointController, s: &KeypointSettings) -> Result<u
     for k in 0..most {
         controller.tick(0, true)?;
         controller.integrate()?;
-        if at_rest(
-            controller.state().qd.as_slice(),
-            controller.qdd().as_slice(),
-            s,
-        ) {
+        if at_rest(&controller.state().qd, controller.qdd(), s) {
             return Ok(k + 1);
         }
     }
@@ -408,9 +406,8 @@ fn settle(controller: &mut KeypointController, s: &KeypointSettings) -> Result<u
 /// velocity coordinate below it \[rad/s or m/s\] and every acceleration below it times the
 /// gains' `k_v` \[rad/s² or m/s²\] (a slow state whose errors still pull it, at the turn of an
 /// oscillation, is not at rest).
-fn at_rest(qd: &[f64], qdd: &[f64], s: &KeypointSettings) -> bool {
-    let fastest = |x: &[f64]| x.iter().fold(0.0, |m: f64, v| m.max(v.abs()));
-    fastest(qd) < s.settle_speed && fastest(qdd) < s.settle_speed * s.gains.kv
+fn at_rest(qd: &DVector<f64>, qdd: &DVector<f64>, s: &KeypointSettings) -> bool {
+    qd.amax() < s.settle_speed && qdd.amax() < s.settle_speed * s.gains.kv
 }
 
 /// Everything a keypoint run needs, built once.
@@ -720,6 +717,11 @@ pub fn joint_route_quality(
 mod rest_tests {
     use super::*;
 
+    /// A vector of the rates or accelerations `x`.
+    fn vector(x: &[f64]) -> DVector<f64> {
+        DVector::from_row_slice(x)
+    }
+
     /// At rest needs both: slow, and not pulled (the acceleration bound is `settle_speed ·
     /// k_v`, 0.2 rad/s² with the defaults); a settle speed of 0 is never met.
     #[test]
@@ -727,21 +729,31 @@ mod rest_tests {
         let s = KeypointSettings::default();
         let (v, a) = (s.settle_speed, s.settle_speed * s.gains.kv);
         assert_eq!(a, 0.01 * 20.0);
-        assert!(at_rest(&[0.0, 0.5 * v], &[0.0, -0.5 * a], &s));
-        assert!(!at_rest(&[0.0, -1.5 * v], &[0.0, 0.0], &s), "too fast");
-        assert!(!at_rest(&[0.0, 0.0], &[0.0, 1.5 * a], &s), "pulled");
+        assert!(at_rest(
+            &vector(&[0.0, 0.5 * v]),
+            &vector(&[0.0, -0.5 * a]),
+            &s
+        ));
         assert!(
-            !at_rest(&[v, 0.0], &[0.0, 0.0], &s),
+            !at_rest(&vector(&[0.0, -1.5 * v]), &vector(&[0.0, 0.0]), &s),
+            "too fast"
+        );
+        assert!(
+            !at_rest(&vector(&[0.0, 0.0]), &vector(&[0.0, 1.5 * a]), &s),
+            "pulled"
+        );
+        assert!(
+            !at_rest(&vector(&[v, 0.0]), &vector(&[0.0, 0.0]), &s),
             "the rate bound is strict"
         );
         assert!(
-            !at_rest(&[0.0], &[a], &s),
+            !at_rest(&vector(&[0.0]), &vector(&[a]), &s),
             "the acceleration bound is strict"
         );
         let never = KeypointSettings {
             settle_speed: 0.0,
             ..s
         };
-        assert!(!at_rest(&[0.0], &[0.0], &never));
+        assert!(!at_rest(&vector(&[0.0]), &vector(&[0.0]), &never));
     }
 }
