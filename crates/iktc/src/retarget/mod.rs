@@ -33,6 +33,7 @@
 //! ```
 
 mod body;
+mod com;
 mod contacts;
 mod drift;
 mod floor;
@@ -479,8 +480,16 @@ fn setup(
     let state = start_state(&robot, &cfg, &body)?;
     kin.update(&robot, &state)?;
     let clip = scale::scale_clip(&robot, &kin, &body, kp, cfg.support.ankle_height, s.hands)?;
-    let plan = plan::plan(&robot, &kin, &body, kp, &clip, &cfg.support, s)?;
     let tracks = posture_tracks(&robot, &state, posture, s.posture_margin)?;
+    let on = plan::PlanRobot {
+        robot: &robot,
+        start: &state,
+        kin: &kin,
+        body: &body,
+        support: &cfg.support,
+        posture: &tracks,
+    };
+    let plan = plan::plan(&on, kp, &clip, s)?;
     let controller =
         KeypointController::new(robot.clone(), state, &body, plan, tracks, &cfg.support, s)?;
     Ok(Setup {

@@ -3,9 +3,10 @@
 //! The scaled points ([`super::scale`]) are interpolated at the tick times by natural cubic
 //! splines ([`CubicSpline`]); the feet are held in stance ([`super::contacts`]); the COM
 //! reference is the scaled pelvis' ground projection plus the robot's own horizontal offset of
-//! its COM from its pelvis in its start posture (turned with the clip's heading: G1's COM is
-//! 4.1 cm ahead of its pelvis: held over the pelvis, its torso's orientation missed the
-//! clip's by a mean 29–43° on the shared clips, with the offset by 10–31°), pulled into the support polygon of the
+//! its COM from its pelvis in the posture asked of it at that tick ([`super::com`]: G1's COM is
+//! 4.1 cm ahead of its pelvis standing; held over the pelvis, its torso's orientation missed
+//! the clip's by a mean 29–43° on the shared clips, with the start posture's offset by
+//! 10–31°), pulled into the support polygon of the
 //! feet on the ground (shrunk by `com_margin`), then smoothed by two passes of a centred moving
 //! average of `com_smoothing` \[s\]; orientations come from the points: the pelvis frame from
 //! the hip axis and the vertical, the torso frame from the shoulder axis and the hips-to-
@@ -23,14 +24,16 @@
 use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, UnitQuaternion, Vector3, Vector6};
 
 use super::body::RobotBody;
+use super::com;
 use super::contacts::{
     detect, hold, hold_turning, moving_average, quintic, remove_short, runs, PIVOT_RATE,
     PIVOT_SMOOTHING,
 };
 use super::scale::ScaledClip;
+use super::tracker::PostureTracks;
 use super::{KeypointSettings, SupportArea};
 use crate::error::{Error, Result};
-use crate::model::{Kinematics, Robot};
+use crate::model::{Kinematics, Robot, State};
 use crate::motion::{lowpass_track, BodyPoint, CubicSpline, Keypoints};
 use crate::sim::imitate::{sole_pose, SupportSettings};
 use crate::task::{ComReference, FrameReference};
@@ -226,16 +229,25 @@ pub(crate) fn pull_inside(polygon: &SupportPolygon, p: (f64, f64), margin: f64) 
     polygon.pull_towards(p, c, margin)
 }
 
-/// The plan of a run (see the module documentation). `kin` is at the start posture.
+/// The robot a plan is made for: its model, its start state and the kinematics at it, its
+/// body frames and feet, and its posture references per tick.
+pub(crate) struct PlanRobot<'a> {
+    pub robot: &'a Robot,
+    pub start: &'a State,
+    pub kin: &'a Kinematics,
+    pub body: &'a RobotBody,
+    pub support: &'a SupportSettings,
+    pub posture: &'a PostureTracks,
+}
+
+/// The plan of a run (see the module documentation).
 pub(crate) fn plan(
-    robot: &Robot,
-    kin: &Kinematics,
-    body: &RobotBody,
+    r: &PlanRobot,
     kp: &Keypoints,
     clip: &ScaledClip,
-    support: &SupportSettings,
     s: &KeypointSettings,
 ) -> Result<Plan> {
+    let (robot, kin, body, support) = (r.robot, r.kin, r.body, r.support);
     let n = kp.points.len();
     let frames = kp.frame_count();
     let (t0, t1) = (kp.times[0], kp.times[frames - 1]);
@@ -380,11 +392,23 @@ pub(crate) fn plan(
             .collect();
         feet[i] = pose_refs(pos, rot, s.dt);
     }
-    // COM over the support polygon of the feet on the ground.
-    // The robot's COM relative to its pelvis in its start posture, horizontal: where its COM
-    // is when it stands as the captured person stands.
-    let mut com_offset = kin.com() - kin.frame_pose(robot, body.pelvis)?.translation.vector;
-    com_offset.z = 0.0;
+    // Pelvis and torso orientations, from the same construction on the robot at its start.
+    let at0 = |p: BodyPoint| -> Result<Vector3<f64>> {
+        let f = body.frame_of(p).ok_or_else(|| missing(p))?;
+        Ok(kin.frame_pose(robot, f)?.translation.vector)
+    };
+    let (rlh, rrh) = (at0(BodyPoint::LeftHip)?, at0(BodyPoint::RightHip)?);
+    let (rls, rrs) = (
+        at0(BodyPoint::LeftShoulder)?,
+        at0(BodyPoint::RightShoulder)?,
+    );
+    let c_pelvis = pelvis_frame(rlh, rrh).inverse() * kin.frame_pose(robot, body.pelvis)?.rotation;
+    let pelvis_rot: Vec<UnitQuaternion<f64>> = (0..ticks)
+        .map(|k| pelvis_frame(lh[k], rh[k]) * c_pelvis)
+        .collect();
+    // COM over the support polygon of the feet on the ground: the scaled pelvis plus the
+    // robot's own COM offset from its pelvis in the posture asked of it ([`com`]).
+    let com_offset = com::com_offsets(robot, r.start, body.pelvis, &pelvis_rot, r.posture)?;
     let mut com: Vec<Vector3<f64>> = Vec::with_capacity(ticks);
     for k in 0..ticks {
         let any = contact[0][k] || contact[1][k];
@@ -400,8 +424,7 @@ pub(crate) fn plan(
                 )
             })
             .collect();
-        let turn = UnitQuaternion::from_euler_angles(0.0, 0.0, heading[k] - heading[0]);
-        let c = pelvis_x[k] + turn * com_offset;
+        let c = pelvis_x[k] + com_offset[k];
         let p = (c.x, c.y);
         let (l, w) = (support.sole_length, support.sole_width);
         let soles: Vec<Pose2> = on.iter().map(|a| sole_pose(a, support)).collect();
@@ -421,20 +444,6 @@ pub(crate) fn plan(
             velocity: r.velocity,
             acceleration: r.acceleration,
         })
-        .collect();
-    // Pelvis and torso orientations, from the same construction on the robot at its start.
-    let at0 = |p: BodyPoint| -> Result<Vector3<f64>> {
-        let f = body.frame_of(p).ok_or_else(|| missing(p))?;
-        Ok(kin.frame_pose(robot, f)?.translation.vector)
-    };
-    let (rlh, rrh) = (at0(BodyPoint::LeftHip)?, at0(BodyPoint::RightHip)?);
-    let (rls, rrs) = (
-        at0(BodyPoint::LeftShoulder)?,
-        at0(BodyPoint::RightShoulder)?,
-    );
-    let c_pelvis = pelvis_frame(rlh, rrh).inverse() * kin.frame_pose(robot, body.pelvis)?.rotation;
-    let pelvis_rot: Vec<UnitQuaternion<f64>> = (0..ticks)
-        .map(|k| pelvis_frame(lh[k], rh[k]) * c_pelvis)
         .collect();
     // Legs within reach: lower the pelvis (and the points above it) where needed.
     let mut drop = vec![0.0; ticks];
@@ -711,6 +720,7 @@ fn unwrap(mut a: Vec<f64>) -> Vec<f64> {
 mod tests {
     use super::*;
     use crate::profile::RobotProfile;
+    use crate::retarget::contacts::PIVOT_TURN;
     use crate::sim::ImitateConfig;
 
     /// The plans of `clip` on `robot` as the keypoint route builds them, with and without
@@ -748,17 +758,27 @@ mod tests {
             s.hands,
         )
         .unwrap();
-        let free = plan(&robot, &kin, &body, &kp, &scaled, &cfg.support, s).unwrap();
+        let posture = super::super::posture_tracks(&robot, &state, None, s.posture_margin).unwrap();
+        let on = PlanRobot {
+            robot: &robot,
+            start: &state,
+            kin: &kin,
+            body: &body,
+            support: &cfg.support,
+            posture: &posture,
+        };
+        let free = plan(&on, &kp, &scaled, s).unwrap();
         let standing = KeypointSettings {
             standing: true,
             ..s.clone()
         };
-        let held = plan(&robot, &kin, &body, &kp, &scaled, &cfg.support, &standing).unwrap();
+        let held = plan(&on, &kp, &scaled, &standing).unwrap();
         (robot, kin, body, cfg.support, free, held)
     }
 
     /// `humanoid3d_dance_a` spins on its feet: with the default a foot's yaw turns by more
-    /// than a radian over one of its stances, about its sole's centre, which stays where the
+    /// than [`PIVOT_TURN`] over one of its stances (0.96 rad on G1), about its sole's centre,
+    /// which stays where the
     /// stance holds it; with `pivot_turn: None` every stance holds the foot's yaw. Either way
     /// the sole's centre is constant in every stance, and a pivoting foot turns no faster
     /// than [`PIVOT_RATE`] there.
@@ -804,7 +824,7 @@ mod tests {
                 }
             }
         }
-        assert!(largest_turn > 1.0, "{largest_turn}");
+        assert!(largest_turn > PIVOT_TURN, "{largest_turn}");
     }
 
     /// Standing: feet, pelvis and COM are constant at the robot's start, both feet on the ground
@@ -918,34 +938,44 @@ mod tests {
     }
 
     /// The COM reference is the pelvis' ground projection plus the robot's own COM offset from
-    /// its pelvis in the start posture, turned with the heading, wherever that lies inside the
-    /// support polygon (unsmoothed here, so it is compared tick by tick; elsewhere it is pulled
-    /// to the polygon's margin). On G1 the offset is 4.1 cm: held over the pelvis instead, the
-    /// reference would match on no tick.
+    /// its pelvis frame in the posture asked of it (here the start posture, every tick) with
+    /// the pelvis frame at its orientation reference, wherever that lies inside the support
+    /// polygon (unsmoothed here, so it is compared tick by tick; elsewhere it is pulled to the
+    /// polygon's margin). The offset is computed here from the robot placed by the plan's
+    /// pelvis reference. On G1 it is about 4 cm: held over the pelvis instead, the reference
+    /// would match on no tick.
     #[test]
     fn the_com_reference_carries_the_robots_com_offset_from_its_pelvis() {
         let s = KeypointSettings {
             com_smoothing: 0.0,
             ..KeypointSettings::default()
         };
-        let (robot, kin, body, _, free, _) = plans_with("g1", "humanoid3d_walk", &s);
-        let mut offset = kin.com()
-            - kin
-                .frame_pose(&robot, body.pelvis)
-                .unwrap()
-                .translation
-                .vector;
-        offset.z = 0.0;
-        assert!(offset.norm() > 0.03, "G1's offset: {offset}");
-        let r0 = free.pelvis[0].rotation;
+        let (robot, mut kin, body, _, free, _) = plans_with("g1", "humanoid3d_walk", &s);
+        let profile = RobotProfile::builtin("g1").unwrap();
+        let cfg = profile.imitate_config(ImitateConfig::default()).unwrap();
+        let mut state = super::super::start_state(&robot, &cfg, &body).unwrap();
+        let base_in_pelvis =
+            kin.frame_pose(&robot, body.pelvis).unwrap().inverse() * state.base_pose(&robot);
         let (mut with, mut without) = (0, 0);
         for k in 0..free.ticks {
-            let yaw = (free.pelvis[k].rotation * r0.inverse()).euler_angles().2;
-            let turn = UnitQuaternion::from_euler_angles(0.0, 0.0, yaw);
-            let p = free.pelvis[k].position.position;
+            let r = &free.pelvis[k];
+            let pelvis = Isometry3::from_parts(Translation3::from(r.position.position), r.rotation);
+            state
+                .set_base_pose(&robot, &(pelvis * base_in_pelvis))
+                .unwrap();
+            kin.update(&robot, &state).unwrap();
+            let placed = kin.frame_pose(&robot, body.pelvis).unwrap();
+            // The robot placed by the reference: its pelvis frame is there.
+            assert!((placed.translation.vector - r.position.position).norm() < 1e-9);
+            let offset = kin.com() - placed.translation.vector;
+            assert!(
+                offset.xy().norm() > 0.03,
+                "G1's offset at tick {k}: {offset}"
+            );
+            let p = r.position.position;
             let c = free.com[k].position;
             // A reference built from stored positions: equal up to rounding.
-            if (c.xy() - (p + turn * offset).xy()).norm() < 1e-9 {
+            if (c.xy() - (p + offset).xy()).norm() < 1e-9 {
                 with += 1;
             }
             if (c.xy() - p.xy()).norm() < 1e-9 {
