@@ -34,6 +34,22 @@ pub enum HandsArg {
     Segments,
 }
 
+/// `--max-slide`: a length \[m\] or `none`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MaxSlide(pub Option<f64>);
+
+fn parse_max_slide(s: &str) -> Result<MaxSlide, String> {
+    if s.eq_ignore_ascii_case("none") {
+        return Ok(MaxSlide(None));
+    }
+    match s.parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(MaxSlide(Some(v))),
+        _ => Err(format!(
+            "`{s}`: expected a length > 0 [m] (human scale) or `none`"
+        )),
+    }
+}
+
 /// Options of the keypoint retargeting (`iktc imitate`, `iktc retarget`).
 #[derive(clap::Args, Debug, Clone, Default)]
 pub struct KeypointArgs {
@@ -66,6 +82,11 @@ pub struct KeypointArgs {
     /// rad over a stance) does not pivot about its sole's centre, the legs take the turn.
     #[arg(long)]
     pub no_pivot: bool,
+    /// A stance over which the captured ankle slides further than this [m, human scale] is
+    /// split into steps: the robot lifts the foot and sets it down where the captured foot has
+    /// slid, instead of holding it behind. `none` holds every stance.
+    #[arg(long, value_name = "M", value_parser = parse_max_slide)]
+    pub max_slide: Option<MaxSlide>,
 }
 
 impl KeypointArgs {
@@ -85,6 +106,9 @@ impl KeypointArgs {
         }
         if route == RetargetArg::Joints && self.no_pivot {
             anyhow::bail!("--no-pivot applies to --retarget keypoints only");
+        }
+        if route == RetargetArg::Joints && self.max_slide.is_some() {
+            anyhow::bail!("--max-slide applies to --retarget keypoints only");
         }
         cfg.smoothing = match (self.no_smoothing, self.smoothing, route) {
             (true, _, _) => None,
@@ -119,6 +143,10 @@ pub fn keypoint_settings(
             None
         } else {
             KeypointSettings::default().pivot_turn
+        },
+        max_slide: match k.max_slide {
+            Some(MaxSlide(m)) => m,
+            None => KeypointSettings::default().max_slide,
         },
         ..KeypointSettings::default()
     }

@@ -94,6 +94,8 @@ pub fn py_retarget_keypoints(
         settings.contact_speed = f64::MAX;
         // Planted: no pivots (the whole clip is one stance, over which the feet turn).
         settings.pivot_turn = None;
+        // Nor slides split into steps.
+        settings.max_slide = None;
     }
     py.detach(|| -> iktc::Result<PyKeypointTrajectory> {
         let kp = motion.motion.keypoints(DEFAULT_MAX_GAP)?;

@@ -26,8 +26,8 @@ use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, UnitQuaternion, Vect
 use super::body::RobotBody;
 use super::com;
 use super::contacts::{
-    detect, hold, hold_turning, moving_average, quintic, remove_short, runs, PIVOT_RATE,
-    PIVOT_SMOOTHING,
+    detect, hold, hold_turning, moving_average, quintic, remove_short, runs, split_slides,
+    PIVOT_RATE, PIVOT_SMOOTHING,
 };
 use super::scale::ScaledClip;
 use super::tracker::PostureTracks;
@@ -336,6 +336,9 @@ pub(crate) fn plan(
         );
         remove_short(&mut c, false, min_len);
         remove_short(&mut c, true, min_len);
+        if let Some(d) = s.max_slide {
+            split_slides(&mut c, &ankle, d, min_len);
+        }
         contact[i] = times.iter().map(|t| c[frame_of_tick(*t)]).collect();
     }
     // Feet: x, y (of the sole's centre) and yaw held in stance (the yaw followed where the foot
