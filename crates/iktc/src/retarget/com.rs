@@ -10,9 +10,9 @@
 //!
 //! `d_k = c(q_k) − p(q_k)` with its vertical component set to 0,
 //!
-//! `c` the COM and `p` the pelvis frame's origin in the world (a horizontal difference does not
-//! depend on where the base is, so the base is placed at the origin, turned so that the pelvis
-//! frame has its reference orientation). Standing as at its start, `d_k` is the start
+//! `c` the COM and `p` the pelvis frame's origin in the world (a difference does not depend on
+//! where the robot is, so the base is placed with the pelvis frame at the origin, turned to
+//! its reference orientation, and `d_k` is the COM's horizontal position). Standing as at its start, `d_k` is the start
 //! posture's offset turned with the pelvis (G1's COM 4.1 cm ahead of its pelvis frame); where
 //! the captured person bends (a bow, a reach, a crouch), the robot's own masses move its COM
 //! from its pelvis as the posture moves them, and the legs are not asked to hold a COM where
@@ -57,10 +57,11 @@ pub(crate) fn com_offsets(
                 state.q[*iq] = *v;
             }
         }
+        // The pelvis frame at the origin: the COM is its offset.
         let pelvis_pose = Isometry3::from_parts(Translation3::identity(), *rot);
         state.set_base_pose(robot, &(pelvis_pose * base_in_pelvis))?;
         kin.update(robot, &state)?;
-        let mut d = kin.com() - kin.frame_pose(robot, pelvis)?.translation.vector;
+        let mut d = kin.com();
         d.z = 0.0;
         offsets.push(d);
     }
@@ -97,12 +98,15 @@ mod tests {
     const TOL: f64 = 1e-12;
 
     /// At the start posture and orientation the offset is the start's own COM offset from the
-    /// pelvis frame, computed directly; turned about the vertical with the pelvis, it turns
-    /// with it; bending the waist forward (G1's `waist_pitch_joint`, positive pitch leans the
-    /// torso forward) carries it forward, by more than 2 cm at 0.5 rad.
+    /// pelvis frame, computed directly (the start turned by 0.4 rad and moved, so that the
+    /// base's placement matters); turned about the vertical with the pelvis, it turns with it;
+    /// bending the waist forward (G1's `waist_pitch_joint`, positive pitch leans the torso
+    /// forward) carries it forward, by more than 2 cm at 0.5 rad.
     #[test]
     fn the_offset_follows_the_posture_and_turns_with_the_pelvis() {
-        let (robot, pelvis, start) = g1();
+        let (robot, pelvis, mut start) = g1();
+        let turned = Isometry3::new(Vector3::new(1.0, -2.0, 0.8), Vector3::new(0.0, 0.0, 0.4));
+        start.set_base_pose(&robot, &turned).unwrap();
         let kin = Kinematics::new(&robot, &start).unwrap();
         let p0 = kin.frame_pose(&robot, pelvis).unwrap();
         let mut direct = kin.com() - p0.translation.vector;
@@ -129,6 +133,22 @@ mod tests {
         let ahead = (d[1] - d[0]).dot(&forward);
         assert!(ahead > 0.02, "{ahead} m");
         assert!(d.iter().all(|v| v.z == 0.0));
+    }
+
+    /// Any frame can stand for the pelvis, one away from the base too: G1's torso frame (above
+    /// the waist joints) at its start orientation gives the COM's offset from it, computed
+    /// directly.
+    #[test]
+    fn a_frame_away_from_the_base_gives_the_offset_from_it() {
+        let (robot, _, start) = g1();
+        let torso = robot.frame_id("torso_link").unwrap();
+        let kin = Kinematics::new(&robot, &start).unwrap();
+        let t0 = kin.frame_pose(&robot, torso).unwrap();
+        let mut direct = kin.com() - t0.translation.vector;
+        direct.z = 0.0;
+        let standing = super::super::posture_tracks(&robot, &start, None, 0.0).unwrap();
+        let d = com_offsets(&robot, &start, torso, &[t0.rotation], &standing).unwrap();
+        assert!((d[0] - direct).norm() < TOL, "{} against {direct}", d[0]);
     }
 
     /// A track shorter than the ticks holds its last value: the ticks after its end have the
