@@ -206,10 +206,12 @@ def iktc_binary():
     override = os.environ.get("IKTC_BIN")
     if override:
         return override
-    for profile in ("debug", "release"):
-        path = REPO / "target" / profile / "iktc"
-        if path.exists():
-            return str(path)
+    # The newest build: a stale debug binary beside a fresh release one (or the other way
+    # round) would compare the Python module with older code.
+    built = [REPO / "target" / profile / "iktc" for profile in ("debug", "release")]
+    built = [p for p in built if p.exists()]
+    if built:
+        return str(max(built, key=lambda p: p.stat().st_mtime))
     raise AssertionError("the iktc binary is not built: run `cargo build -p iktc-cli` (or set IKTC_BIN)")
 
 
