@@ -41,7 +41,10 @@ pub struct PyKeypointTrajectory {
 /// over `dt` [s]; the posture level follows the joint route's references where the profile has
 /// a map for the motion's format. `hold_feet`: every frame counts as stance, so both feet are
 /// held where they stand for the whole clip (a standing imitation), at their yaw, instead of
-/// stepping where the clip's feet leave the ground or pivoting where they turn. `standing`: the feet and the pelvis held at the robot's
+/// stepping where the clip's feet leave the ground or slide, or pivoting where they turn.
+/// `max_slide` [m, human scale]: a stance over which the captured ankle slides further is
+/// split into steps (`iktc::retarget::KeypointSettings::max_slide`; `None` holds every
+/// stance). `standing`: the feet and the pelvis held at the robot's
 /// start pose and only the clip's upper body imitated, relative to its pelvis (see
 /// `iktc::retarget::KeypointSettings::standing`). `smoothing`: cut-off [Hz] of the zero-phase
 /// low-pass applied to the body points before they are differentiated (`None`: as captured).
@@ -52,7 +55,7 @@ pub struct PyKeypointTrajectory {
 /// (`iktc::retarget::HandScaling`). `reach`: also measure the static reach of the body points
 /// (`iktc::retarget::KeypointSettings::reach`; about doubles the time), in `quality`.
 #[pyfunction]
-#[pyo3(name = "retarget_keypoints", signature = (motion, robot, *, dt=0.005, hold_feet=false, standing=false, smoothing=None, approach_rate=0.0, hands="leg", reach=false))]
+#[pyo3(name = "retarget_keypoints", signature = (motion, robot, *, dt=0.005, hold_feet=false, standing=false, smoothing=None, approach_rate=0.0, hands="leg", reach=false, max_slide=Some(iktc::retarget::MAX_SLIDE)))]
 #[allow(clippy::too_many_arguments)]
 pub fn py_retarget_keypoints(
     py: Python<'_>,
@@ -65,6 +68,7 @@ pub fn py_retarget_keypoints(
     approach_rate: f64,
     hands: &str,
     reach: bool,
+    max_slide: Option<f64>,
 ) -> PyResult<PyKeypointTrajectory> {
     let profile = robot.required_profile("keypoint retargeting", "feet, pelvis and hands")?;
     let hands = match hands {
@@ -82,6 +86,7 @@ pub fn py_retarget_keypoints(
         smoothing,
         hands,
         reach,
+        max_slide,
         ..KeypointSettings::default()
     };
     settings.bounds = settings

@@ -123,3 +123,18 @@ def test_the_run_says_which_levels_the_joint_limits_cost(runs):
     settle = jvrc.settle_sacrificed
     assert settle["hands_swing_feet"] > 0, settle
     assert sum(settle.values()) == settle["hands_swing_feet"], settle
+
+
+def test_a_sliding_foot_steps_unless_every_stance_is_held_and_bad_slides_are_errors():
+    # CMU 131_01 slides a foot on the ground: split into steps (the default 5 cm), G1 follows
+    # the captured legs more closely than with every stance held.
+    from test_controller import REPO
+    robot = iktc.Robot("g1")
+    motion = iktc.load_motion(str(REPO / "crates/iktc/tests/data/motions/cmu/131_01.bvh"))
+    stepping = iktc.retarget_keypoints(motion, robot)
+    held = iktc.retarget_keypoints(motion, robot, max_slide=None)
+    assert stepping.quality["mean_cm"] < held.quality["mean_cm"] - 0.5
+    assert stepping.quality["slip_mm"] <= 2.0
+    for bad in (0.0, -0.05, float("nan")):
+        with pytest.raises(iktc.IktcError, match="max_slide"):
+            iktc.retarget_keypoints(motion, robot, max_slide=bad)

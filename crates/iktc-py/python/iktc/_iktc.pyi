@@ -202,7 +202,8 @@ def retarget_keypoints(motion: Motion, robot: Robot, *, dt: float = 0.005,
                        smoothing: Optional[float] = None,
                        approach_rate: float = 0.0,
                        hands: str = "leg",
-                       reach: bool = False) -> KeypointTrajectory: ...
+                       reach: bool = False,
+                       max_slide: Optional[float] = 0.05) -> KeypointTrajectory: ...
 
 class Imitation:
     def __init__(self, robot: Robot, motion: Motion, *, map: Optional[str] = None,
