@@ -331,8 +331,8 @@ mod tests {
     }
 
     /// No part shorter than `gap` is split off. With 5.5 cm allowed and a gap of 8 frames the
-    /// split is at frame 16 as with 4; with a gap of 17 there is none (the rest after the
-    /// flight would be 6 frames). With 0.5 cm allowed and a gap of 12 the slide passes it at
+    /// split is at frame 16 as with 4, and with 12 (the rest after the flight exactly 12
+    /// frames); with a gap of 17 there is none (the rest after the flight would be 6 frames). With 0.5 cm allowed and a gap of 12 the slide passes it at
     /// frame 11, when the part is 11 frames long, and the split waits for frame 12. A gap of 0
     /// still ends the stance for one frame.
     #[test]
@@ -345,6 +345,8 @@ mod tests {
         };
         assert_eq!(split(0.055, 8), vec![(0, 16), (24, 40), (45, 50)]);
         assert_eq!(split(0.055, 17), runs(&c0));
+        // The rest after the flight exactly `gap` long (frames 28–39) still splits.
+        assert_eq!(split(0.055, 12), vec![(0, 16), (28, 40), (45, 50)]);
         assert_eq!(split(0.005, 12), vec![(0, 12), (24, 40), (45, 50)]);
         assert_eq!(split(0.055, 0)[..2], [(0, 16), (17, 40)]);
     }
