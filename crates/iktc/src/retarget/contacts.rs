@@ -333,8 +333,8 @@ mod tests {
     /// No part shorter than `gap` is split off. With 5.5 cm allowed and a gap of 8 frames the
     /// split is at frame 16 as with 4, and with 12 (the rest after the flight exactly 12
     /// frames); with a gap of 17 there is none (the rest after the flight would be 6 frames). With 0.5 cm allowed and a gap of 12 the slide passes it at
-    /// frame 11, when the part is 11 frames long, and the split waits for frame 12. A gap of 0
-    /// still ends the stance for one frame.
+    /// frame 11, when the part is 11 frames long, and the split waits for frame 12; a later
+    /// part is measured from its own start. A gap of 0 still ends the stance for one frame.
     #[test]
     fn no_stance_part_shorter_than_the_gap_is_split_off() {
         let (c0, ankle) = sliding();
@@ -348,6 +348,10 @@ mod tests {
         // The rest after the flight exactly `gap` long (frames 28–39) still splits.
         assert_eq!(split(0.055, 12), vec![(0, 16), (28, 40), (45, 50)]);
         assert_eq!(split(0.005, 12), vec![(0, 12), (24, 40), (45, 50)]);
+        // A later part too short where the slide passes the allowance again: with 2.5 cm and
+        // a gap of 4 the first split is at 13, the second part starts at 17 (7 cm), the slide
+        // is 3 cm on at frame 20, 3 frames into the part, and the split waits for frame 21.
+        assert_eq!(split(0.025, 4), vec![(0, 13), (17, 21), (25, 40), (45, 50)]);
         assert_eq!(split(0.055, 0)[..2], [(0, 16), (17, 40)]);
     }
 
