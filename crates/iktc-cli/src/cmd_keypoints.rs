@@ -363,6 +363,11 @@ fn print(run: &KeypointRun, joints: Option<&RetargetQuality>) -> std::io::Result
         joints.map(|j| format!("{:.0} / {:.0}", j.jerk_rms, j.jerk_max)),
     )?;
     row(
+        "jerk² where the limits bound",
+        format!("{:.0} %", 100.0 * k.jerk_limit_share),
+        joints.map(|j| format!("{:.0} %", 100.0 * j.jerk_limit_share)),
+    )?;
+    row(
         "worst margins",
         format!(
             "{:+.1e} {:+.1e} {:+.1e}",
@@ -375,5 +380,5 @@ fn print(run: &KeypointRun, joints: Option<&RetargetQuality>) -> std::io::Result
             )
         }),
     )?;
-    crate::outln!("(mean / max; jerk in rad/s³; margins position [rad], velocity [rad/s], acceleration [rad/s²], positive = a limit exceeded)")
+    crate::outln!("(mean / max; jerk in rad/s³, and its square's share on the ticks the solver corrected into the joint limits' box and the ticks after them; margins position [rad], velocity [rad/s], acceleration [rad/s²], positive = a limit exceeded)")
 }

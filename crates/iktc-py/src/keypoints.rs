@@ -197,7 +197,7 @@ impl PyKeypointTrajectory {
     /// The run's quality figures (`iktc::retarget::RetargetQuality`), as `iktc imitate` writes
     /// them in `keypoints_summary.json`: `mean_cm`, `points` (per body point `{"point",
     /// "mean_cm", "max_cm"}`), `orientations` (`{"frame", "mean_deg", "max_deg"}`), `slip_mm`,
-    /// `below_ground_mm`, `float_mm` (highest a foot the clip has on the ground floats) and `float_share` (share of those foot-ticks above 1 cm), `stance_ticks`, `jerk_rms` and `jerk_max` [rad/s³], the worst
+    /// `below_ground_mm`, `float_mm` (highest a foot the clip has on the ground floats) and `float_share` (share of those foot-ticks above 1 cm), `stance_ticks`, `jerk_rms` and `jerk_max` [rad/s³], `jerk_limit_share` (the share of the squared jerk on the ticks the solver corrected into the joint limits' box and the ticks after them), the worst
     /// `position_margin` [rad], `velocity_margin` [rad/s] and `acceleration_margin` [rad/s²]
     /// (positive: a limit exceeded), `on_limit` (`(joint, share)` pairs: the joints on a
     /// position limit on some ticks and the share of the ticks, the most often first), and `reach_cm`, `balanced_reach_cm` (the reach keeping
@@ -241,6 +241,7 @@ impl PyKeypointTrajectory {
         d.set_item("stance_ticks", q.stance_ticks)?;
         d.set_item("jerk_rms", q.jerk_rms)?;
         d.set_item("jerk_max", q.jerk_max)?;
+        d.set_item("jerk_limit_share", q.jerk_limit_share)?;
         d.set_item("position_margin", q.position_margin)?;
         d.set_item("velocity_margin", q.velocity_margin)?;
         d.set_item("acceleration_margin", q.acceleration_margin)?;

@@ -92,6 +92,14 @@ def test_the_soft_approach_halves_the_plans_jerk_and_bad_rates_are_errors():
         iktc.retarget_keypoints(motion, robot, approach_rate=-1.0)
 
 
+def test_the_quality_says_how_much_of_the_jerk_the_joint_limits_cause():
+    # G1, humanoid3d_punch: the arms reach their range ends; most of the squared jerk falls on
+    # the ticks the solver corrected into the box and the ticks after them (96 % from the
+    # command line on 2026-12-06), recomputed in the Rust tests from the ticks.
+    q = iktc.retarget_keypoints(iktc.load_motion("humanoid3d_punch"), iktc.Robot("g1")).quality
+    assert 0.5 < q["jerk_limit_share"] <= 1.0, q["jerk_limit_share"]
+
+
 def test_hands_by_the_leg_ratio_move_the_hands_differently_and_bad_names_are_errors():
     robot = iktc.Robot("g1")
     motion = iktc.load_motion("humanoid3d_punch")

@@ -84,9 +84,15 @@ fn format_key(m: &Motion) -> &'static str {
 
 fn print(q: &RetargetQuality) {
     eprintln!(
-        "  {:9} mean {:5.2} cm | slip {:6.2} mm | below {:5.2} mm | float {:6.1} mm {:4.1} % | jerk rms {:8.1} max {:9.1} rad/s³ | margins pos {:+.2e} vel {:+.2e} acc {:+.2e}",
+        "  {:9} mean {:5.2} cm | slip {:6.2} mm | below {:5.2} mm | float {:6.1} mm {:4.1} % | jerk rms {:8.1} max {:9.1} rad/s³, {:3.0} % of its square where the limits bound | margins pos {:+.2e} vel {:+.2e} acc {:+.2e}",
         q.route, q.mean_cm, q.slip_mm, q.below_ground_mm, q.float_mm, 100.0 * q.float_share, q.jerk_rms, q.jerk_max,
-        q.position_margin, q.velocity_margin, q.acceleration_margin
+        100.0 * q.jerk_limit_share, q.position_margin, q.velocity_margin, q.acceleration_margin
+    );
+    assert!(
+        (0.0..=1.0).contains(&q.jerk_limit_share),
+        "{}: jerk share {}",
+        q.route,
+        q.jerk_limit_share
     );
     if let (Some(reach), Some(run)) = (q.reach_cm, q.reach_run_cm) {
         eprintln!(
@@ -774,4 +780,63 @@ fn a_bad_pivot_turn_is_an_error() {
         };
         assert!(s.validate().is_ok(), "{good:?}");
     }
+}
+
+/// The share of the squared joint jerk on the ticks the box shaped
+/// (`RetargetQuality::jerk_limit_share`), recomputed from the same controller run tick by
+/// tick: the ticks IKTC corrected (or a fallback answered) and the ticks after them. On G1
+/// `humanoid3d_punch` the arms reach their range ends, so the box shapes some ticks and not
+/// others, and most of the jerk is there.
+#[test]
+fn the_jerk_share_at_the_limits_is_recomputed_from_the_ticks() {
+    let profile = RobotProfile::builtin("g1").unwrap();
+    let kp = builtin_keypoints("humanoid3d_punch");
+    // Settling for the whole settle time: both runs settle alike.
+    let s = KeypointSettings {
+        settle_speed: 0.0,
+        ..KeypointSettings::default()
+    };
+    let run = retarget_keypoints(&profile, &kp, None, &s).unwrap();
+    let mut c = iktc::retarget::keypoint_controller(&profile, &kp, None, &s).unwrap();
+    for _ in 0..run.settle_ticks {
+        c.tick(0, true).unwrap();
+        c.integrate().unwrap();
+    }
+    let base = profile.robot().unwrap().base_nv();
+    let (mut rows, mut corrected) = (Vec::new(), Vec::new());
+    for k in 0..c.ticks() {
+        let r = c.tick(k, false).unwrap();
+        let shaped = r.corrected_from.is_some() || r.fallback.is_some();
+        corrected.push(shaped || c.used_fallback());
+        rows.push(c.qdd().as_slice()[base..].to_vec());
+        c.integrate().unwrap();
+    }
+    // The same run.
+    assert_eq!(rows.len(), run.accelerations.len());
+    for (a, b) in rows.iter().zip(&run.accelerations) {
+        assert_eq!(a.as_slice(), &b[base..]);
+    }
+    let (mut at_limits, mut all) = (0.0, 0.0);
+    for k in 1..rows.len() {
+        let squared: f64 = (0..rows[k].len())
+            .map(|j| ((rows[k][j] - rows[k - 1][j]) / s.dt).powi(2))
+            .sum();
+        all += squared;
+        if corrected[k] || corrected[k - 1] {
+            at_limits += squared;
+        }
+    }
+    let share = run.quality.jerk_limit_share;
+    assert!(
+        (share - at_limits / all).abs() < 1e-12,
+        "{share} against {}",
+        at_limits / all
+    );
+    let n = corrected.iter().filter(|c| **c).count();
+    assert!(
+        n > 0 && n < corrected.len(),
+        "{n} of {} ticks corrected",
+        corrected.len()
+    );
+    assert!(share > 0.5 && share < 1.0, "{share}");
 }

@@ -211,6 +211,9 @@ pub struct KeypointFigures {
     pub rms_jerk: f64,
     /// Largest joint jerk \[rad/s³\].
     pub max_jerk: f64,
+    /// Share of the squared joint jerk on the ticks the solver corrected into the box and the
+    /// ticks after them \[–\] ([`crate::retarget::RetargetQuality::jerk_limit_share`]).
+    pub jerk_limit_share: f64,
     /// Share of the ticks solved by GF because IKTC's answer left the box \[–\].
     pub fallback_share: f64,
     /// Share of the ticks solved by GF to keep the feet's levels (stance, floor) more exactly
@@ -287,6 +290,7 @@ impl KeypointFigures {
             worst_acceleration_margin: q.acceleration_margin,
             rms_jerk: q.jerk_rms,
             max_jerk: q.jerk_max,
+            jerk_limit_share: q.jerk_limit_share,
             fallback_share: run.fallback_ticks as f64 / ticks,
             stance_gf_share: run.stance_gf_ticks as f64 / ticks,
             leg_ratio: run.scaling.leg,

@@ -68,7 +68,7 @@ use crate::profile::RobotProfile;
 use crate::resources::RunLimits;
 use crate::sim::imitate::SupportSettings;
 use crate::sim::{percentile, ImitateConfig, ImitationController};
-use crate::solver::{Damping, Method, SolverSettings};
+use crate::solver::{Damping, Method, SolveReport, SolverSettings};
 use crate::task::Gains;
 
 /// Damping λ_max reached at a singularity by default \[unit of a singular value of J\]: the
@@ -640,7 +640,7 @@ pub fn retarget_keypoints_on(
     for k in 0..ticks {
         let state = controller.state().clone();
         let start = Instant::now();
-        controller.tick(k, false)?;
+        let corrected = shaped_by_box(controller.tick(k, false)?) || controller.used_fallback();
         tick_us.push(start.elapsed().as_secs_f64() * 1e6);
         let plan = controller.plan();
         let on = controller.stance();
@@ -657,6 +657,7 @@ pub fn retarget_keypoints_on(
             &state,
             controller.qdd().as_slice(),
         )?;
+        rec.record_correction(corrected);
         accelerations.push(controller.qdd().as_slice().to_vec());
         let start = Instant::now();
         controller.integrate()?;
@@ -702,6 +703,12 @@ pub fn retarget_keypoints_on(
     })
 }
 
+/// Whether the solve of `r` corrected the prioritized solution into the box: IKTC corrected a
+/// level, or a fallback answered ([`RetargetQuality::jerk_limit_share`]).
+fn shaped_by_box(r: &SolveReport) -> bool {
+    r.corrected_from.is_some() || r.fallback.is_some()
+}
+
 /// The quality figures of the joint-angle route on the same clip: the imitation of Table 1
 /// ([`ImitationController`]) with the profile's feet, pelvis and posture, the robot's own
 /// joint ranges (no narrowed ones), IKTC with `s.method` and `s.bounds`, on the references
@@ -731,7 +738,7 @@ pub fn joint_route_quality(
     let mut kin = Kinematics::new(robot, ctl.state())?;
     for k in 0..plan.ticks.min(refs.len()) {
         let state = ctl.state().clone();
-        ctl.tick(robot, k)?;
+        let corrected = shaped_by_box(ctl.tick(robot, k)?);
         kin.update(robot, &state)?;
         rec.record(
             robot,
@@ -743,6 +750,7 @@ pub fn joint_route_quality(
             &state,
             ctl.qdd().as_slice(),
         )?;
+        rec.record_correction(corrected);
         ctl.integrate(robot)?;
     }
     Ok(rec.finish(robot))

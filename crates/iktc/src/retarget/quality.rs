@@ -24,7 +24,10 @@
 //!   foot-ticks on which it is above [`FLOAT_HEIGHT`];
 //! * optionally, the static reach of the body points ([`super::reach`]);
 //! * joint jerk `(q̈_k − q̈_{k−1}) / Δt` of the active joints \[rad/s³\]: RMS over joints and
-//!   ticks, and max ([`DofSmoothness`]);
+//!   ticks, and max ([`DofSmoothness`]); and the share of its square summed over joints and
+//!   ticks that falls on the ticks where the joint limits shaped the command: tick k counts
+//!   when the solver corrected the prioritized solution into the box on tick k or k − 1
+//!   (IKTC's correction began, went on, moved to another level or ended there);
 //! * the worst limit margins ([`dof_margins`]): positive means a limit was exceeded.
 
 use nalgebra::{Point3, UnitQuaternion, Vector3};
@@ -110,6 +113,14 @@ pub struct RetargetQuality {
     pub jerk_rms: f64,
     /// Largest joint jerk \[rad/s³\].
     pub jerk_max: f64,
+    /// Share of the squared joint jerk (summed over the active joints and ticks) on the ticks
+    /// where the box shaped the command: a tick on which the solver corrected the prioritized
+    /// solution, or the tick after one (where the correction ends) \[–\]; 0 without jerk or
+    /// without a recorded correction ([`QualityRecorder::record_correction`]). Near 1 with the
+    /// viable or quiet bounds alone, the jerk is the joint limits' (the soft approach to the
+    /// range ends smooths it, and then shapes most ticks itself); near 0, the references' or
+    /// the contacts'.
+    pub jerk_limit_share: f64,
     /// Worst position margin \[rad\] (positive: a limit exceeded by that much).
     pub position_margin: f64,
     /// Worst velocity margin \[rad/s\].
@@ -156,6 +167,8 @@ pub struct QualityRecorder {
     q: Vec<Vec<f64>>,
     qd: Vec<Vec<f64>>,
     qdd: Vec<Vec<f64>>,
+    /// Per recorded tick: whether the solver corrected it into the box.
+    corrected: Vec<bool>,
     pos: Vec<f64>,
 }
 
@@ -175,8 +188,17 @@ impl QualityRecorder {
             q: Vec::new(),
             qd: Vec::new(),
             qdd: Vec::new(),
+            corrected: Vec::new(),
             pos: Vec::new(),
         }
+    }
+
+    /// Marks the last recorded tick as corrected into the box by the solver (IKTC's correction,
+    /// or a fallback that answered instead of the prioritized solution), for
+    /// [`RetargetQuality::jerk_limit_share`]. Ticks not marked count as uncorrected.
+    pub(crate) fn record_correction(&mut self, corrected: bool) {
+        self.corrected.resize(self.ticks.saturating_sub(1), false);
+        self.corrected.push(corrected);
     }
 
     /// Records tick `k` of `plan`: the state at its start (`kin` updated at it) and the q̈ applied
@@ -332,6 +354,7 @@ impl QualityRecorder {
             stance_ticks: self.stance_ticks,
             jerk_rms: (sum_sq / count.max(1) as f64).sqrt(),
             jerk_max,
+            jerk_limit_share: jerk_limit_share(&self.qdd, &self.corrected, self.dt),
             position_margin: pm,
             velocity_margin: vm,
             acceleration_margin: am,
@@ -340,5 +363,62 @@ impl QualityRecorder {
             balanced_reach_cm: None,
             reach_run_cm: None,
         }
+    }
+}
+
+/// [`RetargetQuality::jerk_limit_share`] of the joint accelerations `qdd` (one row per tick,
+/// the active joints \[rad/s²\]) recorded every `dt` \[s\], with `corrected[k]` whether tick k
+/// was corrected into the box (missing entries: not corrected): the squared jerk of the steps
+/// k − 1 → k on which tick k or k − 1 was corrected, over the squared jerk of every step.
+pub(crate) fn jerk_limit_share(qdd: &[Vec<f64>], corrected: &[bool], dt: f64) -> f64 {
+    let at = |k: usize| corrected.get(k).copied().unwrap_or(false);
+    let (mut limited, mut total) = (0.0, 0.0);
+    for (k, pair) in qdd.windows(2).enumerate() {
+        let squared: f64 = pair[1]
+            .iter()
+            .zip(&pair[0])
+            .map(|(a, b)| ((a - b) / dt).powi(2))
+            .sum();
+        total += squared;
+        if at(k) || at(k + 1) {
+            limited += squared;
+        }
+    }
+    if total > 0.0 {
+        limited / total
+    } else {
+        0.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::jerk_limit_share;
+
+    /// By hand, Δt = 0.5 s, one joint: q̈ = 0, 1, 1, 3 rad/s² gives jerks 2, 0, 4 rad/s³
+    /// (squares 4, 0, 16). With tick 2 corrected, the steps 1 → 2 and 2 → 3 count: 16 of 20.
+    #[test]
+    fn the_share_counts_the_steps_into_and_out_of_a_corrected_tick() {
+        let qdd = [vec![0.0], vec![1.0], vec![1.0], vec![3.0]];
+        let share = jerk_limit_share(&qdd, &[false, false, true, false], 0.5);
+        assert!((share - 16.0 / 20.0).abs() < 1e-15, "{share}");
+        // Tick 0 corrected: only the step 0 → 1 (4 of 20).
+        let first = jerk_limit_share(&qdd, &[true], 0.5);
+        assert!((first - 4.0 / 20.0).abs() < 1e-15, "{first}");
+        // Every tick or none; missing entries are uncorrected.
+        assert_eq!(jerk_limit_share(&qdd, &[true; 4], 0.5), 1.0);
+        assert_eq!(jerk_limit_share(&qdd, &[], 0.5), 0.0);
+    }
+
+    /// Several joints add their squares; a run without jerk (or without a step) has share 0.
+    #[test]
+    fn the_share_sums_the_joints_and_is_zero_without_jerk() {
+        // Joint a: jerks 1, 1; joint b: 0, 3 (Δt = 1 s). Step 1 → 2 corrected: (1 + 9) / 11.
+        let qdd = [vec![0.0, 0.0], vec![1.0, 0.0], vec![2.0, 3.0]];
+        let share = jerk_limit_share(&qdd, &[false, false, true], 1.0);
+        assert!((share - 10.0 / 11.0).abs() < 1e-15, "{share}");
+        let still = vec![vec![0.5, -1.0]; 3];
+        assert_eq!(jerk_limit_share(&still, &[true, true, true], 1.0), 0.0);
+        assert_eq!(jerk_limit_share(&qdd[..1], &[true], 1.0), 0.0);
     }
 }
