@@ -11,7 +11,7 @@ use crate::cmd_retarget::ClipStatus;
 /// The figures shown: key in `quality.json`'s `figures`, column label with its unit. A column
 /// appears when some clip has its figure (the keypoint and joint routes measure different
 /// things).
-const COLUMNS: [(&str, &str); 28] = [
+const COLUMNS: [(&str, &str); 29] = [
     ("duration", "duration [s]"),
     ("mean_keypoint_error", "mean keypoint error [m]"),
     (
@@ -58,6 +58,10 @@ const COLUMNS: [(&str, &str); 28] = [
     ("rms_jerk", "RMS jerk [rad/s³]"),
     ("max_jerk", "max jerk [rad/s³]"),
     ("max_rms_jerk", "max RMS jerk [rad/s³]"),
+    (
+        "jerk_limit_share",
+        "share of the squared jerk on the ticks corrected into the joint limits' box [–]",
+    ),
     ("com_min_margin", "COM min margin [m]"),
     ("fallback_share", "fallback share [–]"),
     (
