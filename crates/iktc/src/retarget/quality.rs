@@ -116,7 +116,7 @@ pub struct RetargetQuality {
     /// Share of the squared joint jerk (summed over the active joints and ticks) on the ticks
     /// where the box shaped the command: a tick on which the solver corrected the prioritized
     /// solution, or the tick after one (where the correction ends) \[–\]; 0 without jerk or
-    /// without a recorded correction ([`QualityRecorder::record_correction`]). Near 1 with the
+    /// when no tick was marked corrected (the recorder's `record_correction`). Near 1 with the
     /// viable or quiet bounds alone, the jerk is the joint limits' (the soft approach to the
     /// range ends smooths it, and then shapes most ticks itself); near 0, the references' or
     /// the contacts'.
