@@ -354,7 +354,7 @@ impl QualityRecorder {
             stance_ticks: self.stance_ticks,
             jerk_rms: (sum_sq / count.max(1) as f64).sqrt(),
             jerk_max,
-            jerk_limit_share: jerk_limit_share(&self.qdd, &self.corrected, self.dt),
+            jerk_limit_share: jerk_limit_share(&self.qdd, &self.corrected),
             position_margin: pm,
             velocity_margin: vm,
             acceleration_margin: am,
@@ -367,17 +367,18 @@ impl QualityRecorder {
 }
 
 /// [`RetargetQuality::jerk_limit_share`] of the joint accelerations `qdd` (one row per tick,
-/// the active joints \[rad/s²\]) recorded every `dt` \[s\], with `corrected[k]` whether tick k
-/// was corrected into the box (missing entries: not corrected): the squared jerk of the steps
-/// k − 1 → k on which tick k or k − 1 was corrected, over the squared jerk of every step.
-pub(crate) fn jerk_limit_share(qdd: &[Vec<f64>], corrected: &[bool], dt: f64) -> f64 {
+/// the active joints \[rad/s²\]), with `corrected[k]` whether tick k was corrected into the box
+/// (missing entries: not corrected): the squared jerk of the steps k − 1 → k on which tick k
+/// or k − 1 was corrected, over the squared jerk of every step. The period cancels in the
+/// ratio: the squared changes of q̈ stand for the squared jerks.
+pub(crate) fn jerk_limit_share(qdd: &[Vec<f64>], corrected: &[bool]) -> f64 {
     let at = |k: usize| corrected.get(k).copied().unwrap_or(false);
     let (mut limited, mut total) = (0.0, 0.0);
     for (k, pair) in qdd.windows(2).enumerate() {
         let squared: f64 = pair[1]
             .iter()
             .zip(&pair[0])
-            .map(|(a, b)| ((a - b) / dt).powi(2))
+            .map(|(a, b)| (a - b).powi(2))
             .sum();
         total += squared;
         if at(k) || at(k + 1) {
@@ -395,30 +396,30 @@ pub(crate) fn jerk_limit_share(qdd: &[Vec<f64>], corrected: &[bool], dt: f64) ->
 mod tests {
     use super::jerk_limit_share;
 
-    /// By hand, Δt = 0.5 s, one joint: q̈ = 0, 1, 1, 3 rad/s² gives jerks 2, 0, 4 rad/s³
-    /// (squares 4, 0, 16). With tick 2 corrected, the steps 1 → 2 and 2 → 3 count: 16 of 20.
+    /// By hand, one joint: q̈ = 0, 2, 2, 6 rad/s² changes by 2, 0, 4 (squares 4, 0, 16). With
+    /// tick 2 corrected, the steps 1 → 2 and 2 → 3 count: 16 of 20.
     #[test]
     fn the_share_counts_the_steps_into_and_out_of_a_corrected_tick() {
-        let qdd = [vec![0.0], vec![1.0], vec![1.0], vec![3.0]];
-        let share = jerk_limit_share(&qdd, &[false, false, true, false], 0.5);
+        let qdd = [vec![0.0], vec![2.0], vec![2.0], vec![6.0]];
+        let share = jerk_limit_share(&qdd, &[false, false, true, false]);
         assert!((share - 16.0 / 20.0).abs() < 1e-15, "{share}");
         // Tick 0 corrected: only the step 0 → 1 (4 of 20).
-        let first = jerk_limit_share(&qdd, &[true], 0.5);
+        let first = jerk_limit_share(&qdd, &[true]);
         assert!((first - 4.0 / 20.0).abs() < 1e-15, "{first}");
         // Every tick or none; missing entries are uncorrected.
-        assert_eq!(jerk_limit_share(&qdd, &[true; 4], 0.5), 1.0);
-        assert_eq!(jerk_limit_share(&qdd, &[], 0.5), 0.0);
+        assert_eq!(jerk_limit_share(&qdd, &[true; 4]), 1.0);
+        assert_eq!(jerk_limit_share(&qdd, &[]), 0.0);
     }
 
     /// Several joints add their squares; a run without jerk (or without a step) has share 0.
     #[test]
     fn the_share_sums_the_joints_and_is_zero_without_jerk() {
-        // Joint a: jerks 1, 1; joint b: 0, 3 (Δt = 1 s). Step 1 → 2 corrected: (1 + 9) / 11.
+        // Joint a changes by 1, 1; joint b by 0, 3. Step 1 → 2 corrected: (1 + 9) / 11.
         let qdd = [vec![0.0, 0.0], vec![1.0, 0.0], vec![2.0, 3.0]];
-        let share = jerk_limit_share(&qdd, &[false, false, true], 1.0);
+        let share = jerk_limit_share(&qdd, &[false, false, true]);
         assert!((share - 10.0 / 11.0).abs() < 1e-15, "{share}");
         let still = vec![vec![0.5, -1.0]; 3];
-        assert_eq!(jerk_limit_share(&still, &[true, true, true], 1.0), 0.0);
-        assert_eq!(jerk_limit_share(&qdd[..1], &[true], 1.0), 0.0);
+        assert_eq!(jerk_limit_share(&still, &[true, true, true]), 0.0);
+        assert_eq!(jerk_limit_share(&qdd[..1], &[true]), 0.0);
     }
 }
