@@ -653,11 +653,10 @@ pub fn retarget_keypoints_on(
             &body,
             plan,
             &support,
-            (k, on),
+            (k, on, corrected),
             &state,
             controller.qdd().as_slice(),
         )?;
-        rec.record_correction(corrected);
         accelerations.push(controller.qdd().as_slice().to_vec());
         let start = Instant::now();
         controller.integrate()?;
@@ -746,11 +745,10 @@ pub fn joint_route_quality(
             &setup.body,
             plan,
             &setup.support,
-            (k, [plan.contact[0][k], plan.contact[1][k]]),
+            (k, [plan.contact[0][k], plan.contact[1][k]], corrected),
             &state,
             ctl.qdd().as_slice(),
         )?;
-        rec.record_correction(corrected);
         ctl.integrate(robot)?;
     }
     Ok(rec.finish(robot))

@@ -1052,7 +1052,7 @@ mod tests {
                     &body,
                     &plan,
                     &support,
-                    (t, [false; 2]),
+                    (t, [false; 2], false),
                     &state,
                     &qdd,
                 )

@@ -116,7 +116,7 @@ pub struct RetargetQuality {
     /// Share of the squared joint jerk (summed over the active joints and ticks) on the ticks
     /// where the box shaped the command: a tick on which the solver corrected the prioritized
     /// solution, or the tick after one (where the correction ends) \[–\]; 0 without jerk or
-    /// when no tick was marked corrected (the recorder's `record_correction`). Near 1 with the
+    /// without a corrected tick. Near 1 with the
     /// viable or quiet bounds alone, the jerk is the joint limits' (the soft approach to the
     /// range ends smooths it, and then shapes most ticks itself); near 0, the references' or
     /// the contacts'.
@@ -193,16 +193,10 @@ impl QualityRecorder {
         }
     }
 
-    /// Marks the last recorded tick as corrected into the box by the solver (IKTC's correction,
-    /// or a fallback that answered instead of the prioritized solution), for
-    /// [`RetargetQuality::jerk_limit_share`]. Ticks not marked count as uncorrected.
-    pub(crate) fn record_correction(&mut self, corrected: bool) {
-        self.corrected.resize(self.ticks.saturating_sub(1), false);
-        self.corrected.push(corrected);
-    }
-
     /// Records tick `k` of `plan`: the state at its start (`kin` updated at it) and the q̈ applied
-    /// over it; `stance` says which feet are held on the ground (for the slip).
+    /// over it; `stance` says which feet are held on the ground (for the slip), `corrected`
+    /// whether the solver corrected the tick into the box (IKTC's correction, or a fallback that
+    /// answered instead of the prioritized solution; for [`RetargetQuality::jerk_limit_share`]).
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn record(
         &mut self,
@@ -211,7 +205,7 @@ impl QualityRecorder {
         body: &RobotBody,
         plan: &Plan,
         support: &SupportSettings,
-        (k, stance): (usize, [bool; 2]),
+        (k, stance, corrected): (usize, [bool; 2], bool),
         state: &State,
         qdd: &[f64],
     ) -> Result<()> {
@@ -278,6 +272,7 @@ impl QualityRecorder {
         self.q.push(self.pos[b..].to_vec());
         self.qd.push(state.qd.as_slice()[b..].to_vec());
         self.qdd.push(qdd[b..].to_vec());
+        self.corrected.push(corrected);
         self.ticks += 1;
         Ok(())
     }
