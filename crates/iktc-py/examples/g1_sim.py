@@ -40,11 +40,10 @@ KV = 20.0
 #: jumps across the band and flips between its two force limits every step, for good (one hinge
 #: of 1.8 g·m² at 25 N·m, commanded 3 rad/s: 0 and 13.9 rad/s in turn at 1 ms; it settles at 0.1 ms).
 #: On G1 the wrists (0.6–5 g·m² about their axes) and the shoulders' yaw (6–10 g·m²) are that
-#: light: at 1 ms a servo flipped on 361 of the 508 ticks of the upper-body standing imitation
-#: (``run_standing_keypoints(standing=True)``), the servos trailed its plan by 0.41 rad rms and the
-#: feet slipped 11.3 mm. At 0.5, 0.2, 0.1, 0.05 and 0.02 ms: flips on 324, 221, 65, 11 and 2 ticks,
-#: servos 0.140, 0.036, 0.026, 0.025, 0.025 rad rms behind, feet slipping 4.60, 3.66, 3.22, 3.06,
-#: 2.98 mm. (Explicit Euler at 1 ms falls.)
+#: light. The upper-body standing imitation (``run_standing_keypoints(standing=True)``, 508
+#: ticks; MuJoCo 4.0.1, 2026-12-06) at 1, 0.5, 0.2, 0.1 and 0.05 ms: a servo flips on 141, 103,
+#: 52, 21 and 5 ticks, the servos trail the plan by 0.094, 0.026, 0.024, 0.024 and 0.024 rad rms,
+#: the feet slip 9.0, 4.0, 2.6, 2.6 and 2.6 mm. (Explicit Euler at 1 ms falls.)
 PHYSICS_STEP = 0.0001
 #: Control period [s]: one iktc tick, then CONTROL_PERIOD / PHYSICS_STEP physics steps.
 CONTROL_PERIOD = 0.005
