@@ -194,6 +194,18 @@ def test_the_damping_ratio_estimate_picks_the_dominant_mode_of_several():
     assert z == pytest.approx(0.72, abs=0.01) and w == pytest.approx(4.9, rel=0.01)
 
 
+def test_the_damping_ratio_estimate_passes_over_a_pair_that_does_not_oscillate_in_the_record():
+    # Two nearly equal real decays can come out of Prony's fit as a barely complex pair with a
+    # large amplitude (−9.25 ± 0.62j rad/s: a tenth of a cycle in 2 s). It outweighs the
+    # designed pair (ζ = 0.7, 5.5 rad/s) in energy but is no oscillation.
+    t = np.arange(0.0, 2.0, g1_sim.CONTROL_PERIOD)
+    slow = 0.05 * np.exp(-9.25 * t) * np.cos(0.62 * t + 0.2)
+    wn, zeta = 5.5, 0.7
+    pair = 0.02 * np.exp(-zeta * wn * t) * np.cos(wn * np.sqrt(1 - zeta ** 2) * t + 0.5)
+    z, w = g1_sim.damping_ratio(t, 0.002 + slow + pair)
+    assert z == pytest.approx(zeta, abs=0.01) and w == pytest.approx(wn, rel=0.01)
+
+
 def _expm(m):
     """exp(m) by scaling and squaring of the Taylor series (small, well-scaled matrices)."""
     s = max(0, int(np.ceil(np.log2(max(np.linalg.norm(m, 1), 1e-300)))) + 1)
