@@ -2,11 +2,12 @@
 //! `iktc imitate`) run from Python, its state recorded tick by tick (q, v, q̈) as numpy arrays,
 //! e.g. as the set points of a simulated robot's servos.
 
-use iktc::batch::{posture_references, Posture};
+use std::sync::Arc;
+
+use iktc::batch::{body_frames, posture_references, Posture, TrainingTrajectory};
+use iktc::model::Robot;
 use iktc::motion::DEFAULT_MAX_GAP;
-use iktc::retarget::{
-    retarget_keypoints, HandScaling, KeypointSettings, RetargetQuality, Sacrifices,
-};
+use iktc::retarget::{retarget_keypoints, HandScaling, KeypointRun, KeypointSettings, Sacrifices};
 use iktc::sim::ImitateConfig;
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
@@ -22,16 +23,10 @@ use crate::to_py;
 #[pyclass(name = "KeypointTrajectory", module = "iktc", frozen)]
 pub struct PyKeypointTrajectory {
     dt: f64,
-    times: Vec<f64>,
-    nq: usize,
-    nv: usize,
-    q: Vec<f64>,
-    v: Vec<f64>,
-    qdd: Vec<f64>,
-    fallback_ticks: usize,
-    sacrificed: Sacrifices,
-    settle_sacrificed: Sacrifices,
-    quality: RetargetQuality,
+    robot: Arc<Robot>,
+    /// The body frames the saved files carry (`iktc::batch::body_frames`).
+    bodies: Vec<String>,
+    run: KeypointRun,
 }
 
 /// Runs the keypoint retargeting of `motion` on `robot` (which must have a profile) as
@@ -122,19 +117,11 @@ pub fn py_retarget_keypoints(
             None => Posture::Start("the motion has no skeleton".into()),
         };
         let run = retarget_keypoints(profile, &kp, posture.references(), &settings)?;
-        let flat = |rows: &[Vec<f64>]| rows.iter().flatten().copied().collect::<Vec<f64>>();
         Ok(PyKeypointTrajectory {
             dt,
-            times: run.times.clone(),
-            nq: robot.robot.nq(),
-            nv: robot.robot.nv(),
-            q: flat(&run.trajectory),
-            v: flat(&run.velocities),
-            qdd: flat(&run.accelerations),
-            fallback_ticks: run.fallback_ticks,
-            sacrificed: run.sacrificed,
-            settle_sacrificed: run.settle_sacrificed,
-            quality: run.quality,
+            robot: robot.robot.clone(),
+            bodies: body_frames(profile, &cfg),
+            run,
         })
     })
     .map_err(to_py)
@@ -151,33 +138,45 @@ impl PyKeypointTrajectory {
     /// Tick times from the clip's start [s], shape (N,).
     #[getter]
     fn times<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        array(py, &self.times)
+        array(py, &self.run.times)
     }
 
     /// Configurations q at the start of each tick, shape (N, nq): base position [m],
     /// quaternion (x, y, z, w), joints [rad].
     #[getter]
     fn q<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        table(py, [self.times.len(), self.nq], self.q.clone())
+        table(
+            py,
+            [self.run.times.len(), self.robot.nq()],
+            self.run.trajectory.concat(),
+        )
     }
 
     /// Velocities v at the start of each tick, shape (N, nv): base twist [m/s], [rad/s] (base
     /// axes), joint rates [rad/s].
     #[getter]
     fn v<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        table(py, [self.times.len(), self.nv], self.v.clone())
+        table(
+            py,
+            [self.run.times.len(), self.robot.nv()],
+            self.run.velocities.concat(),
+        )
     }
 
     /// The accelerations q̈ solved at each tick, shape (N, nv) [m/s²], [rad/s²].
     #[getter]
     fn qdd<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        table(py, [self.times.len(), self.nv], self.qdd.clone())
+        table(
+            py,
+            [self.run.times.len(), self.robot.nv()],
+            self.run.accelerations.concat(),
+        )
     }
 
     /// Ticks solved by GF because IKTC's answer left the box.
     #[getter]
     fn fallback_ticks(&self) -> usize {
-        self.fallback_ticks
+        self.run.fallback_ticks
     }
 
     /// Which tasks the joint limits cost: per level of the keypoint stack (in priority order),
@@ -185,13 +184,13 @@ impl PyKeypointTrajectory {
     /// corrected to keep every limit; `iktc::retarget::Sacrifices`).
     #[getter]
     fn sacrificed<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        levels_dict(py, &self.sacrificed)
+        levels_dict(py, &self.run.sacrificed)
     }
 
     /// The same over the settling on the clip's first frame, before the clip starts.
     #[getter]
     fn settle_sacrificed<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        levels_dict(py, &self.settle_sacrificed)
+        levels_dict(py, &self.run.settle_sacrificed)
     }
 
     /// The run's quality figures (`iktc::retarget::RetargetQuality`), as `iktc imitate` writes
@@ -205,7 +204,7 @@ impl PyKeypointTrajectory {
     /// with `reach=True`).
     #[getter]
     fn quality<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let q = &self.quality;
+        let q = &self.run.quality;
         let d = PyDict::new(py);
         d.set_item("route", &q.route)?;
         d.set_item("ticks", q.ticks)?;
@@ -257,9 +256,65 @@ impl PyKeypointTrajectory {
         Ok(d)
     }
 
-    fn __len__(&self) -> usize {
-        self.times.len()
+    /// Names of the body frames whose world positions the saved files carry (`body_names` of
+    /// the NPZ): the profile's pelvis, torso, head and hands that are set, then the feet.
+    #[getter]
+    fn body_names(&self) -> Vec<String> {
+        self.bodies.clone()
     }
+
+    /// Writes the run as `iktc retarget` writes a clip's `motion.npz`: `fps`, `joint_names`,
+    /// `body_names`, `time` [s], `joint_pos` [rad], `joint_vel` [rad/s], `base_pos` [m],
+    /// `base_quat_xyzw`, `base_lin_vel` [m/s] and `base_ang_vel` [rad/s] in the base's axes, and
+    /// `body_pos_w` (frames × bodies × 3) [m]. `rate` [Hz]: the output rate (default: the
+    /// control rate, every tick copied exactly); other rates interpolate the ticks linearly
+    /// (the base orientation by slerp) and compute the body positions from the interpolated
+    /// configuration (`iktc::batch::TrainingTrajectory`). Raises IktcError for a rate that is
+    /// not finite and > 0, or a file that cannot be written.
+    #[pyo3(signature = (path, rate=None))]
+    fn save_npz(
+        &self,
+        py: Python<'_>,
+        path: std::path::PathBuf,
+        rate: Option<f64>,
+    ) -> PyResult<()> {
+        let bytes = py.detach(|| self.training(rate)?.npz()).map_err(to_py)?;
+        write_file(&path, &bytes)
+    }
+
+    /// Writes the run as `iktc retarget` writes a clip's `motion.csv`: columns `t`, `base_x
+    /// base_y base_z` [m], `base_qx base_qy base_qz base_qw`, then one column per joint [rad];
+    /// `rate` as in `save_npz`.
+    #[pyo3(signature = (path, rate=None))]
+    fn save_csv(
+        &self,
+        py: Python<'_>,
+        path: std::path::PathBuf,
+        rate: Option<f64>,
+    ) -> PyResult<()> {
+        let text = py
+            .detach(|| self.training(rate).map(|t| t.csv()))
+            .map_err(to_py)?;
+        write_file(&path, text.as_bytes())
+    }
+
+    fn __len__(&self) -> usize {
+        self.run.times.len()
+    }
+}
+
+impl PyKeypointTrajectory {
+    /// The run resampled at `rate` [Hz] (default the control rate).
+    fn training(&self, rate: Option<f64>) -> iktc::Result<TrainingTrajectory> {
+        let rate = rate.unwrap_or(1.0 / self.dt);
+        TrainingTrajectory::from_keypoint_run(&self.robot, &self.run, self.dt, &self.bodies, rate)
+    }
+}
+
+/// Writes `bytes` to `path`; an I/O error is raised as IktcError naming the file.
+fn write_file(path: &std::path::Path, bytes: &[u8]) -> PyResult<()> {
+    std::fs::write(path, bytes)
+        .map_err(|e| crate::IktcError::new_err(format!("cannot write {}: {e}", path.display())))
 }
 
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

@@ -64,6 +64,85 @@ def test_retarget_npz_and_csv_equal_the_python_keypoint_retargeting():
     assert worst_difference(d, run.q, run.v) < 1e-9
 
 
+def cli_npz(*args):
+    """`iktc retarget` on the walk clip for G1 with `args`: its NPZ and the CSV's text."""
+    out = tempfile.mkdtemp()
+    subprocess.run([iktc_binary(), "retarget", str(CLIP), "--robot", "g1", "--no-viewer",
+                    *args, "--out", out], check=True, stdout=subprocess.DEVNULL,
+                   stderr=subprocess.DEVNULL)
+    with open(os.path.join(out, "humanoid3d_walk", "motion.csv")) as f:
+        text = f.read()
+    return np.load(os.path.join(out, "humanoid3d_walk", "motion.npz")), text
+
+
+def saved(run, rate=None):
+    """The run's `save_npz` and `save_csv` at `rate`, read back."""
+    out = tempfile.mkdtemp()
+    run.save_npz(os.path.join(out, "m.npz"), rate=rate)
+    run.save_csv(os.path.join(out, "m.csv"), rate=rate)
+    with open(os.path.join(out, "m.csv")) as f:
+        return np.load(os.path.join(out, "m.npz")), f.read()
+
+
+def assert_same_archive(a, b):
+    assert sorted(a.files) == sorted(b.files)
+    for name in ("joint_names", "body_names"):
+        assert list(a[name]) == list(b[name])
+    for name in a.files:
+        if name not in ("joint_names", "body_names"):
+            assert a[name].shape == b[name].shape, name
+            assert np.allclose(a[name], b[name], rtol=0, atol=1e-9), name
+
+
+def assert_same_csv(a, b):
+    ra, rb = list(csv.reader(a.splitlines())), list(csv.reader(b.splitlines()))
+    assert ra[0] == rb[0] and len(ra) == len(rb)
+    assert np.allclose(np.array(ra[1:], float), np.array(rb[1:], float), rtol=0, atol=1e-9)
+
+
+def test_a_python_run_saves_the_files_iktc_retarget_writes():
+    """`KeypointTrajectory.save_npz` / `save_csv` write what `iktc retarget` writes for the same
+    clip, at the control rate and at another output rate."""
+    run = iktc.retarget_keypoints(iktc.load_motion(str(CLIP)), iktc.Robot("g1"))
+    npz, text = saved(run)
+    cli, cli_text = cli_npz()
+    assert_same_archive(npz, cli)
+    assert_same_csv(text, cli_text)
+    assert list(npz["body_names"]) == run.body_names and float(npz["fps"]) == 200.0
+    # At the control rate every tick is copied: the archive holds the run's own arrays.
+    assert np.array_equal(npz["joint_pos"], run.q[:, 7:])
+    assert np.array_equal(npz["base_pos"], run.q[:, :3])
+    slow, slow_text = saved(run, rate=50.0)
+    cli_slow, cli_slow_text = cli_npz("--rate", "50")
+    assert_same_archive(slow, cli_slow)
+    assert_same_csv(slow_text, cli_slow_text)
+    # 50 Hz divides 200 Hz: its frames are every fourth tick, copied.
+    n = slow["joint_pos"].shape[0]
+    assert float(slow["fps"]) == 50.0 and n == (len(run) - 1) // 4 + 1
+    assert np.array_equal(slow["joint_pos"], npz["joint_pos"][::4][:n])
+    assert np.array_equal(slow["body_pos_w"], npz["body_pos_w"][::4][:n])
+
+
+def test_saving_a_run_rejects_a_bad_rate_and_an_unwritable_path():
+    run = iktc.retarget_keypoints(iktc.load_motion("humanoid3d_walk"), iktc.Robot("g1"))
+    out = tempfile.mkdtemp()
+    for rate in (0.0, -50.0, float("nan"), float("inf")):
+        try:
+            run.save_npz(os.path.join(out, "m.npz"), rate=rate)
+        except iktc.IktcError as e:
+            assert "rate" in str(e)
+        else:
+            raise AssertionError(f"rate {rate} accepted")
+    assert not os.path.exists(os.path.join(out, "m.npz"))
+    missing = os.path.join(out, "no such folder", "m.csv")
+    try:
+        run.save_csv(missing)
+    except iktc.IktcError as e:
+        assert "no such folder" in str(e)
+    else:
+        raise AssertionError("an unwritable path accepted")
+
+
 def test_retarget_joints_npz_equals_the_python_imitation():
     d, robot = batch_outputs("--retarget", "joints")
     sim = iktc.Imitation(robot, iktc.load_motion(str(CLIP)))

@@ -18,7 +18,7 @@ pub use quality::{
     KeypointFigures, Penetration, MARGIN_ROUNDING, PENETRATION_TOLERANCE,
 };
 pub use retarget::{
-    posture_references, BatchRetarget, ClipOutcome, ClipRun, Posture, RetargetMethod,
+    body_frames, posture_references, BatchRetarget, ClipOutcome, ClipRun, Posture, RetargetMethod,
     DEFAULT_RETARGET_METHOD, MIN_CLIP_FRAMES,
 };
 pub use training::TrainingTrajectory;

@@ -207,6 +207,24 @@ pub fn posture_references(
     })
 }
 
+/// The body frames whose world positions a retargeted clip's outputs carry: `profile`'s named
+/// frames (pelvis, torso, head, hands) that are set, then the feet of the imitation `config`
+/// (from [`RobotProfile::imitate_config`]) not already listed.
+pub fn body_frames(profile: &RobotProfile, config: &ImitateConfig) -> Vec<String> {
+    let f = &profile.frames;
+    let mut v: Vec<String> = [&f.pelvis, &f.torso, &f.head, &f.left_hand, &f.right_hand]
+        .into_iter()
+        .flatten()
+        .cloned()
+        .collect();
+    for foot in &config.feet {
+        if !v.contains(foot) {
+            v.push(foot.clone());
+        }
+    }
+    v
+}
+
 impl BatchRetarget {
     /// A batch of `profile`'s robot ([`RobotProfile::robot`]) with the imitation settings
     /// [`RobotProfile::imitate_config`] makes of `base`, the keypoint settings' defaults with
@@ -246,21 +264,10 @@ impl BatchRetarget {
         }
     }
 
-    /// The body frames whose world positions are written: the profile's named frames (pelvis,
-    /// torso, head, hands) that are set, then the feet of the imitation.
+    /// The body frames whose world positions are written ([`body_frames`] of the batch's
+    /// profile and imitation settings).
     pub fn body_frames(&self) -> Vec<String> {
-        let f = &self.profile.frames;
-        let mut v: Vec<String> = [&f.pelvis, &f.torso, &f.head, &f.left_hand, &f.right_hand]
-            .into_iter()
-            .flatten()
-            .cloned()
-            .collect();
-        for foot in &self.config.feet {
-            if !v.contains(foot) {
-                v.push(foot.clone());
-            }
-        }
-        v
+        body_frames(&self.profile, &self.config)
     }
 
     /// A text that changes whenever an output could: the crate version, the method, the
