@@ -120,8 +120,40 @@ fn unknown_tags_and_attributes_in_a_joint() {
     let msg = urdf_error("<limit ", "<limits ");
     assert_names(
         &msg,
-        &["joint `j`", "<limits>", "expected one of", "<limit>"],
+        &[
+            "joint `j`",
+            "<limits>",
+            "misspelled <limit>",
+            "expected one of",
+        ],
     );
+    // Within two edits of a URDF element, or containing one: a misspelling, an error.
+    for (tag, known) in [
+        ("lmit", "limit"),
+        ("Limit", "limit"),
+        ("joint_limit", "limit"),
+        ("axes", "axis"),
+        ("orgin", "origin"),
+    ] {
+        let replaced = match known {
+            "limit" => GOOD.replace("<limit ", &format!("<{tag} ")),
+            "axis" => GOOD.replace("<axis ", &format!("<{tag} ")),
+            _ => GOOD.replace(
+                "<origin xyz=\"0 0 0.2\"",
+                &format!("<{tag} xyz=\"0 0 0.2\""),
+            ),
+        };
+        assert_ne!(replaced, GOOD, "{tag}");
+        let msg = load(&replaced).unwrap_err().to_string();
+        assert_names(
+            &msg,
+            &[
+                "joint `j`",
+                &format!("<{tag}>"),
+                &format!("misspelled <{known}>"),
+            ],
+        );
+    }
     let msg = urdf_error("velocity=", "veloctiy=");
     assert_names(&msg, &["joint `j`", "`veloctiy`", "velocity"]);
     // No <limit> at all on a revolute joint: URDF requires one.
@@ -137,9 +169,66 @@ fn unknown_tags_and_attributes_in_a_joint() {
         r.active_joints().next().unwrap().limit.velocity,
         f64::INFINITY
     );
+    // An exporter's extension inside <joint> (onshape-to-robot writes <joint_properties>)
+    // misspells nothing URDF defines: ignored, with a warning naming it; the joint is as
+    // without it.
+    let extended = GOOD.replace(
+        "<axis xyz=\"0 0 1\"/>",
+        "<axis xyz=\"0 0 1\"/><joint_properties friction=\"0.0\"/>",
+    );
+    assert_ne!(extended, GOOD);
+    let r = load(&extended).unwrap();
+    assert_eq!(
+        r.warnings(),
+        ["joint `j`: <joint_properties> is not URDF; ignored"]
+    );
+    let plain = load(GOOD).unwrap();
+    let (a, b) = (
+        r.active_joints().next().unwrap(),
+        plain.active_joints().next().unwrap(),
+    );
+    assert_eq!(
+        (a.limit.lower, a.limit.upper, a.limit.velocity),
+        (b.limit.lower, b.limit.upper, b.limit.velocity)
+    );
     // A misspelled <mass> inside <inertial>.
     let msg = urdf_error("<mass value", "<mas value");
     assert_names(&msg, &["link `a`", "<mas>", "<mass>"]);
+}
+
+#[test]
+fn a_floating_joint_from_a_massless_root_is_the_base() {
+    // Some exporters mark the floating base as a `floating` joint from a `world` link.
+    let marked = GOOD.replace(
+        "<link name=\"b\"/>",
+        "<link name=\"b\"/><link name=\"world\"/>\
+         <joint name=\"float\" type=\"floating\"><parent link=\"world\"/><child link=\"a\"/></joint>",
+    );
+    assert_ne!(marked, GOOD);
+    let floating = ModelOptions {
+        base: BaseKind::Floating,
+        ..ModelOptions::default()
+    };
+    let r = Robot::from_urdf_str(&marked, &floating).unwrap();
+    let plain = Robot::from_urdf_str(GOOD, &floating).unwrap();
+    assert_eq!((r.nq(), r.nv()), (plain.nq(), plain.nv()));
+    assert_eq!((r.nq(), r.nv()), (8, 7));
+    assert_eq!(r.total_mass(), plain.total_mass());
+    assert_eq!(r.warnings().len(), 1);
+    assert_names(&r.warnings()[0], &["`float`", "`world`", "base at `a`"]);
+    // Fixed, as ModelOptions says by default.
+    assert_eq!(load(&marked).unwrap().nq(), 1);
+    // A root with mass is a body: its floating joint stays unsupported.
+    let heavy = marked.replace(
+        "<link name=\"world\"/>",
+        "<link name=\"world\"><inertial><mass value=\"1\"/><inertia ixx=\"0.1\" ixy=\"0\" ixz=\"0\" iyy=\"0.1\" iyz=\"0\" izz=\"0.1\"/></inertial></link>",
+    );
+    let msg = load(&heavy).unwrap_err().to_string();
+    assert_names(&msg, &["joint `float`", "Floating", "ModelOptions::base"]);
+    // So is a floating joint below the root.
+    let inner = GOOD.replace("type=\"revolute\"", "type=\"floating\"");
+    let msg = load(&inner).unwrap_err().to_string();
+    assert_names(&msg, &["joint `j`", "Floating"]);
 }
 
 #[test]

@@ -213,10 +213,44 @@ pub(crate) fn read_urdf(text: &str, limits: &ReadLimits) -> Result<(urdf_rs::Rob
         named = unnamed_materials_named(text, &raw.unnamed_materials);
         named.as_str()
     };
-    let u = urdf_rs::read_from_string(text).map_err(|e| Error::Urdf {
+    let mut u = urdf_rs::read_from_string(text).map_err(|e| Error::Urdf {
         message: format!("cannot parse the URDF: {e}"),
     })?;
+    let mut raw = raw;
+    raw.floating_root = drop_floating_root(&mut u);
     Ok((u, raw))
+}
+
+/// A `floating` joint from a massless root link (`world`) to its one child is how some
+/// exporters mark a floating base: the root link and that joint are dropped, the child becomes
+/// the root, and the base is what [`ModelOptions::base`](super::ModelOptions) says, as for
+/// any other URDF. Returns the warning to give, or `None` when `u` has no such joint (any other
+/// `floating` or `planar` joint stays an error).
+fn drop_floating_root(u: &mut urdf_rs::Robot) -> Option<String> {
+    let is_child = |name: &str| u.joints.iter().any(|j| j.child.link == name);
+    let roots: Vec<usize> = (0..u.links.len())
+        .filter(|i| !is_child(&u.links[*i].name))
+        .collect();
+    let [root] = roots.as_slice() else {
+        return None;
+    };
+    let root_name = u.links[*root].name.clone();
+    let from_root: Vec<usize> = (0..u.joints.len())
+        .filter(|i| u.joints[*i].parent.link == root_name)
+        .collect();
+    let [j] = from_root.as_slice() else {
+        return None;
+    };
+    let floating = matches!(u.joints[*j].joint_type, urdf_rs::JointType::Floating);
+    if !floating || u.links[*root].inertial.mass.value != 0.0 {
+        return None;
+    }
+    let joint = u.joints.remove(*j);
+    u.links.remove(*root);
+    Some(format!(
+        "joint `{}` (floating) from the massless root link `{root_name}`: read as the base at `{}` (floating or fixed as ModelOptions::base says)",
+        joint.name, joint.child.link
+    ))
 }
 
 impl Robot {
@@ -239,7 +273,9 @@ impl Robot {
     /// * the nesting depth (at most [`ReadLimits::max_xml_depth`]), before the document is
     ///   parsed into a tree;
     /// * the elements inside each `<joint>` and `<inertial>` and the attributes of `<limit>`:
-    ///   an unknown one (a misspelling) is an error;
+    ///   an unknown one is an error, but for an element inside `<joint>` that misspells none
+    ///   URDF defines (an exporter's extension such as `<joint_properties>`), which is ignored
+    ///   with a warning;
     /// * a revolute or prismatic joint needs a `<limit>` (URDF requires it) with a range
     ///   `lower < upper` (a zero-width range is an error: make the joint fixed or lock it);
     /// * `velocity` must be finite and > 0 (0 or a negative value would mean a joint that
@@ -257,6 +293,12 @@ impl Robot {
     ) -> Result<Robot> {
         let (u, raw) = read_urdf(text, limits)?;
         let mut b = builder_from_urdf(&u, &raw.joints)?;
+        if let Some(note) = &raw.floating_root {
+            b.warn(note.clone());
+        }
+        for (joint, tag) in &raw.ignored {
+            b.warn(format!("joint `{joint}`: <{tag}> is not URDF; ignored"));
+        }
         if !raw.unnamed_materials.is_empty() {
             b.warn(format!(
                 "{} <material> element(s) without the `name` URDF requires: read as unnamed",

@@ -7,7 +7,8 @@
 //!   level: 20 000 nested elements overflow the stack);
 //! * the elements inside each `<joint>` and `<inertial>` of the robot (a misspelled `<limit>`
 //!   would otherwise leave a revolute joint with the range \[0, 0\]; a misspelled `<mass>` a
-//!   massless link), and the attributes of `<limit>`;
+//!   massless link), and the attributes of `<limit>`; an element inside `<joint>` that
+//!   misspells none URDF defines is an exporter's extension and is ignored with a warning;
 //! * which `<limit>` attributes are written at all, so that a missing value and an explicit 0
 //!   can be told apart (the typed parse gives 0 for both);
 //! * where a `<material>` has no `name`: URDF requires one, `urdf-rs` rejects the document
@@ -34,6 +35,39 @@ pub(crate) const JOINT_CHILDREN: [&str; 9] = [
     "mimic",
     "safety_controller",
 ];
+
+/// An element inside `<joint>` that URDF does not define is a misspelling of one it does (an
+/// error) when its name is within this many single-character edits of that name, or contains
+/// it (`<limits>`, `<joint_limit>`); otherwise it is an exporter's extension
+/// (`<joint_properties>` of onshape-to-robot), ignored with a warning.
+const MISSPELLING_EDITS: usize = 2;
+
+/// The number of single-character insertions, deletions and substitutions that turn `a` into
+/// `b` (Levenshtein distance).
+fn edits(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut diagonal = row[0];
+        row[0] = i + 1;
+        for (j, cb) in b.iter().enumerate() {
+            let next = (row[j + 1] + 1)
+                .min(row[j] + 1)
+                .min(diagonal + usize::from(ca != *cb));
+            diagonal = row[j + 1];
+            row[j + 1] = next;
+        }
+    }
+    row[b.len()]
+}
+
+/// The element URDF defines inside `<joint>` that `tag` looks like a misspelling of, if any.
+fn misspelled_joint_child(tag: &str) -> Option<&'static str> {
+    let lower = tag.to_ascii_lowercase();
+    JOINT_CHILDREN
+        .into_iter()
+        .find(|known| lower.contains(known) || edits(&lower, known) <= MISSPELLING_EDITS)
+}
 
 /// Elements URDF allows inside `<inertial>`.
 const INERTIAL_CHILDREN: [&str; 3] = ["origin", "mass", "inertia"];
@@ -103,6 +137,11 @@ pub(crate) struct RawUrdf {
     pub joints: HashMap<String, RawJoint>,
     /// Byte offsets just past `<material` of every `<material>` without a `name` attribute.
     pub unnamed_materials: Vec<usize>,
+    /// Elements inside a joint that URDF does not define and that misspell none it does, as
+    /// (joint, tag): ignored (see [`MISSPELLING_EDITS`]).
+    pub ignored: Vec<(String, String)>,
+    /// The warning of a floating root joint read as the base (`urdf::drop_floating_root`).
+    pub floating_root: Option<String>,
 }
 
 /// `text` with `name=""` written into each `<material` at the byte offsets `at` (ascending,
@@ -120,14 +159,16 @@ pub(crate) fn unnamed_materials_named(text: &str, at: &[usize]) -> String {
 }
 
 /// Streams `text` once; returns the robot's joints by name and where `<material>` lacks a
-/// name. Errors: a nesting deeper than `limits.max_xml_depth`, an element URDF does not know
-/// inside a robot's `<joint>` or `<inertial>`, an unknown `<limit>` attribute, malformed XML.
+/// name, and the elements inside a joint it ignores. Errors: a nesting deeper than
+/// `limits.max_xml_depth`, an element URDF does not know inside a robot's `<inertial>`, or
+/// inside a `<joint>` one that looks like a misspelling of a known one ([`MISSPELLING_EDITS`]), an unknown `<limit>` attribute, malformed XML.
 pub(crate) fn check_raw(text: &str, limits: &ReadLimits) -> Result<RawUrdf> {
     limits.validate()?;
     let mut reader = quick_xml::Reader::from_str(text);
     let mut stack: Vec<Open> = Vec::new();
     let mut joints: HashMap<String, RawJoint> = HashMap::new();
     let mut unnamed_materials = Vec::new();
+    let mut ignored = Vec::new();
     loop {
         let at = usize::try_from(reader.buffer_position()).unwrap_or(usize::MAX);
         let event = reader.read_event().map_err(|e| {
@@ -172,10 +213,15 @@ pub(crate) fn check_raw(text: &str, limits: &ReadLimits) -> Result<RawUrdf> {
         if in_robot_joint {
             let joint = parent.map_or("", |p| p.name.as_str());
             if !JOINT_CHILDREN.contains(&tag.as_str()) {
-                return Err(error(format!(
-                    "joint `{joint}` contains <{tag}>, which URDF does not define inside <joint>; expected one of {}",
-                    JOINT_CHILDREN.map(|t| format!("<{t}>")).join(", ")
-                )));
+                match misspelled_joint_child(&tag) {
+                    Some(known) => {
+                        return Err(error(format!(
+                            "joint `{joint}` contains <{tag}>, which URDF does not define inside <joint> (a misspelled <{known}>?); expected one of {}",
+                            JOINT_CHILDREN.map(|t| format!("<{t}>")).join(", ")
+                        )))
+                    }
+                    None => ignored.push((joint.to_string(), tag.clone())),
+                }
             }
             if tag == "limit" {
                 if let Some((bad, _)) = attrs
@@ -216,5 +262,40 @@ pub(crate) fn check_raw(text: &str, limits: &ReadLimits) -> Result<RawUrdf> {
     Ok(RawUrdf {
         joints,
         unnamed_materials,
+        ignored,
+        floating_root: None,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn edits_count_insertions_deletions_and_substitutions() {
+        // Hand-counted: kitten → sitting is s/k, s/e→i, +g.
+        assert_eq!(edits("kitten", "sitting"), 3);
+        assert_eq!(edits("", "abc"), 3);
+        assert_eq!(edits("abc", ""), 3);
+        assert_eq!(edits("limit", "limit"), 0);
+        assert_eq!(edits("limits", "limit"), 1);
+        assert_eq!(edits("lmit", "limit"), 1);
+        assert_eq!(edits("origni", "origin"), 2);
+        // Symmetric.
+        assert_eq!(edits("sitting", "kitten"), 3);
+    }
+
+    #[test]
+    fn a_misspelling_is_near_a_known_child_and_an_extension_is_not() {
+        assert_eq!(misspelled_joint_child("limits"), Some("limit"));
+        assert_eq!(misspelled_joint_child("AXIS"), Some("axis"));
+        assert_eq!(misspelled_joint_child("mimc"), Some("mimic"));
+        assert_eq!(
+            misspelled_joint_child("safety_controler"),
+            Some("safety_controller")
+        );
+        assert_eq!(misspelled_joint_child("joint_properties"), None);
+        assert_eq!(misspelled_joint_child("gazebo"), None);
+        assert_eq!(misspelled_joint_child("transmission"), None);
+    }
 }

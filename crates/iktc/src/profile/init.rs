@@ -2,15 +2,19 @@
 //!
 //! Guesses, each marked `# guessed` in the written TOML:
 //! * feet: per side, the deepest link whose name contains `foot`, `ankle`, `sole` or `toe`
-//!   (the side from a `left`/`l_`/`_l` or `right`/`r_`/`_r` in its name); their sole rectangle
-//!   and ankle height from the link's collision boxes and spheres (the bounding rectangle of
-//!   their footprints, the ankle height from the lowest point), else, when the URDF's folder is
+//!   (the side from a `left`/`l_`/`_l`/`_l<digit>` or `right`/`r_`/`_r`/`_r<digit>` in its
+//!   name); their sole rectangle and ankle height from the collision boxes and spheres of that
+//!   link and of the links fixed to it (the bounding rectangle of their footprints, the ankle
+//!   height from the lowest point), else, when the URDF's folder is
 //!   known ([`init_profile_toml_at`]), from its collision meshes, else its visual meshes (the
 //!   ankle height from the lowest vertex, the sole the bounding rectangle of the vertices within
-//!   [`SOLE_BAND`] of it), else a placeholder;
+//!   [`SOLE_BAND`] of it); a link that gives no sole and is fixed to its parent (a toe or heel
+//!   contact point) hands the foot to the link the last movable joint above it moves, when
+//!   that one gives a sole (the contact points fixed to it); else a placeholder;
 //! * pelvis: the first link (from the root) whose name contains `pelvis`, else the root link;
 //! * torso (`torso`, `chest`, `trunk`) and head (`head`, `neck`): the matching link nearest the
-//!   root; hands (`hand`, `palm`, `wrist`): the deepest matching link per side; a side without
+//!   root; hands (`hand`, `palm`, `wrist`, `end_effector`, `eef`): the deepest matching link
+//!   per side; a side without
 //!   one gets a frame added (key `frame`) at the far end of its deepest `elbow`/`forearm` link
 //!   (the farthest vertex of its meshes from the elbow, else twice its centre of mass);
 //! * base: floating when both feet were found, else fixed;
@@ -39,9 +43,16 @@ fn side_of(lower: &str) -> Option<Side> {
         tags.iter()
             .any(|t| lower.starts_with(t) || lower.ends_with(&t.chars().rev().collect::<String>()))
     };
-    if lower.contains("left") || has(&["l_", "l-"]) || lower.contains("_l_") {
+    // `_l_`, or `_l` before a digit (`zarm_l7_link`, `leg_l6_link`).
+    let tagged = |c: char| {
+        lower.contains(&format!("_{c}_"))
+            || lower
+                .match_indices(&format!("_{c}"))
+                .any(|(i, _)| lower[i + 2..].starts_with(|d: char| d.is_ascii_digit()))
+    };
+    if lower.contains("left") || has(&["l_", "l-"]) || tagged('l') {
         Some(Side::Left)
-    } else if lower.contains("right") || has(&["r_", "r-"]) || lower.contains("_r_") {
+    } else if lower.contains("right") || has(&["r_", "r-"]) || tagged('r') {
         Some(Side::Right)
     } else {
         None
@@ -98,15 +109,41 @@ fn lowest(points: &[Vector3<f64>]) -> f64 {
     points.iter().map(|p| p.z).fold(f64::INFINITY, f64::min)
 }
 
-/// A guessed sole ([`Sole`]) from the collision boxes and spheres of `link` (their footprints
-/// in the link frame, ignoring their rotation about z).
-fn sole_from_collisions(link: &urdf_rs::Link) -> Option<Sole> {
+fn isometry(p: &urdf_rs::Pose) -> Isometry3<f64> {
+    Isometry3::from_parts(
+        Translation3::new(p.xyz[0], p.xyz[1], p.xyz[2]),
+        UnitQuaternion::from_euler_angles(p.rpy[0], p.rpy[1], p.rpy[2]),
+    )
+}
+
+/// The collision shapes of link `name` and of every link attached to it through fixed joints
+/// (contact points at a sole's corners, a sole plate), each with its pose in `name`'s frame.
+fn fixed_subtree<'a>(
+    u: &'a urdf_rs::Robot,
+    name: &str,
+) -> Vec<(Isometry3<f64>, &'a urdf_rs::Collision)> {
+    let mut out = Vec::new();
+    let mut open = vec![(name.to_string(), Isometry3::identity())];
+    while let Some((link, at)) = open.pop() {
+        if let Some(l) = u.links.iter().find(|l| l.name == link) {
+            out.extend(l.collision.iter().map(|c| (at * isometry(&c.origin), c)));
+        }
+        for j in u
+            .joints
+            .iter()
+            .filter(|j| j.parent.link == link && matches!(j.joint_type, urdf_rs::JointType::Fixed))
+        {
+            open.push((j.child.link.clone(), at * isometry(&j.origin)));
+        }
+    }
+    out
+}
+
+/// A guessed sole ([`Sole`]) from collision boxes and spheres posed in the foot's frame (their
+/// footprints, ignoring their rotation about z).
+fn sole_from_collisions(shapes: &[(Isometry3<f64>, &urdf_rs::Collision)]) -> Option<Sole> {
     let mut points = Vec::new();
-    for c in &link.collision {
-        let o = Isometry3::from_parts(
-            Translation3::new(c.origin.xyz[0], c.origin.xyz[1], c.origin.xyz[2]),
-            UnitQuaternion::from_euler_angles(c.origin.rpy[0], c.origin.rpy[1], c.origin.rpy[2]),
-        );
+    for (o, c) in shapes {
         match &c.geometry {
             urdf_rs::Geometry::Sphere { radius } => {
                 // The footprint is the contact point; the sphere reaches `radius` lower.
@@ -174,6 +211,52 @@ fn sole_from_meshes(link: &urdf_rs::Link, dir: &std::path::Path) -> Option<(Sole
     sole(true)
         .map(|s| (s, "from the link's collision meshes"))
         .or_else(|| sole(false).map(|s| (s, "from the link's visual meshes")))
+}
+
+/// The sole of link `name`: from the collision boxes and spheres of it and of the links fixed
+/// to it, else from its meshes in `dir`, with where it came from.
+fn sole_of(
+    u: &urdf_rs::Robot,
+    name: &str,
+    dir: Option<&std::path::Path>,
+) -> Option<(Sole, &'static str)> {
+    sole_from_collisions(&fixed_subtree(u, name))
+        .map(|s| {
+            (
+                s,
+                "from the collision boxes/spheres of the link and the links fixed to it",
+            )
+        })
+        .or_else(|| {
+            let link = u.links.iter().find(|l| l.name == name)?;
+            sole_from_meshes(link, dir?)
+        })
+}
+
+/// The foot frame and its sole for the deepest foot-named link `named`: that link with its
+/// sole ([`sole_of`]), or, when it gives none and is fixed to its parent (a toe or heel
+/// contact point), the link the last movable joint above it moves, if that one gives a sole
+/// (the contact points fixed to it then make it). Else `named`, without a sole.
+fn foot_guess<'a>(
+    u: &'a urdf_rs::Robot,
+    named: &'a str,
+    dir: Option<&std::path::Path>,
+) -> (&'a str, Option<(Sole, &'static str)>) {
+    if let Some(sole) = sole_of(u, named, dir) {
+        return (named, Some(sole));
+    }
+    let mut moved = named;
+    while let Some(j) = u
+        .joints
+        .iter()
+        .find(|j| j.child.link == moved && matches!(j.joint_type, urdf_rs::JointType::Fixed))
+    {
+        moved = j.parent.link.as_str();
+    }
+    match sole_of(u, moved, dir) {
+        Some(sole) if moved != named => (moved, Some(sole)),
+        _ => (named, None),
+    }
 }
 
 /// Links shorter than this from their origin to their far end \[m\] give no hand point.
@@ -302,7 +385,7 @@ pub fn init_profile_toml_at(
     // The body's own link comes before the sensors and frames attached to it.
     let torso = pick(&links, &["torso", "chest", "trunk"], None, true);
     let head = pick(&links, &["head", "neck"], None, true);
-    let hand_words = ["hand", "palm", "wrist"];
+    let hand_words = ["hand", "palm", "wrist", "end_effector", "eef"];
     let left_hand = deepest(&links, &hand_words, Some(Side::Left));
     let right_hand = deepest(&links, &hand_words, Some(Side::Right));
     // A side without a hand link: a frame added at the far end of its forearm.
@@ -353,14 +436,15 @@ pub fn init_profile_toml_at(
     match feet {
         Some((l, r)) => {
             for (side, link) in [("left", l), ("right", r)] {
-                let urdf_link = u.links.iter().find(|x| x.name == link.name);
-                let sole = urdf_link
-                    .and_then(sole_from_collisions)
-                    .map(|s| (s, "from the link's collision boxes/spheres"))
-                    .or_else(|| urdf_link.zip(dir).and_then(|(l, d)| sole_from_meshes(l, d)));
+                let (frame, sole) = foot_guess(&u, &link.name, dir);
                 out.push_str(&format!(
-                    "[feet.{side}]\nframe = {} # guessed: deepest link named like a foot on the {side}\n",
-                    quote(&link.name)
+                    "[feet.{side}]\nframe = {} # guessed: {}\n",
+                    quote(frame),
+                    if frame == link.name {
+                        format!("deepest link named like a foot on the {side}")
+                    } else {
+                        format!("the link `{}` (deepest named like a foot on the {side}) is fixed to", link.name)
+                    }
                 ));
                 let (len, wid, off, ankle, why) = match sole {
                     // To 0.1 mm: meshes are stored in single precision.
@@ -485,5 +569,140 @@ mod tests {
             Vector3::new(0.0, 0.04, -0.05),
         ];
         assert!(sole_from_vertices(&across).is_none());
+    }
+
+    /// A biped whose feet are marked by contact spheres on links fixed below the ankle (toe and
+    /// heel points, named like feet), and whose hands are end-effector links named by an arm
+    /// index (`zarm_l7_…`), as Leju's Kuavo is described.
+    fn contact_point_biped() -> String {
+        let inertial = r#"<inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>"#;
+        let link = |n: &str| format!(r#"<link name="{n}">{inertial}</link>"#);
+        let joint = |n: &str, kind: &str, parent: &str, child: &str, xyz: &str| {
+            let limit = if kind == "revolute" {
+                r#"<axis xyz="0 1 0"/><limit lower="-1" upper="1" velocity="5" effort="10"/>"#
+            } else {
+                ""
+            };
+            format!(
+                r#"<joint name="{n}" type="{kind}"><origin xyz="{xyz}"/><parent link="{parent}"/><child link="{child}"/>{limit}</joint>"#
+            )
+        };
+        let mut x = String::from(r#"<robot name="contact_biped"><link name="dummy_link"/>"#);
+        x += &link("base_link");
+        x += &joint("dummy_to_base", "fixed", "dummy_link", "base_link", "0 0 0");
+        for (s, y) in [("l", 0.1), ("r", -0.1)] {
+            for n in ["1", "6"] {
+                x += &link(&format!("leg_{s}{n}_link"));
+                x += &link(&format!("zarm_{s}{n}_link"));
+            }
+            x += &joint(
+                &format!("leg_{s}1_joint"),
+                "revolute",
+                "base_link",
+                &format!("leg_{s}1_link"),
+                &format!("0 {y} -0.1"),
+            );
+            x += &joint(
+                &format!("leg_{s}6_joint"),
+                "revolute",
+                &format!("leg_{s}1_link"),
+                &format!("leg_{s}6_link"),
+                "0 0 -0.6",
+            );
+            x += &joint(
+                &format!("zarm_{s}1_joint"),
+                "revolute",
+                "base_link",
+                &format!("zarm_{s}1_link"),
+                &format!("0 {} 0.4", 2.0 * y),
+            );
+            x += &joint(
+                &format!("zarm_{s}6_joint"),
+                "revolute",
+                &format!("zarm_{s}1_link"),
+                &format!("zarm_{s}6_link"),
+                "0 0 -0.25",
+            );
+            x += &format!(r#"<link name="zarm_{s}7_end_effector"/>"#);
+            x += &joint(
+                &format!("zarm_{s}7_end_joint"),
+                "fixed",
+                &format!("zarm_{s}6_link"),
+                &format!("zarm_{s}7_end_effector"),
+                "0 0 -0.2",
+            );
+            // Contact points 0.06 m below the ankle, spheres of 5 mm: x from −0.07 to 0.17,
+            // y ±0.05 about the foot's centre line.
+            for (name, px, py) in [
+                ("foot_toe", 0.17, 0.0),
+                ("foot_heel", -0.07, 0.0),
+                ("l_foot_toe", 0.17, 0.05),
+                ("r_foot_heel", -0.07, -0.05),
+            ] {
+                let n = if name.starts_with("foot") {
+                    format!("{s}_{name}")
+                } else {
+                    format!("{s}{name}")
+                };
+                x += &format!(
+                    r#"<link name="{n}"><collision><geometry><sphere radius="0.005"/></geometry></collision></link>"#
+                );
+                x += &joint(
+                    &format!("{n}_joint"),
+                    "fixed",
+                    &format!("leg_{s}6_link"),
+                    &n,
+                    &format!("{px} {py} -0.06"),
+                );
+            }
+        }
+        x + "</robot>"
+    }
+
+    #[test]
+    fn a_foot_marked_by_contact_points_is_the_ankle_link_with_the_points_sole() {
+        let toml = init_profile_toml(&contact_point_biped(), "b.urdf").unwrap();
+        for side in ["l", "r"] {
+            // The deepest foot-named link is a contact point fixed to the ankle: the foot is the
+            // ankle link, and its sole the points' rectangle, 5 mm (the spheres) lower.
+            let name = if side == "l" { "left" } else { "right" };
+            let block = toml.split(&format!("[feet.{name}]")).nth(1).unwrap();
+            assert!(
+                block.starts_with(&format!("\nframe = \"leg_{side}6_link\"")),
+                "{block}"
+            );
+            assert!(block.contains("ankle_height = 0.065 "), "{block}");
+            assert!(
+                block.contains("sole = { length = 0.24, width = 0.1, offset_x = 0.05 }"),
+                "{block}"
+            );
+        }
+        assert!(toml.contains("base = \"floating\""));
+        // The hands: end effectors, their sides from the arm index (`zarm_l7_…`).
+        assert!(
+            toml.contains("left_hand = \"zarm_l7_end_effector\""),
+            "{toml}"
+        );
+        assert!(
+            toml.contains("right_hand = \"zarm_r7_end_effector\""),
+            "{toml}"
+        );
+    }
+
+    #[test]
+    fn sides_are_read_from_the_usual_tags() {
+        for (name, side) in [
+            ("left_ankle_roll_link", Some(Side::Left)),
+            ("l_foot", Some(Side::Left)),
+            ("foot_l", Some(Side::Left)),
+            ("leg_l6_link", Some(Side::Left)),
+            ("zarm_r7_end_effector", Some(Side::Right)),
+            ("arm_r_elbow", Some(Side::Right)),
+            ("ankle_link", None),
+            ("base_link", None),
+            ("torso_l", Some(Side::Left)),
+        ] {
+            assert!(side_of(name) == side, "{name}");
+        }
     }
 }
