@@ -84,7 +84,7 @@ mod walk;
 
 pub use build::{check_map_joints, MISSING};
 pub use glob::glob_match;
-pub use init::{init_profile_toml, init_profile_toml_at, urdf_key, SOLE_BAND};
+pub use init::{init_profile_toml, init_profile_toml_at, urdf_key, CROUCH, SOLE_BAND};
 pub use load::{builtin_profile_text, BUILTIN_PROFILES};
 pub use schema::{
     AccelerationProfile, AddedFrame, BodyFrames, Feet, Foot, ImitateProfile, JerkProfile, LockRule,
