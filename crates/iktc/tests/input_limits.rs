@@ -169,6 +169,13 @@ fn unknown_tags_and_attributes_in_a_joint() {
         r.active_joints().next().unwrap().limit.velocity,
         f64::INFINITY
     );
+    // With one, URDF ignores its range (the joint turns without end) and keeps its rates.
+    let r = load(&GOOD.replace("revolute", "continuous")).unwrap();
+    let l = r.active_joints().next().unwrap().limit;
+    assert_eq!(
+        (l.lower, l.upper, l.velocity),
+        (f64::NEG_INFINITY, f64::INFINITY, 2.0)
+    );
     // An exporter's extension inside <joint> (onshape-to-robot writes <joint_properties>)
     // misspells nothing URDF defines: ignored, with a warning naming it; the joint is as
     // without it.
