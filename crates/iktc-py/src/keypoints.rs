@@ -278,8 +278,7 @@ impl PyKeypointTrajectory {
         path: std::path::PathBuf,
         rate: Option<f64>,
     ) -> PyResult<()> {
-        let bytes = py.detach(|| self.training(rate)?.npz()).map_err(to_py)?;
-        write_file(&path, &bytes)
+        self.save(py, &path, rate, TrainingTrajectory::npz)
     }
 
     /// Writes the run as `iktc retarget` writes a clip's `motion.csv`: columns `t`, `base_x
@@ -292,10 +291,7 @@ impl PyKeypointTrajectory {
         path: std::path::PathBuf,
         rate: Option<f64>,
     ) -> PyResult<()> {
-        let text = py
-            .detach(|| self.training(rate).map(|t| t.csv()))
-            .map_err(to_py)?;
-        write_file(&path, text.as_bytes())
+        self.save(py, &path, rate, |t| Ok(t.csv().into_bytes()))
     }
 
     fn __len__(&self) -> usize {
@@ -304,17 +300,25 @@ impl PyKeypointTrajectory {
 }
 
 impl PyKeypointTrajectory {
+    /// Writes the run resampled at `rate` ([`Self::training`]) to `path` as `encode` makes it,
+    /// outside the GIL; an I/O error is raised as IktcError naming the file.
+    fn save(
+        &self,
+        py: Python<'_>,
+        path: &std::path::Path,
+        rate: Option<f64>,
+        encode: impl Fn(&TrainingTrajectory) -> iktc::Result<Vec<u8>> + Send + Sync,
+    ) -> PyResult<()> {
+        let bytes = py.detach(|| encode(&self.training(rate)?)).map_err(to_py)?;
+        std::fs::write(path, bytes)
+            .map_err(|e| crate::IktcError::new_err(format!("cannot write {}: {e}", path.display())))
+    }
+
     /// The run resampled at `rate` [Hz] (default the control rate).
     fn training(&self, rate: Option<f64>) -> iktc::Result<TrainingTrajectory> {
         let rate = rate.unwrap_or(1.0 / self.dt);
         TrainingTrajectory::from_keypoint_run(&self.robot, &self.run, self.dt, &self.bodies, rate)
     }
-}
-
-/// Writes `bytes` to `path`; an I/O error is raised as IktcError naming the file.
-fn write_file(path: &std::path::Path, bytes: &[u8]) -> PyResult<()> {
-    std::fs::write(path, bytes)
-        .map_err(|e| crate::IktcError::new_err(format!("cannot write {}: {e}", path.display())))
 }
 
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

@@ -21,7 +21,7 @@ mod urdf;
 mod urdf_check;
 
 #[cfg(feature = "urdf")]
-pub(crate) use urdf::read_urdf;
+pub(crate) use urdf::{pose as urdf_pose, read_urdf};
 
 pub use builtin::{builtin_robot, planar3r, BUILTIN_ROBOTS};
 #[cfg(feature = "urdf")]

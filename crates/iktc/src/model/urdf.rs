@@ -10,7 +10,8 @@ use super::urdf_check::{check_raw, unnamed_materials_named, RawJoint, RawUrdf};
 use crate::error::{Error, Result};
 use crate::resources::ReadLimits;
 
-fn pose(p: &urdf_rs::Pose) -> Isometry3<f64> {
+/// A URDF `<origin>` as an isometry (translation `xyz` \[m\], rotation `rpy` \[rad\]).
+pub(crate) fn pose(p: &urdf_rs::Pose) -> Isometry3<f64> {
     Isometry3::from_parts(
         Translation3::new(p.xyz[0], p.xyz[1], p.xyz[2]),
         // URDF rpy: R = Rz(yaw) · Ry(pitch) · Rx(roll), which is nalgebra's convention.

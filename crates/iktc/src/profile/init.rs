@@ -23,7 +23,7 @@
 //! * locks: movable joints whose names contain `finger`, `thumb`, `index`, `middle`, `ring`,
 //!   `little` or `pinky`, as one glob pattern each.
 
-use nalgebra::{DMatrix, DVector, Isometry3, Translation3, UnitQuaternion, Vector3};
+use nalgebra::{DMatrix, DVector, Isometry3, Vector3};
 
 use crate::error::{Error, Result};
 
@@ -111,13 +111,6 @@ fn lowest(points: &[Vector3<f64>]) -> f64 {
     points.iter().map(|p| p.z).fold(f64::INFINITY, f64::min)
 }
 
-fn isometry(p: &urdf_rs::Pose) -> Isometry3<f64> {
-    Isometry3::from_parts(
-        Translation3::new(p.xyz[0], p.xyz[1], p.xyz[2]),
-        UnitQuaternion::from_euler_angles(p.rpy[0], p.rpy[1], p.rpy[2]),
-    )
-}
-
 /// The collision shapes of link `name` and of every link attached to it through fixed joints
 /// (contact points at a sole's corners, a sole plate), each with its pose in `name`'s frame.
 fn fixed_subtree<'a>(
@@ -128,14 +121,21 @@ fn fixed_subtree<'a>(
     let mut open = vec![(name.to_string(), Isometry3::identity())];
     while let Some((link, at)) = open.pop() {
         if let Some(l) = u.links.iter().find(|l| l.name == link) {
-            out.extend(l.collision.iter().map(|c| (at * isometry(&c.origin), c)));
+            out.extend(
+                l.collision
+                    .iter()
+                    .map(|c| (at * crate::model::urdf_pose(&c.origin), c)),
+            );
         }
         for j in u
             .joints
             .iter()
             .filter(|j| j.parent.link == link && matches!(j.joint_type, urdf_rs::JointType::Fixed))
         {
-            open.push((j.child.link.clone(), at * isometry(&j.origin)));
+            open.push((
+                j.child.link.clone(),
+                at * crate::model::urdf_pose(&j.origin),
+            ));
         }
     }
     out
@@ -335,14 +335,10 @@ fn crouch_posture(text: &str, u: &urdf_rs::Robot, feet: &[&str]) -> Option<Vec<(
         if joints.len() < 6 {
             return None;
         }
-        let joints: Vec<(String, usize, usize, f64, f64)> = joints
-            .into_iter()
-            .map(|j| (j.0, j.1, j.2, j.3, j.4))
-            .collect();
         legs.push((foot, joints, hip));
     }
     for (_, joints, _) in &legs {
-        for (_, iq, _, lo, hi) in joints {
+        for (_, iq, _, lo, hi, _) in joints {
             state.q[*iq] = 0.0_f64.clamp(*lo, *hi);
         }
     }
@@ -359,7 +355,7 @@ fn crouch_posture(text: &str, u: &urdf_rs::Robot, feet: &[&str]) -> Option<Vec<(
         targets.push(t);
     }
     for (_, joints, _) in &legs {
-        for (_, iq, _, lo, hi) in joints {
+        for (_, iq, _, lo, hi, _) in joints {
             let z = state.q[*iq];
             if lo.is_finite() && hi.is_finite() {
                 state.q[*iq] = z + NUDGE * (0.5 * (lo + hi) - z);
@@ -389,7 +385,7 @@ fn crouch_posture(text: &str, u: &urdf_rs::Robot, feet: &[&str]) -> Option<Vec<(
             if largest > MAX_STEP {
                 dq *= MAX_STEP / largest;
             }
-            for ((_, iq, _, lo, hi), d) in joints.iter().zip(dq.iter()) {
+            for ((_, iq, _, lo, hi, _), d) in joints.iter().zip(dq.iter()) {
                 state.q[*iq] = (state.q[*iq] + d).clamp(*lo, *hi);
             }
         }
