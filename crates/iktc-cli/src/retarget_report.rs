@@ -11,9 +11,41 @@ use crate::cmd_retarget::ClipStatus;
 /// The figures shown: key in `quality.json`'s `figures`, column label with its unit. A column
 /// appears when some clip has its figure (the keypoint and joint routes measure different
 /// things).
-const COLUMNS: [(&str, &str); 29] = [
+const COLUMNS: [(&str, &str); 40] = [
     ("duration", "duration [s]"),
-    ("mean_keypoint_error", "mean keypoint error [m]"),
+    (
+        "neutral_keypoint_error",
+        "mean keypoint error against the person (joint centres, leg scale) [m]",
+    ),
+    ("contact_slip", "foot slip over the person's contacts [m]"),
+    (
+        "contact_height",
+        "highest sole over the person's contacts [m]",
+    ),
+    ("lowest_sole", "lowest sole [m]"),
+    ("skate_share", "share of foot-ticks skating [–]"),
+    (
+        "knee_flexion_gap",
+        "median knee flexion, robot − person [rad]",
+    ),
+    (
+        "elbow_flexion_gap",
+        "median elbow flexion, robot − person [rad]",
+    ),
+    ("trunk_lean_gap", "median trunk lean, robot − person [rad]"),
+    (
+        "hip_height_gap",
+        "median hip height, robot − scaled person [m]",
+    ),
+    (
+        "reversal_share",
+        "share of ticks where q̈'s change reverses [–]",
+    ),
+    ("flip_max", "largest tick-to-tick sign flip of q̈ [rad/s²]"),
+    (
+        "mean_keypoint_error",
+        "the tool's own tracking error against its targets [m]",
+    ),
     (
         "reach_keypoint_error",
         "static reach: least mean keypoint error of a posture within the joint ranges [m]",

@@ -188,10 +188,38 @@ pub struct KeypointFigures {
     pub duration: f64,
     /// Control ticks recorded.
     pub ticks: usize,
-    /// Every joint limit kept: position, velocity and acceleration margins at most
-    /// [`MARGIN_ROUNDING`].
+    /// Every joint limit kept (position, velocity and acceleration margins at most
+    /// [`MARGIN_ROUNDING`]) and every neutral figure within its limit
+    /// ([`crate::retarget::FidelityLimits`]); `failures` says what failed.
     pub healthy: bool,
-    /// Mean over the body points of each point's mean position error \[m\].
+    /// What made the clip unhealthy, in words (empty if healthy).
+    pub failures: Vec<String>,
+    /// The neutral mean keypoint error: the robot's joint centres against the captured
+    /// person's, scaled by the leg and placed at the robot's hips \[m\]
+    /// ([`crate::retarget::fidelity`]).
+    pub neutral_keypoint_error: f64,
+    /// Largest slip of a robot ankle over the person's contacts \[m\].
+    pub contact_slip: f64,
+    /// Highest a sole is above the floor over the person's contacts \[m\].
+    pub contact_height: f64,
+    /// Lowest sole corner \[m\] (negative: below the floor).
+    pub lowest_sole: f64,
+    /// Share of the foot-ticks on which a sole skates on the floor \[–\].
+    pub skate_share: f64,
+    /// Median knee flexion, robot − person, mean of both knees \[rad\].
+    pub knee_flexion_gap: f64,
+    /// Median elbow flexion, robot − person, mean of both elbows \[rad\].
+    pub elbow_flexion_gap: f64,
+    /// Median trunk lean, robot − person \[rad\].
+    pub trunk_lean_gap: f64,
+    /// Median hip height above the ankles, robot − scaled person \[m\].
+    pub hip_height_gap: f64,
+    /// Share of the ticks whose change of q̈ reverses, over joints \[–\].
+    pub reversal_share: f64,
+    /// Largest sign flip of a joint's q̈ between two ticks \[rad/s²\].
+    pub flip_max: f64,
+    /// The tool's own tracking error: the mean over its tracked body points of each point's
+    /// mean position error against its own scaled targets \[m\] (the pelvis counts as 0).
     pub mean_keypoint_error: f64,
     /// Largest position error of any body point \[m\].
     pub max_keypoint_error: f64,
@@ -268,11 +296,47 @@ impl KeypointFigures {
             .iter()
             .max_by(|a, b| a.mean_cm.total_cmp(&b.mean_cm));
         let margins = [q.position_margin, q.velocity_margin, q.acceleration_margin];
+        let mut failures: Vec<String> = ["position", "velocity", "acceleration"]
+            .iter()
+            .zip(margins)
+            .filter(|(_, m)| m.is_nan() || *m > MARGIN_ROUNDING)
+            .map(|(what, m)| format!("a joint's {what} limit exceeded by {m:.3e}"))
+            .collect();
+        let fid = q.fidelity.as_ref();
+        match fid {
+            Some(f) => failures.extend(f.failures.iter().cloned()),
+            None => failures.push("no neutral figures".into()),
+        }
+        let gap = |names: &[&str]| -> f64 {
+            let v: Vec<f64> = fid
+                .map(|f| {
+                    f.posture
+                        .iter()
+                        .filter(|p| names.contains(&p.name.as_str()))
+                        .map(|p| p.robot_median - p.person_median)
+                        .collect()
+                })
+                .unwrap_or_default();
+            v.iter().sum::<f64>() / v.len().max(1) as f64
+        };
+        let c = fid.map(|f| &f.contacts);
         Self {
             route: "keypoints",
             duration: run.times.len() as f64 * dt,
             ticks: q.ticks,
-            healthy: margins.iter().all(|m| *m <= MARGIN_ROUNDING),
+            healthy: failures.is_empty(),
+            failures,
+            neutral_keypoint_error: fid.map_or(f64::NAN, |f| f.keypoint_mean_cm / 100.0),
+            contact_slip: c.map_or(f64::NAN, |c| c.slip_max_mm / 1000.0),
+            contact_height: c.map_or(f64::NAN, |c| c.height_max_mm / 1000.0),
+            lowest_sole: c.map_or(f64::NAN, |c| c.lowest_sole_mm / 1000.0),
+            skate_share: c.map_or(f64::NAN, |c| c.skate_share),
+            knee_flexion_gap: gap(&["left_knee", "right_knee"]).to_radians(),
+            elbow_flexion_gap: gap(&["left_elbow", "right_elbow"]).to_radians(),
+            trunk_lean_gap: gap(&["trunk_lean"]).to_radians(),
+            hip_height_gap: gap(&["hip_height"]) / 100.0,
+            reversal_share: fid.map_or(f64::NAN, |f| f.smoothness.reversal_share),
+            flip_max: fid.map_or(f64::NAN, |f| f.smoothness.flip_max),
             mean_keypoint_error: q.mean_cm / 100.0,
             max_keypoint_error: q.points.iter().map(|e| e.max_cm).fold(0.0, f64::max) / 100.0,
             worst_keypoint: worst.map_or_else(String::new, |e| e.point.clone()),

@@ -147,7 +147,7 @@ fn point_of(side: Side, limb: &str) -> BodyPoint {
 }
 
 /// The links from the root down to the link of frame `f` (root first).
-fn chain(robot: &Robot, f: FrameId) -> Result<Vec<usize>> {
+pub(super) fn chain(robot: &Robot, f: FrameId) -> Result<Vec<usize>> {
     let frame = robot.frames().get(f.0).ok_or_else(|| Error::UnknownName {
         kind: "frame",
         name: format!("#{}", f.0),
@@ -167,7 +167,7 @@ fn chain(robot: &Robot, f: FrameId) -> Result<Vec<usize>> {
 }
 
 /// The index, in both chains, of the first link after their common part.
-fn branch(chains: &[Vec<usize>; 2]) -> usize {
+pub(super) fn branch(chains: &[Vec<usize>; 2]) -> usize {
     let common = chains[0]
         .iter()
         .zip(&chains[1])

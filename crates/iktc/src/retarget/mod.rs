@@ -33,9 +33,11 @@
 //! ```
 
 mod body;
+pub mod centres;
 mod com;
 mod contacts;
 mod drift;
+pub mod fidelity;
 mod floor;
 mod plan;
 mod quality;
@@ -45,7 +47,9 @@ mod tracker;
 mod viewer;
 
 pub use body::{BodyFrameNames, RobotBody, MIN_HEAD_HEIGHT};
+pub use centres::RobotJointCentres;
 pub use contacts::{PIVOT_RATE, PIVOT_SMOOTHING, PIVOT_TURN};
+pub use fidelity::{Fidelity, FidelityLimits};
 pub use floor::FLOOR_ENGAGE;
 pub use quality::{
     JointOnLimit, OrientationError, PointError, QualityRecorder, RetargetQuality, FLOAT_HEIGHT,
@@ -669,6 +673,14 @@ pub fn retarget_keypoints_on(
     }
     let contacts = controller.plan().contact.clone();
     let mut quality = rec.finish(&robot);
+    quality.fidelity = Some(measure_fidelity(
+        &robot,
+        &body,
+        &support,
+        kp,
+        (&times, &trajectory, &accelerations),
+        s.dt,
+    )?);
     if s.reach {
         let stride = ((REACH_PERIOD / s.dt).round() as usize).max(1);
         let balance = (&support, s.com_margin);
@@ -700,6 +712,36 @@ pub fn retarget_keypoints_on(
         settle_sacrificed: controller.settle_sacrificed().clone(),
         settle_ticks,
     })
+}
+
+/// The neutral fidelity figures ([`fidelity`]) of a run on `robot`: per tick its clip time,
+/// configuration and applied q̈ (base and joints; the joints' are measured).
+fn measure_fidelity(
+    robot: &Robot,
+    body: &RobotBody,
+    support: &SupportSettings,
+    kp: &Keypoints,
+    (times, trajectory, accelerations): (&[f64], &[Vec<f64>], &[Vec<f64>]),
+    dt: f64,
+) -> Result<Fidelity> {
+    let centres = RobotJointCentres::find(robot, body)?;
+    let samples = fidelity::robot_samples(robot, &centres, body.feet, support, trajectory)?;
+    let b = robot.base_nv();
+    let qdd: Vec<Vec<f64>> = accelerations
+        .iter()
+        .map(|a| a.get(b..).unwrap_or_default().to_vec())
+        .collect();
+    Ok(fidelity::fidelity(
+        &fidelity::FidelityInput {
+            person: kp,
+            times,
+            robot: &samples,
+            robot_leg: fidelity::robot_leg(robot, &centres)?,
+            qdd: &qdd,
+            dt,
+        },
+        &FidelityLimits::default(),
+    ))
 }
 
 /// Whether the solve of `r` corrected the prioritized solution into the box: IKTC corrected a
@@ -735,9 +777,14 @@ pub fn joint_route_quality(
     let plan = setup.controller.plan();
     let mut rec = QualityRecorder::new("joints", &setup.body, s.dt);
     let mut kin = Kinematics::new(robot, ctl.state())?;
+    let t0 = kp.times.first().copied().unwrap_or(0.0);
+    let (mut times, mut trajectory, mut accelerations) = (Vec::new(), Vec::new(), Vec::new());
     for k in 0..plan.ticks.min(refs.len()) {
         let state = ctl.state().clone();
         let corrected = shaped_by_box(ctl.tick(robot, k)?);
+        times.push(t0 + k as f64 * s.dt);
+        trajectory.push(state.q.as_slice().to_vec());
+        accelerations.push(ctl.qdd().as_slice().to_vec());
         kin.update(robot, &state)?;
         rec.record(
             robot,
@@ -751,7 +798,16 @@ pub fn joint_route_quality(
         )?;
         ctl.integrate(robot)?;
     }
-    Ok(rec.finish(robot))
+    let mut quality = rec.finish(robot);
+    quality.fidelity = Some(measure_fidelity(
+        robot,
+        &setup.body,
+        &setup.support,
+        kp,
+        (&times, &trajectory, &accelerations),
+        s.dt,
+    )?);
+    Ok(quality)
 }
 
 #[cfg(test)]

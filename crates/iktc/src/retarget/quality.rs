@@ -147,6 +147,10 @@ pub struct RetargetQuality {
     /// The run's own mean body point error over the same sampled ticks \[cm\], beside
     /// [`RetargetQuality::reach_cm`].
     pub reach_run_cm: Option<f64>,
+    /// The neutral figures: the robot's joint centres against the captured person, contacts
+    /// from the person, posture, smoothness and the verdict ([`super::fidelity`]). `None`
+    /// only from [`QualityRecorder::finish`] alone; every route fills it.
+    pub fidelity: Option<super::Fidelity>,
 }
 
 /// Records the ticks of a run and gives its [`RetargetQuality`]. Allocates during `record`
@@ -357,6 +361,7 @@ impl QualityRecorder {
             reach_cm: None,
             balanced_reach_cm: None,
             reach_run_cm: None,
+            fidelity: None,
         }
     }
 }
