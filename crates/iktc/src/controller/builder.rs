@@ -110,7 +110,15 @@ impl ControllerBuilder {
     ///
     /// Errors: no level started, an unknown frame, no axis, bad gains.
     pub fn frame(&mut self, frame: &str, axes: Axes) -> Result<FrameHandle> {
+        self.weighted_frame(frame, axes, 1.0)
+    }
+
+    /// [`ControllerBuilder::frame`] with the rows weighted by `weight` ([`FrameTask::set_weight`]):
+    /// a task that shares a level with others in a weighted least-squares compromise. Errors:
+    /// as `frame`, and a weight that is not finite and > 0.
+    pub fn weighted_frame(&mut self, frame: &str, axes: Axes, weight: f64) -> Result<FrameHandle> {
         let mut task = FrameTask::new(&self.robot, frame, axes, self.gains)?;
+        task.set_weight(weight)?;
         let pose = self.kin.frame_pose(&self.robot, task.frame())?;
         task.set_reference(FrameReference::hold(pose))?;
         self.add(Task::Frame(task)).map(FrameHandle)

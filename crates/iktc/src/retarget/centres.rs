@@ -17,7 +17,9 @@
 //! Each centre is kept as a point fixed in a link (the group's last joint's child link), so
 //! it follows the limb in any posture. Names play no part.
 
-use nalgebra::{Matrix3, Point3, Vector3};
+use std::sync::Arc;
+
+use nalgebra::{Isometry3, Matrix3, Point3, Translation3, UnitQuaternion, Vector3};
 
 use super::body::{branch, chain, RobotBody};
 use crate::error::{Error, Result};
@@ -107,6 +109,45 @@ impl RobotJointCentres {
             message: "every limb must give three joint centres".into(),
         })?;
         Ok(Self { points })
+    }
+
+    /// `robot` with a frame at every centre (named `centre:<point>`, e.g. `centre:left_hip`),
+    /// and `body` with those frames for its hips, knees, shoulders, elbows and wrists (its
+    /// ankles stay the feet's frames, which the foot tasks and soles are given in): the
+    /// points a retargeting tracks are then the points its fidelity is measured at. Errors:
+    /// a name taken.
+    pub fn frames(
+        &self,
+        robot: &Arc<Robot>,
+        mut body: RobotBody,
+    ) -> Result<(Arc<Robot>, RobotBody)> {
+        let mut r = Robot::clone(robot);
+        let mut ids = Vec::with_capacity(12);
+        for (p, lp) in JOINT_CENTRES.iter().zip(&self.points) {
+            let name = format!("centre:{}", p.name());
+            let link = r
+                .links()
+                .get(lp.link)
+                .map(|l| l.name.clone())
+                .unwrap_or_default();
+            let at = r.frame_id(&link)?;
+            // The frame is given in the link's frame: undo the link frame's own offset.
+            let offset = r.frames()[at.0].offset.inverse()
+                * Isometry3::from_parts(Translation3::from(lp.offset), UnitQuaternion::identity());
+            if r.frame_id(&name).is_err() {
+                r = r.with_frame(&name, &link, offset)?;
+            }
+            ids.push((*p, r.frame_id(&name)?));
+        }
+        for (p, id) in ids {
+            if matches!(p, BodyPoint::LeftAnkle | BodyPoint::RightAnkle) {
+                continue;
+            }
+            if let Some(slot) = body.points.iter_mut().find(|(q, _)| *q == p) {
+                slot.1 = id;
+            }
+        }
+        Ok((Arc::new(r), body))
     }
 
     /// The centres in world coordinates at `kin` \[m\], in [`JOINT_CENTRES`] order.

@@ -9,7 +9,8 @@
 //! 10–31°), pulled into the support polygon of the
 //! feet on the ground (shrunk by `com_margin`), then smoothed by two passes of a centred moving
 //! average of `com_smoothing` \[s\]; orientations come from the points: the pelvis frame from
-//! the hip axis and the vertical, the torso frame from the shoulder axis and the hips-to-
+//! the hip axis and the vertical leaned toward the trunk's direction by
+//! [`KeypointSettings::pelvis_lean`](super::KeypointSettings::pelvis_lean), the torso frame from the shoulder axis and the hips-to-
 //! shoulders direction (`y` along the axis, `z` the other direction made orthogonal to it,
 //! `x = y × z`), each times the constant rotation that maps the same construction on the robot
 //! in its start posture onto the robot's frame. Where a leg would have to stretch beyond
@@ -193,8 +194,20 @@ fn frame_from(axis: Vector3<f64>, up: Vector3<f64>) -> UnitQuaternion<f64> {
     )))
 }
 
-fn pelvis_frame(lh: Vector3<f64>, rh: Vector3<f64>) -> UnitQuaternion<f64> {
-    frame_from(lh - rh, Vector3::z())
+/// The pelvis frame of hips `lh`, `rh` under shoulders `ls`, `rs`: `y` along the hip axis,
+/// `z` along `(1 − a) ẑ + a t̂` made orthogonal to it, `t̂` the trunk's direction from the
+/// hips' middle to the shoulders' and `a` = `trunk` (0: upright, 1: the whole trunk lean).
+fn pelvis_frame(
+    lh: Vector3<f64>,
+    rh: Vector3<f64>,
+    ls: Vector3<f64>,
+    rs: Vector3<f64>,
+    trunk: f64,
+) -> UnitQuaternion<f64> {
+    let t = (0.5 * (ls + rs) - 0.5 * (lh + rh))
+        .try_normalize(1e-12)
+        .unwrap_or_else(Vector3::z);
+    frame_from(lh - rh, (1.0 - trunk) * Vector3::z() + trunk * t)
 }
 
 fn torso_frame(
@@ -405,9 +418,15 @@ pub(crate) fn plan(
         at0(BodyPoint::LeftShoulder)?,
         at0(BodyPoint::RightShoulder)?,
     );
-    let c_pelvis = pelvis_frame(rlh, rrh).inverse() * kin.frame_pose(robot, body.pelvis)?.rotation;
+    let trunk = s.pelvis_lean;
+    let (sl, sr) = (
+        get(BodyPoint::LeftShoulder)?,
+        get(BodyPoint::RightShoulder)?,
+    );
+    let c_pelvis = pelvis_frame(rlh, rrh, rls, rrs, trunk).inverse()
+        * kin.frame_pose(robot, body.pelvis)?.rotation;
     let pelvis_rot: Vec<UnitQuaternion<f64>> = (0..ticks)
-        .map(|k| pelvis_frame(lh[k], rh[k]) * c_pelvis)
+        .map(|k| pelvis_frame(lh[k], rh[k], sl[k], sr[k], trunk) * c_pelvis)
         .collect();
     // COM over the support polygon of the feet on the ground: the scaled pelvis plus the
     // robot's own COM offset from its pelvis in the posture asked of it ([`com`]).

@@ -8,12 +8,16 @@
 //!    floor ([`super::floor`]) keeps their soles above the ground;
 //! 3. `com_xy`: the COM over the support polygon, horizontal;
 //! 4. `pelvis`: the pelvis pose, 6D;
-//! 5. `hands_swing_feet`: the hand frames' positions and the positions of the feet in the
-//!    air, and every active joint at its posture reference with its rows weighted by
-//!    [`KeypointSettings::posture_weight`] (a regulariser, see below);
-//! 6. `elbows_head_torso`: the elbows' and the head's positions, the torso's orientation and
-//!    the orientations of the feet in the air; with weighted posture rows in the fifth level
-//!    it has no coordinate left (rank 0) and moves nothing, and only its errors are reported;
+//! 5. `hands_swing_feet`: the wrists' positions and the positions of the feet in the air;
+//!    the elbows' and the head's positions, the torso's orientation and the orientations of
+//!    the feet in the air with their rows weighted by [`KeypointSettings::body_weight`]; and
+//!    every active joint at its posture reference with its rows weighted by
+//!    [`KeypointSettings::posture_weight`] (a regulariser, see below). The body points are
+//!    the robot's joint centres ([`super::centres`]), the points the fidelity figures measure;
+//! 6. `elbows_head_torso`: only with a body weight of 0, the elbows, head, torso and swing
+//!    feet's orientations in a level of their own; with weighted posture rows in the fifth
+//!    level it has no coordinate left (rank 0) and moves nothing, and only its errors are
+//!    reported;
 //! 7. `posture`: only with a posture weight of 0, every active joint at its posture reference
 //!    in a level of its own (below the weighted rows such a level could only move what they
 //!    already move: it would have rank 0).
@@ -435,12 +439,62 @@ fn set_references(
         ctl.set_frame_reference(*h, p.points[*i].1[k].frame(hold))?;
     }
     for (j, track) in posture_track.iter().enumerate() {
+        if track[0].is_empty() {
+            // Damping where the joint is: the caller set the position.
+            posture_ref[1][j] = 0.0;
+            posture_ref[2][j] = 0.0;
+            continue;
+        }
         for d in 0..3 {
             let v = track[d].get(k).or(track[d].last()).copied().unwrap_or(0.0);
             posture_ref[d][j] = if hold && d > 0 { 0.0 } else { v };
         }
     }
     ctl.set_joints_reference(t.posture, &posture_ref[0], &posture_ref[1], &posture_ref[2])
+}
+
+/// Adds the elbows' and head's positions, the torso's orientation and the swing feet's
+/// orientations to the builder's current level, their rows weighted by `w`.
+#[allow(clippy::too_many_arguments)]
+fn add_body_tasks(
+    b: &mut ControllerBuilder,
+    robot: &Robot,
+    body: &RobotBody,
+    plan: &Plan,
+    points: &mut Vec<(FrameHandle, usize)>,
+    torso: &mut Option<FrameHandle>,
+    feet: &mut Vec<(usize, FrameHandle)>,
+    swing: [bool; 2],
+    w: f64,
+) -> Result<()> {
+    let name = |f: FrameId| -> String {
+        robot
+            .frames()
+            .get(f.0)
+            .map(|f| f.name.clone())
+            .unwrap_or_default()
+    };
+    let hand = |p: &BodyPoint| matches!(p, BodyPoint::LeftWrist | BodyPoint::RightWrist);
+    for (i, (p, _)) in plan
+        .points
+        .iter()
+        .enumerate()
+        .filter(|(_, (p, _))| !hand(p))
+    {
+        if let Some(f) = body.frame_of(*p) {
+            points.push((b.weighted_frame(&name(f), Axes::POSITION, w)?, i));
+        }
+    }
+    if let Some(f) = body.torso {
+        *torso = Some(b.weighted_frame(&name(f), Axes::ORIENTATION, w)?);
+    }
+    for i in (0..2).filter(|i| swing[*i]) {
+        feet.push((
+            i,
+            b.weighted_frame(&name(body.feet[i]), Axes::ORIENTATION, w)?,
+        ));
+    }
+    Ok(())
 }
 
 /// The stack of the contact state `stance` (left, right on the ground).
@@ -508,6 +562,23 @@ fn build_stack(
         }
     }
     let names: Vec<&str> = posture.iter().map(String::as_str).collect();
+    // The elbows, head, torso orientation and swing feet's orientations: weighted into the
+    // fifth level, or (weight 0) a sixth level of their own.
+    let w = s.body_weight;
+    let mut torso = None;
+    if w > 0.0 {
+        add_body_tasks(
+            &mut b,
+            robot,
+            body,
+            plan,
+            &mut points,
+            &mut torso,
+            &mut feet,
+            swing,
+            w,
+        )?;
+    }
     // Weighted into the fifth level, or (weight 0) a level of its own below the sixth: never
     // both, as a posture level below the weighted rows could only move what they already move.
     let weighted = if s.posture_weight > 0.0 {
@@ -515,33 +586,29 @@ fn build_stack(
     } else {
         None
     };
-    // The sixth level only with a task in it (a robot without elbows, head or torso frames
-    // standing on both feet has none).
-    let sixth = body.torso.is_some()
-        || swing.contains(&true)
-        || plan
-            .points
-            .iter()
-            .any(|(p, _)| !hand(p) && body.frame_of(*p).is_some());
-    if sixth {
-        b.level(KEYPOINT_LEVELS[5]);
-    }
-    for (i, (p, _)) in plan
-        .points
-        .iter()
-        .enumerate()
-        .filter(|(_, (p, _))| !hand(p))
-    {
-        if let Some(f) = body.frame_of(*p) {
-            points.push((b.frame(&name(f), Axes::POSITION)?, i));
+    if w == 0.0 {
+        // The sixth level only with a task in it (a robot without elbows, head or torso
+        // frames standing on both feet has none).
+        let sixth = body.torso.is_some()
+            || swing.contains(&true)
+            || plan
+                .points
+                .iter()
+                .any(|(p, _)| !hand(p) && body.frame_of(*p).is_some());
+        if sixth {
+            b.level(KEYPOINT_LEVELS[5]);
         }
-    }
-    let torso = match body.torso {
-        Some(f) => Some(b.frame(&name(f), Axes::ORIENTATION)?),
-        None => None,
-    };
-    for i in (0..2).filter(|i| swing[*i]) {
-        feet.push((i, b.frame(&name(body.feet[i]), Axes::ORIENTATION)?));
+        add_body_tasks(
+            &mut b,
+            robot,
+            body,
+            plan,
+            &mut points,
+            &mut torso,
+            &mut feet,
+            swing,
+            1.0,
+        )?;
     }
     let posture = match weighted {
         Some(h) => h,
@@ -634,6 +701,14 @@ impl KeypointController {
     /// Sets the references of tick `k` on the active stack's IKTC controller, or with
     /// `fallback` on its GF one ([`set_references`]).
     fn refer(&mut self, fallback: bool, k: usize, hold: bool) -> Result<()> {
+        // A joint without a posture track damps its motion where it is (reference: its own
+        // position, at rest).
+        let base = self.robot.base_nq();
+        for (j, track) in self.posture_track.iter().enumerate() {
+            if track[0].is_empty() {
+                self.posture_ref[0][j] = self.state.q.get(base + j).copied().unwrap_or(0.0);
+            }
+        }
         let Stack {
             ctl,
             fallback: gf,

@@ -82,6 +82,10 @@ pub struct FrameTask {
     pub gains: Gains,
     /// The reference.
     pub reference: FrameReference,
+    /// Weight of the task's rows \[–\] (1 unless set): both sides of each row are multiplied
+    /// by it, so that in a level shared with other tasks a unit of this task's error costs
+    /// `weight²` as much as one of a weight-1 task's.
+    weight: f64,
     scratch: DMatrix<f64>,
 }
 
@@ -103,8 +107,28 @@ impl FrameTask {
             axes,
             gains,
             reference: FrameReference::hold(Isometry3::identity()),
+            weight: 1.0,
             scratch: DMatrix::zeros(6, robot.nv()),
         })
+    }
+
+    /// Sets the weight of the task's rows ([`FrameTask`]'s `weight`). Errors: a weight that is
+    /// not finite and > 0.
+    pub fn set_weight(&mut self, weight: f64) -> Result<()> {
+        if !(weight.is_finite() && weight > 0.0) {
+            return Err(Error::InvalidSetting {
+                name: format!("weight of the task on `{}`", self.frame_name),
+                value: weight.to_string(),
+                expected: "a finite weight > 0 [–]".into(),
+            });
+        }
+        self.weight = weight;
+        Ok(())
+    }
+
+    /// The weight of the task's rows \[–\].
+    pub fn weight(&self) -> f64 {
+        self.weight
     }
 
     /// Name of the frame.
@@ -179,6 +203,14 @@ impl FrameTask {
                 drift[k],
                 &self.gains,
             );
+            if self.weight != 1.0 {
+                let m = out.jacobian.nrows();
+                let js = out.jacobian.as_mut_slice();
+                for c in 0..robot.nv() {
+                    js[c * m + r] *= self.weight;
+                }
+                out.rhs[r] *= self.weight;
+            }
             r += 1;
         }
         Ok(())
