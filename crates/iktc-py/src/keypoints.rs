@@ -201,7 +201,9 @@ impl PyKeypointTrajectory {
     /// (positive: a limit exceeded), `on_limit` (`(joint, share)` pairs: the joints on a
     /// position limit on some ticks and the share of the ticks, the most often first), and `reach_cm`, `balanced_reach_cm` (the reach keeping
     /// the clip's feet and the COM over them) and `reach_run_cm` (None unless asked for
-    /// with `reach=True`).
+    /// with `reach=True`), and `fidelity`: the neutral figures (`iktc::retarget::Fidelity`:
+    /// the robot's joint centres against the captured person, contacts from the person,
+    /// posture, smoothness, `healthy` and the `failures` in words).
     #[getter]
     fn quality<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let q = &self.run.quality;
@@ -253,6 +255,12 @@ impl PyKeypointTrajectory {
         d.set_item("reach_cm", q.reach_cm)?;
         d.set_item("reach_run_cm", q.reach_run_cm)?;
         d.set_item("balanced_reach_cm", q.balanced_reach_cm)?;
+        let fidelity = serde_json::to_string(&q.fidelity)
+            .map_err(|e| crate::IktcError::new_err(format!("fidelity figures: {e}")))?;
+        d.set_item(
+            "fidelity",
+            py.import("json")?.call_method1("loads", (fidelity,))?,
+        )?;
         Ok(d)
     }
 

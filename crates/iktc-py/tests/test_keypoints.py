@@ -146,3 +146,18 @@ def test_a_sliding_foot_steps_unless_every_stance_is_held_and_bad_slides_are_err
     for bad in (0.0, -0.05, float("nan")):
         with pytest.raises(iktc.IktcError, match="max_slide"):
             iktc.retarget_keypoints(motion, robot, max_slide=bad)
+
+
+def test_the_quality_has_the_neutral_fidelity_figures(runs):
+    # The robot's twelve joint centres and the neck against the person's, the posture figures
+    # and a verdict that names what failed (healthy exactly when nothing did).
+    robot, r = runs
+    f = r[False].quality["fidelity"]
+    assert [p["point"] for p in f["points"]][-1] == "neck"
+    assert len(f["points"]) == 13
+    names = {p["name"] for p in f["posture"]}
+    assert {"left_knee", "right_knee", "trunk_lean", "hip_height"} <= names
+    assert f["healthy"] == (len(f["failures"]) == 0)
+    mean = sum(p["mean_cm"] for p in f["points"]) / 13
+    assert abs(mean - f["keypoint_mean_cm"]) < 1e-9
+    assert 0.0 <= f["smoothness"]["reversal_share"] <= 1.0
