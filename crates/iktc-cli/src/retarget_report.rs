@@ -136,6 +136,20 @@ fn healthy(c: &ClipStatus) -> bool {
         .unwrap_or(true)
 }
 
+/// What made a clip unhealthy, in words (its figures' `failures`).
+fn failures(c: &ClipStatus) -> Vec<String> {
+    c.figures
+        .as_ref()
+        .and_then(|f| f.get("failures"))
+        .and_then(|f| f.as_array())
+        .map(|a| {
+            a.iter()
+                .filter_map(|m| m.as_str().map(str::to_string))
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
 /// A figure as a table cell: four decimals for magnitudes in [0.01, 10⁴), scientific otherwise.
 fn cell(v: f64) -> String {
     if v == 0.0 || (0.01..1e4).contains(&v.abs()) {
@@ -225,12 +239,20 @@ pub fn render(clips: &[ClipStatus], robot: &str, viewer: bool) -> String {
     s.push_str("<th>files</th></tr></thead><tbody>");
     for c in &ok {
         let h = healthy(c);
+        let why = failures(c).join("; ");
         s.push_str(&format!(
-            "<tr{}><td>{}</td><td data-v=\"{}\">{}</td>",
+            "<tr{}><td>{}</td><td data-v=\"{}\" title=\"{}\">{}</td>",
             if h { "" } else { " class=\"bad\"" },
             escape_html(&c.name),
             u8::from(h),
-            if h { "passed" } else { "FAILED" }
+            escape_html(&why),
+            if h {
+                "passed".to_string()
+            } else if why.is_empty() {
+                "FAILED".to_string()
+            } else {
+                format!("FAILED: {}", escape_html(&why))
+            }
         ));
         for (key, _) in &columns {
             match figure(c, key) {

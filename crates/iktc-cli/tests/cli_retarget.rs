@@ -404,8 +404,17 @@ fn batch_of_good_and_bad_clips_skip_force_and_formats() {
     .unwrap();
     assert_eq!(quality["route"], "keypoints");
     assert_eq!(quality["figures"]["route"], "keypoints");
-    assert!(
+    // The verdict says why whenever it is not healthy, and no joint limit is among the reasons.
+    let failures = quality["figures"]["failures"].as_array().unwrap();
+    assert_eq!(
         quality["figures"]["healthy"].as_bool().unwrap(),
+        failures.is_empty(),
+        "{quality}"
+    );
+    assert!(
+        !failures
+            .iter()
+            .any(|m| m.as_str().unwrap().contains("limit")),
         "{quality}"
     );
     assert!(quality["summary"]["keypoints"]["points"].is_array());

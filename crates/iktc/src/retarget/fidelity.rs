@@ -795,11 +795,22 @@ mod tests {
         let kp = person(&[body; 3]);
         let (s, yaw) = (0.8, 0.4);
         let robot: Vec<RobotSample> = (0..3)
-            .map(|k| sample(placed(&body, yaw, s, Vector3::new(0.5 * k as f64, 1.0, 0.0))))
+            .map(|k| {
+                sample(placed(
+                    &body,
+                    yaw,
+                    s,
+                    Vector3::new(0.5 * k as f64, 1.0, 0.0),
+                ))
+            })
             .collect();
         let f = run(&kp, &robot, s * 0.9, &[vec![0.0]; 3]);
         assert!((f.scale - s).abs() < 1e-12, "{}", f.scale);
-        assert!((f.heading_deg - yaw.to_degrees()).abs() < 1e-9, "{}", f.heading_deg);
+        assert!(
+            (f.heading_deg - yaw.to_degrees()).abs() < 1e-9,
+            "{}",
+            f.heading_deg
+        );
         assert!(f.keypoint_mean_cm < 1e-9, "{}", f.keypoint_mean_cm);
         assert_eq!(f.points.len(), 13);
         for p in &f.posture {
@@ -826,7 +837,11 @@ mod tests {
         let wrist = f.points.iter().find(|p| p.point == "left_wrist").unwrap();
         assert!((wrist.mean_cm - 5.0).abs() < 1e-9, "{wrist:?}");
         assert!((wrist.max_cm - 5.0).abs() < 1e-9, "{wrist:?}");
-        assert!((f.keypoint_mean_cm - 5.0 / 13.0).abs() < 1e-9, "{}", f.keypoint_mean_cm);
+        assert!(
+            (f.keypoint_mean_cm - 5.0 / 13.0).abs() < 1e-9,
+            "{}",
+            f.keypoint_mean_cm
+        );
         // Off across the body instead, the single fitted heading turns every point a little:
         // the fit does not hide the error, it spreads less than all of it onto the others.
         let mut across = body;
@@ -892,14 +907,21 @@ mod tests {
         for r in &mut low {
             r.sole_lowest[0] = 0.004;
         }
-        assert_eq!(run(&kp, &low, 0.9, &[vec![0.0]; 6]).contacts.skate_share, 0.0);
+        assert_eq!(
+            run(&kp, &low, 0.9, &[vec![0.0]; 6]).contacts.skate_share,
+            0.0
+        );
         let mut fast = robot.clone();
         for (k, r) in fast.iter_mut().enumerate() {
             r.sole_lowest[0] = 0.004;
             r.sole_centre[0].x = 0.06 * (k.min(3) as f64) / 3.0;
         }
         let g = run(&kp, &fast, 0.9, &[vec![0.0]; 6]);
-        assert!((g.contacts.skate_share - 3.0 / 12.0).abs() < 1e-12, "{:?}", g.contacts);
+        assert!(
+            (g.contacts.skate_share - 3.0 / 12.0).abs() < 1e-12,
+            "{:?}",
+            g.contacts
+        );
         assert!((g.contacts.skate_distance_m - 0.06).abs() < 1e-12);
     }
 
@@ -931,8 +953,16 @@ mod tests {
         }
         let f = run(&kp, &[sample(crouch), sample(crouch)], 0.9, &[vec![0.0]; 2]);
         assert!(!f.healthy);
-        assert!(f.failures.iter().any(|m| m.starts_with("left_knee")), "{:?}", f.failures);
-        assert!(f.failures.iter().any(|m| m.starts_with("hip_height")), "{:?}", f.failures);
+        assert!(
+            f.failures.iter().any(|m| m.starts_with("left_knee")),
+            "{:?}",
+            f.failures
+        );
+        assert!(
+            f.failures.iter().any(|m| m.starts_with("hip_height")),
+            "{:?}",
+            f.failures
+        );
         let fine = run(&kp, &[sample(body), sample(body)], 0.9, &[vec![0.0]; 2]);
         assert!(fine.healthy, "{:?}", fine.failures);
     }
