@@ -804,7 +804,7 @@ mod tests {
                 ))
             })
             .collect();
-        let f = run(&kp, &robot, s * 0.9, &[vec![0.0]; 3]);
+        let f = run(&kp, &robot, s * 0.9, &vec![vec![0.0]; 3]);
         assert!((f.scale - s).abs() < 1e-12, "{}", f.scale);
         assert!(
             (f.heading_deg - yaw.to_degrees()).abs() < 1e-9,
@@ -832,7 +832,7 @@ mod tests {
         let kp = person(&[body; 2]);
         let mut off = body;
         off[ix(B::LeftWrist)].z -= 0.05;
-        let f = run(&kp, &[sample(off), sample(off)], 0.9, &[vec![0.0]; 2]);
+        let f = run(&kp, &[sample(off), sample(off)], 0.9, &vec![vec![0.0]; 2]);
         assert!(f.heading_deg.abs() < 1e-12, "{}", f.heading_deg);
         let wrist = f.points.iter().find(|p| p.point == "left_wrist").unwrap();
         assert!((wrist.mean_cm - 5.0).abs() < 1e-9, "{wrist:?}");
@@ -846,7 +846,12 @@ mod tests {
         // the fit does not hide the error, it spreads less than all of it onto the others.
         let mut across = body;
         across[ix(B::LeftWrist)].x += 0.05;
-        let g = run(&kp, &[sample(across), sample(across)], 0.9, &[vec![0.0]; 2]);
+        let g = run(
+            &kp,
+            &[sample(across), sample(across)],
+            0.9,
+            &vec![vec![0.0]; 2],
+        );
         assert!(g.heading_deg.abs() > 0.1, "{}", g.heading_deg);
         assert!(g.keypoint_mean_cm > 5.0 / 13.0, "{}", g.keypoint_mean_cm);
     }
@@ -893,7 +898,7 @@ mod tests {
                 r
             })
             .collect();
-        let f = run(&kp, &robot, 0.9, &[vec![0.0]; 6]);
+        let f = run(&kp, &robot, 0.9, &vec![vec![0.0]; 6]);
         let c = &f.contacts;
         assert_eq!(c.windows, 2);
         assert!((c.slip_max_mm - 20.0).abs() < 1e-9, "{c:?}");
@@ -908,7 +913,9 @@ mod tests {
             r.sole_lowest[0] = 0.004;
         }
         assert_eq!(
-            run(&kp, &low, 0.9, &[vec![0.0]; 6]).contacts.skate_share,
+            run(&kp, &low, 0.9, &vec![vec![0.0]; 6])
+                .contacts
+                .skate_share,
             0.0
         );
         let mut fast = robot.clone();
@@ -916,7 +923,7 @@ mod tests {
             r.sole_lowest[0] = 0.004;
             r.sole_centre[0].x = 0.06 * (k.min(3) as f64) / 3.0;
         }
-        let g = run(&kp, &fast, 0.9, &[vec![0.0]; 6]);
+        let g = run(&kp, &fast, 0.9, &vec![vec![0.0]; 6]);
         assert!(
             (g.contacts.skate_share - 3.0 / 12.0).abs() < 1e-12,
             "{:?}",
@@ -951,7 +958,12 @@ mod tests {
             crouch[ix(k)].z += 0.45;
             crouch[ix(a)] = crouch[ix(k)] - Vector3::new(0.0, 0.0, 0.45);
         }
-        let f = run(&kp, &[sample(crouch), sample(crouch)], 0.9, &[vec![0.0]; 2]);
+        let f = run(
+            &kp,
+            &[sample(crouch), sample(crouch)],
+            0.9,
+            &vec![vec![0.0]; 2],
+        );
         assert!(!f.healthy);
         assert!(
             f.failures.iter().any(|m| m.starts_with("left_knee")),
@@ -963,7 +975,7 @@ mod tests {
             "{:?}",
             f.failures
         );
-        let fine = run(&kp, &[sample(body), sample(body)], 0.9, &[vec![0.0]; 2]);
+        let fine = run(&kp, &[sample(body), sample(body)], 0.9, &vec![vec![0.0]; 2]);
         assert!(fine.healthy, "{:?}", fine.failures);
     }
 }
