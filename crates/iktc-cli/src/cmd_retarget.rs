@@ -146,6 +146,10 @@ pub fn run(a: &Args) -> Result<()> {
             crate::cmd_keypoints::RetargetArg::Joints => RetargetMethod::Joints,
         },
     };
+    // Settings are checked once, before any clip (the keypoint route's --dt bound).
+    if batch.method == RetargetMethod::Keypoints {
+        batch.keypoints.validate()?;
+    }
     let (clips, mut statuses, outputs) = discover(&a.inputs, Some(&a.out));
     if !outputs.is_empty() {
         let names: Vec<String> = outputs.iter().map(|p| p.display().to_string()).collect();

@@ -330,13 +330,13 @@ impl KeypointSettings {
         let most = self.max_dt();
         if !(self.dt < most) {
             return Err(Error::InvalidSetting {
-                name: "dt".into(),
+                name: "dt (CLI --dt)".into(),
                 value: crate::resources::fmt_value(self.dt),
                 expected: format!(
-                    "a control period below {} s, at which the held feet's gains (ω = 20 rad/s) \
+                    "a control period below {:.4} s, at which the held feet's gains (ω = 20 rad/s) \
                      and the tasks' (k_p = {}, k_v = {}) track stably \
                      (KeypointSettings::max_dt, Gains::max_stable_dt)",
-                    crate::resources::fmt_value(most),
+                    most,
                     self.gains.kp,
                     self.gains.kv
                 ),
