@@ -161,7 +161,8 @@ struct RawBone {
 
 /// Reads an ASF file; `source` names it in errors ([`Error::Parse`] with the line): an unknown
 /// section, a malformed number, a bone without name, a missing `:hierarchy`, a hierarchy naming
-/// an unknown bone or leaving a bone out.
+/// an unknown bone (as parent or as child) or leaving a bone out. A leading UTF-8 byte-order
+/// mark is skipped.
 pub fn read_asf(text: &str, source: &str) -> Result<Asf> {
     let text = super::strip_bom(text);
     let p = Parser { source };
