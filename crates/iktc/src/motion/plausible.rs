@@ -172,7 +172,7 @@ pub fn check_keypoints(kp: &Keypoints) -> Result<()> {
         }
         let dt = kp.times[f] - kp.times[f - 1];
         let speed = (p - kp.positions[i - n]).norm() / dt;
-        if !(speed <= MAX_BODY_POINT_SPEED) {
+        if speed.is_nan() || speed > MAX_BODY_POINT_SPEED {
             return Err(implausible(
                 &kp.source,
                 format!(

@@ -328,7 +328,7 @@ impl KeypointSettings {
         self.run_limits.check_dt("dt", self.dt)?;
         self.gains.validate()?;
         let most = self.max_dt();
-        if !(self.dt < most) {
+        if self.dt >= most {
             return Err(Error::InvalidSetting {
                 name: "dt (CLI --dt)".into(),
                 value: crate::resources::fmt_value(self.dt),
