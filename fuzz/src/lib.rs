@@ -6,18 +6,26 @@
 //! `crates/iktc/tests/fuzz_replay.rs` (which includes this file), so a fixed crash stays fixed.
 
 use iktc::model::{planar3r, BaseKind, Kinematics, ModelOptions, Robot, StateConfig};
-use iktc::motion::{read_bvh, read_deepmimic, BvhReadOptions, RetargetMap};
+use iktc::motion::{
+    detect_format, motion_from_content, read_amc, read_asf, read_bvh, read_c3d, read_deepmimic,
+    read_points_csv, Asf, BvhReadOptions, MotionContent, MotionFormat, MotionOptions, RetargetMap,
+    DEFAULT_MAX_GAP,
+};
 
 /// The entry point of one fuzz target.
 pub type Entry = fn(&[u8]);
 
 /// Every fuzz target by name, for the replay test.
-pub const TARGETS: [(&str, Entry); 5] = [
+pub const TARGETS: [(&str, Entry); 9] = [
     ("urdf", urdf),
     ("bvh", bvh),
     ("deepmimic", deepmimic),
     ("retarget_map", retarget_map),
     ("config", config),
+    ("asf", asf),
+    ("amc", amc),
+    ("c3d", c3d),
+    ("points_csv", points_csv),
 ];
 
 fn text(data: &[u8]) -> Option<&str> {
@@ -57,6 +65,93 @@ pub fn deepmimic(data: &[u8]) {
     if let Ok(clip) = read_deepmimic(t, "fuzz.txt") {
         let _ = clip.sample(0.5 * clip.duration());
         let _ = clip.to_z_up();
+    }
+}
+
+/// The keypoints of content read from `source`, as `load_motion` finds them after reading
+/// (body map, units and up axis decided, plausibility checked).
+fn keypoints(source: &str, format: MotionFormat, content: MotionContent) {
+    if let Ok(m) = motion_from_content(source.into(), format, content, &MotionOptions::default()) {
+        let _ = m.keypoints(DEFAULT_MAX_GAP);
+        let _ = m.clip();
+    }
+}
+
+/// An ASF skeleton, its rest clip, and its keypoints.
+pub fn asf(data: &[u8]) {
+    let Some(t) = text(data) else { return };
+    if let Ok(asf) = read_asf(t, "fuzz.asf") {
+        if let Ok(clip) = asf.rest_clip() {
+            keypoints("fuzz.asf", MotionFormat::Asf, MotionContent::Skeleton(clip));
+        }
+    }
+}
+
+/// The ASF skeleton the AMC target reads its motions on: the root (all six dofs) and two
+/// bones.
+const AMC_SKELETON: &str = ":version 1.10
+:name fuzz
+:units
+  length 1.0
+  angle deg
+:root
+  order TX TY TZ RX RY RZ
+  axis XYZ
+  position 0 0 0
+  orientation 0 0 0
+:bonedata
+  begin
+    id 1
+    name upper
+    direction 0 0 1
+    length 2
+    axis 0 0 90 XYZ
+    dof rx
+  end
+  begin
+    id 2
+    name lower
+    direction 1 0 0
+    length 1
+    axis 0 0 0 XYZ
+    dof rx ry rz
+  end
+:hierarchy
+  begin
+    root upper
+    upper lower
+  end
+";
+
+/// An AMC motion on [`AMC_SKELETON`] at 120 Hz, then a sample in the middle of the clip.
+pub fn amc(data: &[u8]) {
+    let Some(t) = text(data) else { return };
+    static SKELETON: std::sync::OnceLock<Option<Asf>> = std::sync::OnceLock::new();
+    let Some(asf) = SKELETON.get_or_init(|| read_asf(AMC_SKELETON, "fuzz.asf").ok()) else {
+        return;
+    };
+    if let Ok(clip) = read_amc(t, "fuzz.amc", asf, 120.0) {
+        let _ = clip.sample(0.5 * clip.duration());
+    }
+}
+
+/// A C3D file, then its keypoints where its markers are recognised.
+pub fn c3d(data: &[u8]) {
+    if let Ok(m) = read_c3d(data, "fuzz.c3d") {
+        keypoints("fuzz.c3d", MotionFormat::C3d, MotionContent::Markers(m));
+    }
+}
+
+/// A CSV of named points, then its keypoints; the format detection runs on the bytes too.
+pub fn points_csv(data: &[u8]) {
+    let _ = detect_format(data);
+    let Some(t) = text(data) else { return };
+    if let Ok(m) = read_points_csv(t, "fuzz.csv") {
+        keypoints(
+            "fuzz.csv",
+            MotionFormat::PointsCsv,
+            MotionContent::Markers(m),
+        );
     }
 }
 

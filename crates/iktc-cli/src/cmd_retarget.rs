@@ -44,7 +44,8 @@ pub struct Args {
     /// Worker threads (default: every core).
     #[arg(long)]
     pub jobs: Option<usize>,
-    /// Output rate of motion.csv and motion.npz [Hz] (default: the control rate, 1/--dt).
+    /// Output rate of motion.csv and motion.npz, 1 to 100 000 Hz [Hz] (default: the control
+    /// rate, 1/--dt).
     #[arg(long)]
     pub rate: Option<f64>,
     /// Redo clips whose outputs are up to date.
@@ -113,9 +114,7 @@ pub fn run(a: &Args) -> Result<()> {
         None => std::thread::available_parallelism().map_or(1, |n| n.get()),
     };
     if let Some(r) = a.rate {
-        if !(r.is_finite() && r > 0.0) {
-            anyhow::bail!("--rate {r}: expected a finite rate > 0 [Hz]");
-        }
+        iktc::resources::check_output_rate("--rate", r)?;
     }
     let (resolved, mut config) = prepare_config(&a.scenario)?;
     a.keypoints.apply(a.retarget, &mut config)?;
@@ -147,6 +146,10 @@ pub fn run(a: &Args) -> Result<()> {
             crate::cmd_keypoints::RetargetArg::Joints => RetargetMethod::Joints,
         },
     };
+    // Settings are checked once, before any clip (the keypoint route's --dt bound).
+    if batch.method == RetargetMethod::Keypoints {
+        batch.keypoints.validate()?;
+    }
     let (clips, mut statuses, outputs) = discover(&a.inputs, Some(&a.out));
     if !outputs.is_empty() {
         let names: Vec<String> = outputs.iter().map(|p| p.display().to_string()).collect();

@@ -57,8 +57,9 @@ pub struct WalkArgs {
     pub no_smoothing: bool,
     /// Passes of the ZMP correction of the walking pattern: where the commanded motion's own
     /// ZMP (its links' masses and inertias) comes within 5 mm of the support polygon's edge,
-    /// the COM reference is moved by preview control so that it does not [default: 0, the
-    /// paper's cart-table pattern].
+    /// the COM reference is moved by preview control so that it does not; at most 10, and the
+    /// passes stop once one no longer brings the ZMP closer [default: 0, the paper's
+    /// cart-table pattern].
     #[arg(long, default_value_t = 0)]
     pub zmp_passes: usize,
 }
@@ -194,6 +195,13 @@ pub fn print_walk(with: &WalkRun, without: &WalkRun) -> std::io::Result<()> {
             "  the commanded motion's own ZMP (links' masses and inertias) outside the pattern's polygon on {} single- and {} double-support ticks (smallest margin {:+.4} m): no robot follows the plan there without tipping",
             s.plan_zmp_outside_single, s.plan_zmp_outside_double, s.plan_zmp_min_margin
         )?;
+        if !s.zmp_corrections.is_empty() {
+            crate::outln!(
+                "  ZMP correction: {} passes run, largest |Δp| per pass [m]: {:?}",
+                s.zmp_corrections.len(),
+                s.zmp_corrections
+            )?;
+        }
         crate::outln!(
             "  tick median {:.1} µs, p99 {:.1} µs; {}",
             s.tick_median_us,

@@ -52,7 +52,8 @@ pub struct ScenarioArgs {
     /// in keypoint retargeting; 0 turns it off.
     #[arg(long, value_name = "RATE")]
     pub approach_rate: Option<f64>,
-    /// Control period [s].
+    /// Control period [s]: 1e-5 to 0.1 s; keypoint retargeting needs less than 0.041 s (the
+    /// held feet's gains are unstable beyond).
     #[arg(long, default_value_t = 0.005)]
     pub dt: f64,
     /// Keep running when a run check fails (a foot drifts past its tolerance, the ZMP leaves

@@ -114,7 +114,7 @@ fn tick_bounds_name_their_option() {
 #[test]
 fn bad_files_are_errors() {
     let dir = tmp("files");
-    // A BVH whose frame lasts a million seconds: refused at its header.
+    // A BVH whose frame lasts a million seconds: refused at its header (no capture rate).
     let bvh = dir.join("slow.bvh");
     std::fs::write(
         &bvh,
@@ -129,11 +129,7 @@ fn bad_files_are_errors() {
             "--out",
             dir.to_str().unwrap(),
         ],
-        &[
-            "duration of",
-            "exceeds the limit 3600",
-            "--max-clip-duration",
-        ],
+        &["slow.bvh:13", "Frame Time 1000000 s", "1 to 2000 Hz"],
     );
     // A config with 7 base velocities (expects 6), and one with 1e308.
     let c7 = dir.join("seven.toml");
@@ -221,4 +217,32 @@ fn keypoints_on_a_rig_the_profile_map_does_not_fit() {
         ],
         &["Spine"],
     );
+}
+
+#[test]
+fn counts_and_rates_are_bounded_up_front() {
+    let out = tmp("bounds");
+    let out = out.to_str().unwrap();
+    let clip = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../iktc/tests/data/motions/cmu/131_01.bvh"
+    );
+    // Before: 1e12 Hz aborted allocating 7.9 TB; 1e300 Hz wrote 0 frames with exit 0.
+    for rate in ["1e12", "1e300", "0.5"] {
+        assert_error(
+            &["retarget", clip, "--rate", rate, "--out", out],
+            &["--rate", "output rate in [1, 100000] Hz"],
+        );
+    }
+    // Before: 2^32 passes ran unbounded and diverged.
+    assert_error(
+        &["walk", "--zmp-passes", "4294967296", "--out", out],
+        &["--zmp-passes", "at most 10"],
+    );
+    // The keypoint route's period ends where its held feet's tracking turns unstable.
+    assert_error(
+        &["retarget", clip, "--dt", "0.05", "--out", out],
+        &["--dt", "below 0.0414 s"],
+    );
+    assert_eq!(std::fs::read_dir(out).unwrap().count(), 0);
 }

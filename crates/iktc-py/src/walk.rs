@@ -34,8 +34,9 @@ type PatternZmp = (Vector2<f64>, f64);
 /// `Imitation` (default 6 Hz and the imitation's approach, √k_p = 10 /s; None and 0 turn
 /// them off); `zmp_passes` passes of the ZMP correction (`WalkingController::correct_zmp`:
 /// where the plan's own multibody ZMP comes within 5 mm of the support polygon's edge, the COM
-/// reference is moved by preview control so that it does not; 0, the default, is the paper's
-/// cart-table pattern).
+/// reference is moved by preview control so that it does not; at most 10
+/// (`iktc::resources::MAX_ZMP_PASSES`), stopping once a pass no longer brings the ZMP closer;
+/// 0, the default, is the paper's cart-table pattern).
 #[pyclass(name = "Walking", module = "iktc")]
 pub struct PyWalking {
     ctl: WalkingController,

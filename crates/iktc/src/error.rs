@@ -6,6 +6,25 @@
 //! reported as a *status* in the solution. The one exception is [`Error::RunFailed`]: a
 //! scenario run whose robot fell, gave up its feet or diverged stops with it by default.
 
+use crate::resources::fmt_value;
+
+/// Most names an error lists \[names\]; the rest are counted ([`name_list`]).
+pub const MAX_LISTED_NAMES: usize = 10;
+
+/// `names` joined by commas, the first [`MAX_LISTED_NAMES`] of them and then `… N more`.
+pub fn name_list<S: AsRef<str>>(names: &[S]) -> String {
+    let mut out = names
+        .iter()
+        .take(MAX_LISTED_NAMES)
+        .map(AsRef::as_ref)
+        .collect::<Vec<&str>>()
+        .join(", ");
+    if names.len() > MAX_LISTED_NAMES {
+        out.push_str(&format!(", … {} more", names.len() - MAX_LISTED_NAMES));
+    }
+    out
+}
+
 /// Everything that can be wrong with the input given to iktc.
 ///
 /// Every variant names what is wrong and, where it helps, what was expected.
@@ -19,7 +38,7 @@ pub enum Error {
         message: String,
     },
     /// A joint, link, frame or other named item does not exist.
-    #[error("unknown {kind} `{name}`; valid names are: {}", valid.join(", "))]
+    #[error("unknown {kind} `{name}`; valid names are: {}", name_list(valid))]
     UnknownName {
         /// What kind of name it is ("joint", "frame", "link", ...).
         kind: &'static str,
@@ -29,7 +48,7 @@ pub enum Error {
         valid: Vec<String>,
     },
     /// A number that must be finite is NaN or infinite.
-    #[error("{what} is not finite (got {value})")]
+    #[error("{what} is not finite (got {})", fmt_value(*value))]
     NonFinite {
         /// Which quantity, with its index if any.
         what: String,
@@ -49,8 +68,11 @@ pub enum Error {
     /// A state (the start of a run) puts a joint outside its limits: its position outside its
     /// range or its speed above its velocity limit.
     #[error(
-        "{joint} is outside its limits: {quantity} {value} not in [{lower}, {upper}]; \
-         change the start state or the limits, or ask for recovery (OutsideLimits::Recover)"
+        "{joint} is outside its limits: {quantity} {} not in [{}, {}]; \
+         change the start state or the limits, or ask for recovery (OutsideLimits::Recover)",
+        fmt_value(*value),
+        fmt_value(*lower),
+        fmt_value(*upper)
     )]
     StateOutsideLimits {
         /// The joint (or dof) name.
@@ -78,7 +100,7 @@ pub enum Error {
         controller: u64,
     },
     /// A limit has its lower end above its upper end, or is otherwise unusable.
-    #[error("invalid limit for {what}: lower {lower} > upper {upper}")]
+    #[error("invalid limit for {what}: lower {} > upper {}", fmt_value(*lower), fmt_value(*upper))]
     InvalidLimit {
         /// Which joint or quantity.
         what: String,
@@ -146,6 +168,33 @@ pub enum Error {
         /// What is wrong and what would be valid (e.g. the names that exist).
         message: String,
     },
+    /// An error met inside a run, with where it was met: the run and its input file, the
+    /// phase and the tick with its time ([`Error::at`]).
+    #[error("{context}: {error}")]
+    During {
+        /// Where: e.g. ``keypoint retargeting of `clip.bvh`, tick 12 (t = 0.06 s)``.
+        context: String,
+        /// The error met.
+        error: Box<Error>,
+    },
+}
+
+impl Error {
+    /// This error wrapped in [`Error::During`] with `context` (where it was met).
+    pub fn at(self, context: impl FnOnce() -> String) -> Error {
+        Error::During {
+            context: context(),
+            error: Box::new(self),
+        }
+    }
+
+    /// The innermost error, under every [`Error::During`].
+    pub fn innermost(&self) -> &Error {
+        match self {
+            Error::During { error, .. } => error.innermost(),
+            other => other,
+        }
+    }
 }
 
 /// The result type of the library.
@@ -207,7 +256,46 @@ pub fn check_dim(what: &str, expected: usize, got: usize) -> Result<()> {
 
 #[cfg(test)]
 mod tests {
-    use super::all_finite;
+    use super::{all_finite, name_list, Error, MAX_LISTED_NAMES};
+
+    #[test]
+    fn long_name_lists_are_capped() {
+        let names: Vec<String> = (0..10_000).map(|i| format!("joint_{i}")).collect();
+        let text = name_list(&names);
+        assert!(text.starts_with("joint_0, joint_1,"), "{text}");
+        assert!(
+            text.contains("joint_9,") && !text.contains("joint_10,"),
+            "{text}"
+        );
+        assert!(
+            text.ends_with(&format!("… {} more", 10_000 - MAX_LISTED_NAMES)),
+            "{text}"
+        );
+        assert_eq!(name_list(&["a", "b"]), "a, b");
+        let e = Error::UnknownName {
+            kind: "joint",
+            name: "x".into(),
+            valid: names,
+        };
+        assert!(e.to_string().len() < 300, "{e}");
+    }
+
+    #[test]
+    fn big_numbers_print_compactly() {
+        let e = Error::NonFinite {
+            what: "x".into(),
+            value: f64::NAN,
+        };
+        assert_eq!(e.to_string(), "x is not finite (got NaN)");
+        let e = Error::StateOutsideLimits {
+            joint: "j".into(),
+            quantity: "position [rad]".into(),
+            value: 1e308,
+            lower: -1.0,
+            upper: 1.0,
+        };
+        assert!(e.to_string().contains("1e308 not in [-1, 1]"), "{e}");
+    }
 
     #[test]
     fn all_finite_agrees_with_is_finite() {

@@ -7,6 +7,10 @@
 //!
 //! * [`ReadLimits`] — what a file may hold: XML nesting depth, clip duration and frame count.
 //! * [`RunLimits`] — what a run may do: the control period's range and the number of ticks.
+//! * Constants for what a user asks for directly: the output rate and frames of a written
+//!   trajectory ([`MAX_OUTPUT_RATE`], [`MAX_OUTPUT_FRAMES`]), the walking pattern's ZMP
+//!   correction passes ([`MAX_ZMP_PASSES`]) and the balance fit's iterations
+//!   ([`MAX_LM_ITERATIONS`]).
 
 use crate::error::{Error, Result};
 
@@ -89,7 +93,9 @@ pub struct RunLimits {
     /// any joint servo loop of the robots shipped). Lowered with `RunLimits::min_dt`.
     pub min_dt: f64,
     /// Longest accepted control period \[s\]. Default 0.1 s (10 Hz): a humanoid controlled
-    /// more slowly than that falls between two ticks. Raised with `RunLimits::max_dt`.
+    /// more slowly than that falls between two ticks. Raised with `RunLimits::max_dt`. The
+    /// keypoint route accepts less: periods below `KeypointSettings::max_dt` (0.041 s with
+    /// its held feet's gains), beyond which its tracking is unstable.
     pub max_dt: f64,
     /// Most control ticks in one run \[ticks\]. Default 200 000 (1000 s at the default 5 ms);
     /// a run records every tick (≈ 5 kB per tick for JVRC-1), so this also bounds memory at
@@ -190,6 +196,76 @@ impl RunLimits {
     }
 }
 
+/// Lowest output rate of a written trajectory (`motion.csv`, `motion.npz`) \[Hz\]: 1 Hz,
+/// the slowest a motion sampled for training or playback is of any use (a step lasts about
+/// 0.5 s).
+pub const MIN_OUTPUT_RATE: f64 = 1.0;
+
+/// Highest output rate of a written trajectory \[Hz\]: 100 kHz, the control rate at the
+/// shortest accepted control period ([`RunLimits::min_dt`] = 1e-5 s); a faster output only
+/// interpolates between ticks.
+pub const MAX_OUTPUT_RATE: f64 = 1e5;
+
+/// Most frames in a written trajectory \[frames\]: 1 000 000 (an hour at 240 Hz is 864 000;
+/// about 0.5 GB for a 29-joint robot with eight tracked bodies).
+pub const MAX_OUTPUT_FRAMES: usize = 1_000_000;
+
+/// Most passes of the walking pattern's ZMP correction \[passes\]. Each pass simulates the
+/// whole walk once; the passes stop earlier once one does not shrink the ZMP's largest
+/// distance from the support (see `WalkingController::correct_zmp`).
+pub const MAX_ZMP_PASSES: usize = 10;
+
+/// Most iterations of the Levenberg–Marquardt fit of the balance identification
+/// \[iterations\]: 10 000 (the default is 200; each iteration simulates the identification
+/// run once per parameter).
+pub const MAX_LM_ITERATIONS: usize = 10_000;
+
+/// Checks an output rate `rate` \[Hz\] asked for by `name` (e.g. `"--rate"`): finite and within
+/// [`MIN_OUTPUT_RATE`]`..=`[`MAX_OUTPUT_RATE`].
+pub fn check_output_rate(name: &str, rate: f64) -> Result<f64> {
+    if rate.is_finite() && (MIN_OUTPUT_RATE..=MAX_OUTPUT_RATE).contains(&rate) {
+        Ok(rate)
+    } else {
+        Err(setting(
+            name,
+            rate,
+            &format!(
+                "an output rate in [{MIN_OUTPUT_RATE}, {}] Hz (resources::MIN_OUTPUT_RATE / MAX_OUTPUT_RATE)",
+                fmt_value(MAX_OUTPUT_RATE)
+            ),
+        ))
+    }
+}
+
+/// The number of frames `floor(span · rate + slack) + 1` of a trajectory of `span` \[s\]
+/// written at `rate` \[Hz\] (checked by [`check_output_rate`] under `name`), `slack` \[frames\]
+/// absorbing rounding at the last frame; an error if it exceeds [`MAX_OUTPUT_FRAMES`].
+/// Computed in floating point and compared before any conversion.
+pub fn output_frames(name: &str, span: f64, rate: f64, slack: f64) -> Result<usize> {
+    check_output_rate(name, rate)?;
+    if !(span.is_finite() && span >= 0.0) {
+        return Err(setting(
+            "span of the written trajectory [s]",
+            span,
+            "a finite duration >= 0 [s]",
+        ));
+    }
+    let n = (span * rate + slack).floor() + 1.0;
+    if n > MAX_OUTPUT_FRAMES as f64 {
+        return Err(Error::ResourceLimit {
+            what: format!(
+                "frames written ({} s at {name} {} Hz)",
+                fmt_value(span),
+                fmt_value(rate)
+            ),
+            value: format!("{n:.0}"),
+            limit: MAX_OUTPUT_FRAMES.to_string(),
+            option: format!("a lower {name} (resources::MAX_OUTPUT_FRAMES)"),
+        });
+    }
+    Ok(n as usize)
+}
+
 /// `v` as text: plain decimals, or scientific notation below 1e-5 or from 1e7 on in magnitude
 /// (so that `1e-300` does not print as 300 digits).
 pub fn fmt_value(v: f64) -> String {
@@ -243,6 +319,24 @@ mod tests {
         }
         // A duration shorter than one period still runs one tick.
         assert_eq!(l.ticks("run", 0.001, 0.005), Ok(1));
+    }
+
+    #[test]
+    fn output_rates_and_frames_are_bounded() {
+        for bad in [1e12, 1e300, f64::INFINITY, f64::NAN, 0.0, -1.0, 0.5] {
+            match check_output_rate("--rate", bad) {
+                Err(Error::InvalidSetting { name, .. }) => assert_eq!(name, "--rate"),
+                other => panic!("{bad}: {other:?}"),
+            }
+        }
+        assert_eq!(check_output_rate("--rate", 30.0), Ok(30.0));
+        // 2 s at 50 Hz: frames at 0, 0.02, ..., 2 s.
+        assert_eq!(output_frames("--rate", 2.0, 50.0, 1e-6), Ok(101));
+        // An hour at 100 kHz: 3.6e8 frames, over the limit.
+        match output_frames("--rate", 3600.0, MAX_OUTPUT_RATE, 1e-6) {
+            Err(Error::ResourceLimit { value, .. }) => assert_eq!(value, "360000001"),
+            other => panic!("{other:?}"),
+        }
     }
 
     #[test]

@@ -302,16 +302,25 @@ fn bvh(frames: &str, frame_time: &str, lines: usize) -> String {
 fn clip_duration_and_frames_are_bounded() {
     let opts = BvhReadOptions::default();
     assert!(read_bvh(&bvh("2", "0.01", 2), "ok.bvh", &opts).is_ok());
-    // Before: Frame Time 1e6 tried to allocate ~100 GB when resampled.
+    // Before: Frame Time 1e6 tried to allocate ~100 GB when resampled; no capture runs at
+    // 1e-6 Hz, so it is now refused as a frame time.
     let msg = read_bvh(&bvh("2", "1e6", 2), "slow.bvh", &opts)
         .unwrap_err()
         .to_string();
     assert_names(
         &msg,
+        &["slow.bvh:13", "Frame Time 1000000 s", "1 to 2000 Hz"],
+    );
+    // 5000 frames at 1 Hz last 4999 s, beyond the hour allowed.
+    let msg = read_bvh(&bvh("5000", "1", 5000), "long.bvh", &opts)
+        .unwrap_err()
+        .to_string();
+    assert_names(
+        &msg,
         &[
-            "slow.bvh:13",
-            "duration of slow.bvh",
-            "1000000",
+            "long.bvh:13",
+            "duration of long.bvh",
+            "4999",
             "3600",
             "--max-clip-duration",
         ],
@@ -331,12 +340,12 @@ fn clip_duration_and_frames_are_bounded() {
     // Raised limits accept it (then the missing frame lines are the error).
     let raised = BvhReadOptions {
         limits: ReadLimits {
-            max_clip_duration: 2e6,
+            max_clip_duration: 5000.0,
             ..ReadLimits::default()
         },
         ..Default::default()
     };
-    assert!(read_bvh(&bvh("2", "1e6", 2), "slow.bvh", &raised).is_ok());
+    assert!(read_bvh(&bvh("5000", "1", 5000), "long.bvh", &raised).is_ok());
 }
 
 #[test]

@@ -365,3 +365,24 @@ fn an_asf_without_hierarchy_is_an_error_naming_the_file() {
     assert_eq!(line, 24);
     assert!(msg.contains("without `end`"), "{msg}");
 }
+
+/// A hierarchy line naming an unknown parent is an error naming it and its line, as one
+/// naming an unknown child is.
+#[test]
+fn an_asf_hierarchy_naming_an_unknown_parent_is_an_error() {
+    let good = cmu_asf();
+    // An extra line whose parent is no bone (its child is one, already placed).
+    let bad = good.replace(
+        "    upperneck head\n",
+        "    upperneck head\n    nosuchbone head\n",
+    );
+    assert_ne!(bad, good);
+    let line = 1 + bad[..bad.find("nosuchbone").unwrap()].matches('\n').count();
+    let (source, at, message) = parse_error(read_asf(&bad, "cmu.asf").unwrap_err());
+    assert_eq!((source.as_str(), at), ("cmu.asf", line));
+    assert!(message.contains("`nosuchbone`"), "{message}");
+    // And an unknown child, for comparison.
+    let bad = good.replace("    upperneck head\n", "    upperneck head nosuchbone\n");
+    let (_, _, message) = parse_error(read_asf(&bad, "cmu.asf").unwrap_err());
+    assert!(message.contains("`nosuchbone`"), "{message}");
+}

@@ -186,8 +186,12 @@ fn bad_motion_lines() {
     assert_error(&replaced(17, "Frames: 0"), 17, "zero frames");
     assert_error(&replaced(17, "Frames: many"), 17, "not a frame count");
     assert_error(&replaced(17, "Frame: 2"), 17, "expected `Frames: <number>`");
-    assert_error(&replaced(18, "Frame Time: 0"), 18, "expected > 0");
-    assert_error(&replaced(18, "Frame Time: -0.1"), 18, "expected > 0");
+    assert_error(&replaced(18, "Frame Time: 0"), 18, "expected 0.0005 to 1 s");
+    assert_error(
+        &replaced(18, "Frame Time: -0.1"),
+        18,
+        "expected 0.0005 to 1 s",
+    );
     assert_error(
         &replaced(18, "Frame Time:"),
         18,

@@ -263,7 +263,7 @@ fn forward_kinematics_match_hand_computed_points_in_metres_z_up() {
 #[test]
 fn given_units_and_up_are_used_and_recorded() {
     let options = MotionOptions {
-        units: Units::Fixed(LengthUnit::Millimetres),
+        units: Units::Fixed(LengthUnit::Centimetres),
         up: UpChoice::Fixed(UpAxis::Y),
         ..MotionOptions::default()
     };
@@ -272,13 +272,13 @@ fn given_units_and_up_are_used_and_recorded() {
     assert!(!k.units.automatic && !k.up.automatic);
     assert!(close(
         k.position(0, BodyPoint::Pelvis).unwrap(),
-        Vector3::new(0.0, 0.0, 0.095),
+        Vector3::new(0.0, 0.0, 0.95),
         1e-12
     ));
     // The clip in metres has the offsets scaled by the same unit.
     let clip = m.clip().unwrap().unwrap();
     let spine = clip.skeleton().index_of("Spine").unwrap();
-    assert!((clip.skeleton().joints()[spine].offset.y - 0.010).abs() < 1e-15);
+    assert!((clip.skeleton().joints()[spine].offset.y - 0.10).abs() < 1e-15);
 }
 
 #[test]

@@ -469,3 +469,50 @@ fn the_format_is_detected_from_content_and_a_wrong_guess_says_what_was_tried() {
     let p = temp("bin.amc", &[0xff, 0xfe, 0x00, 0x41]);
     assert!(load_motion(&p, &MotionOptions::default()).is_err());
 }
+
+/// A C3D whose rate is no capture rate (1e30 Hz, 0.01 Hz) is refused, naming the file and
+/// the frame time; 100 Hz loads.
+#[test]
+fn a_c3d_rate_outside_the_capture_rates_is_refused() {
+    let (labels, frames) = pig_frames(3, &|_, _| false);
+    for rate in [1e30f32, 0.01] {
+        let path = temp("rate.c3d", &c3d_bytes(&labels, &frames, rate, -1.0));
+        let e = load_motion(&path, &MotionOptions::default())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("rate.c3d") && e.contains("frame 1: frame time"),
+            "{rate}: {e}"
+        );
+    }
+}
+
+/// A points CSV whose time steps are 1e-12 s is refused, naming the file and the frame;
+/// steps of 0.01 s load.
+#[test]
+fn a_points_csv_with_picosecond_steps_is_refused() {
+    let (labels, frames) = pig_frames(3, &|_, _| false);
+    let csv = |step: f64| {
+        let mut text = "time".to_string();
+        for l in &labels {
+            text.push_str(&format!(",{l}_x,{l}_y,{l}_z"));
+        }
+        text.push('\n');
+        for (f, frame) in frames.iter().enumerate() {
+            text.push_str(&format!("{:e}", f as f64 * step));
+            for p in frame {
+                let p = p.unwrap();
+                text.push_str(&format!(",{},{},{}", p[0], p[1], p[2]));
+            }
+            text.push('\n');
+        }
+        text
+    };
+    let path = temp("steps.csv", csv(0.01).as_bytes());
+    load_motion(&path, &MotionOptions::default()).unwrap();
+    let path = temp("steps.csv", csv(1e-12).as_bytes());
+    let e = load_motion(&path, &MotionOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("steps.csv") && e.contains("frame 1"), "{e}");
+}

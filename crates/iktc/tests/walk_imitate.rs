@@ -227,3 +227,47 @@ fn the_plans_own_zmp_leaves_the_polygon_only_with_the_dance() {
         (0, 0)
     );
 }
+
+/// Passes of the ZMP correction on G1's dance (where the plan's own ZMP leaves the polygon):
+/// at most `MAX_ZMP_PASSES` are accepted; the passes kept shrink the plan's largest ZMP move
+/// `|Δp|` pass after pass (a pass that does not is undone and ends them); the run stays
+/// finite and its measured ZMP inside the support polygon where it was without passes.
+#[test]
+fn zmp_correction_passes_stop_before_they_diverge() {
+    use iktc::resources::MAX_ZMP_PASSES;
+    let profile = iktc::profile::RobotProfile::builtin("g1").unwrap();
+    let robot = profile.robot().unwrap();
+    let mut cfg = profile
+        .walk_config(&robot, WalkImitateConfig::jvrc1().unwrap())
+        .unwrap();
+    let clip = builtin_clip("humanoid3d_dance_b").unwrap();
+    let map = profile.retarget_map("deepmimic", &robot).unwrap();
+    let refs = iktc::sim::imitation_references(&robot, &clip, &map, &cfg.imitate).unwrap();
+    cfg.zmp_passes = MAX_ZMP_PASSES + 1;
+    match run_walk_imitate(&robot, &refs, &cfg) {
+        Err(iktc::Error::InvalidSetting { name, .. }) => assert!(name.contains("zmp_passes")),
+        other => panic!("{:?}", other.map(|_| ())),
+    }
+    cfg.zmp_passes = MAX_ZMP_PASSES;
+    let s = run_walk_imitate(&robot, &refs, &cfg).unwrap().summary;
+    let c = &s.zmp_corrections;
+    eprintln!("ZMP correction |Δp| per pass [m]: {c:?}");
+    assert!(!c.is_empty() && c.len() <= MAX_ZMP_PASSES);
+    assert!(c.iter().all(|d| d.is_finite()), "{c:?}");
+    // Every pass but the last shrank |Δp|; the last did too unless it ended the passes early.
+    let kept = if c.len() < MAX_ZMP_PASSES && c.len() > 1 {
+        c.len() - 1
+    } else {
+        c.len()
+    };
+    assert!(c[..kept].windows(2).all(|w| w[1] < w[0]), "{c:?}");
+    // The measured ZMP stays inside wherever it did without the correction.
+    cfg.zmp_passes = 0;
+    let s0 = run_walk_imitate(&robot, &refs, &cfg).unwrap().summary;
+    assert!(s.min_zmp_margin.is_finite());
+    assert!(
+        s.zmp_inside || !s0.zmp_inside,
+        "ZMP outside by {} m with the passes, inside without",
+        -s.min_zmp_margin
+    );
+}

@@ -77,6 +77,16 @@ impl LmSettings {
         if self.max_iterations == 0 {
             return Err(invalid("LmSettings::max_iterations", 0.0, ">= 1"));
         }
+        if self.max_iterations > crate::resources::MAX_LM_ITERATIONS {
+            return Err(invalid(
+                "LmSettings::max_iterations",
+                self.max_iterations as f64,
+                &format!(
+                    "at most {} (resources::MAX_LM_ITERATIONS)",
+                    crate::resources::MAX_LM_ITERATIONS
+                ),
+            ));
+        }
         Ok(())
     }
 }
@@ -212,4 +222,21 @@ where
         jac.set_column(j, &col);
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn iterations_are_bounded() {
+        let at = |max_iterations: usize| LmSettings {
+            max_iterations,
+            ..LmSettings::default()
+        };
+        assert!(at(crate::resources::MAX_LM_ITERATIONS).validate().is_ok());
+        for bad in [0, crate::resources::MAX_LM_ITERATIONS + 1, usize::MAX] {
+            assert!(at(bad).validate().is_err(), "{bad}");
+        }
+    }
 }

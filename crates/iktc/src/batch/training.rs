@@ -86,8 +86,11 @@ fn check_positive(name: &str, value: f64, expected: &str) -> Result<()> {
     Ok(())
 }
 
+/// The output rate's setting as errors name it.
+const RATE_NAME: &str = "output rate (CLI --rate, Python rate=)";
+
 fn check_rate(rate: f64) -> Result<()> {
-    check_positive("output rate [Hz]", rate, "a rate > 0")
+    crate::resources::check_output_rate(RATE_NAME, rate).map(|_| ())
 }
 
 fn no_tick() -> Error {
@@ -101,7 +104,10 @@ impl TrainingTrajectory {
     /// Resamples `run` (of `robot`) at `rate` \[Hz\] and computes the world positions of
     /// `bodies` (frame names of `robot`).
     ///
-    /// Errors: [`Error::InvalidSetting`] for a rate that is not finite and positive,
+    /// Errors: [`Error::InvalidSetting`] for a rate outside
+    /// [`MIN_OUTPUT_RATE`](crate::resources::MIN_OUTPUT_RATE)`..=`[`MAX_OUTPUT_RATE`](crate::resources::MAX_OUTPUT_RATE),
+    /// [`Error::ResourceLimit`] for more than
+    /// [`MAX_OUTPUT_FRAMES`](crate::resources::MAX_OUTPUT_FRAMES) frames,
     /// [`Error::InsufficientData`] for a run without ticks, [`Error::UnknownName`] for a body
     /// frame the robot lacks.
     pub fn from_run(robot: &Robot, run: &ImitateRun, bodies: &[String], rate: f64) -> Result<Self> {
@@ -202,14 +208,14 @@ impl TrainingTrajectory {
             return Err(no_tick());
         };
         check_positive("control period [s]", dt, "a period > 0")?;
+        let frames =
+            crate::resources::output_frames(RATE_NAME, last.t - first.t, rate, LAST_FRAME_SLACK)?;
         let frame_ids = bodies
             .iter()
             .map(|b| robot.frame_id(b))
             .collect::<Result<Vec<_>>>()?;
         let (nb, nqb) = (robot.base_nv(), robot.base_nq());
         let nv = robot.nv();
-        let span = last.t - first.t;
-        let frames = (span * rate + LAST_FRAME_SLACK).floor() as usize + 1;
         let mut out = Self {
             fps: rate,
             joint_names: joint_names.to_vec(),

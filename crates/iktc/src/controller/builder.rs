@@ -127,7 +127,7 @@ impl ControllerBuilder {
     /// Adds a centre-of-mass task on the selected world axes (x, y, z), holding the COM of the
     /// builder's state, to the current level.
     ///
-    /// Errors: no level started, no axis, bad gains.
+    /// Errors: no level started, no axis, bad gains, a massless robot.
     pub fn com(&mut self, axes: [bool; 3]) -> Result<ComHandle> {
         let mut task = ComTask::new(&self.robot, axes, self.gains)?;
         task.set_reference(ComReference::hold(self.kin.com()))?;

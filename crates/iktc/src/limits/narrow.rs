@@ -55,10 +55,11 @@ impl JointLimits {
                     value: n.joint.clone(),
                     expected: format!(
                         "a joint of the robot; joints are {}",
-                        (0..self.nv())
-                            .filter_map(|i| self.name(i))
-                            .collect::<Vec<_>>()
-                            .join(", ")
+                        crate::error::name_list(
+                            &(0..self.nv())
+                                .filter_map(|i| self.name(i))
+                                .collect::<Vec<_>>()
+                        )
                     ),
                 })?;
             let own = self.dofs()[index];

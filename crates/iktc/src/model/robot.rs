@@ -340,11 +340,12 @@ impl Robot {
                 message: format!(
                     "expected exactly one root link (a link that is no joint's child), found {}: {}",
                     roots.len(),
-                    roots
-                        .iter()
-                        .map(|&i| b.links[i].name.as_str())
-                        .collect::<Vec<_>>()
-                        .join(", ")
+                    crate::error::name_list(
+                        &roots
+                            .iter()
+                            .map(|&i| b.links[i].name.as_str())
+                            .collect::<Vec<_>>()
+                    )
                 ),
             });
         }

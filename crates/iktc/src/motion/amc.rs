@@ -8,7 +8,7 @@
 //! [`AMC_DEFAULT_RATE`]). `:RADIANS`/`:DEGREES` override the ASF's angle unit.
 
 use super::asf::{Asf, AsfDof};
-use super::{Clip, UpAxis};
+use super::{plausible, Clip, UpAxis};
 use crate::error::{Error, Result};
 
 /// A frame being read: its number, its line and the values given so far per slot.
@@ -22,6 +22,7 @@ pub const AMC_DEFAULT_RATE: f64 = 120.0;
 /// bone, a wrong number of values, a non-finite value, a bone given twice, a frame missing a
 /// bone (a truncated frame), no frame.
 pub fn read_amc(text: &str, source: &str, asf: &Asf, frame_rate: f64) -> Result<Clip> {
+    let text = super::strip_bom(text);
     if !(frame_rate.is_finite() && frame_rate > 0.0) {
         return Err(Error::InvalidSetting {
             name: "AMC frame rate".to_string(),
@@ -103,7 +104,7 @@ pub fn read_amc(text: &str, source: &str, asf: &Asf, frame_rate: f64) -> Result<
                     "unknown bone `{}`; the skeleton `{}` has: {}",
                     tokens[0],
                     asf.source,
-                    names.join(", ")
+                    crate::error::name_list(&names)
                 ),
             )
         })?;
@@ -133,6 +134,19 @@ pub fn read_amc(text: &str, source: &str, asf: &Asf, frame_rate: f64) -> Result<
                     .ok_or_else(|| error(line, format!("`{t}` is not a finite number")))
             })
             .collect::<Result<Vec<f64>>>()?;
+        let dofs = if slot == 0 {
+            &asf.root_order
+        } else {
+            &asf.bones[slot - 1].dofs
+        };
+        for (v, dof) in parsed.iter().zip(dofs) {
+            let at = || format!("line {line}, frame {}, {} {dof:?}", frames.len(), tokens[0]);
+            match dof {
+                AsfDof::Rotation(_) if degrees => plausible::check_angle(source, at, *v)?,
+                AsfDof::Rotation(_) => plausible::check_angle(source, at, v.to_degrees())?,
+                AsfDof::Translation(_) => plausible::check_coordinate(source, at, *v)?,
+            }
+        }
         values[slot] = Some(parsed);
     }
     match current.take() {

@@ -161,8 +161,10 @@ struct RawBone {
 
 /// Reads an ASF file; `source` names it in errors ([`Error::Parse`] with the line): an unknown
 /// section, a malformed number, a bone without name, a missing `:hierarchy`, a hierarchy naming
-/// an unknown bone or leaving a bone out.
+/// an unknown bone (as parent or as child) or leaving a bone out. A leading UTF-8 byte-order
+/// mark is skipped.
 pub fn read_asf(text: &str, source: &str) -> Result<Asf> {
+    let text = super::strip_bom(text);
     let p = Parser { source };
     let mut degrees = true;
     let mut root_order: Vec<AsfDof> = Vec::new();
@@ -278,6 +280,16 @@ pub fn read_asf(text: &str, source: &str) -> Result<Asf> {
         return Err(p.error(
             last_line,
             "no `:hierarchy` section (or an empty one): the bones' parents are unknown",
+        ));
+    }
+    // Every parent is the root or a bone, as every child must be a bone.
+    if let Some((line, parent, child)) = links
+        .iter()
+        .find(|(_, parent, _)| parent != "root" && !bones.iter().any(|b| &b.name == parent))
+    {
+        return Err(p.error(
+            *line,
+            format!("`:hierarchy` names unknown bone `{parent}` (parent of `{child}`)"),
         ));
     }
     let angle = |v: f64| if degrees { v.to_radians() } else { v };

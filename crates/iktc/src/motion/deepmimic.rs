@@ -260,6 +260,7 @@ pub fn read_deepmimic_with(
     settings: &DeepMimicSettings,
 ) -> Result<Clip> {
     settings.validate()?;
+    let text = super::strip_bom(text);
     let skeleton = deepmimic_skeleton()?;
     let parse_error = |line: usize, message: String| Error::Parse {
         source_name: source_name.to_string(),

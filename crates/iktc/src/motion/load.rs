@@ -17,6 +17,7 @@ use super::amc::AMC_DEFAULT_RATE;
 use super::body_map::{BodyMap, PointSource};
 use super::keypoints::{clip_keypoints, marker_keypoints, Keypoints};
 use super::markers::{MarkerSet, DEFAULT_MAX_GAP};
+use super::plausible;
 use super::recognise::{recognise_markers, recognise_skeleton};
 use super::units::{
     decide_units, decide_up, extent_along, stands, Measured, Units, UnitsDecision, UpChoice,
@@ -194,11 +195,20 @@ fn io_error(path: &Path, e: std::io::Error) -> Error {
     }
 }
 
-/// The format a file's content shows, if any.
+/// The UTF-8 byte-order mark some editors write at the start of a text file.
+const BOM: &str = "\u{feff}";
+
+/// `text` without a leading UTF-8 byte-order mark.
+pub fn strip_bom(text: &str) -> &str {
+    text.strip_prefix(BOM).unwrap_or(text)
+}
+
+/// The format a file's content shows, if any (a leading UTF-8 byte-order mark is skipped).
 pub fn detect_format(bytes: &[u8]) -> Option<MotionFormat> {
     if bytes.len() >= 512 && bytes.get(1) == Some(&0x50) && bytes[0] < 0x20 {
         return Some(MotionFormat::C3d);
     }
+    let bytes = bytes.strip_prefix(BOM.as_bytes()).unwrap_or(bytes);
     let head = String::from_utf8_lossy(&bytes[..bytes.len().min(4096)]);
     let mut lines = head
         .lines()
@@ -334,13 +344,15 @@ fn read_content(
 ) -> Result<MotionContent> {
     let source = path.display().to_string();
     let text = || {
-        std::str::from_utf8(bytes).map_err(|e| Error::Parse {
-            source_name: source.clone(),
-            line: 1 + bytes
-                .get(..e.valid_up_to())
-                .map_or(0, |b| b.iter().filter(|c| **c == b'\n').count()),
-            message: format!("{} files are text; this one is not UTF-8", format.name()),
-        })
+        std::str::from_utf8(bytes)
+            .map(strip_bom)
+            .map_err(|e| Error::Parse {
+                source_name: source.clone(),
+                line: 1 + bytes
+                    .get(..e.valid_up_to())
+                    .map_or(0, |b| b.iter().filter(|c| **c == b'\n').count()),
+                message: format!("{} files are text; this one is not UTF-8", format.name()),
+            })
     };
     Ok(match format {
         MotionFormat::Bvh => MotionContent::Skeleton(
@@ -374,7 +386,7 @@ fn read_content(
             };
             let asf_text =
                 std::fs::read_to_string(&asf_path).map_err(|e| io_error(&asf_path, e))?;
-            let asf = super::asf::read_asf(&asf_text, &asf_path.display().to_string())?;
+            let asf = super::asf::read_asf(strip_bom(&asf_text), &asf_path.display().to_string())?;
             MotionContent::Skeleton(super::amc::read_amc(
                 text()?,
                 &source,
@@ -454,7 +466,10 @@ fn rest_measure(content: &MotionContent, map: Option<&BodyMap>) -> Result<RestMe
     }
 }
 
-/// Finds the body map and decides units and up axis for content already read.
+/// Finds the body map and decides units and up axis for content already read, and checks
+/// that the content is a plausible human capture ([`plausible`](super::plausible)): frame
+/// times, standing height in the decided unit, and (with a body map) the body points'
+/// distances and speeds.
 pub fn motion_from_content(
     source: String,
     format: MotionFormat,
@@ -475,12 +490,27 @@ pub fn motion_from_content(
     }
     let up = decide_up(options.up, ankles_to_head, measured_on, &source)?;
     let units = decide_units(options.units, extent_along(&rest, up.up), &source)?;
-    Ok(Motion {
+    let times = match &content {
+        MotionContent::Skeleton(clip) => clip.times(),
+        MotionContent::Markers(m) => &m.times,
+    };
+    plausible::check_frame_times(&source, times)?;
+    if let Some(v) = ankles_to_head {
+        let metres = v * units.unit.metres_per_unit();
+        plausible::check_standing_height(&source, &metres, &units.to_string())?;
+    }
+    let motion = Motion {
         source,
         format,
         content,
         body_map,
         units,
         up,
-    })
+    };
+    // Keypoints that cannot be formed (no body map, a marker gap too long) give their own
+    // error where they are asked for.
+    if let Ok(kp) = motion.keypoints(options.max_gap) {
+        plausible::check_keypoints(&kp)?;
+    }
+    Ok(motion)
 }

@@ -58,6 +58,7 @@ mod load;
 mod lowpass;
 mod markers;
 mod names;
+pub mod plausible;
 mod points_csv;
 mod recognise;
 mod retarget;
@@ -89,8 +90,8 @@ pub use deepmimic::{
 };
 pub use keypoints::{clip_keypoints, marker_keypoints, Keypoints};
 pub use load::{
-    detect_format, find_asf, load_motion, motion_from_content, scale_clip, Motion, MotionContent,
-    MotionFormat, MotionOptions,
+    detect_format, find_asf, load_motion, motion_from_content, scale_clip, strip_bom, Motion,
+    MotionContent, MotionFormat, MotionOptions,
 };
 pub use lowpass::{check_smoothing, lowpass, lowpass_track, PAD_PERIODS};
 pub use markers::{FilledGap, MarkerSet, DEFAULT_MAX_GAP};

@@ -35,6 +35,7 @@ fn axis_suffix(column: &str) -> Option<(&str, usize)> {
 /// Reads a points CSV (see the module documentation); `source` names it in errors
 /// ([`Error::Parse`] with the line and column).
 pub fn read_points_csv(text: &str, source: &str) -> Result<MarkerSet> {
+    let text = super::strip_bom(text);
     let error = |line: usize, message: String| Error::Parse {
         source_name: source.to_string(),
         line,

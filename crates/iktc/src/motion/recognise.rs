@@ -110,12 +110,13 @@ pub fn recognise_skeleton(skeleton: &Skeleton, source: &str) -> Result<BodyMap> 
 }
 
 fn joint_list(skeleton: &Skeleton) -> String {
-    skeleton
-        .joints()
-        .iter()
-        .map(|j| j.name.as_str())
-        .collect::<Vec<_>>()
-        .join(", ")
+    crate::error::name_list(
+        &skeleton
+            .joints()
+            .iter()
+            .map(|j| j.name.as_str())
+            .collect::<Vec<_>>(),
+    )
 }
 
 fn unrecognised(source: &str, found: &[MappedPoint], what: &str, shape: &str) -> Error {
@@ -346,7 +347,7 @@ pub fn recognise_markers(markers: &[String], source: &str) -> Result<BodyMap> {
         unrecognised(
             source,
             &found,
-            &format!("markers: {}", markers.join(", ")),
+            &format!("markers: {}", crate::error::name_list(markers)),
             "not applicable to markers",
         )
     })

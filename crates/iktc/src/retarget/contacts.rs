@@ -290,6 +290,25 @@ mod tests {
     use super::*;
     use nalgebra::Vector3;
 
+    /// The heights are measured from each track's own ground: a still toe 8 cm up over a
+    /// lowest toe height of 5 cm is 3 cm above it, within the 5 cm contact height (on); 11
+    /// cm up it is 6 cm above (off). The ankle, 1 m above its ground of 0, never counts; a
+    /// still ankle 3 cm above a ground of 2 cm is 1 cm above it (on), 8 cm above it 6 cm
+    /// (off). Speeds are 0 (still tracks).
+    #[test]
+    fn contact_heights_are_measured_from_each_tracks_ground() {
+        let times = [0.0, 0.1, 0.2];
+        let still = |z: f64| vec![Vector3::new(0.0, 0.0, z); 3];
+        let high_ankle = still(1.0);
+        let detect_toe =
+            |z: f64| detect(&times, &high_ankle, Some(&still(z)), [0.0, 0.05], 0.05, 0.4);
+        assert_eq!(detect_toe(0.08), vec![true; 3]);
+        assert_eq!(detect_toe(0.11), vec![false; 3]);
+        let detect_ankle = |z: f64| detect(&times, &still(z), None, [0.02, 0.0], 0.05, 0.4);
+        assert_eq!(detect_ankle(0.03), vec![true; 3]);
+        assert_eq!(detect_ankle(0.08), vec![false; 3]);
+    }
+
     /// A stance of 40 frames whose ankle is still for 10 frames, slides 1 cm a frame along x
     /// (and rises, which does not count) for 10, then is still again; and a still stance.
     fn sliding() -> (Vec<bool>, Vec<Vector3<f64>>) {

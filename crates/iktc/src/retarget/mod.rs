@@ -338,9 +338,40 @@ impl Default for KeypointSettings {
 }
 
 impl KeypointSettings {
-    /// Checks the numbers.
+    /// The longest control period \[s\] the keypoint route runs at: below
+    /// [`Gains::max_stable_dt`] of the held feet's gains (ω = 20 rad/s: 0.0414 s) and of
+    /// [`KeypointSettings::gains`] (0.083 s at the default ω = 10 rad/s). Beyond it a held
+    /// foot's error grows tick by tick: on CMU 131_01 JVRC-1 stops at 0.05 s (its QP
+    /// overflows at t = 1.6 s) and G1 at 0.1 s (q̈ not finite while settling). Inside it the
+    /// runs end but lose quality as the period grows: G1 on 131_01, the highest a foot the
+    /// clip has on the ground floats, 0.11 m at the default 0.005 s, 0.55 m at 0.01 s,
+    /// 0.27 m at 0.02 s, 1.4 m at 0.04 s; the mean keypoint error 8.8, 10.1, 10.4, 12.3 cm.
+    pub fn max_dt(&self) -> f64 {
+        self.gains
+            .max_stable_dt()
+            .min(tracker::STANCE_GAINS.max_stable_dt())
+    }
+
+    /// Checks the numbers. The control period must also be one at which every level's gains
+    /// track stably ([`KeypointSettings::max_dt`]).
     pub fn validate(&self) -> Result<()> {
         self.run_limits.check_dt("dt", self.dt)?;
+        self.gains.validate()?;
+        let most = self.max_dt();
+        if self.dt >= most {
+            return Err(Error::InvalidSetting {
+                name: "dt (CLI --dt)".into(),
+                value: crate::resources::fmt_value(self.dt),
+                expected: format!(
+                    "a control period below {:.4} s, at which the held feet's gains (ω = 20 rad/s) \
+                     and the tasks' (k_p = {}, k_v = {}) track stably \
+                     (KeypointSettings::max_dt, Gains::max_stable_dt)",
+                    most,
+                    self.gains.kp,
+                    self.gains.kv
+                ),
+            });
+        }
         for (name, v, what) in [
             ("settle_time", self.settle_time, "a time >= 0 [s]"),
             (
@@ -442,6 +473,10 @@ pub struct KeypointRun {
     pub settle_ticks: usize,
 }
 
+/// Fewest frames of a clip the keypoint route retargets \[frames\]: two, one interval to
+/// follow (as `iktc retarget` asks of every clip).
+pub const MIN_FRAMES: usize = 2;
+
 /// Default [`KeypointSettings::settle_speed`] \[rad/s or m/s\].
 pub const SETTLE_SPEED: f64 = 0.01;
 
@@ -452,8 +487,14 @@ pub const SETTLE_SPEED: f64 = 0.01;
 fn settle(controller: &mut KeypointController, s: &KeypointSettings) -> Result<usize> {
     let most = (s.settle_time / s.dt).round() as usize;
     for k in 0..most {
-        controller.tick(0, true)?;
-        controller.integrate()?;
+        let at = || {
+            format!(
+                "tick {k} (t = {} s)",
+                crate::resources::fmt_value(k as f64 * s.dt)
+            )
+        };
+        controller.tick(0, true).map_err(|e| e.at(at))?;
+        controller.integrate().map_err(|e| e.at(at))?;
         if at_rest(&controller.state().qd, controller.qdd(), s) {
             return Ok(k + 1);
         }
@@ -499,6 +540,20 @@ fn start_state(robot: &Robot, cfg: &ImitateConfig, body: &RobotBody) -> Result<S
     Ok(state)
 }
 
+/// Refuses a start state outside the robot's joint ranges (the profile's `posture` against
+/// the URDF's limits) with [`Error::StateOutsideLimits`] naming the joint, its value and its
+/// range, unless `bounds` asks for [`OutsideLimits::Recover`](crate::limits::OutsideLimits)
+/// (CLI `--recover`): the viable box then brings the joint back into its range.
+fn check_start(robot: &Robot, state: &State, bounds: &BoundMethod) -> Result<()> {
+    if bounds.outside_limits() == crate::limits::OutsideLimits::Recover {
+        return Ok(());
+    }
+    let limits = crate::limits::JointLimits::from_robot(robot)?;
+    let mut pos = vec![0.0; robot.nv()];
+    state.dof_positions(robot, &mut pos)?;
+    limits.check_state(&pos, state.qd.as_slice())
+}
+
 fn frame_names(profile: &RobotProfile, cfg: &ImitateConfig) -> Result<BodyFrameNames> {
     let f = &profile.frames;
     let missing = |key: &str| Error::Profile {
@@ -531,6 +586,15 @@ fn setup(
     s: &KeypointSettings,
 ) -> Result<Setup> {
     s.validate()?;
+    if kp.frame_count() < MIN_FRAMES {
+        return Err(Error::InsufficientData {
+            what: format!("keypoint retargeting of `{}`", kp.source),
+            message: format!(
+                "it has {} frame(s); at least {MIN_FRAMES} are needed (an interval to follow)",
+                kp.frame_count()
+            ),
+        });
+    }
     let cfg = profile.imitate_config(ImitateConfig::default())?;
     let names = frame_names(profile, &cfg)?;
     let state0 = State::neutral(&robot);
@@ -539,6 +603,7 @@ fn setup(
     let centres = RobotJointCentres::find(&robot, &body)?;
     let (robot, body) = centres.frames(&robot, body)?;
     let state = start_state(&robot, &cfg, &body)?;
+    check_start(&robot, &state, &s.bounds)?;
     kin.update(&robot, &state)?;
     let clip = scale::scale_clip(&robot, &kin, &body, kp, cfg.support.ankle_height, s.hands)?;
     let tracks = posture_tracks(&robot, &state, posture, s.posture_margin)?;
@@ -670,7 +735,14 @@ pub fn retarget_keypoints_on(
         mut controller,
         scaling,
     } = setup(robot, profile, kp, posture, s)?;
-    let settle_ticks = settle(&mut controller, s)?;
+    let settle_ticks = settle(&mut controller, s).map_err(|e| {
+        e.at(|| {
+            format!(
+                "keypoint retargeting of `{}`, settling on the first frame",
+                kp.source
+            )
+        })
+    })?;
     let ticks = controller.ticks();
     let mut rec = QualityRecorder::new("keypoints", &body, s.dt);
     let mut trajectory = Vec::with_capacity(ticks);
@@ -681,9 +753,17 @@ pub fn retarget_keypoints_on(
     let mut stance = [Vec::with_capacity(ticks), Vec::with_capacity(ticks)];
     let t0 = kp.times.first().copied().unwrap_or(0.0);
     for k in 0..ticks {
+        let at = || {
+            format!(
+                "keypoint retargeting of `{}`, tick {k} (t = {} s)",
+                kp.source,
+                crate::resources::fmt_value(t0 + k as f64 * s.dt)
+            )
+        };
         let state = controller.state().clone();
         let start = Instant::now();
-        let corrected = shaped_by_box(controller.tick(k, false)?) || controller.used_fallback();
+        let report = controller.tick(k, false).map_err(|e| e.at(at))?;
+        let corrected = shaped_by_box(report) || controller.used_fallback();
         tick_us.push(start.elapsed().as_secs_f64() * 1e6);
         let plan = controller.plan();
         let on = controller.stance();
@@ -699,10 +779,11 @@ pub fn retarget_keypoints_on(
             (k, on, corrected),
             &state,
             controller.qdd().as_slice(),
-        )?;
+        )
+        .map_err(|e| e.at(at))?;
         accelerations.push(controller.qdd().as_slice().to_vec());
         let start = Instant::now();
-        controller.integrate()?;
+        controller.integrate().map_err(|e| e.at(at))?;
         if let Some(last) = tick_us.last_mut() {
             *last += start.elapsed().as_secs_f64() * 1e6;
         }

@@ -284,7 +284,7 @@ pub const LAND_TILT: f64 = 0.03;
 /// integration's error over a tick (constant q̈ over Δt on a whirling floating base) acting
 /// as a disturbance that the feedback pulls back in proportion to `1/k_p`. At 900 / 60 a run
 /// diverged (G1, punch). The disturbance is now also compensated ([`super::drift`]).
-const STANCE_GAINS: Gains = Gains {
+pub(crate) const STANCE_GAINS: Gains = Gains {
     kp: 400.0,
     kv: 40.0,
 };

@@ -41,6 +41,7 @@ use crate::controller::FrameHandle;
 use crate::error::{Error, Result};
 use crate::model::{Robot, State};
 use crate::motion::RobotReferences;
+use crate::resources::MAX_ZMP_PASSES;
 use crate::task::{ComReference, FrameReference};
 use crate::walk::{
     link_masses, multibody_zmp, smoothstep, FootState, FootstepPlan, Phase, PreviewSettings, Side,
@@ -90,9 +91,10 @@ pub struct WalkImitateConfig {
     /// The initial difference between the robot's COM and the pattern's is blended out over
     /// this time \[s\] (quintic, zero rate and acceleration at both ends).
     pub com_blend_time: f64,
-    /// Passes of the ZMP correction of the COM reference
-    /// ([`WalkingController::correct_zmp`]); 0 plans on the cart-table alone (the paper's
-    /// pattern, the default).
+    /// Most passes of the ZMP correction of the COM reference
+    /// ([`WalkingController::correct_zmp_passes`]: fewer run once a pass stops improving); 0
+    /// plans on the cart-table alone (the paper's pattern, the default). At most
+    /// [`MAX_ZMP_PASSES`].
     pub zmp_passes: usize,
 }
 
@@ -214,6 +216,9 @@ pub struct WalkSummary {
     /// Smallest signed distance of the commanded motion's ZMP inside the support polygon \[m\]
     /// (−∞ where the body falls faster than gravity).
     pub plan_zmp_min_margin: f64,
+    /// Per pass of the ZMP correction run ([`WalkingController::correct_zmp_passes`]), the
+    /// largest move `|Δp|` it asked of the plan's ZMP \[m\] (empty without correction).
+    pub zmp_corrections: Vec<f64>,
     /// Largest horizontal error of a stance foot's ankle against its reference \[m\].
     pub max_stance_foot_error: f64,
     /// Largest horizontal drift of a stance foot within one stance interval \[m\].
@@ -401,6 +406,13 @@ impl WalkingController {
                 expected: "two feet: right, then left".into(),
             });
         }
+        if cfg.zmp_passes > MAX_ZMP_PASSES {
+            return Err(Error::InvalidSetting {
+                name: "zmp_passes (CLI --zmp-passes)".into(),
+                value: cfg.zmp_passes.to_string(),
+                expected: format!("at most {MAX_ZMP_PASSES} passes (resources::MAX_ZMP_PASSES)"),
+            });
+        }
         // Before the footsteps are planned: the walk lasts at least steps × ssp_duration.
         cfg.imitate.run_limits.ticks(
             "the walk",
@@ -483,9 +495,7 @@ impl WalkingController {
             com_correction: Vec::new(),
             zmp_corrections: Vec::new(),
         };
-        for _ in 0..cfg.zmp_passes {
-            wc.correct_zmp(robot)?;
-        }
+        wc.correct_zmp_passes(robot, cfg.zmp_passes)?;
         Ok(wc)
     }
 
@@ -557,6 +567,37 @@ impl WalkingController {
         }
         self.zmp_corrections.push(residual);
         Ok(residual)
+    }
+
+    /// Up to `passes` passes of [`WalkingController::correct_zmp`], stopping at the first
+    /// that finds the plan inside the margin (`|Δp|` = 0) or whose `|Δp|` is not smaller
+    /// than the pass before: the correction of that earlier pass made the plan's ZMP worse
+    /// (the links' ZMP does not respond to the COM exactly as the cart-table's does, and
+    /// repeated corrections then overshoot), so it is undone; so is one whose plan's
+    /// simulation fails. On G1 walking with DeepMimic's `dance_b` (`tests/walk_imitate.rs`)
+    /// `|Δp|` went 0.446, 0.339, then 0.470 m: the second pass's correction was undone and
+    /// the passes ended there. The kept correction is the
+    /// one whose plan had the smallest `|Δp|` measured. Returns the passes run.
+    pub fn correct_zmp_passes(&mut self, robot: &Robot, passes: usize) -> Result<usize> {
+        // (|Δp| of the plan before a pass, the COM correction before that pass).
+        let mut last: Option<(f64, Vec<[[f64; 3]; 2]>)> = None;
+        for pass in 0..passes {
+            let before = self.com_correction.clone();
+            let measured = self.correct_zmp(robot);
+            if let Some((previous, undo)) = last.take() {
+                // A plan whose simulation fails (q̈ not finite) is worse too.
+                if measured.as_ref().map_or(true, |r| *r >= previous) {
+                    self.com_correction = undo;
+                    return Ok(pass + 1);
+                }
+            }
+            let residual = measured?;
+            if residual == 0.0 {
+                return Ok(pass + 1);
+            }
+            last = Some((residual, before));
+        }
+        Ok(passes)
     }
 
     /// Per ZMP correction pass, the largest move `|Δp|` it asked of the ZMP \[m\] (empty
@@ -863,7 +904,7 @@ pub fn run_walk_imitate(
         .map(|p| (p.start, p.end, p.phase))
         .collect();
     let plan_zmp = plan_zmp_figures(robot, cfg, pattern, origin, &steps)?;
-    let summary = summarize(
+    let mut summary = summarize(
         robot,
         cfg,
         ctl,
@@ -872,6 +913,7 @@ pub fn run_walk_imitate(
         health.report(),
         plan_zmp,
     )?;
+    summary.zmp_corrections = wc.zmp_corrections().to_vec();
     Ok(WalkRun {
         steps,
         footsteps,
@@ -1023,6 +1065,7 @@ fn summarize(
         plan_zmp_outside_single: plan_zmp.0,
         plan_zmp_outside_double: plan_zmp.1,
         plan_zmp_min_margin: plan_zmp.2,
+        zmp_corrections: Vec::new(),
         max_stance_foot_error: max_err,
         max_stance_foot_slip: max_slip,
         worst_margins: worst,

@@ -42,6 +42,9 @@ pub struct ComTask {
 impl ComTask {
     /// A COM task on the selected world axes (x, y, z); e.g. `\[true, true, false\]` for the
     /// horizontal plane of Table 1.
+    ///
+    /// Errors: bad gains, no axis, a robot whose total mass is not > 0 \[kg\] (its COM is
+    /// undefined).
     pub fn new(robot: &Robot, axes: [bool; 3], gains: Gains) -> Result<Self> {
         gains.validate()?;
         if !axes.iter().any(|a| *a) {
@@ -49,6 +52,14 @@ impl ComTask {
                 name: "axes of the COM task".into(),
                 value: "none".into(),
                 expected: "at least one of x, y, z".into(),
+            });
+        }
+        let mass = robot.total_mass();
+        if !(mass.is_finite() && mass > 0.0) {
+            return Err(Error::InvalidSetting {
+                name: "total mass of the robot (a centre-of-mass task) [kg]".into(),
+                value: crate::resources::fmt_value(mass),
+                expected: "a mass > 0: give the links <inertial> masses in the URDF".into(),
             });
         }
         Ok(Self {

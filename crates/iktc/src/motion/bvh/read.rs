@@ -7,6 +7,7 @@ use nalgebra::Vector3;
 
 use super::types::{BvhChannel, BvhClip, BvhJoint, BvhReadOptions};
 use crate::error::{Error, Result};
+use crate::motion::plausible;
 
 /// Reads a Biovision hierarchy (BVH) file.
 ///
@@ -25,6 +26,7 @@ use crate::error::{Error, Result};
 /// a longer duration (`Frame Time` × (frames − 1)) than [`BvhReadOptions::limits`] allow.
 pub fn read_bvh(text: &str, source_name: &str, options: &BvhReadOptions) -> Result<BvhClip> {
     options.length_unit.validate()?;
+    let text = crate::motion::strip_bom(text);
     Reader::new(text, source_name).read(options)
 }
 
@@ -153,10 +155,20 @@ impl<'a> Reader<'a> {
         }
         let (time_line, frame_time) = self.read_header_number("Frame Time")?;
         let frame_time = self.number(&frame_time, time_line, "Frame Time")?;
-        if frame_time <= 0.0 {
+        let (shortest, longest) = (
+            1.0 / plausible::MAX_CAPTURE_RATE,
+            1.0 / plausible::MIN_CAPTURE_RATE,
+        );
+        if !(shortest..=longest).contains(&frame_time) {
             return Err(self.error(
                 time_line,
-                format!("Frame Time {frame_time} s; expected > 0"),
+                format!(
+                    "Frame Time {} s; expected {shortest} to {longest} s (capture rates {} to {} \
+                     Hz, motion::MIN_CAPTURE_RATE / MAX_CAPTURE_RATE)",
+                    crate::resources::fmt_value(frame_time),
+                    plausible::MIN_CAPTURE_RATE,
+                    plausible::MAX_CAPTURE_RATE
+                ),
             ));
         }
         options
@@ -173,6 +185,10 @@ impl<'a> Reader<'a> {
             .min(self.text_len / 2);
         let mut values = Vec::with_capacity(capacity);
         let mut read = 0usize;
+        let channels: Vec<(&str, BvhChannel)> = joints
+            .iter()
+            .flat_map(|j| j.channels.iter().map(move |c| (j.name.as_str(), *c)))
+            .collect();
         while let Some((tokens, line)) = self.next_line() {
             if read == frame_count {
                 return Err(self.error(
@@ -196,8 +212,15 @@ impl<'a> Reader<'a> {
                     ),
                 ));
             }
-            for (k, t) in tokens.iter().enumerate() {
-                values.push(self.number_of(t, line, || format!("frame {read}, value {}", k + 1))?);
+            for (k, (t, (joint, channel))) in tokens.iter().zip(&channels).enumerate() {
+                let v = self.number_of(t, line, || format!("frame {read}, value {}", k + 1))?;
+                let at = || format!("line {line}, frame {read}, channel {joint} {channel:?}");
+                if channel.is_rotation() {
+                    plausible::check_angle(self.source_name, at, v)?;
+                } else {
+                    plausible::check_coordinate(self.source_name, at, v)?;
+                }
+                values.push(v);
             }
             read += 1;
         }

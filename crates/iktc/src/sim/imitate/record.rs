@@ -277,7 +277,14 @@ pub fn run_imitate(
     for k in 0..n {
         let t = k as f64 * cfg.dt;
         let start = Instant::now();
-        ctl.tick(robot, k)?;
+        ctl.tick(robot, k).map_err(|e| {
+            e.at(|| {
+                format!(
+                    "imitation, tick {k} (t = {} s)",
+                    crate::resources::fmt_value(t)
+                )
+            })
+        })?;
         let tick_us = start.elapsed().as_secs_f64() * 1e6;
         let rep = ctl.report();
         let kin = ctl.kinematics();
