@@ -471,6 +471,16 @@ struct Guessed {
     pelvis: Chosen,
 }
 
+/// A link fixed this near to another's origin (\[m\]) and turned this little from it (\[rad\])
+/// is an alias of its frame.
+const ALIAS: f64 = 1e-6;
+
+/// Whether links `a` and `b` of `t` are posed alike (see [`ALIAS`]).
+fn alias(t: &Tree, a: usize, b: usize) -> bool {
+    let d = t.pose[a].inverse() * t.pose[b];
+    d.translation.vector.norm() < ALIAS && d.rotation.angle() < ALIAS
+}
+
 /// Link words naming a foot frame.
 const FOOT_WORDS: [&str; 3] = ["foot", "ankle", "sole"];
 
@@ -504,7 +514,11 @@ impl Guessed {
             ]),
             None => match parts.feet {
                 Some(f) => Some(f.map(|i| {
-                    let frame = named_frame(t, i, &FOOT_WORDS);
+                    // A link named like a foot at the end's own origin (an alias of its
+                    // frame), not a contact point fixed away from it.
+                    let frame = Some(named_frame(t, i, &FOOT_WORDS))
+                        .filter(|f| alias(t, *f, i))
+                        .unwrap_or(i);
                     let why = format!(
                         "the lowest end of a leg chain at q = 0, y = {:+.3} m in the base's frame",
                         t.pos(i).y
@@ -672,7 +686,15 @@ fn write_feet(
             quote(&t.names[*i]),
             mark(why)
         ));
-        let geometry = sole_of(u, t, *i, dir);
+        // An alias fixed at the foot link's origin gives the sole of the whole foot body.
+        let mut body = *i;
+        while let Some((p, false)) = t.parent[body] {
+            if !alias(t, p, *i) {
+                break;
+            }
+            body = p;
+        }
+        let geometry = sole_of(u, t, body, dir);
         let (ankle, ankle_why) = match &geometry {
             Some(((.., a), why)) => (tenth_mm(*a), *why),
             None => (
