@@ -315,23 +315,49 @@ fn marker_families(point: BodyPoint) -> &'static [&'static [&'static str]] {
 }
 
 /// The markers of `markers` in the first family of `point` that has any
-/// ([`marker_families`]).
-fn family_markers(markers: &[String], point: BodyPoint) -> Option<Vec<String>> {
+/// ([`marker_families`]), with that family's index and the stems they matched by.
+fn family_markers(
+    markers: &[String],
+    point: BodyPoint,
+) -> Option<(usize, Vec<String>, std::collections::BTreeSet<String>)> {
     let side = point.limb().map(|(s, _)| s);
     let readings: Vec<_> = markers.iter().map(|m| names::marker_readings(m)).collect();
-    marker_families(point).iter().find_map(|family| {
-        let hit: Vec<String> = markers
-            .iter()
-            .zip(&readings)
-            .filter(|(_, r)| {
-                r.iter().any(|(s, stem)| {
+    marker_families(point)
+        .iter()
+        .enumerate()
+        .find_map(|(k, family)| {
+            let mut stems = std::collections::BTreeSet::new();
+            let mut hit = Vec::new();
+            for (m, r) in markers.iter().zip(&readings) {
+                let matched = r.iter().find(|(s, stem)| {
                     (side.is_none() || *s == side) && family.iter().any(|w| names::stem_is(stem, w))
-                })
-            })
-            .map(|(m, _)| m.clone())
-            .collect();
-        (!hit.is_empty()).then_some(hit)
-    })
+                });
+                if let Some((_, stem)) = matched {
+                    stems.insert(stem.clone());
+                    hit.push(m.clone());
+                }
+            }
+            (!hit.is_empty()).then_some((k, hit, stems))
+        })
+}
+
+/// The markers of a family for `point` ([`family_markers`]), unless the other side's point
+/// has the same family with more of its markers (a pair missing one marker on this side, as
+/// `LWRA` without `LWRB` when the right has both): its centroid would be off the joint.
+fn family_point(markers: &[String], point: BodyPoint) -> Option<Vec<String>> {
+    let (k, hit, stems) = family_markers(markers, point)?;
+    if let Some((side, limb)) = point.limb() {
+        let other = match side {
+            Side::Left => Side::Right,
+            Side::Right => Side::Left,
+        };
+        if let Some((ko, _, so)) = family_markers(markers, BodyPoint::of_limb(other, limb)) {
+            if ko == k && so.len() > stems.len() && stems.is_subset(&so) {
+                return None;
+            }
+        }
+    }
+    Some(hit)
 }
 
 /// The body points found on a marker set, possibly not all required ones: the Plug-in-Gait
@@ -366,7 +392,7 @@ pub fn marker_points(markers: &[String]) -> Vec<MappedPoint> {
     }
     for point in BodyPoint::ALL {
         if found.iter().all(|p| p.point != point) {
-            if let Some(m) = family_markers(markers, point) {
+            if let Some(m) = family_point(markers, point) {
                 found.push(MappedPoint {
                     point,
                     source: PointSource::Markers(m),
