@@ -60,6 +60,9 @@ fn joint(k: usize, j: &J) -> String {
     )
 }
 
+/// A joint as built: parent, child, kind, origin \[m\], axis.
+type Joint = (String, String, &'static str, [f64; 3], [f64; 3]);
+
 /// The hand-known parts of a synthetic humanoid, `[left, right]` where paired.
 #[derive(Debug)]
 struct Known {
@@ -77,7 +80,7 @@ struct Known {
 fn humanoid(b: Build) -> (String, Known) {
     let mut n = Names(1);
     let (x, y, z) = ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]);
-    let mut joints: Vec<(String, String, &str, [f64; 3], [f64; 3])> = Vec::new();
+    let mut joints: Vec<Joint> = Vec::new();
     let mut extra: Vec<(String, String)> = Vec::new();
     let torso = n.next();
     joints.push(("l1".into(), torso.clone(), "revolute", [0.0, 0.0, 0.2], z));
@@ -418,7 +421,7 @@ fn g1_and_jvrc1_get_their_builtin_feet_and_hands() {
         ] {
             assert_eq!(
                 value(&toml, table, key),
-                value(&builtin, table, key),
+                value(builtin, table, key),
                 "{name} {table}.{key}:\n{toml}"
             );
         }
