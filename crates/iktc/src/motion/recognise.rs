@@ -361,7 +361,8 @@ fn family_point(markers: &[String], point: BodyPoint) -> Option<Vec<String>> {
 }
 
 /// The body points found on a marker set, possibly not all required ones: the Plug-in-Gait
-/// table, then marker families ([`marker_families`]), then single markers named like a joint;
+/// table, then marker families (a joint's markers in pairs or groups, front/back, inner/outer,
+/// medial/lateral: their centroid), then single markers named like a joint;
 /// the pelvis falls back to the hips' markers.
 pub fn marker_points(markers: &[String]) -> Vec<MappedPoint> {
     let plain: Vec<String> = markers
