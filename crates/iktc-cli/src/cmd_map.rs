@@ -5,8 +5,9 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use iktc::motion::{
-    builtin_body_map, builtin_map_text, load_motion, BodyMap, Motion, MotionOptions,
-    BUILTIN_BODY_MAP_NAMES, BUILTIN_MAP_NAMES,
+    builtin_body_map, builtin_map_text, draft_body_map_toml, load_motion, marker_points,
+    skeleton_points, BodyMap, Motion, MotionContent, MotionOptions, BUILTIN_BODY_MAP_NAMES,
+    BUILTIN_MAP_NAMES,
 };
 
 /// How a motion file is read: units, up axis, skeleton.
@@ -80,7 +81,8 @@ pub enum MapCommand {
         name: String,
     },
     /// Find the body points of a motion file (or check a body map against it), print them
-    /// and write them as an editable body map.
+    /// and write them as an editable body map; when some required points are not found, the
+    /// map holds those found and a commented entry for each missing one, to fill in.
     Init {
         /// The motion file (.bvh, .amc, .asf, DeepMimic, .c3d, .csv).
         #[arg(long)]
@@ -130,15 +132,6 @@ pub fn run(a: &Args) -> Result<()> {
                 }
                 None => None,
             };
-            let m = load(motion, options, given)?;
-            let mut body_map = m.body_map.clone()?;
-            if let Some(stem) = motion.file_stem() {
-                body_map.name = stem.to_string_lossy().to_string();
-            }
-            let keypoints = m.keypoints(iktc::motion::DEFAULT_MAX_GAP)?;
-            crate::outln!("{}", keypoints.summary())?;
-            let text = body_map.to_toml_string();
-            crate::out::write_out(format_args!("{text}"))?;
             let out = out.clone().unwrap_or_else(|| {
                 let stem = motion
                     .file_stem()
@@ -146,8 +139,58 @@ pub fn run(a: &Args) -> Result<()> {
                     .unwrap_or_else(|| "motion".to_string());
                 PathBuf::from(format!("{stem}.map.toml"))
             });
-            std::fs::write(&out, text).with_context(|| format!("writing `{}`", out.display()))?;
+            let name = motion
+                .file_stem()
+                .map(|s| s.to_string_lossy().to_string())
+                .unwrap_or_else(|| "motion".to_string());
+            let m = match load(motion, options, given.clone()) {
+                Ok(m) => m,
+                // Without a body map the up axis cannot be decided: read the file with one
+                // assumed, only for its names, and write what was found.
+                Err(first) if given.is_none() => {
+                    let assumed = MotionArgs {
+                        up: "z".into(),
+                        units: "m".into(),
+                        ..options.clone()
+                    };
+                    load(motion, &assumed, None).map_err(|_| first)?
+                }
+                Err(e) => return Err(e),
+            };
+            let text = match &m.body_map {
+                Ok(body_map) => {
+                    let mut body_map = body_map.clone();
+                    body_map.name = name.clone();
+                    body_map.to_toml_string()
+                }
+                Err(e) => {
+                    let (found, what, available) = match &m.content {
+                        MotionContent::Markers(set) => {
+                            (marker_points(&set.names), "markers", set.names.clone())
+                        }
+                        MotionContent::Skeleton(clip) => (
+                            skeleton_points(clip.skeleton()),
+                            "joints",
+                            clip.skeleton()
+                                .joints()
+                                .iter()
+                                .map(|j| j.name.clone())
+                                .collect(),
+                        ),
+                    };
+                    crate::outln!(
+                        "not every required body point was recognised ({e}); the map holds what was found and a commented entry for each point to fill in"
+                    )?;
+                    draft_body_map_toml(&name, &found, what, &available)
+                }
+            };
+            crate::out::write_out(format_args!("{text}"))?;
+            std::fs::write(&out, &text).with_context(|| format!("writing `{}`", out.display()))?;
             crate::outln!("wrote {}", out.display())?;
+            if m.body_map.is_ok() {
+                let keypoints = m.keypoints(iktc::motion::DEFAULT_MAX_GAP)?;
+                crate::outln!("{}", keypoints.summary())?;
+            }
             Ok(())
         }
     }

@@ -117,3 +117,89 @@ fn map_init_writes_a_body_map_that_is_accepted_back() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// A marker set whose wrists are missing: `map init` still writes a map, with the points found
+/// (the shoulders from their front/back pair) and a commented entry for each missing one.
+#[test]
+fn map_init_writes_what_was_found_when_points_are_missing() {
+    let dir = tmp("partial");
+    // Standing subject, metres, z up: (name, x, y, z) for the left side, mirrored for the right.
+    let left = [
+        ("Shoulder_Front", 0.05, 0.2, 1.45),
+        ("Shoulder_Back", -0.05, 0.2, 1.45),
+        ("Elbow_Lateral", 0.0, 0.23, 1.15),
+        ("ASIS", 0.1, 0.1, 0.95),
+        ("PSIS", -0.1, 0.1, 0.95),
+        ("Knee_Lateral", 0.0, 0.13, 0.5),
+        ("Ankle_Lateral", 0.0, 0.13, 0.08),
+        ("Toe", 0.15, 0.1, 0.02),
+    ];
+    let mut names = vec![
+        ("Head_Front", 0.1, 0.0, 1.65),
+        ("Head_Back", -0.1, 0.0, 1.65),
+    ];
+    let mut rows: Vec<(String, f64, f64, f64)> = names
+        .drain(..)
+        .map(|(n, x, y, z)| (n.to_string(), x, y, z))
+        .collect();
+    for (side, s) in [("L", 1.0), ("R", -1.0)] {
+        for (n, x, y, z) in left {
+            rows.push((format!("{side}_{n}"), x, s * y, z));
+        }
+    }
+    let header: Vec<String> = rows
+        .iter()
+        .flat_map(|(n, ..)| ["x", "y", "z"].map(|a| format!("{n}_{a}")))
+        .collect();
+    let mut csv = format!("time,{}\n", header.join(","));
+    for t in [0.0, 0.01] {
+        let cells: Vec<String> = rows
+            .iter()
+            .flat_map(|(_, x, y, z)| [x, y, z].map(|v| v.to_string()))
+            .collect();
+        csv.push_str(&format!("{t},{}\n", cells.join(",")));
+    }
+    let motion = dir.join("custom.csv");
+    std::fs::write(&motion, csv).unwrap();
+    let out_path = dir.join("custom.map.toml");
+    let out = iktc()
+        .args(["map", "init", "--motion"])
+        .arg(&motion)
+        .arg("--out")
+        .arg(&out_path)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(&out_path).unwrap();
+    assert!(
+        text.contains("left_shoulder = [\"L_Shoulder_Front\", \"L_Shoulder_Back\"]"),
+        "{text}"
+    );
+    assert!(
+        text.contains("left_hip = [\"L_ASIS\", \"L_PSIS\"]"),
+        "{text}"
+    );
+    assert!(
+        text.contains("# left_wrist = [\"...\"]  # REQUIRED"),
+        "{text}"
+    );
+    assert!(
+        text.contains("# right_wrist = [\"...\"]  # REQUIRED"),
+        "{text}"
+    );
+    // Filled in, it is accepted back.
+    let filled = text
+        .replace(
+            "# left_wrist = [\"...\"]",
+            "left_wrist = [\"L_Elbow_Lateral\"]",
+        )
+        .replace(
+            "# right_wrist = [\"...\"]",
+            "right_wrist = [\"R_Elbow_Lateral\"]",
+        );
+    BodyMap::from_toml_str(&filled, "filled").unwrap();
+}

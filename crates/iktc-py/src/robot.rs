@@ -285,14 +285,47 @@ impl PyRobot {
 /// `# guessed`), as `iktc profile init` writes it: feet and soles (from collision shapes or
 /// meshes), pelvis, torso, head and hands (a frame at the end of a bare forearm), finger locks.
 /// With `out` the profile is also written there, its `urdf` key relative to `out`'s folder.
+///
+/// `feet` and `hands` (`(left, right)` link names), `head`, `torso`, `pelvis` (link names) and
+/// `sole` (`(length, width)` or `(length, width, offset_x)` [m]) are given instead of guessed,
+/// as `iktc profile init`'s flags. A URDF the model loader rejects raises its error.
 #[pyfunction]
-#[pyo3(signature = (urdf, *, out=None))]
-pub fn profile_init(urdf: &str, out: Option<&str>) -> PyResult<String> {
+#[pyo3(signature = (urdf, *, out=None, feet=None, hands=None, head=None, torso=None, pelvis=None, sole=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn profile_init(
+    urdf: &str,
+    out: Option<&str>,
+    feet: Option<(String, String)>,
+    hands: Option<(String, String)>,
+    head: Option<String>,
+    torso: Option<String>,
+    pelvis: Option<String>,
+    sole: Option<Vec<f64>>,
+) -> PyResult<String> {
+    let sole = match sole.as_deref() {
+        None => None,
+        Some(&[length, width]) => Some(iktc::profile::Sole { length, width, offset_x: 0.0 }),
+        Some(&[length, width, offset_x]) => Some(iktc::profile::Sole { length, width, offset_x }),
+        Some(v) => {
+            return Err(crate::IktcError::new_err(format!(
+                "sole = {v:?}: expected (length, width) or (length, width, offset_x) [m]"
+            )))
+        }
+    };
+    let options = iktc::profile::InitOptions {
+        feet: feet.map(|(l, r)| [l, r]),
+        hands: hands.map(|(l, r)| [l, r]),
+        head,
+        torso,
+        pelvis,
+        sole,
+    };
     let path = Path::new(urdf);
     let text = std::fs::read_to_string(path)
         .map_err(|e| crate::IktcError::new_err(format!("cannot read {urdf}: {e}")))?;
     let key = iktc::profile::urdf_key(path, out.map(Path::new)).map_err(to_py)?;
-    let toml = iktc::profile::init_profile_toml_at(&text, &key, path.parent()).map_err(to_py)?;
+    let toml = iktc::profile::init_profile_toml_with(&text, &key, path.parent(), &options)
+        .map_err(to_py)?;
     if let Some(o) = out {
         std::fs::write(o, &toml)
             .map_err(|e| crate::IktcError::new_err(format!("cannot write {o}: {e}")))?;

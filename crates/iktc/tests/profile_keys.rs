@@ -558,9 +558,9 @@ fn init_guesses_the_soles_from_the_feet_meshes() {
         let p = parse(&toml).unwrap();
         let feet = p.feet.clone().unwrap();
         let want = if collision {
-            (0.2, 0.08, 0.03, 0.05, "from the link's collision meshes")
+            (0.2, 0.08, 0.03, 0.05, "from the collision geometry")
         } else {
-            (0.22, 0.09, 0.02, 0.04, "from the link's visual meshes")
+            (0.22, 0.09, 0.02, 0.04, "from the visual geometry")
         };
         for f in [&feet.left, &feet.right] {
             let got = (f.sole.length, f.sole.width, f.sole.offset_x, f.ankle_height);
@@ -671,7 +671,7 @@ fn init_adds_hand_frames_at_the_end_of_bare_forearms() {
         (
             Some(dir.as_path()),
             0.28,
-            "farthest vertex of its visual meshes",
+            "farthest point of its visual geometry",
         ),
         (None, 0.24, "twice its centre of mass"),
     ] {

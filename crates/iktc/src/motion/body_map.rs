@@ -43,7 +43,7 @@ pub enum FoundBy {
 }
 
 impl FoundBy {
-    fn describe(self) -> &'static str {
+    pub(crate) fn describe(self) -> &'static str {
         match self {
             FoundBy::Name => "name",
             FoundBy::Structure => "structure",

@@ -97,7 +97,8 @@ pub use lowpass::{check_smoothing, lowpass, lowpass_track, PAD_PERIODS};
 pub use markers::{FilledGap, MarkerSet, DEFAULT_MAX_GAP};
 pub use points_csv::read_points_csv;
 pub use recognise::{
-    builtin_body_map, recognise_markers, recognise_skeleton, BUILTIN_BODY_MAP_NAMES,
+    builtin_body_map, draft_body_map_toml, marker_points, recognise_markers, recognise_skeleton,
+    skeleton_points, BUILTIN_BODY_MAP_NAMES,
 };
 pub use retarget::{retarget, shrunk_range, Retargeted, RobotReferences, Track};
 #[cfg(feature = "toml")]

@@ -140,6 +140,128 @@ pub(crate) const CHEST_WORDS: [&str; 5] = ["chest", "thorax", "upperchest", "spi
 /// Base words naming the neck on marker data.
 pub(crate) const NECK_WORDS: [&str; 2] = ["neck", "lowerneck"];
 
+/// Qualifier words a marker name adds before or after its body word to tell the markers of a
+/// pair or family apart (front/back, inner/outer, medial/lateral, upper/lower, Plug-in-Gait's
+/// `A`/`B`, …): `LShoulderFront`, `LWristIn`, `LKNEM`, `LWRA`, `LFSHO`.
+pub(crate) const QUALIFIERS: [&str; 30] = [
+    "front",
+    "back",
+    "inner",
+    "outer",
+    "inside",
+    "outside",
+    "in",
+    "out",
+    "medial",
+    "lateral",
+    "med",
+    "lat",
+    "anterior",
+    "posterior",
+    "ant",
+    "post",
+    "top",
+    "upper",
+    "lower",
+    "high",
+    "low",
+    "side",
+    "mid",
+    "tip",
+    "a",
+    "b",
+    "f",
+    "i",
+    "o",
+    "m",
+];
+
+/// A name split into lower-case words at separators (`_`, `-`, `.`, spaces) and case changes
+/// (`WaistLFront` → `waist`, `l`, `front`; `LWRA` stays one word).
+fn words(s: &str) -> Vec<String> {
+    let chars: Vec<char> = s.chars().collect();
+    let mut out = Vec::new();
+    let mut cur = String::new();
+    for (i, &c) in chars.iter().enumerate() {
+        if !c.is_ascii_alphanumeric() {
+            if !cur.is_empty() {
+                out.push(std::mem::take(&mut cur));
+            }
+            continue;
+        }
+        let prev = i.checked_sub(1).map(|k| chars[k]);
+        let next = chars.get(i + 1);
+        let boundary = c.is_ascii_uppercase()
+            && (prev.is_some_and(|p| p.is_ascii_lowercase() || p.is_ascii_digit())
+                || (prev.is_some_and(|p| p.is_ascii_uppercase())
+                    && next.is_some_and(|n| n.is_ascii_lowercase())));
+        if boundary && !cur.is_empty() {
+            out.push(std::mem::take(&mut cur));
+        }
+        cur.push(c.to_ascii_lowercase());
+    }
+    if !cur.is_empty() {
+        out.push(cur);
+    }
+    out
+}
+
+/// The ways a marker name can be read as a side and a stem (lower-case letters and digits):
+/// after dropping everything up to the last `:` or `|` (`Skeleton:LShoulder`), a side word
+/// `l`/`left`/`r`/`right` anywhere among its words (`WaistLFront`, `HeadL`, `L_Wrist_In`), a
+/// leading or trailing `left`/`right`, a leading `L`/`R` letter (`LSHO`, `LFArm`), or no side.
+pub(crate) fn marker_readings(name: &str) -> Vec<(Option<Side>, String)> {
+    let plain = name.rsplit([':', '|']).next().unwrap_or(name).trim();
+    let w = words(plain);
+    let mut out = Vec::new();
+    if w.len() > 1 {
+        for (tags, side) in [(["l", "left"], Side::Left), (["r", "right"], Side::Right)] {
+            if let Some(k) = w.iter().position(|t| tags.contains(&t.as_str())) {
+                let rest: String = w
+                    .iter()
+                    .enumerate()
+                    .filter(|(i, _)| *i != k)
+                    .map(|(_, t)| t.as_str())
+                    .collect();
+                out.push((Some(side), rest));
+            }
+        }
+    }
+    let joined: String = w.concat();
+    for (word, side) in [("left", Side::Left), ("right", Side::Right)] {
+        for rest in [joined.strip_prefix(word), joined.strip_suffix(word)]
+            .into_iter()
+            .flatten()
+        {
+            if !rest.is_empty() {
+                out.push((Some(side), rest.to_string()));
+            }
+        }
+    }
+    for (letter, side) in [('l', Side::Left), ('r', Side::Right)] {
+        if let Some(rest) = joined.strip_prefix(letter).filter(|r| !r.is_empty()) {
+            out.push((Some(side), rest.to_string()));
+        }
+    }
+    out.push((None, joined));
+    out
+}
+
+/// Whether `stem` is the body word `word`, with at most one qualifier ([`QUALIFIERS`]) before
+/// and one after it, and trailing digits (a marker's number in a family: `LForefoot5`)
+/// dropped when `word` has none.
+pub(crate) fn stem_is(stem: &str, word: &str) -> bool {
+    let bare = |s: &str| s == word || QUALIFIERS.iter().any(|q| s.strip_suffix(q) == Some(word));
+    let check = |s: &str| {
+        bare(s)
+            || QUALIFIERS
+                .iter()
+                .any(|q| s.strip_prefix(q).is_some_and(bare))
+    };
+    let trimmed = stem.trim_end_matches(|c: char| c.is_ascii_digit());
+    check(stem) || (trimmed != stem && !trimmed.is_empty() && check(trimmed))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -167,5 +289,31 @@ mod tests {
         assert_eq!(n("Spine2"), (None, "spine2".into()));
         assert_eq!(n("DEF-spine.006"), (None, "spine006".into()));
         assert_eq!(n("HandRight"), (Some(R), "hand".into()));
+    }
+
+    #[test]
+    fn marker_names_are_read_as_side_and_stem() {
+        use Side::{Left as L, Right as R};
+        let has = |name: &str, side: Option<Side>, stem: &str| {
+            marker_readings(name)
+                .iter()
+                .any(|(s, t)| *s == side && t == stem)
+        };
+        assert!(has("WaistLFront", Some(L), "waistfront"));
+        assert!(has("Skeleton:LShoulder", Some(L), "shoulder"));
+        assert!(has("LFArm", Some(L), "farm"));
+        assert!(has("RWRA", Some(R), "wra"));
+        assert!(has("HeadL", Some(L), "head"));
+        assert!(has("L_Wrist_In", Some(L), "wristin"));
+        assert!(has("right_knee_lateral", Some(R), "kneelateral"));
+        assert!(has("C7", None, "c7"));
+        assert!(stem_is("wristin", "wrist"));
+        assert!(stem_is("fsho", "sho"));
+        assert!(stem_is("kneelateral", "knee"));
+        assert!(stem_is("forefoot5", "forefoot"));
+        assert!(stem_is("t10", "t10"));
+        assert!(!stem_is("t10", "t8"));
+        assert!(!stem_is("shoulderblade", "shoulder"));
+        assert!(!stem_is("wrist", "wr"));
     }
 }

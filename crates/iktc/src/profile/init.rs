@@ -1,30 +1,35 @@
-//! A starting profile guessed from a URDF's tree (`iktc profile init`).
+//! A starting profile guessed from a URDF (`iktc profile init`).
 //!
-//! Guesses, each marked `# guessed` in the written TOML:
-//! * feet: per side, the deepest link whose name contains `foot`, `ankle`, `sole` or `toe`
-//!   (the side from a `left`/`l_`/`_l`/`_l<digit>` or `right`/`r_`/`_r`/`_r<digit>` in its
-//!   name); their sole rectangle and ankle height from the collision boxes and spheres of that
-//!   link and of the links fixed to it (the bounding rectangle of their footprints, the ankle
-//!   height from the lowest point), else, when the URDF's folder is
-//!   known ([`init_profile_toml_at`]), from its collision meshes, else its visual meshes (the
-//!   ankle height from the lowest vertex, the sole the bounding rectangle of the vertices within
-//!   [`SOLE_BAND`] of it); a link that gives no sole and is fixed to its parent (a toe or heel
-//!   contact point) hands the foot to the link the last movable joint above it moves, when
-//!   that one gives a sole (the contact points fixed to it); else a placeholder;
-//! * pelvis: the first link (from the root) whose name contains `pelvis`, else the root link;
-//! * torso (`torso`, `chest`, `trunk`) and head (`head`, `neck`): the matching link nearest the
-//!   root; hands (`hand`, `palm`, `wrist`, `end_effector`, `eef`): the deepest matching link
-//!   per side; a side without
-//!   one gets a frame added (key `frame`) at the far end of its deepest `elbow`/`forearm` link
-//!   (the farthest vertex of its meshes from the elbow, else twice its centre of mass);
+//! The URDF is first built as a model ([`Robot::from_urdf_str`](crate::model::Robot)): a URDF
+//! the model rejects gets no profile. Then, each guess marked `# guessed` in the written TOML
+//! (and each part given instead, marked `# given`, see [`InitOptions`]):
+//! * feet, hands, torso, head from the tree's shape at q = 0 (see [`MIN_DROP`](super::MIN_DROP),
+//!   [`MIN_LEG_JOINTS`](super::MIN_LEG_JOINTS), [`MIDLINE`](super::MIDLINE),
+//!   [`MIN_ARM_JOINTS`](super::MIN_ARM_JOINTS)):
+//!   the two leg chains ending lowest, sides from the lateral (y) coordinate, +y left; the
+//!   arm chains' far ends; where they meet; the chain going up; when the shape gives no pair of
+//!   feet or hands, links named like them (`foot`, `ankle`, `sole`, `toe`; `hand`, `palm`,
+//!   `wrist`, …, the side from a `left`/`l_`/`_l`/`_l<digit>` or `right`/… tag);
+//! * a hand frame: a link fixed to the arm's last link named like a hand, else that link; an
+//!   arm of at most [`FOREARM_JOINTS`] joints ends at a forearm, and a frame (key `frame`) is
+//!   added at its far end (the farthest point of its geometry from the elbow, else twice its
+//!   centre of mass);
+//! * soles and ankle heights from the feet's collision, else visual geometry (boxes, spheres,
+//!   cylinders, meshes; the points within [`SOLE_BAND`](super::SOLE_BAND) of the lowest); a
+//!   sole narrower than [`NARROW_SOLE`](super::NARROW_SOLE) or longer than
+//!   [`LONG_SOLE`](super::LONG_SOLE) gets a comment questioning it;
+//! * pelvis: the base (root link), or a link fixed to it named like a pelvis;
 //! * base: floating when both feet were found, else fixed;
-//! * posture: for a floating biped with six leg joints per side, the legs bent so that the
-//!   hips sit [`CROUCH`] of the leg's length lower, the feet level where they were;
+//! * posture: for a floating biped, the legs bent so that the hips sit [`CROUCH`] of the leg's
+//!   length lower, the feet level where they were (as much of the foot's pose as the leg's
+//!   joints can hold);
 //! * locks: movable joints whose names contain `finger`, `thumb`, `index`, `middle`, `ring`,
 //!   `little` or `pinky`, as one glob pattern each.
 
-use nalgebra::{DMatrix, DVector, Isometry3, Vector3};
+use nalgebra::{DMatrix, DVector, Vector3};
 
+use super::shape::{find_parts, named_frame, named_like, Parts, Tree};
+use super::sole::{link_points, questioned, sole_of, SoleGuess};
 use crate::error::{Error, Result};
 
 /// A link of the parsed tree: name, parent link index, depth from the root.
@@ -83,179 +88,24 @@ fn deepest<'a>(links: &'a [TreeLink], words: &[&str], side: Option<Side>) -> Opt
     pick(links, words, side, false)
 }
 
-/// A guessed sole: `(length, width, offset_x, ankle_height)` \[m\].
-type Sole = (f64, f64, f64, f64);
-
-/// The sole over the footprint points `footprint` (link frame) \[m\]: their bounding rectangle
-/// in x and y, the ankle height `−zmin` from the lowest point `zmin` \[m\] below the link's
-/// origin. `None` for a rectangle without length or width, or `zmin ≥ 0`.
-fn rectangle<'a>(footprint: impl Iterator<Item = &'a Vector3<f64>>, zmin: f64) -> Option<Sole> {
-    let (mut xmin, mut xmax, mut ymin, mut ymax) = (
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-    );
-    for p in footprint {
-        xmin = xmin.min(p.x);
-        xmax = xmax.max(p.x);
-        ymin = ymin.min(p.y);
-        ymax = ymax.max(p.y);
-    }
-    let (l, w) = (xmax - xmin, ymax - ymin);
-    (l > 0.0 && w > 0.0 && zmin < 0.0).then(|| (l, w, 0.5 * (xmin + xmax), -zmin))
-}
-
-/// The lowest height of `points` \[m\] (`+∞` for none).
-fn lowest(points: &[Vector3<f64>]) -> f64 {
-    points.iter().map(|p| p.z).fold(f64::INFINITY, f64::min)
-}
-
-/// The collision shapes of link `name` and of every link attached to it through fixed joints
-/// (contact points at a sole's corners, a sole plate), each with its pose in `name`'s frame.
-fn fixed_subtree<'a>(
-    u: &'a urdf_rs::Robot,
-    name: &str,
-) -> Vec<(Isometry3<f64>, &'a urdf_rs::Collision)> {
-    let mut out = Vec::new();
-    let mut open = vec![(name.to_string(), Isometry3::identity())];
-    while let Some((link, at)) = open.pop() {
-        if let Some(l) = u.links.iter().find(|l| l.name == link) {
-            out.extend(
-                l.collision
-                    .iter()
-                    .map(|c| (at * crate::model::urdf_pose(&c.origin), c)),
-            );
-        }
-        for j in u
-            .joints
-            .iter()
-            .filter(|j| j.parent.link == link && matches!(j.joint_type, urdf_rs::JointType::Fixed))
-        {
-            open.push((
-                j.child.link.clone(),
-                at * crate::model::urdf_pose(&j.origin),
-            ));
-        }
-    }
-    out
-}
-
-/// A guessed sole ([`Sole`]) from collision boxes and spheres posed in the foot's frame (their
-/// footprints, ignoring their rotation about z).
-fn sole_from_collisions(shapes: &[(Isometry3<f64>, &urdf_rs::Collision)]) -> Option<Sole> {
-    let mut points = Vec::new();
-    for (o, c) in shapes {
-        match &c.geometry {
-            urdf_rs::Geometry::Sphere { radius } => {
-                // The footprint is the contact point; the sphere reaches `radius` lower.
-                points.push(o.translation.vector - Vector3::z() * *radius);
-            }
-            urdf_rs::Geometry::Box { size } => {
-                let h = Vector3::new(size[0], size[1], size[2]) * 0.5;
-                for sx in [-1.0, 1.0] {
-                    for sy in [-1.0, 1.0] {
-                        for sz in [-1.0, 1.0] {
-                            let corner = h.component_mul(&Vector3::new(sx, sy, sz));
-                            points.push((o * nalgebra::Point3::from(corner)).coords);
-                        }
-                    }
-                }
-            }
-            _ => {}
-        }
-    }
-    rectangle(points.iter(), lowest(&points))
-}
-
-/// Vertices of a foot mesh up to this height above its lowest one make its sole \[m\]: the
-/// flat underside of a foot, not the toe's upward curve or the ankle's housing above it.
-pub const SOLE_BAND: f64 = 0.01;
-
-/// A guessed sole ([`Sole`]) from the mesh vertices `v` of a foot link, in its frame (see the
-/// module documentation).
-fn sole_from_vertices(v: &[Vector3<f64>]) -> Option<Sole> {
-    let zmin = lowest(v);
-    rectangle(v.iter().filter(|p| p.z <= zmin + SOLE_BAND), zmin)
-}
-
-/// The vertices \[m\] of every collision (`collision`) or visual mesh of `link`, in its frame,
-/// read from the URDF's folder `dir`; `None` when one of those shapes is not a mesh or cannot
-/// be read.
-fn link_vertices(
-    link: &urdf_rs::Link,
-    collision: bool,
-    dir: &std::path::Path,
-) -> Option<Vec<Vector3<f64>>> {
-    let parts: Vec<(&urdf_rs::Geometry, &urdf_rs::Pose)> = if collision {
-        link.collision
-            .iter()
-            .map(|c| (&c.geometry, &c.origin))
-            .collect()
-    } else {
-        link.visual
-            .iter()
-            .map(|v| (&v.geometry, &v.origin))
-            .collect()
-    };
-    let mut all = Vec::new();
-    for (g, o) in parts {
-        all.extend(crate::mesh::urdf::mesh_vertices(g, o, dir).ok()??);
-    }
-    Some(all)
-}
-
-/// The sole of `link` from its collision meshes, else its visual meshes, read from the URDF's
-/// folder `dir`, with which of the two it came from. `None` when neither gives one (no mesh,
-/// a mesh that cannot be read, or one that does not reach below the link's origin).
-fn sole_from_meshes(link: &urdf_rs::Link, dir: &std::path::Path) -> Option<(Sole, &'static str)> {
-    let sole = |collision| sole_from_vertices(&link_vertices(link, collision, dir)?);
-    sole(true)
-        .map(|s| (s, "from the link's collision meshes"))
-        .or_else(|| sole(false).map(|s| (s, "from the link's visual meshes")))
-}
-
-/// The sole of link `name`: from the collision boxes and spheres of it and of the links fixed
-/// to it, else from its meshes in `dir`, with where it came from.
-fn sole_of(
-    u: &urdf_rs::Robot,
-    name: &str,
-    dir: Option<&std::path::Path>,
-) -> Option<(Sole, &'static str)> {
-    sole_from_collisions(&fixed_subtree(u, name))
-        .map(|s| {
-            (
-                s,
-                "from the collision boxes/spheres of the link and the links fixed to it",
-            )
-        })
-        .or_else(|| {
-            let link = u.links.iter().find(|l| l.name == name)?;
-            sole_from_meshes(link, dir?)
-        })
-}
-
-/// The foot frame and its sole for the deepest foot-named link `named`: that link with its
+/// The foot frame and its sole for the foot link `named` (index into `t`): that link with its
 /// sole ([`sole_of`]), or, when it gives none and is fixed to its parent (a toe or heel
 /// contact point), the link the last movable joint above it moves, if that one gives a sole
 /// (the contact points fixed to it then make it). Else `named`, without a sole.
-fn foot_guess<'a>(
-    u: &'a urdf_rs::Robot,
-    named: &'a str,
+fn foot_guess(
+    u: &urdf_rs::Robot,
+    t: &Tree,
+    named: usize,
     dir: Option<&std::path::Path>,
-) -> (&'a str, Option<(Sole, &'static str)>) {
-    if let Some(sole) = sole_of(u, named, dir) {
+) -> (usize, Option<(SoleGuess, &'static str)>) {
+    if let Some(sole) = sole_of(u, t, named, dir) {
         return (named, Some(sole));
     }
     let mut moved = named;
-    while let Some(j) = u
-        .joints
-        .iter()
-        .find(|j| j.child.link == moved && matches!(j.joint_type, urdf_rs::JointType::Fixed))
-    {
-        moved = j.parent.link.as_str();
+    while let Some((p, false)) = t.parent[moved] {
+        moved = p;
     }
-    match sole_of(u, moved, dir) {
+    match sole_of(u, t, moved, dir) {
         Some(sole) if moved != named => (moved, Some(sole)),
         _ => (named, None),
     }
@@ -279,12 +129,41 @@ const NUDGE: f64 = 0.3;
 /// The posture's solve moves a joint by at most this per iteration \[rad\].
 const MAX_STEP: f64 = 0.1;
 
+/// The rows of a foot's pose error (position x, y, z, then rotation about x, y, z in the
+/// base's frame) a leg of `joints` movable joints can hold: all six with six or more joints;
+/// with five, all but the turn about the vertical (the foot kept level); with three or four,
+/// the position; none with fewer.
+fn foot_rows(joints: usize) -> &'static [usize] {
+    match joints {
+        6.. => &[0, 1, 2, 3, 4, 5],
+        5 => &[0, 1, 2, 3, 4],
+        3 | 4 => &[0, 1, 2],
+        _ => &[],
+    }
+}
+
+/// The position and rotation errors `ep`, `er` with the rows a leg of `joints` joints cannot
+/// hold ([`foot_rows`]) set to zero.
+fn held(joints: usize, ep: Vector3<f64>, er: Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
+    let rows = foot_rows(joints);
+    let keep = |v: Vector3<f64>, first: usize| {
+        Vector3::from_fn(|i, _| {
+            if rows.contains(&(first + i)) {
+                v[i]
+            } else {
+                0.0
+            }
+        })
+    };
+    (keep(ep, 0), keep(er, 3))
+}
+
 /// A start posture for a floating biped whose feet frames are `feet` (see [`CROUCH`]): the
 /// movable joints from the root to each foot that are not on both legs' paths (a waist below
-/// the hips is held), solved by damped least squares for the foot's pose relative to the
-/// base, each within its range. `None` when the URDF does not build, a leg has fewer than six
-/// such joints (its foot's pose would be out of its reach), or the solve does not reach the
-/// pose within 1 mm and 0.01 rad.
+/// the hips is held), solved by damped least squares for the rows of the foot's pose relative
+/// to the base that the leg can hold ([`foot_rows`]), each joint within its range. `None` when
+/// the URDF does not build, a leg has fewer than three such joints, or the solve does not
+/// reach the held rows within 1 mm and 0.01 rad.
 fn crouch_posture(text: &str, u: &urdf_rs::Robot, feet: &[&str]) -> Option<Vec<(String, f64)>> {
     use crate::model::{BaseKind, Kinematics, ModelOptions, Robot, State};
     let options = ModelOptions {
@@ -332,7 +211,7 @@ fn crouch_posture(text: &str, u: &urdf_rs::Robot, feet: &[&str]) -> Option<Vec<(
         joints.retain(|j| !shared.contains(&j.0));
         // The hip: the link the leg's first joint from the body moves.
         let hip = robot.frame_id(&joints.last()?.5).ok()?;
-        if joints.len() < 6 {
+        if foot_rows(joints.len()).is_empty() {
             return None;
         }
         legs.push((foot, joints, hip));
@@ -370,14 +249,18 @@ fn crouch_posture(text: &str, u: &urdf_rs::Robot, feet: &[&str]) -> Option<Vec<(
             let pose = kin.frame_pose(&robot, *foot).ok()?;
             let ep = target.translation.vector - pose.translation.vector;
             let er = (target.rotation * pose.rotation.inverse()).scaled_axis();
+            let (ep, er) = held(joints.len(), ep, er);
             if ep.norm() < 1e-9 && er.norm() < 1e-9 {
                 reached = true;
                 break;
             }
             kin.frame_jacobian(&robot, *foot, &mut jac).ok()?;
-            let j = DMatrix::from_fn(6, joints.len(), |r, c| jac[(r, joints[c].2)]);
-            let e = DVector::from_iterator(6, ep.iter().chain(er.iter()).copied());
-            let a = &j * j.transpose() + DMatrix::identity(6, 6) * 1e-6;
+            let rows = foot_rows(joints.len());
+            let m = rows.len();
+            let j = DMatrix::from_fn(m, joints.len(), |r, c| jac[(rows[r], joints[c].2)]);
+            let full: Vec<f64> = ep.iter().chain(er.iter()).copied().collect();
+            let e = DVector::from_iterator(m, rows.iter().map(|r| full[*r]));
+            let a = &j * j.transpose() + DMatrix::identity(m, m) * 1e-6;
             let mut dq = j.transpose() * a.lu().solve(&e)?;
             // At most MAX_STEP per joint and iteration: near the straight leg's singularity a
             // full step overshoots into the joints' limits.
@@ -391,9 +274,12 @@ fn crouch_posture(text: &str, u: &urdf_rs::Robot, feet: &[&str]) -> Option<Vec<(
         }
         kin.update(&robot, &state).ok()?;
         let pose = kin.frame_pose(&robot, *foot).ok()?;
-        let ep = (target.translation.vector - pose.translation.vector).norm();
-        let er = (target.rotation * pose.rotation.inverse()).angle();
-        if !(reached || (ep < 1e-3 && er < 1e-2)) {
+        let (ep, er) = held(
+            joints.len(),
+            target.translation.vector - pose.translation.vector,
+            (target.rotation * pose.rotation.inverse()).scaled_axis(),
+        );
+        if !(reached || (ep.norm() < 1e-3 && er.norm() < 1e-2)) {
             return None;
         }
     }
@@ -410,26 +296,30 @@ fn crouch_posture(text: &str, u: &urdf_rs::Robot, feet: &[&str]) -> Option<Vec<(
 /// Links shorter than this from their origin to their far end \[m\] give no hand point.
 const MIN_FOREARM: f64 = 0.05;
 
-/// The far end of a forearm link without a hand link below it, in its frame \[m\], and where
-/// it came from: the vertex of its visual (else collision) meshes in `dir` farthest from its
-/// origin (the elbow), else twice its centre of mass (the end of a uniform rod from the
-/// elbow). `None` when neither reaches [`MIN_FOREARM`].
+/// An arm of at most this many movable joints from the torso ends at a forearm (three at the
+/// shoulder, one at the elbow), not a hand \[–\]: a frame is added at its far end.
+pub const FOREARM_JOINTS: usize = 4;
+
+/// The far end of the forearm link `i` of `t`, in its frame \[m\], and where it came from:
+/// the point of its visual (else collision) geometry (with the links fixed to it) farthest
+/// from its origin (the elbow), else twice its centre of mass (the end of a uniform rod from
+/// the elbow). `None` when neither reaches [`MIN_FOREARM`].
 fn hand_point(
-    link: &urdf_rs::Link,
+    u: &urdf_rs::Robot,
+    t: &Tree,
+    i: usize,
     dir: Option<&std::path::Path>,
 ) -> Option<(Vector3<f64>, &'static str)> {
     let far = |collision| -> Option<Vector3<f64>> {
-        let mut best: Option<Vector3<f64>> = None;
-        for v in link_vertices(link, collision, dir?)? {
-            if best.is_none_or(|b| v.norm() > b.norm()) {
-                best = Some(v);
-            }
-        }
-        best.filter(|b| b.norm() >= MIN_FOREARM)
+        link_points(u, t, i, dir, collision)
+            .into_iter()
+            .max_by(|a, b| a.norm().total_cmp(&b.norm()))
+            .filter(|b| b.norm() >= MIN_FOREARM)
     };
+    let link = u.links.iter().find(|l| l.name == t.names[i])?;
     far(false)
-        .map(|p| (p, "the farthest vertex of its visual meshes"))
-        .or_else(|| far(true).map(|p| (p, "the farthest vertex of its collision meshes")))
+        .map(|p| (p, "the farthest point of its visual geometry"))
+        .or_else(|| far(true).map(|p| (p, "the farthest point of its collision geometry")))
         .or_else(|| {
             let c = 2.0 * Vector3::from(link.inertial.origin.xyz.0);
             (c.norm() >= MIN_FOREARM).then_some((c, "twice its centre of mass"))
@@ -470,23 +360,80 @@ pub fn urdf_key(urdf: &std::path::Path, profile: Option<&std::path::Path>) -> Re
     })
 }
 
+/// Parts of the robot given to [`init_profile_toml_with`] instead of guessed (`iktc profile
+/// init --feet … --hands … --head … --torso … --pelvis … --sole …`): link names of the URDF.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct InitOptions {
+    /// The foot links, `[left, right]`.
+    pub feet: Option<[String; 2]>,
+    /// The hand links (or frames fixed to them), `[left, right]`.
+    pub hands: Option<[String; 2]>,
+    /// The head link.
+    pub head: Option<String>,
+    /// The torso link.
+    pub torso: Option<String>,
+    /// The pelvis link.
+    pub pelvis: Option<String>,
+    /// The sole of both feet \[m\] (the ankle height is still guessed from the geometry).
+    pub sole: Option<super::Sole>,
+}
+
 /// Writes a starting profile for the URDF `text`, whose path relative to where the profile
 /// will be written is `urdf_path`. Every guessed value is marked `# guessed`; the result parses
 /// as a [`RobotProfile`](super::RobotProfile) (keys it could not guess are left out or
 /// commented).
 ///
-/// Errors: a URDF that does not parse or has no single root link.
+/// Errors: a URDF the model loader rejects ([`Robot::from_urdf_str`](crate::model::Robot)'s
+/// error), or one without a single root link.
 pub fn init_profile_toml(text: &str, urdf_path: &str) -> Result<String> {
     init_profile_toml_at(text, urdf_path, None)
 }
 
-/// [`init_profile_toml`] for a URDF in the folder `dir`: a foot without collision boxes or
-/// spheres has its sole guessed from its meshes there (see the module documentation).
+/// [`init_profile_toml`] for a URDF in the folder `dir`: feet without primitive shapes have
+/// their soles guessed from their meshes there (see the module documentation).
 pub fn init_profile_toml_at(
     text: &str,
     urdf_path: &str,
     dir: Option<&std::path::Path>,
 ) -> Result<String> {
+    init_profile_toml_with(text, urdf_path, dir, &InitOptions::default())
+}
+
+/// A part's link (index into the tree) and why it was chosen.
+type Chosen = (usize, String);
+
+/// The link called `name` in `t`, or an error naming the flag's key and the links.
+fn given(t: &Tree, key: &str, name: &str) -> Result<usize> {
+    t.index(name).ok_or_else(|| Error::UnknownName {
+        kind: "link",
+        name: format!("{name}` (given for `{key}`"),
+        valid: t.names.clone(),
+    })
+}
+
+/// Checks a given sole: length and width finite and > 0, offset finite \[m\].
+fn check_sole(s: &super::Sole) -> Result<()> {
+    let ok = s.length.is_finite() && s.length > 0.0 && s.width.is_finite() && s.width > 0.0;
+    if ok && s.offset_x.is_finite() {
+        return Ok(());
+    }
+    Err(Error::InvalidSetting {
+        name: "sole".into(),
+        value: format!("{}, {}, {}", s.length, s.width, s.offset_x),
+        expected: "a length and width > 0 and a finite offset_x [m]".into(),
+    })
+}
+
+/// [`init_profile_toml_at`] with the parts in `options` given instead of guessed (each link
+/// name checked against the URDF).
+pub fn init_profile_toml_with(
+    text: &str,
+    urdf_path: &str,
+    dir: Option<&std::path::Path>,
+    options: &InitOptions,
+) -> Result<String> {
+    // The model first: a URDF it rejects gets no profile.
+    crate::model::Robot::from_urdf_str(text, &crate::model::ModelOptions::default())?;
     let (u, _) = crate::model::read_urdf(text, &crate::resources::ReadLimits::default())?;
     let is_child = |name: &str| u.joints.iter().any(|j| j.child.link == name);
     let roots: Vec<&urdf_rs::Link> = u.links.iter().filter(|l| !is_child(&l.name)).collect();
@@ -503,53 +450,291 @@ pub fn init_profile_toml_at(
             ),
         });
     };
-    // Breadth-first from the root: depth of every link, parents before children.
-    let mut links: Vec<TreeLink> = vec![TreeLink {
-        name: root.name.clone(),
-        lower: root.name.to_lowercase(),
-        depth: 0,
-    }];
-    let mut i = 0;
-    while i < links.len() {
-        let (parent, depth) = (links[i].name.clone(), links[i].depth);
-        for j in u.joints.iter().filter(|j| j.parent.link == parent) {
-            if links.iter().all(|l| l.name != j.child.link) {
-                links.push(TreeLink {
-                    name: j.child.link.clone(),
-                    lower: j.child.link.to_lowercase(),
-                    depth: depth + 1,
-                });
+    if let Some(s) = &options.sole {
+        check_sole(s)?;
+    }
+    let t = Tree::new(&u, &root.name);
+    let parts = find_parts(&t);
+    let guess = Guessed::new(&t, &parts, options, dir, &u)?;
+    Ok(write_profile(text, &u, &t, &guess, options, urdf_path, dir))
+}
+
+/// Everything guessed or given, ready to write.
+struct Guessed {
+    feet: Option<[Chosen; 2]>,
+    hands: [Option<Chosen>; 2],
+    /// Per side, a frame to add at the far end of a bare forearm: its parent link, its
+    /// position there \[m\], and where that came from.
+    hand_ends: [Option<(usize, Vector3<f64>, &'static str)>; 2],
+    torso: Option<Chosen>,
+    head: Option<Chosen>,
+    pelvis: Chosen,
+}
+
+/// A link fixed this near to another's origin (\[m\]) and turned this little from it (\[rad\])
+/// is an alias of its frame.
+const ALIAS: f64 = 1e-6;
+
+/// Whether links `a` and `b` of `t` are posed alike (see [`ALIAS`]).
+fn alias(t: &Tree, a: usize, b: usize) -> bool {
+    let d = t.pose[a].inverse() * t.pose[b];
+    d.translation.vector.norm() < ALIAS && d.rotation.angle() < ALIAS
+}
+
+/// Link words naming a foot frame.
+const FOOT_WORDS: [&str; 3] = ["foot", "ankle", "sole"];
+
+/// Link words naming a hand frame.
+const HAND_WORDS: [&str; 7] = ["hand", "palm", "wrist", "end_effector", "eef", "tcp", "tip"];
+
+impl Guessed {
+    fn new(
+        t: &Tree,
+        parts: &Parts,
+        o: &InitOptions,
+        dir: Option<&std::path::Path>,
+        u: &urdf_rs::Robot,
+    ) -> Result<Guessed> {
+        let links: Vec<TreeLink> = t
+            .names
+            .iter()
+            .enumerate()
+            .map(|(i, n)| TreeLink {
+                name: n.clone(),
+                lower: n.to_lowercase(),
+                depth: depth(t, i),
+            })
+            .collect();
+        let by_name = |l: Option<&TreeLink>| l.and_then(|l| t.index(&l.name));
+        let side_name = ["left", "right"];
+        let feet = match &o.feet {
+            Some([l, r]) => Some([
+                (given(t, "feet.left.frame", l)?, "given".to_string()),
+                (given(t, "feet.right.frame", r)?, "given".to_string()),
+            ]),
+            None => match parts.feet {
+                Some(f) => Some(f.map(|i| {
+                    // A link named like a foot at the end's own origin (an alias of its
+                    // frame), not a contact point fixed away from it.
+                    let frame = Some(named_frame(t, i, &FOOT_WORDS))
+                        .filter(|f| alias(t, *f, i))
+                        .unwrap_or(i);
+                    let why = format!(
+                        "the lowest end of a leg chain at q = 0, y = {:+.3} m in the base's frame",
+                        t.pos(i).y
+                    );
+                    if frame == i {
+                        (i, why)
+                    } else {
+                        (
+                            frame,
+                            format!("named like a foot, fixed to {} ({why})", t.names[i]),
+                        )
+                    }
+                })),
+                None => {
+                    let words = [FOOT_WORDS[0], FOOT_WORDS[1], FOOT_WORDS[2], "toe"];
+                    let l = by_name(deepest(&links, &words, Some(Side::Left)));
+                    let r = by_name(deepest(&links, &words, Some(Side::Right)));
+                    l.zip(r).map(|(l, r)| {
+                        [(l, 0), (r, 1)].map(|(i, s)| {
+                            let (frame, _) = foot_guess(u, t, i, dir);
+                            let why = if frame == i {
+                                format!("deepest link named like a foot on the {}", side_name[s])
+                            } else {
+                                format!("the link `{}` (deepest named like a foot on the {}) is fixed to", t.names[i], side_name[s])
+                            };
+                            (frame, why)
+                        })
+                    })
+                }
+            },
+        };
+        let mut hands: [Option<Chosen>; 2] = [None, None];
+        let mut hand_ends = [None, None];
+        match (&o.hands, parts.hands) {
+            (Some([l, r]), _) => {
+                hands = [
+                    Some((given(t, "frames.left_hand", l)?, "given".to_string())),
+                    Some((given(t, "frames.right_hand", r)?, "given".to_string())),
+                ];
+            }
+            (None, Some(h)) => {
+                for s in 0..2 {
+                    let frame = named_frame(t, h[s], &HAND_WORDS);
+                    let bare = parts.arm_joints[s] <= FOREARM_JOINTS
+                        && !named_like(&t.names[frame], &HAND_WORDS);
+                    match bare.then(|| hand_point(u, t, h[s], dir)).flatten() {
+                        Some((xyz, why)) => hand_ends[s] = Some((h[s], xyz, why)),
+                        None => {
+                            hands[s] = Some((frame, format!("the far end of the arm chain on the {} ({} joints from the torso)", side_name[s], parts.arm_joints[s])));
+                        }
+                    }
+                }
+            }
+            (None, None) => {
+                for (s, side) in [Side::Left, Side::Right].into_iter().enumerate() {
+                    if let Some(i) = by_name(deepest(&links, &HAND_WORDS, Some(side))) {
+                        hands[s] = Some((i, "a link named like it".to_string()));
+                        continue;
+                    }
+                    let forearm = ["elbow", "forearm", "lower_arm", "lowerarm"];
+                    if let Some(i) = by_name(deepest(&links, &forearm, Some(side))) {
+                        hand_ends[s] = hand_point(u, t, i, dir).map(|(xyz, why)| (i, xyz, why));
+                    }
+                }
             }
         }
-        i += 1;
+        let pick_part = |key: &str,
+                         given_name: &Option<String>,
+                         shape: Option<usize>,
+                         what: &str,
+                         words: &[&str]|
+         -> Result<Option<Chosen>> {
+            Ok(match given_name {
+                Some(n) => Some((given(t, key, n)?, "given".to_string())),
+                None => match shape {
+                    Some(i) => Some((i, what.to_string())),
+                    None => by_name(pick(&links, words, None, true))
+                        .map(|i| (i, "a link named like it".to_string())),
+                },
+            })
+        };
+        let torso = pick_part(
+            "frames.torso",
+            &o.torso,
+            parts.torso,
+            "the link where the arm chains meet",
+            &["torso", "chest", "trunk"],
+        )?;
+        let head = pick_part(
+            "frames.head",
+            &o.head,
+            parts.head,
+            "the end of the chain going up from the torso (or the highest link fixed to it)",
+            &["head", "neck"],
+        )?;
+        let pelvis = match &o.pelvis {
+            Some(n) => (given(t, "frames.pelvis", n)?, "given".to_string()),
+            None => t
+                .fixed_below(0)
+                .into_iter()
+                .find(|i| named_like(&t.names[*i], &["pelvis"]))
+                .map(|i| {
+                    let why = if i == 0 {
+                        "the base (the root link)"
+                    } else {
+                        "named like a pelvis, fixed to the base"
+                    };
+                    (i, why.to_string())
+                })
+                .unwrap_or((0, "the base (the root link)".to_string())),
+        };
+        Ok(Guessed {
+            feet,
+            hands,
+            hand_ends,
+            torso,
+            head,
+            pelvis,
+        })
     }
-    let foot_words = ["foot", "ankle", "sole", "toe"];
-    let left = deepest(&links, &foot_words, Some(Side::Left));
-    let right = deepest(&links, &foot_words, Some(Side::Right));
-    let pelvis = links
-        .iter()
-        .find(|l| l.lower.contains("pelvis"))
-        .unwrap_or(&links[0]);
-    // The body's own link comes before the sensors and frames attached to it.
-    let torso = pick(&links, &["torso", "chest", "trunk"], None, true);
-    let head = pick(&links, &["head", "neck"], None, true);
-    let hand_words = ["hand", "palm", "wrist", "end_effector", "eef"];
-    let left_hand = deepest(&links, &hand_words, Some(Side::Left));
-    let right_hand = deepest(&links, &hand_words, Some(Side::Right));
-    // A side without a hand link: a frame added at the far end of its forearm.
-    let forearm_words = ["elbow", "forearm", "lower_arm", "lowerarm"];
-    let hand_end = |side: Side, found: Option<&TreeLink>| {
-        if found.is_some() {
-            return None;
-        }
-        let forearm = deepest(&links, &forearm_words, Some(side))?;
-        let link = u.links.iter().find(|l| l.name == forearm.name)?;
-        let (xyz, why) = hand_point(link, dir)?;
-        Some((forearm.name.clone(), xyz, why))
-    };
-    let left_end = hand_end(Side::Left, left_hand);
-    let right_end = hand_end(Side::Right, right_hand);
+}
 
+/// The depth of link `i` in `t` (links from the root).
+fn depth(t: &Tree, i: usize) -> usize {
+    let (mut d, mut j) = (0, i);
+    while let Some((p, _)) = t.parent[j] {
+        d += 1;
+        j = p;
+    }
+    d
+}
+
+/// `# given` or `# guessed: why`.
+fn mark(why: &str) -> String {
+    if why == "given" {
+        "# given".to_string()
+    } else {
+        format!("# guessed: {why}")
+    }
+}
+
+/// The `[feet.*]` tables of `g` (with their soles), and the foot frames.
+fn write_feet(
+    out: &mut String,
+    u: &urdf_rs::Robot,
+    t: &Tree,
+    g: &Guessed,
+    o: &InitOptions,
+    dir: Option<&std::path::Path>,
+) -> Vec<String> {
+    let Some(feet) = &g.feet else {
+        out.push_str(
+            "# No pair of feet found (two leg chains ending below the base, nor links named \
+             foot/ankle/sole/toe with a left/right tag):\n\
+             # add [feet.left] and [feet.right] (frame, ankle_height, sole) for a standing robot, \
+             or pass --feet LEFT,RIGHT.\n\n",
+        );
+        return Vec::new();
+    };
+    let mut frames = Vec::new();
+    for (side, (i, why)) in ["left", "right"].iter().zip(feet) {
+        frames.push(t.names[*i].clone());
+        out.push_str(&format!(
+            "[feet.{side}]\nframe = {} {}\n",
+            quote(&t.names[*i]),
+            mark(why)
+        ));
+        // An alias fixed at the foot link's origin gives the sole of the whole foot body.
+        let mut body = *i;
+        while let Some((p, false)) = t.parent[body] {
+            if !alias(t, p, *i) {
+                break;
+            }
+            body = p;
+        }
+        let geometry = sole_of(u, t, body, dir);
+        let (ankle, ankle_why) = match &geometry {
+            Some(((.., a), why)) => (tenth_mm(*a), *why),
+            None => (
+                0.1,
+                "PLACEHOLDER, no geometry below the link: measure the robot",
+            ),
+        };
+        let (len, wid, off, sole_why) = match (&o.sole, &geometry) {
+            (Some(s), _) => (s.length, s.width, s.offset_x, "given".to_string()),
+            (None, Some(((a, b, c, _), why))) => {
+                (tenth_mm(*a), tenth_mm(*b), tenth_mm(*c), why.to_string())
+            }
+            (None, None) => (0.2, 0.1, 0.0, ankle_why.to_string()),
+        };
+        out.push_str(&format!(
+            "ankle_height = {ankle:?} # guessed: {ankle_why}\n"
+        ));
+        if o.sole.is_none() {
+            if let Some(q) = questioned(len, wid) {
+                out.push_str(&q);
+            }
+        }
+        out.push_str(&format!(
+            "sole = {{ length = {len:?}, width = {wid:?}, offset_x = {off:?} }} {}\n\n",
+            mark(&sole_why)
+        ));
+    }
+    frames
+}
+
+/// The profile's text (see [`init_profile_toml_with`]).
+fn write_profile(
+    text: &str,
+    u: &urdf_rs::Robot,
+    t: &Tree,
+    g: &Guessed,
+    o: &InitOptions,
+    urdf_path: &str,
+    dir: Option<&std::path::Path>,
+) -> String {
     let mut out = String::new();
     let name = if u.name.is_empty() { "robot" } else { &u.name };
     out.push_str(&format!(
@@ -558,12 +743,14 @@ pub fn init_profile_toml_at(
         quote(name),
         quote(urdf_path)
     ));
-    let feet = left.zip(right);
-    let mut foot_frames: Vec<&str> = Vec::new();
     out.push_str(&format!(
         "base = \"{}\" # guessed: {}\n",
-        if feet.is_some() { "floating" } else { "fixed" },
-        if feet.is_some() {
+        if g.feet.is_some() {
+            "floating"
+        } else {
+            "fixed"
+        },
+        if g.feet.is_some() {
             "two feet were found"
         } else {
             "no pair of feet was found"
@@ -582,50 +769,14 @@ pub fn init_profile_toml_at(
         ));
     }
     out.push('\n');
-    match feet {
-        Some((l, r)) => {
-            for (side, link) in [("left", l), ("right", r)] {
-                let (frame, sole) = foot_guess(&u, &link.name, dir);
-                foot_frames.push(frame);
-                out.push_str(&format!(
-                    "[feet.{side}]\nframe = {} # guessed: {}\n",
-                    quote(frame),
-                    if frame == link.name {
-                        format!("deepest link named like a foot on the {side}")
-                    } else {
-                        format!("the link `{}` (deepest named like a foot on the {side}) is fixed to", link.name)
-                    }
-                ));
-                let (len, wid, off, ankle, why) = match sole {
-                    // To 0.1 mm: meshes are stored in single precision.
-                    Some(((a, b, c, d), why)) => (tenth_mm(a), tenth_mm(b), tenth_mm(c), tenth_mm(d), why),
-                    None => (
-                        0.2,
-                        0.1,
-                        0.0,
-                        0.1,
-                        "PLACEHOLDER, no collision box, sphere or readable mesh below the \
-                         link: measure the robot",
-                    ),
-                };
-                out.push_str(&format!(
-                    "ankle_height = {ankle:?} # guessed: {why}\n\
-                     sole = {{ length = {len:?}, width = {wid:?}, offset_x = {off:?} }} # guessed: {why}\n\n"
-                ));
-            }
-        }
-        None => out.push_str(
-            "# No pair of feet found (links named foot/ankle/sole/toe with a left/right tag):\n\
-             # add [feet.left] and [feet.right] (frame, ankle_height, sole) for a standing robot.\n\n",
-        ),
-    }
-    for (key, end) in [("left_hand", &left_end), ("right_hand", &right_end)] {
+    let foot_frames = write_feet(&mut out, u, t, g, o, dir);
+    for (key, end) in ["left_hand", "right_hand"].iter().zip(&g.hand_ends) {
         if let Some((parent, xyz, why)) = end {
             out.push_str(&format!(
                 "[[frame]] # guessed: no hand link; the far end of the forearm ({why})\n\
                  name = {}\nparent = {}\nxyz = [{:?}, {:?}, {:?}]\n\n",
                 quote(key),
-                quote(parent),
+                quote(&t.names[*parent]),
                 tenth_mm(xyz.x),
                 tenth_mm(xyz.y),
                 tenth_mm(xyz.z),
@@ -633,41 +784,54 @@ pub fn init_profile_toml_at(
         }
     }
     out.push_str("[frames]\n");
-    out.push_str(&format!(
-        "pelvis = {} # guessed: {}\n",
-        quote(&pelvis.name),
-        if pelvis.lower.contains("pelvis") {
-            "named like a pelvis"
-        } else {
-            "the root link"
-        }
-    ));
-    for (key, found) in [
-        ("torso", torso),
-        ("head", head),
-        ("left_hand", left_hand),
-        ("right_hand", right_hand),
+    let (p, why) = &g.pelvis;
+    out.push_str(&format!("pelvis = {} {}\n", quote(&t.names[*p]), mark(why)));
+    for (key, found, end) in [
+        ("torso", &g.torso, &None),
+        ("head", &g.head, &None),
+        ("left_hand", &g.hands[0], &g.hand_ends[0]),
+        ("right_hand", &g.hands[1], &g.hand_ends[1]),
     ] {
-        let end = match key {
-            "left_hand" => left_end.as_ref(),
-            "right_hand" => right_end.as_ref(),
-            _ => None,
-        };
         match (found, end) {
-            (Some(l), _) => out.push_str(&format!(
-                "{key} = {} # guessed: a link named like it\n",
-                quote(&l.name)
-            )),
+            (Some((i, why)), _) => {
+                out.push_str(&format!("{key} = {} {}\n", quote(&t.names[*i]), mark(why)))
+            }
             (None, Some((parent, _, _))) => out.push_str(&format!(
-                "{key} = {} # guessed: the frame added at the end of `{parent}` above\n",
-                quote(key)
+                "{key} = {} # guessed: the frame added at the end of `{}` above\n",
+                quote(key),
+                t.names[*parent]
             )),
-            (None, None) => out.push_str(&format!("# {key} = \"...\" # not found\n")),
+            (None, None) => out.push_str(&format!(
+                "# {key} = \"...\" # not found: pass --{}\n",
+                match key {
+                    "left_hand" | "right_hand" => "hands LEFT,RIGHT",
+                    k => k,
+                }
+            )),
         }
     }
-    out.push_str("\n# Initial joint angles [rad] (joint = angle), e.g. bent knees for a humanoid.\n[posture]\n");
-    match (foot_frames.len() == 2)
-        .then(|| crouch_posture(text, &u, &foot_frames))
+    write_posture(&mut out, text, u, &foot_frames);
+    out.push_str(
+        "\n# Default narrowed ranges [rad] (joint = [lower, upper]).\n[narrow]\n\n\
+         [acceleration]\nper_velocity = 10.0 # guessed: the paper's ratio (180°/s, 1800°/s²)\n\n\
+         # Walking settings (`iktc walk`); left out: 0.1 m steps, 4 cm swing, 0.6 s single and\n\
+         # 0.1 s double support, a push changing the COM velocity by 0.08 m/s.\n\
+         [walk]\n# step_length = 0.1\n# swing_height = 0.04\n# ssp_duration = 0.6\n# dsp_duration = 0.1\n\
+         # push = { time = 2.15, impulse = [5.0, 0.0] }\n\n\
+         # Retargeting maps per motion format (built-in name or TOML file relative to this file).\n\
+         [imitate.maps]\n# deepmimic = \"my_deepmimic_map.toml\"\n",
+    );
+    out
+}
+
+/// The `[posture]` table: the crouch for a floating biped ([`crouch_posture`]).
+fn write_posture(out: &mut String, text: &str, u: &urdf_rs::Robot, feet: &[String]) {
+    out.push_str(
+        "\n# Initial joint angles [rad] (joint = angle), e.g. bent knees for a humanoid.\n[posture]\n",
+    );
+    let names: Vec<&str> = feet.iter().map(String::as_str).collect();
+    match (names.len() == 2)
+        .then(|| crouch_posture(text, u, &names))
         .flatten()
     {
         Some(posture) => {
@@ -680,65 +844,16 @@ pub fn init_profile_toml_at(
                 out.push_str(&format!("{} = {value:?}\n", quote(&name)));
             }
         }
-        None if foot_frames.len() == 2 => out.push_str(
+        None if names.len() == 2 => out.push_str(
             "# not guessed: the legs' joints could not bend the knees with the feet in place\n",
         ),
         None => {}
     }
-    out.push_str(
-        "\n# Default narrowed ranges [rad] (joint = [lower, upper]).\n[narrow]\n\n\
-         [acceleration]\nper_velocity = 10.0 # guessed: the paper's ratio (180°/s, 1800°/s²)\n\n\
-         # Walking settings (`iktc walk`); left out: 0.1 m steps, 4 cm swing, 0.6 s single and\n\
-         # 0.1 s double support, a push changing the COM velocity by 0.08 m/s.\n\
-         [walk]\n# step_length = 0.1\n# swing_height = 0.04\n# ssp_duration = 0.6\n# dsp_duration = 0.1\n\
-         # push = { time = 2.15, impulse = [5.0, 0.0] }\n\n\
-         # Retargeting maps per motion format (built-in name or TOML file relative to this file).\n\
-         [imitate.maps]\n# deepmimic = \"my_deepmimic_map.toml\"\n",
-    );
-    Ok(out)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// A box foot 0.2 × 0.08 m whose underside is 0.05 m below the frame, centred 0.03 m ahead
-    /// of it, with a toe tip raised 0.02 m (above the sole band) reaching 0.05 m further and an
-    /// ankle housing above: the sole is the underside's rectangle.
-    #[test]
-    fn the_sole_of_a_mesh_is_its_underside() {
-        let mut v = Vec::new();
-        for x in [-0.07, 0.13] {
-            for y in [-0.04, 0.04] {
-                v.push(Vector3::new(x, y, -0.05));
-                v.push(Vector3::new(x, y, 0.0));
-            }
-        }
-        v.push(Vector3::new(0.18, 0.0, -0.05 + 2.0 * SOLE_BAND));
-        v.push(Vector3::new(0.0, 0.06, 0.1));
-        let (l, w, off, ankle) = sole_from_vertices(&v).unwrap();
-        for (got, want) in [(l, 0.2), (w, 0.08), (off, 0.03), (ankle, 0.05)] {
-            assert!((got - want).abs() < 1e-12, "{got} {want}");
-        }
-        // A mesh entirely above the frame has no sole below it, nor one whose lowest vertex is
-        // at the frame's height (an ankle height of 0).
-        let above: Vec<_> = v.iter().map(|p| p + Vector3::z()).collect();
-        assert!(sole_from_vertices(&above).is_none());
-        let level: Vec<_> = v.iter().map(|p| p + 0.05 * Vector3::z()).collect();
-        assert!(sole_from_vertices(&level).is_none());
-        assert!(sole_from_vertices(&[]).is_none());
-        // An underside that is a line (no width) or a point across (no length) is no sole.
-        let line = [
-            Vector3::new(-0.07, 0.0, -0.05),
-            Vector3::new(0.13, 0.0, -0.05),
-        ];
-        assert!(sole_from_vertices(&line).is_none());
-        let across = [
-            Vector3::new(0.0, -0.04, -0.05),
-            Vector3::new(0.0, 0.04, -0.05),
-        ];
-        assert!(sole_from_vertices(&across).is_none());
-    }
 
     /// A biped whose feet are marked by contact spheres on links fixed below the ankle (toe and
     /// heel points, named like feet), and whose hands are end-effector links named by an arm

@@ -80,14 +80,23 @@ mod glob;
 mod init;
 mod load;
 mod schema;
+mod shape;
+#[cfg(test)]
+mod shape_tests;
+mod sole;
 mod walk;
 
 pub use build::{check_map_joints, MISSING};
 pub use glob::glob_match;
-pub use init::{init_profile_toml, init_profile_toml_at, urdf_key, CROUCH, SOLE_BAND};
+pub use init::{
+    init_profile_toml, init_profile_toml_at, init_profile_toml_with, urdf_key, InitOptions, CROUCH,
+    FOREARM_JOINTS,
+};
 pub use load::{builtin_profile_text, BUILTIN_PROFILES};
 pub use schema::{
     AccelerationProfile, AddedFrame, BodyFrames, Feet, Foot, ImitateProfile, JerkProfile, LockRule,
     ProfileOrigin, PushProfile, RobotProfile, Sole, WalkProfile, DEFAULT_ACCELERATION_PER_VELOCITY,
 };
+pub use shape::{MIDLINE, MIN_ARM_JOINTS, MIN_DROP, MIN_LEG_JOINTS};
+pub use sole::{LONG_SOLE, NARROW_SOLE, SOLE_BAND};
 pub use walk::DEFAULT_PUSH_VELOCITY_CHANGE;
