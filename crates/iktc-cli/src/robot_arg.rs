@@ -36,7 +36,8 @@ pub struct RobotOptions {
 /// overrides its profile key, and gives it for a URDF without a profile.
 #[derive(clap::Args, Debug, Clone, Default)]
 pub struct ProfileFlags {
-    /// Foot frames RIGHT,LEFT (profile keys `feet.right.frame`, `feet.left.frame`).
+    /// Foot frames LEFT,RIGHT (profile keys `feet.left.frame`, `feet.right.frame`), in the order
+    /// `iktc profile init --feet` takes them.
     #[arg(long = "feet", value_delimiter = ',')]
     pub feet: Vec<String>,
     /// Sole rectangle LENGTH,WIDTH[,OFFSET_X] in the foot frame [m] (profile keys
@@ -172,9 +173,9 @@ fn apply_flags(
         return Ok(keys);
     };
     if !f.feet.is_empty() {
-        let [right, left] = &f.feet[..] else {
+        let [left, right] = &f.feet[..] else {
             anyhow::bail!(
-                "--feet `{}`: expected two foot frames RIGHT,LEFT (profile keys `feet.right.frame`, `feet.left.frame`)",
+                "--feet `{}`: expected two foot frames LEFT,RIGHT (profile keys `feet.left.frame`, `feet.right.frame`)",
                 f.feet.join(",")
             );
         };
@@ -220,7 +221,7 @@ fn apply_flags(
             keys.push(("feet.right.ankle_height".into(), "--ankle-height"));
         }
     } else if f.sole.is_some() || f.ankle_height.is_some() {
-        anyhow::bail!("--sole and --ankle-height need the foot frames: pass --feet RIGHT,LEFT (profile keys `feet.right.frame`, `feet.left.frame`)");
+        anyhow::bail!("--sole and --ankle-height need the foot frames: pass --feet LEFT,RIGHT (profile keys `feet.left.frame`, `feet.right.frame`)");
     }
     if let Some(pelvis) = &f.pelvis {
         p.frames.pelvis = Some(pelvis.trim().to_string());
@@ -260,7 +261,7 @@ fn apply_flags(
 const FLAG_OF_KEY: [(&str, &str); 5] = [
     (
         "feet",
-        "--feet RIGHT,LEFT --sole LENGTH,WIDTH[,OFFSET_X] --ankle-height H",
+        "--feet LEFT,RIGHT --sole LENGTH,WIDTH[,OFFSET_X] --ankle-height H",
     ),
     ("frames.pelvis", "--pelvis FRAME"),
     ("imitate.maps", "--map NAME|FILE"),

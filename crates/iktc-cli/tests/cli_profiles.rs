@@ -299,7 +299,7 @@ fn a_bare_urdf_names_the_missing_flag_and_key() {
     // And the command that guesses every missing key into a profile.
     assert!(e.contains(&format!("`iktc profile init {u} --out ")), "{e}");
     // With feet but no sole.
-    let feet = "right_ankle_roll_link,left_ankle_roll_link";
+    let feet = "left_ankle_roll_link,right_ankle_roll_link";
     let o = run(&["imitate", "--robot", u, "--feet", feet]);
     let e = stderr(&o);
     assert!(e.contains("--sole") && e.contains("feet.left.sole"), "{e}");
@@ -342,7 +342,7 @@ fn a_wrong_name_from_a_flag_names_the_flag_the_key_and_the_valid_names() {
         "--robot",
         u,
         "--feet",
-        "right_ankle_roll_link,left_ankle_roll_link",
+        "left_ankle_roll_link,right_ankle_roll_link",
         "--sole",
         "0.17,0.05,0.035",
         "--ankle-height",
