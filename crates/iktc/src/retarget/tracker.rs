@@ -1192,10 +1192,9 @@ mod tests {
     }
 
     /// With a posture weight the posture rows (one per active joint, 29 on G1) follow the
-    /// hands' positions (3 rows each) in the fifth level, and with a body weight so do the
-    /// elbows (3 rows each) and the torso's orientation (3); with a body weight of 0 those
-    /// make the sixth level. With a posture weight of 0 the posture has a level of its own,
-    /// last.
+    /// hands' positions (3 rows each) in the fifth level; the elbows (3 rows each) and the
+    /// torso's orientation (3) make the sixth, or join the fifth with a body weight. With a
+    /// posture weight of 0 the posture has a level of its own, last.
     #[test]
     fn the_posture_rows_share_the_hands_level() {
         let stance = [FootMode::Stance, FootMode::Stance];
@@ -1207,26 +1206,25 @@ mod tests {
             ("stance_feet", 12),
             ("com_xy", 2),
             ("pelvis", 6),
-            ("hands_swing_feet", 6 + 6 + 3 + 29),
-        ];
-        assert_eq!(levels(&stack), named(&want));
-        let separate = KeypointSettings {
-            body_weight: 0.0,
-            ..s.clone()
-        };
-        let stack =
-            build_stack(&robot, &state, &body, c.plan(), &names, &separate, stance).unwrap();
-        let want = [
-            ("stance_feet", 12),
-            ("com_xy", 2),
-            ("pelvis", 6),
             ("hands_swing_feet", 6 + 29),
             ("elbows_head_torso", 6 + 3),
         ];
         assert_eq!(levels(&stack), named(&want));
+        let weighted = KeypointSettings {
+            body_weight: 0.2,
+            ..s.clone()
+        };
+        let stack =
+            build_stack(&robot, &state, &body, c.plan(), &names, &weighted, stance).unwrap();
+        let want = [
+            ("stance_feet", 12),
+            ("com_xy", 2),
+            ("pelvis", 6),
+            ("hands_swing_feet", 6 + 6 + 3 + 29),
+        ];
+        assert_eq!(levels(&stack), named(&want));
         let s0 = KeypointSettings {
             posture_weight: 0.0,
-            body_weight: 0.0,
             ..s
         };
         let stack = build_stack(&robot, &state, &body, c.plan(), &names, &s0, stance).unwrap();
@@ -1246,11 +1244,7 @@ mod tests {
     /// a body with only a torso, or only elbows, has it.
     #[test]
     fn the_sixth_level_is_there_only_with_a_task() {
-        // The sixth level is the body weight 0's.
-        let s = KeypointSettings {
-            body_weight: 0.0,
-            ..KeypointSettings::default()
-        };
+        let s = KeypointSettings::default();
         let (robot, state, body, c, names) = g1(&s);
         let hands_only = RobotBody {
             torso: None,
