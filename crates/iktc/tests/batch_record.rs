@@ -230,7 +230,15 @@ fn leftovers_of_an_interrupted_batch_are_removed_and_clips_kept() {
     std::fs::create_dir_all(dir.join("sub/clip")).unwrap();
     std::fs::write(dir.join("sub/clip").join(RECORD_FILE), "r").unwrap();
     std::fs::write(dir.join("sub/clip/motion.csv"), "whole").unwrap();
+    // A user's files are kept: a name that ends in `.tmp` without the leading dot, a hidden
+    // file with another ending.
+    std::fs::write(dir.join("notes.tmp"), "mine").unwrap();
+    std::fs::write(dir.join(".hidden"), "mine").unwrap();
     remove_leftovers(&dir).unwrap();
+    assert!(dir.join("notes.tmp").is_file() && dir.join(".hidden").is_file());
+    // A missing folder has nothing left over; a file is not a folder to clean.
+    assert!(remove_leftovers(&dir.join("missing")).is_ok());
+    assert!(remove_leftovers(&dir.join("notes.tmp")).is_err());
     assert!(!dir.join("sub/.clip.99.tmp").exists());
     assert!(!dir.join(".other.99.old").exists());
     assert!(!dir.join(".batch.json.99.tmp").exists());
