@@ -3,21 +3,27 @@
 //! ([`iktc::batch::run_parallel`]) through [`BatchRetarget::retarget`] (keypoint retargeting
 //! by default, `--retarget joints` for the joint-angle route) and gets its own folder
 //! `OUT/<clip>/` with `motion.csv`, `motion.npz`, `quality.json` and `viewer.html`; a clip that
-//! fails is listed with its error and the batch goes on. Every file is written to a temporary
-//! name and renamed, and `.settings` (the settings hash) is written last: a clip is skipped on a
-//! re-run when its `.settings` holds the same hash and is newer than its input (`--force` redoes
-//! it). `OUT/index.html` is the dataset report, `OUT/batch.json` the list of clips and errors.
+//! fails is listed with its error (its earlier folder removed) and the batch goes on. Clips are
+//! found by [`iktc::batch::discover`]. A clip's folder is written beside its place and renamed
+//! into it whole, its `.record` last ([`iktc::batch::write_clip_folder`]): a clip is skipped
+//! on a re-run when its `.record` holds the digest of its input's bytes, the robot's files,
+//! the settings and the version ([`iktc::batch::clip_record`]) and its files are all there
+//! (`--force` redoes it). SIGINT or SIGTERM stops the batch taking clips: the clips in hand
+//! finish, and the report lists the clips not run (a second signal ends the process at once).
+//! `OUT/index.html` is the dataset report, `OUT/batch.json` the list of clips and errors.
 
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
-use std::time::{Instant, SystemTime};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::Instant;
 
 use anyhow::{Context, Result};
 use iktc::batch::{
-    longest_first, run_parallel_in, BatchRetarget, ClipOutcome, ClipRun, RetargetMethod,
+    clip_record, discover, is_done, longest_first, remove_leftovers, run_parallel_until,
+    write_clip_folder, BatchRetarget, ClipInput, ClipOutcome, ClipRun, RetargetMethod,
 };
 use iktc::mesh::MeshSet;
-use iktc::profile::glob_match;
 use iktc::sim::viewer::imitation_viewer;
 use serde::Serialize;
 
@@ -56,23 +62,9 @@ pub struct Args {
     pub no_viewer: bool,
 }
 
-/// Motion file extensions taken from folders.
-/// (CSV files of named points are read when named, not taken from folders, where CSV files of
-/// other kinds are common.)
-pub const MOTION_EXTENSIONS: [&str; 5] = ["bvh", "amc", "c3d", "txt", "json"];
-
-/// Files of one clip, in the order they are written (`.settings` last).
+/// Files of one clip besides its viewer.
 const OUTPUTS: [&str; 3] = ["motion.csv", "motion.npz", "quality.json"];
-const SETTINGS_FILE: &str = ".settings";
-
-/// One input clip: its file and its output name (a relative path without extension).
-#[derive(Debug, Clone)]
-pub struct ClipInput {
-    /// The motion file.
-    pub path: PathBuf,
-    /// Output folder name under `--out`.
-    pub name: String,
-}
+const VIEWER: &str = "viewer.html";
 
 /// What became of a clip.
 #[derive(Debug, Clone, Serialize)]
@@ -81,7 +73,8 @@ pub struct ClipStatus {
     pub name: String,
     /// Input file.
     pub input: String,
-    /// `retargeted`, `skipped` (up to date) or `failed`.
+    /// `retargeted`, `skipped` (up to date), `failed` or `interrupted` (not run: the batch
+    /// was stopped by a signal).
     pub status: &'static str,
     /// The error of a failed clip.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -93,12 +86,19 @@ pub struct ClipStatus {
     /// Quality figures (from quality.json for a skipped clip).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub figures: Option<serde_json::Value>,
+    /// The files of the clip's folder (names), for the report's links.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub files: Vec<String>,
 }
 
 /// `batch.json`.
 #[derive(Debug, Serialize)]
 struct BatchFile<'a> {
     settings_hash: &'a str,
+    /// [`BatchRetarget::dependency_digest`].
+    dependencies: &'a str,
+    /// Whether a signal stopped the batch.
+    interrupted: bool,
     robot: &'a str,
     clips: &'a [ClipStatus],
 }
@@ -116,6 +116,75 @@ pub fn run(a: &Args) -> Result<()> {
     if let Some(r) = a.rate {
         iktc::resources::check_output_rate("--rate", r)?;
     }
+    let (batch, robot) = batch_of(a)?;
+    let found = discover(&a.inputs, Some(&a.out));
+    if !found.output_folders.is_empty() {
+        let names: Vec<String> = found
+            .output_folders
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect();
+        eprintln!(
+            "not searched: {} folder(s) of iktc output ({})",
+            names.len(),
+            names.join(", ")
+        );
+    }
+    let mut statuses: Vec<ClipStatus> = found
+        .problems
+        .iter()
+        .map(|p| status(&p.path, &p.path, "failed", Some(p.message.clone())))
+        .collect();
+    std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
+    remove_leftovers(&a.out)?;
+    let hash = batch.settings_hash();
+    let dependencies = batch.dependency_digest()?;
+    let mut outputs = OUTPUTS.to_vec();
+    if !a.no_viewer {
+        outputs.push(VIEWER);
+    }
+    let mut todo: Vec<(ClipInput, String)> = Vec::new();
+    for c in found.clips {
+        let dir = a.out.join(&c.name);
+        let mut s = status(&c.name, &c.path.display().to_string(), "skipped", None);
+        match clip_record(&dependencies, &c.path) {
+            Err(e) => {
+                s.status = "failed";
+                s.error = Some(e.to_string());
+                statuses.push(s);
+            }
+            Ok(r) if !a.force && is_done(&dir, &r, &outputs) => {
+                s.figures = read_figures(&dir);
+                s.files = files_of(&dir);
+                statuses.push(s);
+            }
+            Ok(r) => todo.push((c, r)),
+        }
+    }
+    let skipped = statuses.iter().filter(|s| s.status == "skipped").count();
+    let stop = stop_on_signal()?;
+    let done = run_clips(a, &batch, &todo, skipped, jobs, &stop, &hash);
+    let interrupted = done.len() < todo.len();
+    for (i, (c, _)) in todo.iter().enumerate() {
+        if !done.iter().any(|s| s.0 == i) {
+            let input = c.path.display().to_string();
+            statuses.push(status(&c.name, &input, "interrupted", None));
+        }
+    }
+    statuses.extend(done.into_iter().map(|(_, s)| s));
+    statuses.sort_by(|x, y| x.name.cmp(&y.name));
+    let summary = BatchFile {
+        settings_hash: &hash,
+        dependencies: &dependencies,
+        interrupted,
+        robot: &robot,
+        clips: &statuses,
+    };
+    write_summary(&a.out, &summary)
+}
+
+/// The batch of the command's robot, profile and settings, and the robot's name as given.
+fn batch_of(a: &Args) -> Result<(BatchRetarget, String)> {
     let (resolved, mut config) = prepare_config(&a.scenario)?;
     a.keypoints.apply(a.retarget, &mut config)?;
     let profile = resolved
@@ -150,32 +219,39 @@ pub fn run(a: &Args) -> Result<()> {
     if batch.method == RetargetMethod::Keypoints {
         batch.keypoints.validate()?;
     }
-    let (clips, mut statuses, outputs) = discover(&a.inputs, Some(&a.out));
-    if !outputs.is_empty() {
-        let names: Vec<String> = outputs.iter().map(|p| p.display().to_string()).collect();
+    Ok((batch, resolved.source))
+}
+
+/// A flag set by the first SIGINT or SIGTERM (the batch then takes no more clips); a second
+/// one ends the process at once (the clips in hand leave only temporary folders, removed by
+/// the next run).
+fn stop_on_signal() -> Result<Arc<AtomicBool>> {
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = Arc::clone(&stop);
+    ctrlc::set_handler(move || {
+        if flag.swap(true, Ordering::SeqCst) {
+            eprintln!("\nstopped at once; the clips in hand are left out");
+            std::process::exit(130);
+        }
         eprintln!(
-            "not searched: {} folder(s) of iktc output ({})",
-            outputs.len(),
-            names.join(", ")
+            "\ninterrupted: finishing the clips in hand, taking no more (a second signal stops at once)"
         );
-    }
-    std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
-    remove_temporaries(&a.out)?;
-    let hash = batch.settings_hash();
-    let (todo, skipped): (Vec<ClipInput>, Vec<ClipInput>) = clips
-        .into_iter()
-        .partition(|c| a.force || !up_to_date(&a.out.join(&c.name), &c.path, &hash));
-    for c in &skipped {
-        statuses.push(ClipStatus {
-            name: c.name.clone(),
-            input: c.path.display().to_string(),
-            status: "skipped",
-            error: None,
-            seconds: 0.0,
-            frames: 0,
-            figures: read_figures(&a.out.join(&c.name)),
-        });
-    }
+    })
+    .context("installing the SIGINT/SIGTERM handler")?;
+    Ok(stop)
+}
+
+/// Runs the clips of `todo` (each with its record) until done or `stop`; returns the status of
+/// every clip that ran, with its index in `todo`.
+fn run_clips(
+    a: &Args,
+    batch: &BatchRetarget,
+    todo: &[(ClipInput, String)],
+    skipped: usize,
+    jobs: usize,
+    stop: &AtomicBool,
+    hash: &str,
+) -> Vec<(usize, ClipStatus)> {
     // The robot's meshes, read once for every clip's viewer.
     let meshes = if a.no_viewer || todo.is_empty() {
         None
@@ -183,118 +259,129 @@ pub fn run(a: &Args) -> Result<()> {
         crate::viewer::robot_meshes(&batch.profile)
     };
     let viewer = (!a.no_viewer).then_some(meshes.as_ref());
-    let mut progress = Progress::new(&todo, skipped.len());
+    let clips: Vec<&ClipInput> = todo.iter().map(|(c, _)| c).collect();
+    let mut progress = Progress::new(&clips, skipped);
     // The longest clips first (by file size), so that a long clip does not run alone at the end.
-    let order = longest_first(&todo, |c| {
+    let order = longest_first(todo, |(c, _)| {
         std::fs::metadata(&c.path).map(|m| m.len()).unwrap_or(0)
     });
-    run_parallel_in(
-        &todo,
+    let mut done = Vec::new();
+    run_parallel_until(
+        todo,
         &order,
         jobs,
-        |_, c| {
+        stop,
+        |_, (c, record)| {
             let start = Instant::now();
-            let r = retarget_one(&batch, c, &a.out.join(&c.name), &hash, viewer);
+            let dir = a.out.join(&c.name);
+            let r = retarget_one(batch, c, &dir, hash, record, viewer);
+            if r.is_err() {
+                // An earlier folder of a clip that now fails no longer describes its input.
+                let _ = std::fs::remove_dir_all(&dir);
+            }
             (r, start.elapsed().as_secs_f64())
         },
         |i, r| {
-            let c = &todo[i];
-            let (status, seconds) = match r {
-                Ok((Ok((frames, figures)), s)) => (
-                    ClipStatus {
-                        name: c.name.clone(),
-                        input: c.path.display().to_string(),
-                        status: "retargeted",
-                        error: None,
-                        seconds: s,
-                        frames,
-                        figures: Some(figures),
-                    },
-                    s,
-                ),
-                Ok((Err(e), s)) => (failed(c, format!("{e:#}"), s), s),
-                Err(panic) => (failed(c, format!("internal error: {panic}"), 0.0), 0.0),
+            let c = &todo[i].0;
+            let input = c.path.display().to_string();
+            let (s, seconds) = match r {
+                Ok((Ok((frames, figures, files)), s)) => {
+                    let mut st = status(&c.name, &input, "retargeted", None);
+                    (st.seconds, st.frames) = (s, frames);
+                    (st.figures, st.files) = (Some(figures), files);
+                    (st, s)
+                }
+                Ok((Err(e), s)) => {
+                    let mut st = status(&c.name, &input, "failed", Some(format!("{e:#}")));
+                    st.seconds = s;
+                    (st, s)
+                }
+                Err(panic) => {
+                    let e = format!("internal error: {panic}");
+                    (status(&c.name, &input, "failed", Some(e)), 0.0)
+                }
             };
-            progress.done(i, &status, seconds);
-            statuses.push(status);
+            progress.done(i, &s, seconds);
+            done.push((i, s));
         },
     );
     progress.finish();
-    statuses.sort_by(|x, y| x.name.cmp(&y.name));
+    done
+}
+
+/// Writes `batch.json` and `index.html` and prints the counts; an error if a clip failed or
+/// the batch was interrupted.
+fn write_summary(out: &Path, summary: &BatchFile<'_>) -> Result<()> {
+    let statuses = summary.clips;
     write_atomic(
-        &a.out.join("batch.json"),
-        crate::finite::to_json(
-            "batch.json",
-            &BatchFile {
-                settings_hash: &hash,
-                robot: &resolved.source,
-                clips: &statuses,
-            },
-        )?
-        .as_bytes(),
+        &out.join("batch.json"),
+        crate::finite::to_json("batch.json", summary)?.as_bytes(),
     )?;
-    let html = crate::retarget_report::render(&statuses, &resolved.source, !a.no_viewer);
-    write_atomic(&a.out.join("index.html"), html.as_bytes())?;
+    let html = crate::retarget_report::render(statuses, summary.robot);
+    write_atomic(&out.join("index.html"), html.as_bytes())?;
     let count = |s: &str| statuses.iter().filter(|c| c.status == s).count();
-    let failed_count = count("failed");
+    let (failed, not_run) = (count("failed"), count("interrupted"));
     crate::outln!(
-        "{} clips: {} retargeted, {} skipped (up to date), {} failed; report {}",
+        "{} clips: {} retargeted, {} skipped (up to date), {} failed, {} not run; report {}",
         statuses.len(),
         count("retargeted"),
         count("skipped"),
-        failed_count,
-        a.out.join("index.html").display()
+        failed,
+        not_run,
+        out.join("index.html").display()
     )?;
-    if failed_count > 0 {
+    if not_run > 0 {
         anyhow::bail!(
-            "{failed_count} of {} clips failed (listed in {})",
+            "interrupted: {not_run} of {} clips not run, {failed} failed (listed in {})",
             statuses.len(),
-            a.out.join("index.html").display()
+            out.join("batch.json").display()
+        );
+    }
+    if failed > 0 {
+        anyhow::bail!(
+            "{failed} of {} clips failed (listed in {})",
+            statuses.len(),
+            out.join("index.html").display()
         );
     }
     Ok(())
 }
 
-fn failed(c: &ClipInput, error: String, seconds: f64) -> ClipStatus {
+fn status(name: &str, input: &str, status: &'static str, error: Option<String>) -> ClipStatus {
     ClipStatus {
-        name: c.name.clone(),
-        input: c.path.display().to_string(),
-        status: "failed",
-        error: Some(error),
-        seconds,
+        name: name.to_string(),
+        input: input.to_string(),
+        status,
+        error,
+        seconds: 0.0,
         frames: 0,
         figures: None,
+        files: Vec::new(),
     }
 }
 
-/// Retargets one clip and writes its files; returns its frame count and quality figures.
+/// Retargets one clip and writes its folder whole ([`write_clip_folder`], `record` last);
+/// returns its frame count, quality figures and the names of the files written.
 fn retarget_one(
     batch: &BatchRetarget,
     c: &ClipInput,
     dir: &Path,
     hash: &str,
+    record: &str,
     viewer: Option<Option<&MeshSet>>,
-) -> Result<(usize, serde_json::Value)> {
-    // A stale marker must not vouch for files being replaced, nor for a clip that now fails.
-    let marker = dir.join(SETTINGS_FILE);
-    if marker.exists() {
-        std::fs::remove_file(&marker).with_context(|| format!("removing {}", marker.display()))?;
-    }
+) -> Result<(usize, serde_json::Value, Vec<String>)> {
     let outcome = batch.retarget(&c.path)?;
     let ClipOutcome {
         run,
         trajectory,
         quality,
     } = &outcome;
-    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    remove_temporaries(dir)?;
-    write_atomic(&dir.join(OUTPUTS[0]), trajectory.csv().as_bytes())?;
-    write_atomic(&dir.join(OUTPUTS[1]), &trajectory.npz()?)?;
     let figures = serde_json::to_value(quality)?;
     let doc = serde_json::json!({
         "clip": c.name,
         "input": c.path.display().to_string(),
         "settings_hash": hash,
+        "record": record,
         "output_rate_hz": trajectory.fps,
         "frames": trajectory.len(),
         "quaternion_order": "x, y, z, w",
@@ -305,10 +392,14 @@ fn retarget_one(
         "figures": figures,
         "summary": outcome.summary()?,
     });
-    write_atomic(
-        &dir.join(OUTPUTS[2]),
-        crate::finite::to_json("quality.json", &doc)?.as_bytes(),
-    )?;
+    let mut files: Vec<(&str, Vec<u8>)> = vec![
+        (OUTPUTS[0], trajectory.csv().into_bytes()),
+        (OUTPUTS[1], trajectory.npz()?),
+        (
+            OUTPUTS[2],
+            crate::finite::to_json("quality.json", &doc)?.into_bytes(),
+        ),
+    ];
     if let Some(meshes) = viewer {
         let mut data = match run {
             ClipRun::Keypoints { keypoints, run, .. } => iktc::retarget::keypoint_viewer(
@@ -320,11 +411,18 @@ fn retarget_one(
             ClipRun::Joints { experiment, run } => imitation_viewer(run, experiment)?,
         };
         crate::viewer::attach(&mut data, &batch.robot, meshes)?;
-        let html = crate::viewer::render_viewer(&data)?;
-        write_atomic(&dir.join("viewer.html"), html.as_bytes())?;
+        files.push((VIEWER, crate::viewer::render_viewer(&data)?.into_bytes()));
     }
-    write_atomic(&marker, format!("{hash}\n").as_bytes())?;
-    Ok((trajectory.len(), figures))
+    write_clip_folder(dir, record, |tmp| -> Result<()> {
+        for (name, bytes) in &files {
+            let p = tmp.join(name);
+            std::fs::write(&p, bytes).with_context(|| format!("writing {}", p.display()))?;
+        }
+        Ok(())
+    })
+    .with_context(|| format!("writing the folder {}", dir.display()))?;
+    let names = files.iter().map(|(n, _)| n.to_string()).collect();
+    Ok((trajectory.len(), figures, names))
 }
 
 /// Writes `bytes` to a temporary file beside `path`, then renames it over `path`: a reader
@@ -340,196 +438,19 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
         .with_context(|| format!("renaming {} to {}", tmp.display(), path.display()))
 }
 
-/// Removes the temporary files an interrupted batch left in `dir` (`.NAME.PID.tmp`).
-fn remove_temporaries(dir: &Path) -> Result<()> {
-    for e in std::fs::read_dir(dir).with_context(|| format!("reading {}", dir.display()))? {
-        let p = e?.path();
-        let name = p.file_name().map(|n| n.to_string_lossy().into_owned());
-        if name.is_some_and(|n| n.starts_with('.') && n.ends_with(".tmp")) && p.is_file() {
-            std::fs::remove_file(&p).with_context(|| format!("removing {}", p.display()))?;
-        }
-    }
-    Ok(())
-}
-
-fn modified(p: &Path) -> Option<SystemTime> {
-    std::fs::metadata(p).and_then(|m| m.modified()).ok()
-}
-
-/// Whether the clip's outputs in `dir` were made from `input` with the settings `hash` and
-/// after the input last changed.
-fn up_to_date(dir: &Path, input: &Path, hash: &str) -> bool {
-    let marker = dir.join(SETTINGS_FILE);
-    let same = std::fs::read_to_string(&marker).is_ok_and(|s| s.trim() == hash);
-    let newer = matches!((modified(&marker), modified(input)), (Some(m), Some(i)) if m >= i);
-    same && newer && OUTPUTS.iter().all(|o| dir.join(o).is_file())
-}
-
 fn read_figures(dir: &Path) -> Option<serde_json::Value> {
     let text = std::fs::read_to_string(dir.join(OUTPUTS[2])).ok()?;
     let v: serde_json::Value = serde_json::from_str(&text).ok()?;
     v.get("figures").cloned()
 }
 
-fn is_motion_file(p: &Path) -> bool {
-    p.extension()
-        .and_then(|e| e.to_str())
-        .is_some_and(|e| MOTION_EXTENSIONS.contains(&e.to_ascii_lowercase().as_str()))
-}
-
-/// Whether `dir` holds what iktc writes: the batch's `--out` folder (`out`), a folder of an
-/// earlier batch (its `batch.json`) or of one of its clips (its settings marker), or the
-/// output of `iktc imitate` (its `keypoints_summary.json`). Their files (`quality.json`,
-/// summaries, trajectories) are not motion to retarget, wherever the output went, so a batch
-/// whose `--out` lies inside its input folder can run again.
-fn is_output_folder(dir: &Path, out: Option<&Path>) -> bool {
-    let same = |a: &Path, b: &Path| match (a.canonicalize(), b.canonicalize()) {
-        (Ok(a), Ok(b)) => a == b,
-        _ => false,
-    };
-    out.is_some_and(|o| same(dir, o))
-        || dir.join("batch.json").is_file()
-        || dir.join(SETTINGS_FILE).is_file()
-        || dir.join("keypoints_summary.json").is_file()
-}
-
-/// Every file under `dir`, sorted, recursively, leaving out the folders of iktc's output
-/// ([`is_output_folder`]), which are counted in `skipped`.
-fn walk(
-    dir: &Path,
-    out_dir: Option<&Path>,
-    out: &mut Vec<PathBuf>,
-    skipped: &mut Vec<PathBuf>,
-) -> std::io::Result<()> {
-    let mut entries: Vec<PathBuf> = std::fs::read_dir(dir)?
-        .map(|e| e.map(|e| e.path()))
-        .collect::<std::io::Result<_>>()?;
-    entries.sort();
-    for p in entries {
-        if p.is_dir() {
-            if is_output_folder(&p, out_dir) {
-                skipped.push(p);
-            } else {
-                walk(&p, out_dir, out, skipped)?;
-            }
-        } else {
-            out.push(p);
-        }
-    }
-    Ok(())
-}
-
-/// `path` relative to `base`, without its extension, with `/` separators.
-fn clip_name(path: &Path, base: &Path) -> String {
-    let rel = path.strip_prefix(base).unwrap_or(path).with_extension("");
-    rel.components()
-        .map(|c| c.as_os_str().to_string_lossy().into_owned())
-        .collect::<Vec<_>>()
-        .join("/")
-}
-
-/// The clips the inputs name, and an error entry for every input that names none (or a clip
-/// whose output name another input already took). Folders and globs are searched without the
-/// folders of iktc's output (`out`, the batch's `--out`, and those of earlier batches), which
-/// are listed in the third value.
-pub fn discover(
-    inputs: &[String],
-    out: Option<&Path>,
-) -> (Vec<ClipInput>, Vec<ClipStatus>, Vec<PathBuf>) {
-    let mut outputs = Vec::new();
-    let mut clips: Vec<ClipInput> = Vec::new();
-    let mut errors = Vec::new();
-    let mut bad = |input: &str, error: String| {
-        errors.push(ClipStatus {
-            name: input.to_string(),
-            input: input.to_string(),
-            status: "failed",
-            error: Some(error),
-            seconds: 0.0,
-            frames: 0,
-            figures: None,
-        })
-    };
-    for input in inputs {
-        let p = Path::new(input);
-        let found: Vec<ClipInput> = if p.is_file() {
-            vec![ClipInput {
-                path: p.to_path_buf(),
-                name: clip_name(p, p.parent().unwrap_or(Path::new(""))),
-            }]
-        } else if p.is_dir() {
-            let mut files = Vec::new();
-            if let Err(e) = walk(p, out, &mut files, &mut outputs) {
-                bad(input, format!("reading folder: {e}"));
-                continue;
-            }
-            files
-                .into_iter()
-                .filter(|f| is_motion_file(f))
-                .map(|f| ClipInput {
-                    name: clip_name(&f, p),
-                    path: f,
-                })
-                .collect()
-        } else if input.contains(['*', '?']) {
-            // The folder before the first wildcard, searched recursively.
-            let base: PathBuf = p
-                .components()
-                .take_while(|c| !c.as_os_str().to_string_lossy().contains(['*', '?']))
-                .collect();
-            let root = if base.as_os_str().is_empty() {
-                PathBuf::from(".")
-            } else {
-                base.clone()
-            };
-            let mut files = Vec::new();
-            if let Err(e) = walk(&root, out, &mut files, &mut outputs) {
-                bad(input, format!("reading folder {}: {e}", root.display()));
-                continue;
-            }
-            files
-                .into_iter()
-                .filter(|f| {
-                    let s = if base.as_os_str().is_empty() {
-                        f.strip_prefix(".").unwrap_or(f)
-                    } else {
-                        f
-                    };
-                    glob_match(input, &s.to_string_lossy())
-                })
-                .map(|f| ClipInput {
-                    name: clip_name(&f, &root),
-                    path: f,
-                })
-                .collect()
-        } else {
-            bad(input, "no such file or folder".into());
-            continue;
-        };
-        if found.is_empty() {
-            bad(
-                input,
-                format!("no motion file (.{}) found", MOTION_EXTENSIONS.join(", .")),
-            );
-        }
-        for c in found {
-            if let Some(other) = clips.iter().find(|o| o.name == c.name) {
-                if other.path != c.path {
-                    bad(
-                        &c.path.display().to_string(),
-                        format!(
-                            "its output name `{}` is taken by {}",
-                            c.name,
-                            other.path.display()
-                        ),
-                    );
-                }
-                continue;
-            }
-            clips.push(c);
-        }
-    }
-    (clips, errors, outputs)
+/// The output files (viewer and [`OUTPUTS`]) that `dir` holds.
+fn files_of(dir: &Path) -> Vec<String> {
+    std::iter::once(VIEWER)
+        .chain(OUTPUTS)
+        .filter(|f| dir.join(f).is_file())
+        .map(str::to_string)
+        .collect()
 }
 
 /// Progress on standard error: a bar redrawn in place with the ETA on a terminal, a log line
@@ -547,7 +468,7 @@ struct Progress {
 }
 
 impl Progress {
-    fn new(todo: &[ClipInput], skipped: usize) -> Self {
+    fn new(todo: &[&ClipInput], skipped: usize) -> Self {
         let bytes: Vec<u64> = todo
             .iter()
             .map(|c| std::fs::metadata(&c.path).map_or(1, |m| m.len().max(1)))

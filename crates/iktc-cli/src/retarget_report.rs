@@ -200,8 +200,11 @@ fn histogram(label: &str, values: &[f64]) -> String {
 }
 
 /// The page.
-pub fn render(clips: &[ClipStatus], robot: &str, viewer: bool) -> String {
-    let mut ok: Vec<&ClipStatus> = clips.iter().filter(|c| c.status != "failed").collect();
+pub fn render(clips: &[ClipStatus], robot: &str) -> String {
+    let mut ok: Vec<&ClipStatus> = clips
+        .iter()
+        .filter(|c| matches!(c.status, "retargeted" | "skipped"))
+        .collect();
     let failed: Vec<&ClipStatus> = clips.iter().filter(|c| c.status == "failed").collect();
     // Worst first: failed checks, then the largest keypoint (or upper-body) error.
     ok.sort_by(|a, b| {
@@ -222,7 +225,7 @@ pub fn render(clips: &[ClipStatus], robot: &str, viewer: bool) -> String {
          </style></head><body>",
     );
     s.push_str(&format!(
-        "<h1>Dataset report</h1><p>Robot: {}. {} clips: {} retargeted, {} up to date (skipped), {} failed. \
+        "<h1>Dataset report</h1><p>Robot: {}. {} clips: {} retargeted, {} up to date (skipped), {} failed, {} not run (batch interrupted). \
          Rows are sorted worst first (checks failed, then the largest mean keypoint error, or upper-body RMS error on the joint route); click a header to sort by it. \
          Checks: on the keypoint route every joint limit kept, on the joint route the run checks (feet held, finite state, COM over the support). \
          Margins are signed: positive means a limit was exceeded.</p>",
@@ -230,7 +233,8 @@ pub fn render(clips: &[ClipStatus], robot: &str, viewer: bool) -> String {
         clips.len(),
         clips.iter().filter(|c| c.status == "retargeted").count(),
         clips.iter().filter(|c| c.status == "skipped").count(),
-        failed.len()
+        failed.len(),
+        clips.iter().filter(|c| c.status == "interrupted").count()
     ));
     s.push_str("<h2>Clips</h2><table id=\"clips\"><thead><tr><th>clip</th><th>checks</th>");
     for (_, label) in &columns {
@@ -260,13 +264,19 @@ pub fn render(clips: &[ClipStatus], robot: &str, viewer: bool) -> String {
                 None => s.push_str("<td data-v=\"\">–</td>"),
             }
         }
+        // Links to the files the clip's folder holds, the viewer first.
         let dir = escape_html(&c.name);
-        let mut links = format!(
-            "<a href=\"{dir}/motion.csv\">csv</a> <a href=\"{dir}/motion.npz\">npz</a> <a href=\"{dir}/quality.json\">quality</a>"
-        );
-        if viewer {
-            links = format!("<a href=\"{dir}/viewer.html\">viewer</a> {links}");
-        }
+        let links: Vec<String> = [
+            ("viewer.html", "viewer"),
+            ("motion.csv", "csv"),
+            ("motion.npz", "npz"),
+            ("quality.json", "quality"),
+        ]
+        .iter()
+        .filter(|(f, _)| c.files.iter().any(|x| x == f))
+        .map(|(f, label)| format!("<a href=\"{dir}/{f}\">{label}</a>"))
+        .collect();
+        let links = links.join(" ");
         s.push_str(&format!("<td>{links}</td></tr>"));
     }
     s.push_str("</tbody></table><h2>Distributions across the dataset</h2>");

@@ -257,7 +257,7 @@ fn batch_of_good_and_bad_clips_skip_force_and_formats() {
             "motion.npz",
             "quality.json",
             "viewer.html",
-            ".settings",
+            ".record",
         ] {
             assert!(out.join(c).join(f).is_file(), "{c}/{f}");
         }
@@ -274,7 +274,7 @@ fn batch_of_good_and_bad_clips_skip_force_and_formats() {
             "{b}: {e}"
         );
         assert!(err.contains(&format!("{b}: FAILED")), "{err}");
-        assert!(!out.join(b).join(".settings").exists());
+        assert!(!out.join(b).exists(), "{b}: no folder for a failed clip");
     }
     let index = std::fs::read_to_string(out.join("index.html")).unwrap();
     assert!(index.contains("Failures (3)"));
@@ -284,7 +284,7 @@ fn batch_of_good_and_bad_clips_skip_force_and_formats() {
     assert!(
         files(&out)
             .iter()
-            .all(|f| !f.to_string_lossy().ends_with(".tmp")),
+            .all(|f| !f.to_string_lossy().contains(".tmp")),
         "temporary files left"
     );
 
@@ -304,7 +304,8 @@ fn batch_of_good_and_bad_clips_skip_force_and_formats() {
     let index = std::fs::read_to_string(out.join("index.html")).unwrap();
     assert!(index.contains("humanoid3d_walk") && index.contains("data-v="));
 
-    // A touched input is redone, the others skipped.
+    // A touched input (a later time, the same bytes) is skipped; an input replaced by another
+    // clip with an older time (as `cp -p` or `rsync -a` leave it) is redone, from its new bytes.
     let walk = input.join("humanoid3d_walk.txt");
     std::fs::File::options()
         .append(true)
@@ -312,11 +313,26 @@ fn batch_of_good_and_bad_clips_skip_force_and_formats() {
         .unwrap()
         .set_modified(SystemTime::now() + std::time::Duration::from_secs(5))
         .unwrap();
+    let punch = input.join("humanoid3d_punch.txt");
+    let old_time = mtime(&punch) - std::time::Duration::from_secs(3600 * 24 * 365);
+    std::fs::copy(data().join("humanoid3d_dance_a.txt"), &punch).unwrap();
+    std::fs::File::options()
+        .append(true)
+        .open(&punch)
+        .unwrap()
+        .set_modified(old_time)
+        .unwrap();
     let o = retarget(&[input.to_str().unwrap(), "--out", out.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(1));
     let st = statuses(&out);
-    assert_eq!(st["humanoid3d_walk"], "retargeted");
-    assert_eq!(st["humanoid3d_punch"], "skipped");
+    assert_eq!(st["humanoid3d_walk"], "skipped");
+    assert_eq!(st["humanoid3d_punch"], "retargeted");
+    assert_eq!(
+        read_csv(&out.join("humanoid3d_punch/motion.csv")).1.len(),
+        read_csv(&out.join("humanoid3d_dance_a/motion.csv")).1.len(),
+        "the punch folder holds the dance clip it was replaced by"
+    );
+    std::fs::copy(data().join("humanoid3d_punch.txt"), &punch).unwrap();
 
     // --force redoes every clip; the good ones alone exit 0.
     let goods: Vec<String> = CLIPS
@@ -556,12 +572,7 @@ fn killed_batch_leaves_only_complete_files() {
         .spawn()
         .unwrap();
     let start = std::time::Instant::now();
-    let marked = |out: &Path| {
-        files(out)
-            .iter()
-            .filter(|f| f.ends_with(".settings"))
-            .count()
-    };
+    let marked = |out: &Path| files(out).iter().filter(|f| f.ends_with(".record")).count();
     while !out.is_dir() || marked(&out) == 0 {
         assert!(child.try_wait().unwrap().is_none(), "the batch ended first");
         assert!(start.elapsed().as_secs() < 120);
@@ -571,10 +582,15 @@ fn killed_batch_leaves_only_complete_files() {
     child.wait().unwrap();
     let done = marked(&out);
     assert!(done < 8, "the kill came after the whole batch");
-    // Every file under its final name is complete; a marked clip has all its files.
+    // Every file under its final name, outside the temporary folders, is complete; a marked
+    // clip has all its files.
     for f in files(&out) {
         let name = f.file_name().unwrap().to_string_lossy().into_owned();
-        if name.ends_with(".tmp") {
+        let temporary = f.components().any(|c| {
+            let c = c.as_os_str().to_string_lossy();
+            c.starts_with('.') && c.ends_with(".tmp")
+        });
+        if temporary {
             continue;
         }
         match name.as_str() {
@@ -595,7 +611,7 @@ fn killed_batch_leaves_only_complete_files() {
                     .trim_end()
                     .ends_with("</html>"))
             }
-            ".settings" => {
+            ".record" => {
                 let d = f.parent().unwrap();
                 for o in ["motion.csv", "motion.npz", "quality.json", "viewer.html"] {
                     assert!(d.join(o).is_file(), "{}", d.join(o).display());
@@ -612,7 +628,7 @@ fn killed_batch_leaves_only_complete_files() {
     assert_eq!(st.values().filter(|s| *s == "retargeted").count(), 8 - done);
     assert!(files(&out)
         .iter()
-        .all(|f| !f.to_string_lossy().ends_with(".tmp")));
+        .all(|f| !f.to_string_lossy().contains(".tmp")));
 }
 
 /// `--standing`: G1's feet (the profile's ankle frames) and pelvis stay where they start while

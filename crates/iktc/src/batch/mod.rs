@@ -3,20 +3,29 @@
 //! its outputs for training code ([`TrainingTrajectory`] as CSV and NPZ, written by
 //! [`npz`] without a dependency), its quality figures ([`ClipQuality`]), and a pool of worker
 //! threads over the clips ([`run_parallel`], the longest clips first with [`longest_first`]).
-//! Files, progress and the dataset report are the command line's (`iktc retarget`).
+//! Finding the clips of files, folders and patterns ([`discover()`]), the record of a finished
+//! clip and writing its folder whole ([`record`]). Progress and the dataset report are the
+//! command line's (`iktc retarget`).
 
+pub mod discover;
 pub mod npz;
 pub mod pool;
 pub mod quality;
+pub mod record;
 pub mod retarget;
 pub mod training;
 
+pub use discover::{
+    discover, is_motion_file, is_output_folder, ClipInput, Discovery, DiscoveryProblem,
+    MOTION_EXTENSIONS, RECORD_FILE,
+};
 pub use npz::{crc32, npz_bytes, zip_stored, NpyArray, NpyData};
-pub use pool::{longest_first, run_parallel, run_parallel_in};
+pub use pool::{longest_first, run_parallel, run_parallel_in, run_parallel_until};
 pub use quality::{
     run_penetration, sole_penetration, trajectory_penetration, ClipQuality, JointFigures,
     KeypointFigures, Penetration, MARGIN_ROUNDING, PENETRATION_TOLERANCE,
 };
+pub use record::{clip_record, is_done, remove_leftovers, write_clip_folder};
 pub use retarget::{
     body_frames, posture_references, BatchRetarget, ClipOutcome, ClipRun, Posture, RetargetMethod,
     DEFAULT_RETARGET_METHOD, MIN_CLIP_FRAMES,

@@ -10,7 +10,7 @@
 //! arbitrary order).
 
 use std::panic::{catch_unwind, AssertUnwindSafe};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::mpsc;
 
 /// Runs `work(i, &items[i])` for every item on `jobs` threads (at least 1, at most the
@@ -38,8 +38,27 @@ pub fn longest_first<T>(items: &[T], cost: impl Fn(&T) -> u64) -> Vec<usize> {
 
 /// As [`run_parallel`], the jobs taken in `order` (indices into `items`; each index at most
 /// once, any index out of range skipped); `work` and `done` still receive the item's own index.
-pub fn run_parallel_in<T, R, W, D>(items: &[T], order: &[usize], jobs: usize, work: W, mut done: D)
+pub fn run_parallel_in<T, R, W, D>(items: &[T], order: &[usize], jobs: usize, work: W, done: D)
 where
+    T: Sync,
+    R: Send,
+    W: Fn(usize, &T) -> R + Sync,
+    D: FnMut(usize, Result<R, String>),
+{
+    run_parallel_until(items, order, jobs, &AtomicBool::new(false), work, done);
+}
+
+/// As [`run_parallel_in`], no job taken once `stop` is set (e.g. by a signal handler): the
+/// jobs running then finish and are reported, the jobs not yet taken are not run (nor
+/// reported).
+pub fn run_parallel_until<T, R, W, D>(
+    items: &[T],
+    order: &[usize],
+    jobs: usize,
+    stop: &AtomicBool,
+    work: W,
+    mut done: D,
+) where
     T: Sync,
     R: Send,
     W: Fn(usize, &T) -> R + Sync,
@@ -53,7 +72,10 @@ where
             let tx = tx.clone();
             let (next, work) = (&next, &work);
             scope.spawn(move || {
-                while let Some(&i) = order.get(next.fetch_add(1, Ordering::Relaxed)) {
+                while !stop.load(Ordering::SeqCst) {
+                    let Some(&i) = order.get(next.fetch_add(1, Ordering::Relaxed)) else {
+                        break;
+                    };
                     let Some(item) = items.get(i) else { continue };
                     let r = catch_unwind(AssertUnwindSafe(|| work(i, item))).map_err(|p| {
                         p.downcast_ref::<&str>()
@@ -144,6 +166,29 @@ mod tests {
         };
         assert_eq!(makespan(&[0, 1, 2]), 3);
         assert_eq!(makespan(&longest_first(&costs, |c| *c)), 2);
+    }
+
+    /// A stop set by the third job: one worker runs jobs 0, 1 and 2 and takes no other.
+    #[test]
+    fn no_job_is_taken_after_the_stop() {
+        let items: Vec<usize> = (0..10).collect();
+        let order: Vec<usize> = (0..10).collect();
+        let stop = AtomicBool::new(false);
+        let mut reported = Vec::new();
+        run_parallel_until(
+            &items,
+            &order,
+            1,
+            &stop,
+            |i, _| {
+                if i == 2 {
+                    stop.store(true, Ordering::SeqCst);
+                }
+                i
+            },
+            |i, r| reported.push((i, r.unwrap())),
+        );
+        assert_eq!(reported, vec![(0, 0), (1, 1), (2, 2)]);
     }
 
     #[test]

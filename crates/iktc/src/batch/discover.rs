@@ -1,0 +1,321 @@
+//! Finding the clips of a batch: motion files named directly, folders searched recursively,
+//! and glob patterns ([`discover`]).
+//!
+//! A folder walk follows symbolic links but enters each real folder once (by its canonical
+//! path), so a link cycle ends; a real file reached under several names is taken once, under
+//! the first name in sorted order. An entry that cannot be read (a folder whose listing
+//! fails, a dangling link) is reported by name in [`Discovery::problems`] and the walk goes
+//! on with the others. Folders of iktc's own output ([`is_output_folder`]) are not searched.
+
+use std::collections::HashSet;
+use std::path::{Path, PathBuf};
+
+use crate::profile::glob_match;
+
+/// Motion file extensions taken from folders (lower case; matched without regard to case).
+/// CSV files of named points are read when named, not taken from folders, where CSV files of
+/// other kinds are common.
+pub const MOTION_EXTENSIONS: [&str; 5] = ["bvh", "amc", "c3d", "txt", "json"];
+
+/// The file that marks a finished clip's folder ([`super::record`]).
+pub const RECORD_FILE: &str = ".record";
+
+/// The marker file of clip folders written by earlier versions of iktc.
+const LEGACY_MARKER: &str = ".settings";
+
+/// One input clip: its file and its output name.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ClipInput {
+    /// The motion file, as found (a link is not resolved).
+    pub path: PathBuf,
+    /// Output name: the path relative to the folder searched (or the file name of a file
+    /// given directly), without extension, `/` between folders.
+    pub name: String,
+}
+
+/// An input, or an entry under one, that gave no clip.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct DiscoveryProblem {
+    /// The input, or the entry under a folder, it concerns.
+    pub path: String,
+    /// What is wrong.
+    pub message: String,
+}
+
+/// What [`discover`] found.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Discovery {
+    /// The clips, each real file once, in the inputs' order (a folder's in sorted order).
+    pub clips: Vec<ClipInput>,
+    /// Every input that names no clip, every entry that could not be read, every clip whose
+    /// output name another clip already took.
+    pub problems: Vec<DiscoveryProblem>,
+    /// Folders of iktc's output that were not searched.
+    pub output_folders: Vec<PathBuf>,
+}
+
+/// Whether `p` has one of the [`MOTION_EXTENSIONS`].
+pub fn is_motion_file(p: &Path) -> bool {
+    p.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| MOTION_EXTENSIONS.contains(&e.to_ascii_lowercase().as_str()))
+}
+
+/// Whether `dir` holds what iktc writes: the batch's output folder `out`, a folder of an
+/// earlier batch (its `batch.json`) or of one of its clips (its [`RECORD_FILE`] or the marker
+/// of earlier versions), or the output of `iktc imitate` (its `keypoints_summary.json`).
+pub fn is_output_folder(dir: &Path, out: Option<&Path>) -> bool {
+    let same = |a: &Path, b: &Path| match (a.canonicalize(), b.canonicalize()) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    };
+    out.is_some_and(|o| same(dir, o))
+        || [
+            "batch.json",
+            RECORD_FILE,
+            LEGACY_MARKER,
+            "keypoints_summary.json",
+        ]
+        .iter()
+        .any(|f| dir.join(f).is_file())
+}
+
+/// `path` relative to `base`, without its extension, with `/` separators.
+pub fn clip_name(path: &Path, base: &Path) -> String {
+    let rel = path.strip_prefix(base).unwrap_or(path).with_extension("");
+    rel.components()
+        .map(|c| c.as_os_str().to_string_lossy().into_owned())
+        .collect::<Vec<_>>()
+        .join("/")
+}
+
+/// Lists a folder's entries (paths), as [`std::fs::read_dir`]; a test can put another in.
+type ReadDir<'a> = &'a dyn Fn(&Path) -> std::io::Result<Vec<std::io::Result<PathBuf>>>;
+
+fn read_dir(dir: &Path) -> std::io::Result<Vec<std::io::Result<PathBuf>>> {
+    Ok(std::fs::read_dir(dir)?
+        .map(|e| e.map(|e| e.path()))
+        .collect())
+}
+
+/// One folder walk's state: the real folders entered, and what was found.
+struct Walk<'a> {
+    out: Option<&'a Path>,
+    read: ReadDir<'a>,
+    entered: HashSet<PathBuf>,
+    files: Vec<PathBuf>,
+    problems: Vec<DiscoveryProblem>,
+    output_folders: Vec<PathBuf>,
+}
+
+impl Walk<'_> {
+    fn problem(&mut self, p: &Path, message: String) {
+        self.problems.push(DiscoveryProblem {
+            path: p.display().to_string(),
+            message,
+        });
+    }
+
+    /// Every file under `dir`, sorted, recursively; each real folder entered once.
+    fn folder(&mut self, dir: &Path) {
+        let real = match dir.canonicalize() {
+            Ok(r) => r,
+            Err(e) => return self.problem(dir, format!("cannot read the folder: {e}")),
+        };
+        if !self.entered.insert(real) {
+            return;
+        }
+        let entries = match (self.read)(dir) {
+            Ok(e) => e,
+            Err(e) => return self.problem(dir, format!("cannot read the folder: {e}")),
+        };
+        let mut paths = Vec::with_capacity(entries.len());
+        for e in entries {
+            match e {
+                Ok(p) => paths.push(p),
+                Err(e) => self.problem(dir, format!("cannot read an entry of the folder: {e}")),
+            }
+        }
+        paths.sort();
+        for p in paths {
+            match std::fs::metadata(&p) {
+                Ok(m) if m.is_dir() => {
+                    if is_output_folder(&p, self.out) {
+                        self.output_folders.push(p);
+                    } else {
+                        self.folder(&p);
+                    }
+                }
+                Ok(_) => self.files.push(p),
+                Err(e) => self.problem(&p, format!("cannot read the entry: {e}")),
+            }
+        }
+    }
+}
+
+/// The clips the `inputs` name: files, folders (searched recursively for
+/// [`MOTION_EXTENSIONS`]) and glob patterns (`*` and `?`, `*` crossing folders, searched from
+/// the folder before the first wildcard). Folders of iktc's output ([`is_output_folder`],
+/// `out` the batch's own) are not searched. Each real file gives one clip, under the first
+/// name it is found by; a second file whose output name is taken is a problem, as is every
+/// input that names no clip and every entry that cannot be read.
+pub fn discover(inputs: &[String], out: Option<&Path>) -> Discovery {
+    discover_with(inputs, out, &read_dir)
+}
+
+fn discover_with(inputs: &[String], out: Option<&Path>, read: ReadDir<'_>) -> Discovery {
+    let mut found = Discovery::default();
+    let mut seen: HashSet<PathBuf> = HashSet::new();
+    for input in inputs {
+        let mut walk = Walk {
+            out,
+            read,
+            entered: HashSet::new(),
+            files: Vec::new(),
+            problems: Vec::new(),
+            output_folders: Vec::new(),
+        };
+        let clips = input_clips(input, &mut walk);
+        let named_none = clips.is_empty();
+        found.problems.append(&mut walk.problems);
+        found.output_folders.append(&mut walk.output_folders);
+        if named_none && !found.problems.iter().any(|p| p.path == *input) {
+            found.problems.push(DiscoveryProblem {
+                path: input.clone(),
+                message: format!("no motion file (.{}) found", MOTION_EXTENSIONS.join(", .")),
+            });
+        }
+        for c in clips {
+            add_clip(&mut found, &mut seen, c);
+        }
+    }
+    found
+}
+
+/// Adds `c` unless its real file was taken; a name taken by another file is a problem.
+fn add_clip(found: &mut Discovery, seen: &mut HashSet<PathBuf>, c: ClipInput) {
+    let real = c.path.canonicalize().unwrap_or_else(|_| c.path.clone());
+    if !seen.insert(real) {
+        return;
+    }
+    if let Some(other) = found.clips.iter().find(|o| o.name == c.name) {
+        found.problems.push(DiscoveryProblem {
+            path: c.path.display().to_string(),
+            message: format!(
+                "its output name `{}` is taken by {}",
+                c.name,
+                other.path.display()
+            ),
+        });
+        return;
+    }
+    found.clips.push(c);
+}
+
+/// The clips of one input, its unreadable entries left in `walk.problems`.
+fn input_clips(input: &str, walk: &mut Walk<'_>) -> Vec<ClipInput> {
+    let p = Path::new(input);
+    if p.is_file() {
+        return vec![ClipInput {
+            path: p.to_path_buf(),
+            name: clip_name(p, p.parent().unwrap_or(Path::new(""))),
+        }];
+    }
+    if p.is_dir() {
+        walk.folder(p);
+        return std::mem::take(&mut walk.files)
+            .into_iter()
+            .filter(|f| is_motion_file(f))
+            .map(|f| ClipInput {
+                name: clip_name(&f, p),
+                path: f,
+            })
+            .collect();
+    }
+    if !input.contains(['*', '?']) {
+        walk.problem(p, "no such file or folder".into());
+        return Vec::new();
+    }
+    // The folder before the first wildcard, searched recursively.
+    let base: PathBuf = p
+        .components()
+        .take_while(|c| !c.as_os_str().to_string_lossy().contains(['*', '?']))
+        .collect();
+    let root = if base.as_os_str().is_empty() {
+        PathBuf::from(".")
+    } else {
+        base.clone()
+    };
+    walk.folder(&root);
+    std::mem::take(&mut walk.files)
+        .into_iter()
+        .filter(|f| {
+            let s = if base.as_os_str().is_empty() {
+                f.strip_prefix(".").unwrap_or(f)
+            } else {
+                f
+            };
+            glob_match(input, &s.to_string_lossy())
+        })
+        .map(|f| ClipInput {
+            name: clip_name(&f, &root),
+            path: f,
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tmp(name: &str) -> PathBuf {
+        let d = std::env::temp_dir().join(format!("iktc-discover-{}-{name}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).unwrap();
+        d
+    }
+
+    /// A folder whose listing fails (injected: the tests run with every permission) is named
+    /// with its error, and the clips of the other folders are still found.
+    #[test]
+    fn an_unreadable_folder_is_named_and_the_others_kept() {
+        let d = tmp("unreadable");
+        for sub in ["a", "b", "c"] {
+            std::fs::create_dir_all(d.join(sub)).unwrap();
+            std::fs::write(d.join(sub).join("clip.bvh"), "x").unwrap();
+        }
+        let refuse = |p: &Path| {
+            if p.ends_with("b") {
+                Err(std::io::Error::new(
+                    std::io::ErrorKind::PermissionDenied,
+                    "injected refusal",
+                ))
+            } else {
+                read_dir(p)
+            }
+        };
+        let found = discover_with(&[d.display().to_string()], None, &refuse);
+        let names: Vec<&str> = found.clips.iter().map(|c| c.name.as_str()).collect();
+        assert_eq!(names, ["a/clip", "c/clip"]);
+        assert_eq!(found.problems.len(), 1, "{:?}", found.problems);
+        assert_eq!(found.problems[0].path, d.join("b").display().to_string());
+        assert!(found.problems[0].message.contains("injected refusal"));
+    }
+
+    /// An entry the listing cannot give (injected) is named by its folder; the rest is kept.
+    #[test]
+    fn an_unreadable_entry_is_named_by_its_folder() {
+        let d = tmp("entry");
+        std::fs::write(d.join("clip.bvh"), "x").unwrap();
+        let broken = |p: &Path| {
+            let mut v = read_dir(p)?;
+            v.push(Err(std::io::Error::other("injected entry error")));
+            Ok(v)
+        };
+        let found = discover_with(&[d.display().to_string()], None, &broken);
+        assert_eq!(found.clips.len(), 1);
+        assert_eq!(found.problems.len(), 1);
+        assert_eq!(found.problems[0].path, d.display().to_string());
+        assert!(found.problems[0].message.contains("injected entry error"));
+    }
+}
