@@ -304,8 +304,16 @@ pub fn profile_init(
 ) -> PyResult<String> {
     let sole = match sole.as_deref() {
         None => None,
-        Some(&[length, width]) => Some(iktc::profile::Sole { length, width, offset_x: 0.0 }),
-        Some(&[length, width, offset_x]) => Some(iktc::profile::Sole { length, width, offset_x }),
+        Some(&[length, width]) => Some(iktc::profile::Sole {
+            length,
+            width,
+            offset_x: 0.0,
+        }),
+        Some(&[length, width, offset_x]) => Some(iktc::profile::Sole {
+            length,
+            width,
+            offset_x,
+        }),
         Some(v) => {
             return Err(crate::IktcError::new_err(format!(
                 "sole = {v:?}: expected (length, width) or (length, width, offset_x) [m]"

@@ -148,6 +148,8 @@ pub fn trajectory_penetration(
 /// One clip's quality figures (the `figures` of its `quality.json`), by route.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 #[serde(untagged)]
+// One value per clip, written once: the size of the keypoint figures costs nothing.
+#[allow(clippy::large_enum_variant)]
 pub enum ClipQuality {
     /// Keypoint retargeting ([`crate::retarget::retarget_keypoints`]).
     Keypoints(KeypointFigures),
