@@ -443,7 +443,9 @@ fn batch_of_good_and_bad_clips_skip_force_and_formats() {
         assert!(quality["figures"][key].is_f64(), "{key}");
     }
     // The report shows the keypoint route's columns, not the joint route's.
-    assert!(index.contains("<th>mean keypoint error [m]</th>"));
+    assert!(index.contains(
+        "<th>mean keypoint error against the person (joint centres, leg scale) [m]</th>"
+    ));
     assert!(!index.contains("<th>upper-body RMS error [rad]</th>"));
     // Constant acceleration over a tick: (q⁺ − q)/Δt = (q̇ + q̇⁺)/2 for every joint.
     let dt: f64 = DT.parse().unwrap();

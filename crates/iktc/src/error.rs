@@ -25,6 +25,39 @@ pub fn name_list<S: AsRef<str>>(names: &[S]) -> String {
     out
 }
 
+/// The number of single-character insertions, deletions and substitutions that turn `a` into
+/// `b` (Levenshtein distance).
+pub(crate) fn edits(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut diagonal = row[0];
+        row[0] = i + 1;
+        for (j, cb) in b.iter().enumerate() {
+            let next = (row[j + 1] + 1)
+                .min(row[j] + 1)
+                .min(diagonal + usize::from(ca != *cb));
+            diagonal = row[j + 1];
+            row[j + 1] = next;
+        }
+    }
+    row[b.len()]
+}
+
+/// [`name_list`] of `valid` with the names nearest `name` first (fewest edits, ignoring case;
+/// ties in their order), so that a misspelt name's intended one is among those listed.
+pub fn nearest_names<S: AsRef<str>>(name: &str, valid: &[S]) -> String {
+    let lower = name.to_lowercase();
+    let mut sorted: Vec<(usize, usize, &str)> = valid
+        .iter()
+        .enumerate()
+        .map(|(i, v)| (edits(&lower, &v.as_ref().to_lowercase()), i, v.as_ref()))
+        .collect();
+    sorted.sort();
+    let names: Vec<&str> = sorted.into_iter().map(|(_, _, v)| v).collect();
+    name_list(&names)
+}
+
 /// Everything that can be wrong with the input given to iktc.
 ///
 /// Every variant names what is wrong and, where it helps, what was expected.
@@ -38,7 +71,10 @@ pub enum Error {
         message: String,
     },
     /// A joint, link, frame or other named item does not exist.
-    #[error("unknown {kind} `{name}`; valid names are: {}", name_list(valid))]
+    #[error(
+        "unknown {kind} `{name}`; valid names are (nearest first): {}",
+        nearest_names(name, valid)
+    )]
     UnknownName {
         /// What kind of name it is ("joint", "frame", "link", ...).
         kind: &'static str,
@@ -278,6 +314,18 @@ mod tests {
             valid: names,
         };
         assert!(e.to_string().len() < 300, "{e}");
+    }
+
+    /// A misspelt name's intended one is listed first, however far down the list it is.
+    #[test]
+    fn the_nearest_names_come_first() {
+        let mut valid: Vec<String> = (0..40).map(|i| format!("joint{i:02}")).collect();
+        valid.push("LeftElbow".into());
+        let list = nearest_names("LeftElbw", &valid);
+        assert!(list.starts_with("LeftElbow, "), "{list}");
+        assert!(list.ends_with("… 31 more"), "{list}");
+        assert_eq!(edits("kitten", "sitting"), 3);
+        assert_eq!(edits("", "abc"), 3);
     }
 
     #[test]

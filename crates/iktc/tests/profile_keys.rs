@@ -617,7 +617,7 @@ fn added_frames_sit_at_their_offset_and_bad_ones_name_their_key() {
         (
             "name = \"x\"\nparent = \"NOPE\"",
             "frame[0].parent",
-            "valid names are: base_link,",
+            "valid names are (nearest first):",
         ),
         (
             "name = \"PELVIS_S\"\nparent = \"L_ELBOW_Y_S\"",

@@ -42,24 +42,7 @@ pub(crate) const JOINT_CHILDREN: [&str; 9] = [
 /// (`<joint_properties>` of onshape-to-robot), ignored with a warning.
 const MISSPELLING_EDITS: usize = 2;
 
-/// The number of single-character insertions, deletions and substitutions that turn `a` into
-/// `b` (Levenshtein distance).
-fn edits(a: &str, b: &str) -> usize {
-    let b: Vec<char> = b.chars().collect();
-    let mut row: Vec<usize> = (0..=b.len()).collect();
-    for (i, ca) in a.chars().enumerate() {
-        let mut diagonal = row[0];
-        row[0] = i + 1;
-        for (j, cb) in b.iter().enumerate() {
-            let next = (row[j + 1] + 1)
-                .min(row[j] + 1)
-                .min(diagonal + usize::from(ca != *cb));
-            diagonal = row[j + 1];
-            row[j + 1] = next;
-        }
-    }
-    row[b.len()]
-}
+use crate::error::edits;
 
 /// The element URDF defines inside `<joint>` that `tag` looks like a misspelling of, if any.
 fn misspelled_joint_child(tag: &str) -> Option<&'static str> {
