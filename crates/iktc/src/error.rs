@@ -292,7 +292,7 @@ pub fn check_dim(what: &str, expected: usize, got: usize) -> Result<()> {
 
 #[cfg(test)]
 mod tests {
-    use super::{all_finite, name_list, Error, MAX_LISTED_NAMES};
+    use super::{all_finite, edits, name_list, nearest_names, Error, MAX_LISTED_NAMES};
 
     #[test]
     fn long_name_lists_are_capped() {

@@ -678,6 +678,43 @@ fn write_feet(
         );
         return Vec::new();
     };
+    // Each foot's geometry; the profile takes one sole and ankle height for both feet, so a
+    // foot without geometry takes the other's, and two that differ take their mean.
+    let geometry: Vec<Option<(f64, f64, f64, f64, String)>> = feet
+        .iter()
+        .map(|(i, _)| {
+            // An alias fixed at the foot link's origin gives the sole of the whole foot body.
+            let mut body = *i;
+            while let Some((p, false)) = t.parent[body] {
+                if !alias(t, p, *i) {
+                    break;
+                }
+                body = p;
+            }
+            sole_of(u, t, body, dir).map(|((a, b, c, h), why)| (a, b, c, h, why.to_string()))
+        })
+        .collect();
+    let both = match (&geometry[0], &geometry[1]) {
+        (Some(l), Some(r)) if (l.0, l.1, l.2, l.3) == (r.0, r.1, r.2, r.3) => Some(l.clone()),
+        (Some(l), Some(r)) => Some((
+            0.5 * (l.0 + r.0),
+            0.5 * (l.1 + r.1),
+            0.5 * (l.2 + r.2),
+            0.5 * (l.3 + r.3),
+            format!(
+                "the mean of both feet's geometry (left {:.4} x {:.4} m, right {:.4} x {:.4} m)",
+                l.0, l.1, r.0, r.1
+            ),
+        )),
+        (Some(g), None) | (None, Some(g)) => Some((
+            g.0,
+            g.1,
+            g.2,
+            g.3,
+            format!("{} (one foot's: the other has no geometry)", g.4),
+        )),
+        (None, None) => None,
+    };
     let mut frames = Vec::new();
     for (side, (i, why)) in ["left", "right"].iter().zip(feet) {
         frames.push(t.names[*i].clone());
@@ -686,28 +723,19 @@ fn write_feet(
             quote(&t.names[*i]),
             mark(why)
         ));
-        // An alias fixed at the foot link's origin gives the sole of the whole foot body.
-        let mut body = *i;
-        while let Some((p, false)) = t.parent[body] {
-            if !alias(t, p, *i) {
-                break;
-            }
-            body = p;
-        }
-        let geometry = sole_of(u, t, body, dir);
-        let (ankle, ankle_why) = match &geometry {
-            Some(((.., a), why)) => (tenth_mm(*a), *why),
+        let (ankle, ankle_why) = match &both {
+            Some((.., a, why)) => (tenth_mm(*a), why.clone()),
             None => (
                 0.1,
-                "PLACEHOLDER, no geometry below the link: measure the robot",
+                "PLACEHOLDER, no geometry below the link: measure the robot".to_string(),
             ),
         };
-        let (len, wid, off, sole_why) = match (&o.sole, &geometry) {
+        let (len, wid, off, sole_why) = match (&o.sole, &both) {
             (Some(s), _) => (s.length, s.width, s.offset_x, "given".to_string()),
-            (None, Some(((a, b, c, _), why))) => {
-                (tenth_mm(*a), tenth_mm(*b), tenth_mm(*c), why.to_string())
+            (None, Some((a, b, c, _, why))) => {
+                (tenth_mm(*a), tenth_mm(*b), tenth_mm(*c), why.clone())
             }
-            (None, None) => (0.2, 0.1, 0.0, ankle_why.to_string()),
+            (None, None) => (0.2, 0.1, 0.0, ankle_why.clone()),
         };
         out.push_str(&format!(
             "ankle_height = {ankle:?} # guessed: {ankle_why}\n"

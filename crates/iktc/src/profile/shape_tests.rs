@@ -454,3 +454,27 @@ fn a_urdf_the_model_rejects_gets_no_profile() {
         assert_eq!(e.to_string(), model.to_string());
     }
 }
+
+/// The profile holds one sole for both feet: a foot without geometry takes the other's
+/// (the right foot's box removed here), and the profile written says so and loads.
+#[test]
+fn a_foot_without_geometry_takes_the_other_feet_sole() {
+    let (urdf, _) = humanoid(Build {
+        leg: 6,
+        hands: true,
+        foot: 0,
+    });
+    let boxed = r#"<collision><origin xyz="0.04 0 -0.05"/><geometry><box size="0.22 0.1 0.03"/></geometry></collision>"#;
+    assert_eq!(urdf.matches(boxed).count(), 2);
+    let one = urdf.replacen(boxed, "", 1);
+    let toml = init_profile_toml(&one, "a.urdf").unwrap();
+    assert_eq!(
+        toml.matches("sole = { length = 0.22, width = 0.1, offset_x = 0.04 }")
+            .count(),
+        2,
+        "{toml}"
+    );
+    assert_eq!(toml.matches("ankle_height = 0.065 ").count(), 2, "{toml}");
+    assert!(toml.contains("the other has no geometry"), "{toml}");
+    assert!(!toml.contains("PLACEHOLDER"), "{toml}");
+}
