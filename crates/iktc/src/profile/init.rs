@@ -660,6 +660,9 @@ fn mark(why: &str) -> String {
     }
 }
 
+/// A foot's sole length, width, forward offset and ankle height \[m\], and where they came from.
+type FootGeometry = (f64, f64, f64, f64, String);
+
 /// The `[feet.*]` tables of `g` (with their soles), and the foot frames.
 fn write_feet(
     out: &mut String,
@@ -680,7 +683,7 @@ fn write_feet(
     };
     // Each foot's geometry; the profile takes one sole and ankle height for both feet, so a
     // foot without geometry takes the other's, and two that differ take their mean.
-    let geometry: Vec<Option<(f64, f64, f64, f64, String)>> = feet
+    let geometry: Vec<Option<FootGeometry>> = feet
         .iter()
         .map(|(i, _)| {
             // An alias fixed at the foot link's origin gives the sole of the whole foot body.
