@@ -676,9 +676,7 @@ fn posture_tracks(
                 }
                 [p, v, a]
             }
-            // No reference: the start posture regularises (damping alone, the joint's own
-            // position as its reference, let G1's held feet slip more over the person's
-            // contacts: a mean 63 → 92 mm over the development set).
+            // No reference: the start posture regularises.
             _ => [
                 vec![state.joint(robot, &j.name)?; 1],
                 vec![0.0; 1],

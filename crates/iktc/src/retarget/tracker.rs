@@ -439,18 +439,21 @@ fn set_references(
         ctl.set_frame_reference(*h, p.points[*i].1[k].frame(hold))?;
     }
     for (j, track) in posture_track.iter().enumerate() {
-        if track[0].is_empty() {
-            // Damping where the joint is: the caller set the position.
-            posture_ref[1][j] = 0.0;
-            posture_ref[2][j] = 0.0;
-            continue;
-        }
         for d in 0..3 {
             let v = track[d].get(k).or(track[d].last()).copied().unwrap_or(0.0);
             posture_ref[d][j] = if hold && d > 0 { 0.0 } else { v };
         }
     }
     ctl.set_joints_reference(t.posture, &posture_ref[0], &posture_ref[1], &posture_ref[2])
+}
+
+/// The name of frame `f` of `robot` (empty for an id it does not have).
+fn frame_name(robot: &Robot, f: FrameId) -> String {
+    robot
+        .frames()
+        .get(f.0)
+        .map(|f| f.name.clone())
+        .unwrap_or_default()
 }
 
 /// Adds the elbows' and head's positions, the torso's orientation and the swing feet's
@@ -467,13 +470,7 @@ fn add_body_tasks(
     swing: [bool; 2],
     w: f64,
 ) -> Result<()> {
-    let name = |f: FrameId| -> String {
-        robot
-            .frames()
-            .get(f.0)
-            .map(|f| f.name.clone())
-            .unwrap_or_default()
-    };
+    let name = |f: FrameId| frame_name(robot, f);
     let hand = |p: &BodyPoint| matches!(p, BodyPoint::LeftWrist | BodyPoint::RightWrist);
     for (i, (p, _)) in plan
         .points
@@ -515,13 +512,7 @@ fn build_stack(
         bounds: s.bounds,
         solver: s.solver,
     });
-    let name = |f: FrameId| -> String {
-        robot
-            .frames()
-            .get(f.0)
-            .map(|f| f.name.clone())
-            .unwrap_or_default()
-    };
+    let name = |f: FrameId| frame_name(robot, f);
     let mut feet = Vec::with_capacity(2);
     if stance.iter().any(|on| *on) {
         b.level(KEYPOINT_LEVELS[0]);
@@ -701,14 +692,6 @@ impl KeypointController {
     /// Sets the references of tick `k` on the active stack's IKTC controller, or with
     /// `fallback` on its GF one ([`set_references`]).
     fn refer(&mut self, fallback: bool, k: usize, hold: bool) -> Result<()> {
-        // A joint without a posture track damps its motion where it is (reference: its own
-        // position, at rest).
-        let base = self.robot.base_nq();
-        for (j, track) in self.posture_track.iter().enumerate() {
-            if track[0].is_empty() {
-                self.posture_ref[0][j] = self.state.q.get(base + j).copied().unwrap_or(0.0);
-            }
-        }
         let Stack {
             ctl,
             fallback: gf,
