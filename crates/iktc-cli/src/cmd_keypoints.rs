@@ -82,6 +82,16 @@ pub struct KeypointArgs {
     /// rad over a stance) does not pivot about its sole's centre, the legs take the turn.
     #[arg(long)]
     pub no_pivot: bool,
+    /// Where no joint map gives the posture level its joint angles, follow the person's
+    /// posture fitted to the directions of their arms and trunk instead of holding the
+    /// robot's start posture there: closer to the person's shape, the feet land less exactly.
+    #[arg(long)]
+    pub posture_fit: bool,
+    /// Largest share of a leg's length (hip–knee plus knee–ankle) the pelvis height may ask
+    /// of it, in (0, 1] (default 0.92): the pelvis is lowered instead. Larger values follow a
+    /// person's straight knees closer and land the feet less exactly.
+    #[arg(long, value_name = "SHARE")]
+    pub max_leg_extension: Option<f64>,
     /// A stance over which the captured ankle slides further than this [m, human scale] is
     /// split into steps: the robot lifts the foot and sets it down where the captured foot has
     /// slid, instead of holding it behind. `none` holds every stance.
@@ -106,6 +116,12 @@ impl KeypointArgs {
         }
         if route == RetargetArg::Joints && self.no_pivot {
             anyhow::bail!("--no-pivot applies to --retarget keypoints only");
+        }
+        if route == RetargetArg::Joints && self.posture_fit {
+            anyhow::bail!("--posture-fit applies to --retarget keypoints only");
+        }
+        if route == RetargetArg::Joints && self.max_leg_extension.is_some() {
+            anyhow::bail!("--max-leg-extension applies to --retarget keypoints only");
         }
         if route == RetargetArg::Joints && self.max_slide.is_some() {
             anyhow::bail!("--max-slide applies to --retarget keypoints only");
@@ -139,6 +155,11 @@ pub fn keypoint_settings(
             HandsArg::Segments => HandScaling::Segments,
         },
         reach: k.reach,
+        posture_fit: k.posture_fit,
+        max_leg_extension: std::env::var("IKTC_EXP_EXT")
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(iktc::retarget::MAX_LEG_EXTENSION), // EXPERIMENT
         pivot_turn: if k.no_pivot {
             None
         } else {

@@ -199,7 +199,7 @@ impl PyKeypointTrajectory {
     /// `below_ground_mm`, `float_mm` (highest a foot the clip has on the ground floats) and `float_share` (share of those foot-ticks above 1 cm), `stance_ticks`, `jerk_rms` and `jerk_max` [rad/s³], `jerk_limit_share` (the share of the squared jerk on the ticks the solver corrected into the joint limits' box and the ticks after them), the worst
     /// `position_margin` [rad], `velocity_margin` [rad/s] and `acceleration_margin` [rad/s²]
     /// (positive: a limit exceeded), `on_limit` (`(joint, share)` pairs: the joints on a
-    /// position limit on some ticks and the share of the ticks, the most often first), and `reach_cm`, `balanced_reach_cm` (the reach keeping
+    /// position limit on some ticks and the share of the ticks, the most often first), and `posture_fit_deg` (the RMS angle between the person's segments and the fitted posture's, `None` without the fit), `reach_cm`, `balanced_reach_cm` (the reach keeping
     /// the clip's feet and the COM over them) and `reach_run_cm` (None unless asked for
     /// with `reach=True`), and `fidelity`: the neutral figures (`iktc::retarget::Fidelity`:
     /// the robot's joint centres against the captured person, contacts from the person,
@@ -255,6 +255,7 @@ impl PyKeypointTrajectory {
         d.set_item("reach_cm", q.reach_cm)?;
         d.set_item("reach_run_cm", q.reach_run_cm)?;
         d.set_item("balanced_reach_cm", q.balanced_reach_cm)?;
+        d.set_item("posture_fit_deg", q.posture_fit_deg)?;
         let fidelity = serde_json::to_string(&q.fidelity)
             .map_err(|e| crate::IktcError::new_err(format!("fidelity figures: {e}")))?;
         d.set_item(

@@ -304,6 +304,37 @@ fn every_shared_clip_onto_g1() {
 /// `humanoid3d_punch`; until the floor bounded every sole corner through the foot's turning
 /// and carried the drift's vertical compensation, up to 0.6 mm on 131_01, a swing foot
 /// turning on the ground), and the stance slip's target with it (at most 0.69 mm).
+/// Largest RMS angle between the person's segments and the fitted posture's \[°\]: G1 has
+/// every segment the fit uses, within ranges wider than the clip's poses.
+const MAX_FIT_DEG: f64 = 20.0;
+
+/// With the posture fitted (`KeypointSettings::posture_fit`), the quality reports how far the
+/// robot takes the person's segment directions; without it, nothing; the fitted posture
+/// changes the run.
+#[test]
+fn the_fitted_posture_is_reported_and_followed() {
+    let profile = RobotProfile::builtin("g1").unwrap();
+    let kp = builtin_keypoints("humanoid3d_punch");
+    let off = KeypointSettings::default();
+    let on = KeypointSettings {
+        posture_fit: true,
+        ..off.clone()
+    };
+    let a = retarget_keypoints(&profile, &kp, None, &off).unwrap();
+    let b = retarget_keypoints(&profile, &kp, None, &on).unwrap();
+    assert_eq!(a.quality.posture_fit_deg, None);
+    let fit = b.quality.posture_fit_deg.unwrap();
+    assert!(fit.is_finite() && fit < MAX_FIT_DEG, "{fit}°");
+    assert_eq!(a.trajectory.len(), b.trajectory.len());
+    let last = a.trajectory.len() - 1;
+    let moved = a.trajectory[last]
+        .iter()
+        .zip(&b.trajectory[last])
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max);
+    assert!(moved > MAX_FIT_DEG.to_radians() / 100.0, "{moved}");
+}
+
 #[test]
 fn soles_stay_above_ground() {
     let mut failures = Vec::new();
@@ -779,6 +810,29 @@ fn a_bad_pivot_turn_is_an_error() {
             ..KeypointSettings::default()
         };
         assert!(s.validate().is_ok(), "{good:?}");
+    }
+}
+
+/// A leg's largest extension is a share of its length in (0, 1]: 0 would lower the pelvis to
+/// the feet, more than 1 asks more than the leg has.
+#[test]
+fn a_leg_extension_outside_its_share_is_an_error() {
+    for bad in [0.0, -0.5, 1.01, f64::NAN, f64::INFINITY] {
+        let s = KeypointSettings {
+            max_leg_extension: bad,
+            ..KeypointSettings::default()
+        };
+        match s.validate() {
+            Err(iktc::Error::InvalidSetting { name, .. }) => assert_eq!(name, "max_leg_extension"),
+            other => panic!("{bad}: {other:?}"),
+        }
+    }
+    for good in [0.5, iktc::retarget::MAX_LEG_EXTENSION, 1.0] {
+        let s = KeypointSettings {
+            max_leg_extension: good,
+            ..KeypointSettings::default()
+        };
+        assert!(s.validate().is_ok(), "{good}");
     }
 }
 

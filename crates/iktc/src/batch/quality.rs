@@ -285,6 +285,10 @@ pub struct KeypointFigures {
     /// The run's mean keypoint error over the same sampled ticks \[m\]; `null` without the
     /// reach.
     pub reach_run_keypoint_error: Option<f64>,
+    /// How far the robot's body takes the person's shape: the RMS angle between the person's
+    /// segment directions and the fitted posture's \[rad\] ([`RetargetQuality::posture_fit_deg`]);
+    /// `null` where the posture was not fitted.
+    pub posture_fit_error: Option<f64>,
 }
 
 impl KeypointFigures {
@@ -383,6 +387,7 @@ impl KeypointFigures {
             reach_keypoint_error: q.reach_cm.map(|c| c / 100.0),
             balanced_reach_keypoint_error: q.balanced_reach_cm.map(|c| c / 100.0),
             reach_run_keypoint_error: q.reach_run_cm.map(|c| c / 100.0),
+            posture_fit_error: q.posture_fit_deg.map(f64::to_radians),
         }
     }
 }

@@ -38,6 +38,7 @@ mod com;
 mod contacts;
 mod drift;
 pub mod fidelity;
+pub mod fit;
 mod floor;
 mod plan;
 mod quality;
@@ -161,16 +162,8 @@ pub struct KeypointSettings {
     /// Wider is smoother but lags the support changes.
     pub com_smoothing: f64,
     /// A leg is not asked to stretch beyond this fraction of its length (hip–knee plus
-    /// knee–ankle) \[–\]: the pelvis is lowered instead (default 0.92). Larger values keep the
-    /// pelvis height of the clip longer but bring the knees near their singularity, where the
-    /// feet's level loses rank: on the shared clips 0.85 crouched G1 (its ankles about 9 cm
-    /// higher under its hips than the scaled human's on CMU `scaled_131_02`). Against 0.88, 0.92
-    /// lowers the mean keypoint error on 100 of 102 runs of 51 Bandai Namco clips (G1 median
-    /// 6.78 → 6.22 cm, JVRC-1 10.47 → 9.91 cm) and on nine of the twelve shared runs (G1
-    /// `humanoid3d_dance_a` 14.0 → 16.6 cm the worst change), with the held feet's slip at
-    /// most 0.9 mm and the soles at most 0.15 mm below the ground; at 0.95 a sole went 0.47 mm
-    /// below on G1 CMU 131_01 (and before the floor bounded every sole corner, from 0.90 G1's
-    /// feet slipped and sank there by 1.4–8.7 mm).
+    /// knee–ankle) \[–\], nor a foot on the ground beyond the reach the person's knee angle
+    /// gives the robot's leg: the pelvis is lowered instead (default [`MAX_LEG_EXTENSION`]).
     pub max_leg_extension: f64,
     /// Posture references from the joint route are kept this far inside the joint ranges
     /// \[rad\] (default 0.05 rad).
@@ -235,6 +228,21 @@ pub struct KeypointSettings {
     /// error against the person by less than 0.1 cm and puts a sole 2.8 mm below the floor
     /// instead of 1.7 mm.
     pub track_joint_centres: bool,
+    /// Where no joint-angle reference is given, the posture level follows the person's
+    /// posture fitted to the directions of their segments ([`fit`]: per tick, the joint angles
+    /// whose arms, shoulder axis and trunk point where the person's do, the base held at the
+    /// pelvis' reference) instead of holding the start posture (default false). What the
+    /// levels above leave free then takes the person's shape: the waist's lean and twist, the
+    /// arms' swivel. The legs keep the start posture's references: the feet and the pelvis
+    /// set a stance leg, and posture rows pulling its knee toward the person's straighter one
+    /// bring it to its singularity (G1 then does not come to rest on a held frame). On the
+    /// development set (2026-12-07, ten clips of six rigs, `iktc retarget`, the neutral
+    /// figures of [`fidelity`]) it lowers G1's mean keypoint error from 11.3 to 10.8 cm and
+    /// JVRC-1's from 12.0 to 10.7 cm, JVRC-1's trunk lean's gap to the person's from 5.4° to
+    /// 4.2° (G1's unchanged, 6.8°), but G1's feet land worse: slip over the person's contacts
+    /// 58 → 69 mm (mean over clips), the lowest sole −2.5 → −4.1 mm, 0.4 mm below the ground
+    /// on CMU 131_01. Off by default until the feet hold.
+    pub posture_fit: bool,
     /// Where the hands' references are placed (default [`HandScaling::Leg`]). On the shared
     /// clips (`tests/retarget_keypoints.rs`) it brings G1's wrists within a mean 2.7–4.8 cm of
     /// the captured ones instead of 5.2–6.8 cm with [`HandScaling::Segments`] on three
@@ -288,6 +296,16 @@ pub const BODY_WEIGHT: f64 = 0.0;
 /// (1.7 mm upright) and widens JVRC-1's knee gap (29° → 33°).
 pub const PELVIS_LEAN: f64 = 0.0;
 
+/// Default [`KeypointSettings::max_leg_extension`] \[–\]: 0.92, a knee bent at least 46°
+/// (equal thigh and shank, `2 acos 0.92`) under a foot right below its hip. Straighter legs
+/// follow the person's knees closer but land the feet worse: on the development set
+/// (2026-12-07, ten clips of six rigs, the neutral figures of [`fidelity`], the posture fitted
+/// to the whole body) G1's knee flexion is 23° from the person's at 0.92, 18° at 0.95 and 15°
+/// at 0.97 (mean over clips of the medians' gap; JVRC-1 30°, 23°, 18°), its mean keypoint
+/// error 10.6, 10.6 and 10.4 cm, and its feet's slip over the person's contacts 57, 91 and
+/// 88 mm (mean over clips; the worst clip 217, 345 and 306 mm).
+pub const MAX_LEG_EXTENSION: f64 = 0.92;
+
 /// Sample period of the static reach ([`KeypointSettings::reach`]) \[s\].
 pub const REACH_PERIOD: f64 = 0.05;
 
@@ -331,7 +349,7 @@ impl Default for KeypointSettings {
             support_area: SupportArea::BothFeet,
             com_margin: 0.02,
             com_smoothing: 0.2,
-            max_leg_extension: 0.92,
+            max_leg_extension: MAX_LEG_EXTENSION,
             posture_margin: 0.05,
             land_height: 0.02,
             land_speed: 0.06,
@@ -341,6 +359,7 @@ impl Default for KeypointSettings {
             body_weight: BODY_WEIGHT,
             pelvis_lean: PELVIS_LEAN,
             track_joint_centres: false,
+            posture_fit: false,
             hands: HandScaling::Leg,
             reach: false,
             pivot_turn: Some(PIVOT_TURN),
@@ -402,11 +421,6 @@ impl KeypointSettings {
             ("posture_weight", self.posture_weight, "a weight >= 0 [–]"),
             ("body_weight", self.body_weight, "a weight >= 0 [–]"),
             ("pelvis_lean", self.pelvis_lean, "a share >= 0 [–]"),
-            (
-                "max_leg_extension",
-                self.max_leg_extension,
-                "a fraction >= 0 [–]",
-            ),
         ] {
             if !(v.is_finite() && v >= 0.0) {
                 return Err(Error::InvalidSetting {
@@ -415,6 +429,14 @@ impl KeypointSettings {
                     expected: format!("a finite {what}"),
                 });
             }
+        }
+        let e = self.max_leg_extension;
+        if !(e > 0.0 && e <= 1.0) {
+            return Err(Error::InvalidSetting {
+                name: "max_leg_extension".into(),
+                value: e.to_string(),
+                expected: "a share of the leg's length in (0, 1] [–]".into(),
+            });
         }
         if let Some(t) = self.pivot_turn {
             if !(t.is_finite() && t >= 0.0) {
@@ -530,6 +552,8 @@ struct Setup {
     support: SupportSettings,
     controller: KeypointController,
     scaling: Scaling,
+    /// The posture fit's RMS direction error \[rad\] ([`fit`]), where the posture was fitted.
+    fit_error: Option<f64>,
 }
 
 /// The robot's start state: the profile's posture, the lowest sole on z = 0.
@@ -622,16 +646,65 @@ fn setup(
     check_start(&robot, &state, &s.bounds)?;
     kin.update(&robot, &state)?;
     let clip = scale::scale_clip(&robot, &kin, &body, kp, cfg.support.ankle_height, s.hands)?;
-    let tracks = posture_tracks(&robot, &state, posture, s.posture_margin)?;
-    let on = plan::PlanRobot {
-        robot: &robot,
-        start: &state,
-        kin: &kin,
-        body: &body,
-        support: &cfg.support,
-        posture: &tracks,
+    let mut tracks = posture_tracks(&robot, &state, posture, s.posture_margin)?;
+    let plan_with = |tracks: &tracker::PostureTracks| {
+        let on = plan::PlanRobot {
+            robot: &robot,
+            start: &state,
+            kin: &kin,
+            body: &body,
+            support: &cfg.support,
+            posture: tracks,
+        };
+        plan::plan(&on, kp, &clip, s)
     };
-    let plan = plan::plan(&on, kp, &clip, s)?;
+    let mut plan = plan_with(&tracks)?;
+    let mut fit_error = None;
+    if posture.is_none() && s.posture_fit && !s.standing {
+        // The person's posture, fitted at the joint centres; the plan again with it (the COM
+        // offset depends on the posture asked).
+        let (fit_robot, fit_body) = centres.frames(&robot, body.clone())?;
+        // The base held at the pelvis' references, which the pelvis level holds.
+        let to_base = kin.frame_pose(&robot, body.pelvis)?.rotation.inverse()
+            * state.base_pose(&robot).rotation;
+        let base: Vec<_> = plan.pelvis.iter().map(|p| p.rotation * to_base).collect();
+        let fitted = fit::fit(
+            &fit_robot,
+            &fit_body,
+            &state,
+            &plan.neutral,
+            Some(&base),
+            s.dt,
+            s.posture_margin,
+        )?;
+        // The legs keep the start posture's references: the feet and the pelvis above the
+        // posture set a stance leg, and its rows pulling a knee toward the person's
+        // straighter one bring it to its singularity (G1 then does not come to rest on a held
+        // frame of `humanoid3d_punch`: 0.47 rad/s).
+        fit_error = Some(2.0 * (0.5 * fitted.rms_error).min(1.0).asin());
+        let legs = [
+            body::chain(&robot, body.feet[0])?,
+            body::chain(&robot, body.feet[1])?,
+        ];
+        let below = body::branch(&legs);
+        let leg_links: Vec<usize> = legs.iter().flat_map(|c| c[below..].to_vec()).collect();
+        for ((name, fitted), track) in fitted
+            .tracks
+            .0
+            .iter()
+            .zip(&fitted.tracks.1)
+            .zip(&mut tracks.1)
+        {
+            let in_leg = robot
+                .joints()
+                .iter()
+                .any(|j| j.name == *name && leg_links.contains(&j.child));
+            if !in_leg {
+                track.clone_from(fitted);
+            }
+        }
+        plan = plan_with(&tracks)?;
+    }
     let controller =
         KeypointController::new(robot.clone(), state, &body, plan, tracks, &cfg.support, s)?;
     Ok(Setup {
@@ -641,6 +714,7 @@ fn setup(
         support: cfg.support,
         controller,
         scaling: clip.scaling,
+        fit_error,
     })
 }
 
@@ -748,6 +822,7 @@ pub fn retarget_keypoints_on(
         support,
         mut controller,
         scaling,
+        fit_error,
     } = setup(robot, profile, kp, posture, s)?;
     let settle_ticks = settle(&mut controller, s).map_err(|e| {
         e.at(|| {
@@ -815,6 +890,7 @@ pub fn retarget_keypoints_on(
         (&times, &trajectory, &accelerations),
         s.dt,
     )?);
+    quality.posture_fit_deg = fit_error.map(f64::to_degrees);
     if s.reach {
         let stride = ((REACH_PERIOD / s.dt).round() as usize).max(1);
         let balance = (&support, s.com_margin);

@@ -13,12 +13,17 @@
 //! [`KeypointSettings::pelvis_lean`](super::KeypointSettings::pelvis_lean), the torso frame from the shoulder axis and the hips-to-
 //! shoulders direction (`y` along the axis, `z` the other direction made orthogonal to it,
 //! `x = y × z`), each times the constant rotation that maps the same construction on the robot
-//! in its start posture onto the robot's frame. Where a leg would have to stretch beyond
-//! `max_leg_extension` of its length `L` (hip–knee plus knee–ankle) to reach its foot's
-//! reference, the pelvis and the points above it are lowered by
-//! `δz = −√((e L)² − |d_xy|²) − d_z` (`d` from the robot's hip, placed by the pelvis reference
+//! in its start posture onto the robot's frame. Where a leg would have to stretch beyond its
+//! reach `r` to reach its foot's reference, the pelvis and the points above it are lowered by
+//! `δz = −√(r² − |d_xy|²) − d_z` (`d` from the robot's hip, placed by the pelvis reference
 //! and heading, to the ankle's reference), the largest over both legs, spread over
-//! `com_smoothing` by a running maximum and the same moving averages. Rates and accelerations are central
+//! `com_smoothing` by a running maximum and the same moving averages. The reach is
+//! `max_leg_extension` of the leg's length (hip–knee `t` plus knee–ankle `s`, the robot's),
+//! and, for a foot the person has on the ground, at most the hip-to-ankle distance the
+//! person's knee angle `α` (between thigh and shank, π straight) gives the robot's leg,
+//! `√(t² + s² − 2ts cos α)` ([`leg_reach`]): the robot's stance knee bends at least as the
+//! person's. A swing leg's knee is the swing foot's and the posture's to bend (bounding it
+//! too lowered G1's hips under its swing legs). Rates and accelerations are central
 //! differences of the sampled references (`ẋ_k = (x_{k+1} − x_{k−1}) / 2Δt`, angular rates
 //! from `log(R_{k+1} R_{k−1}ᵀ) / 2Δt`).
 
@@ -115,6 +120,15 @@ pub(crate) struct Plan {
     /// CMU's several centimetres above, G1's pelvis frame 10 cm above its hips, JVRC-1's at them).
     /// The pelvis point is that middle on both bodies (the alignment point: its target is 0).
     pub neutral: Vec<Vec<(BodyPoint, Vector3<f64>)>>,
+}
+
+/// The distance from hip to ankle \[m\] of a leg with a thigh of `thigh` and a shank of
+/// `shank` \[m\] whose knee's inner angle is `angle` \[rad\] (π for a straight leg), by the
+/// law of cosines: `√(t² + s² − 2ts cos α)`.
+pub(crate) fn leg_reach(thigh: f64, shank: f64, angle: f64) -> f64 {
+    (thigh * thigh + shank * shank - 2.0 * thigh * shank * angle.cos())
+        .max(0.0)
+        .sqrt()
 }
 
 fn finite_differences(x: &[Vector3<f64>], dt: f64) -> (Vec<Vector3<f64>>, Vec<Vector3<f64>>) {
@@ -485,9 +499,23 @@ pub(crate) fn plan(
     .enumerate()
     {
         let (h0, k0, a0) = (at0(hip)?, at0(knee)?, at0(ankle)?);
-        let reach = s.max_leg_extension * ((k0 - h0).norm() + (a0 - k0).norm());
+        let (thigh, shank) = ((k0 - h0).norm(), (a0 - k0).norm());
+        let cap = s.max_leg_extension * (thigh + shank);
+        // The person's knee, as the angle between thigh and shank (π straight).
+        let person = [idx(hip), idx(knee), idx(ankle)];
         let offset = h0 - kin.frame_pose(robot, body.pelvis)?.translation.vector;
         for k in 0..ticks {
+            let reach = match person {
+                [Some(h), Some(n), Some(a)] if contact[i][k] => {
+                    match (&aligned[h], &aligned[n], &aligned[a]) {
+                        (Some(h), Some(n), Some(a)) => {
+                            leg_reach(thigh, shank, (h[k] - n[k]).angle(&(a[k] - n[k]))).min(cap)
+                        }
+                        _ => cap,
+                    }
+                }
+                _ => cap,
+            };
             let turn = UnitQuaternion::from_euler_angles(0.0, 0.0, heading[k] - heading[0]);
             let d = feet[i][k].position.position - (pelvis_x[k] + turn * offset);
             let horizontal = d.xy().norm().min(reach);

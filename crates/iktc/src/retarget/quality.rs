@@ -144,6 +144,11 @@ pub struct RetargetQuality {
     /// of [`RetargetQuality::mean_cm`] is what the run gives up to its rates, priorities and
     /// references.
     pub balanced_reach_cm: Option<f64>,
+    /// How far the robot's body can take the person's shape: the angle between the person's
+    /// segment directions and the fitted posture's, root mean square over the fit's samples
+    /// and segments \[°\] ([`super::fit`]); `None` where the posture was not fitted (a joint
+    /// map's references, standing imitation, [`super::KeypointSettings::posture_fit`] off).
+    pub posture_fit_deg: Option<f64>,
     /// The run's own mean body point error over the same sampled ticks \[cm\], beside
     /// [`RetargetQuality::reach_cm`].
     pub reach_run_cm: Option<f64>,
@@ -360,6 +365,7 @@ impl QualityRecorder {
             on_limit,
             reach_cm: None,
             balanced_reach_cm: None,
+            posture_fit_deg: None,
             reach_run_cm: None,
             fidelity: None,
         }
