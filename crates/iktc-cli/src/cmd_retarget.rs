@@ -20,8 +20,8 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use iktc::batch::{
-    clip_record, discover, is_done, longest_first, remove_leftovers, run_parallel_until,
-    write_clip_folder, BatchRetarget, ClipInput, ClipOutcome, ClipRun, RetargetMethod,
+    clip_state, discover, longest_first, remove_leftovers, run_parallel_until, write_clip_folder,
+    BatchRetarget, ClipInput, ClipOutcome, ClipRun, ClipState, RetargetMethod,
 };
 use iktc::mesh::MeshSet;
 use iktc::sim::viewer::imitation_viewer;
@@ -147,18 +147,18 @@ pub fn run(a: &Args) -> Result<()> {
     for c in found.clips {
         let dir = a.out.join(&c.name);
         let mut s = status(&c.name, &c.path.display().to_string(), "skipped", None);
-        match clip_record(&dependencies, &c.path) {
+        match clip_state(&dependencies, &c.path, &dir, &outputs, a.force) {
             Err(e) => {
                 s.status = "failed";
                 s.error = Some(e.to_string());
                 statuses.push(s);
             }
-            Ok(r) if !a.force && is_done(&dir, &r, &outputs) => {
+            Ok(ClipState::Done) => {
                 s.figures = read_figures(&dir);
                 s.files = files_of(&dir);
                 statuses.push(s);
             }
-            Ok(r) => todo.push((c, r)),
+            Ok(ClipState::ToRun(r)) => todo.push((c, r)),
         }
     }
     let skipped = statuses.iter().filter(|s| s.status == "skipped").count();
