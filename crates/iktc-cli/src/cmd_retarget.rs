@@ -47,7 +47,7 @@ pub struct Args {
     /// Output directory: one folder per clip, index.html and batch.json.
     #[arg(long, default_value = "out/retarget")]
     pub out: PathBuf,
-    /// Worker threads (default: every core).
+    /// Worker threads, 1 to 1024 (default: every core, at most 1024).
     #[arg(long)]
     pub jobs: Option<usize>,
     /// Output rate of motion.csv and motion.npz, 1 to 100 000 Hz [Hz] (default: the control
@@ -109,9 +109,10 @@ pub fn run(a: &Args) -> Result<()> {
         anyhow::bail!("`iktc retarget` takes its motions as INPUT arguments, not --motion");
     }
     let jobs = match a.jobs {
-        Some(0) => anyhow::bail!("--jobs 0: expected at least 1 worker thread"),
-        Some(n) => n,
-        None => std::thread::available_parallelism().map_or(1, |n| n.get()),
+        Some(n) => iktc::resources::check_jobs("--jobs", n)?,
+        None => std::thread::available_parallelism()
+            .map_or(1, |n| n.get())
+            .min(iktc::resources::MAX_JOBS),
     };
     if let Some(r) = a.rate {
         iktc::resources::check_output_rate("--rate", r)?;
