@@ -2,21 +2,32 @@
 //! library's public reader and uses what it returns. Ok or Err are both fine; a panic, an
 //! abort, a stack overflow or a runaway allocation is a bug.
 //!
+//! The discovery target builds folder trees ([`tree`]) in the system's temporary folder.
+//!
 //! The same functions replay the corpora and the crash reproducers in
 //! `crates/iktc/tests/fuzz_replay.rs` (which includes this file), so a fixed crash stays fixed.
 
+#[path = "tree.rs"]
+pub mod tree;
+
+use std::collections::HashSet;
+use std::path::PathBuf;
+
+use iktc::batch::{discover, BatchRetarget};
 use iktc::model::{planar3r, BaseKind, Kinematics, ModelOptions, Robot, StateConfig};
 use iktc::motion::{
     detect_format, motion_from_content, read_amc, read_asf, read_bvh, read_c3d, read_deepmimic,
     read_points_csv, Asf, BvhReadOptions, MotionContent, MotionFormat, MotionOptions, RetargetMap,
     DEFAULT_MAX_GAP,
 };
+use iktc::profile::{ProfileOrigin, RobotProfile};
+use iktc::sim::ImitateConfig;
 
 /// The entry point of one fuzz target.
 pub type Entry = fn(&[u8]);
 
 /// Every fuzz target by name, for the replay test.
-pub const TARGETS: [(&str, Entry); 9] = [
+pub const TARGETS: [(&str, Entry); 11] = [
     ("urdf", urdf),
     ("bvh", bvh),
     ("deepmimic", deepmimic),
@@ -26,6 +37,8 @@ pub const TARGETS: [(&str, Entry); 9] = [
     ("amc", amc),
     ("c3d", c3d),
     ("points_csv", points_csv),
+    ("discover", discover_tree),
+    ("profile", profile),
 ];
 
 fn text(data: &[u8]) -> Option<&str> {
@@ -205,4 +218,55 @@ fn floating_robot() -> Option<Robot> {
         },
     )
     .ok()
+}
+
+/// A folder tree built from the bytes ([`tree::Tree`]), searched by the batch's discovery:
+/// from its top folder (named once, or twice), or through a glob pattern under it, with the
+/// first folder made as the batch's output folder or none. Every clip is listed once: no two
+/// clips share a real file or an output name, and every clip lies under the top folder.
+/// Searching again finds the same.
+pub fn discover_tree(data: &[u8]) {
+    let Some((&how, steps)) = data.split_first() else {
+        return;
+    };
+    let Some(tree) = tree::Tree::build(steps) else {
+        return;
+    };
+    let root = tree.root.display().to_string();
+    let inputs = match how % 4 {
+        0 => vec![root.clone()],
+        1 => vec![root.clone(), root.clone()],
+        2 => vec![format!("{root}/*.bvh"), root.clone()],
+        _ => vec![format!("{root}/*/?.*")],
+    };
+    let out = (how & 4 != 0).then(|| tree.dirs.get(1)).flatten();
+    let found = discover(&inputs, out.map(PathBuf::as_path));
+    let mut real = HashSet::new();
+    let mut names = HashSet::new();
+    for c in &found.clips {
+        assert!(c.path.starts_with(&tree.root), "{c:?} outside {root}");
+        let r = c.path.canonicalize().unwrap_or_else(|_| c.path.clone());
+        assert!(real.insert(r), "{c:?} listed twice: {:?}", found.clips);
+        assert!(names.insert(c.name.clone()), "name of {c:?} taken twice");
+    }
+    assert_eq!(discover(&inputs, out.map(PathBuf::as_path)), found);
+}
+
+/// A robot profile in TOML (as `--profile` and `iktc retarget` read it), its paths naming
+/// the library's embedded files. One that reads is written back to TOML and read again to an
+/// equal profile, and becomes a batch as `iktc retarget` makes one, whose settings and
+/// dependency digest (the clips' records) are formed.
+pub fn profile(data: &[u8]) {
+    let Some(t) = text(data) else { return };
+    let Ok(p) = RobotProfile::from_toml_str(t, "fuzz.toml", ProfileOrigin::Builtin) else {
+        return;
+    };
+    if let Ok(written) = p.to_toml_string() {
+        let back = RobotProfile::from_toml_str(&written, "fuzz.toml", ProfileOrigin::Builtin);
+        assert_eq!(back.as_ref().ok(), Some(&p), "{written}");
+    }
+    if let Ok(batch) = BatchRetarget::from_profile(p, ImitateConfig::default()) {
+        let _ = batch.settings_text();
+        let _ = batch.dependency_digest();
+    }
 }

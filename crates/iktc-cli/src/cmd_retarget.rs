@@ -20,8 +20,8 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use iktc::batch::{
-    clip_record, discover, is_done, longest_first, remove_leftovers, run_parallel_until,
-    write_clip_folder, BatchRetarget, ClipInput, ClipOutcome, ClipRun, RetargetMethod,
+    clip_state, discover, longest_first, remove_leftovers, run_parallel_until, write_clip_folder,
+    BatchRetarget, ClipInput, ClipOutcome, ClipRun, ClipState, RetargetMethod,
 };
 use iktc::mesh::MeshSet;
 use iktc::sim::viewer::imitation_viewer;
@@ -47,7 +47,7 @@ pub struct Args {
     /// Output directory: one folder per clip, index.html and batch.json.
     #[arg(long, default_value = "out/retarget")]
     pub out: PathBuf,
-    /// Worker threads (default: every core).
+    /// Worker threads, 1 to 1024 (default: every core, at most 1024).
     #[arg(long)]
     pub jobs: Option<usize>,
     /// Output rate of motion.csv and motion.npz, 1 to 100 000 Hz [Hz] (default: the control
@@ -109,9 +109,10 @@ pub fn run(a: &Args) -> Result<()> {
         anyhow::bail!("`iktc retarget` takes its motions as INPUT arguments, not --motion");
     }
     let jobs = match a.jobs {
-        Some(0) => anyhow::bail!("--jobs 0: expected at least 1 worker thread"),
-        Some(n) => n,
-        None => std::thread::available_parallelism().map_or(1, |n| n.get()),
+        Some(n) => iktc::resources::check_jobs("--jobs", n)?,
+        None => std::thread::available_parallelism()
+            .map_or(1, |n| n.get())
+            .min(iktc::resources::MAX_JOBS),
     };
     if let Some(r) = a.rate {
         iktc::resources::check_output_rate("--rate", r)?;
@@ -147,18 +148,18 @@ pub fn run(a: &Args) -> Result<()> {
     for c in found.clips {
         let dir = a.out.join(&c.name);
         let mut s = status(&c.name, &c.path.display().to_string(), "skipped", None);
-        match clip_record(&dependencies, &c.path) {
+        match clip_state(&dependencies, &c.path, &dir, &outputs, a.force) {
             Err(e) => {
                 s.status = "failed";
                 s.error = Some(e.to_string());
                 statuses.push(s);
             }
-            Ok(r) if !a.force && is_done(&dir, &r, &outputs) => {
+            Ok(ClipState::Done) => {
                 s.figures = read_figures(&dir);
                 s.files = files_of(&dir);
                 statuses.push(s);
             }
-            Ok(r) => todo.push((c, r)),
+            Ok(ClipState::ToRun(r)) => todo.push((c, r)),
         }
     }
     let skipped = statuses.iter().filter(|s| s.status == "skipped").count();

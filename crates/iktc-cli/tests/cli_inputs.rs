@@ -239,6 +239,16 @@ fn counts_and_rates_are_bounded_up_front() {
         &["walk", "--zmp-passes", "4294967296", "--out", out],
         &["--zmp-passes", "at most 10"],
     );
+    // Worker threads: 1 to resources::MAX_JOBS = 1024.
+    for jobs in ["0", "1025", "18446744073709551615"] {
+        assert_error(
+            &["retarget", clip, "--jobs", jobs, "--out", out],
+            &[
+                &format!("--jobs = {jobs}"),
+                "worker count in [1, 1024] threads",
+            ],
+        );
+    }
     // The keypoint route's period ends where its held feet's tracking turns unstable.
     assert_error(
         &["retarget", clip, "--dt", "0.05", "--out", out],

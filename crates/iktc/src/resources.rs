@@ -9,8 +9,8 @@
 //! * [`RunLimits`] — what a run may do: the control period's range and the number of ticks.
 //! * Constants for what a user asks for directly: the output rate and frames of a written
 //!   trajectory ([`MAX_OUTPUT_RATE`], [`MAX_OUTPUT_FRAMES`]), the walking pattern's ZMP
-//!   correction passes ([`MAX_ZMP_PASSES`]) and the balance fit's iterations
-//!   ([`MAX_LM_ITERATIONS`]).
+//!   correction passes ([`MAX_ZMP_PASSES`]), the balance fit's iterations
+//!   ([`MAX_LM_ITERATIONS`]) and a batch's worker threads ([`MAX_JOBS`]).
 
 use crate::error::{Error, Result};
 
@@ -220,6 +220,26 @@ pub const MAX_ZMP_PASSES: usize = 10;
 /// run once per parameter).
 pub const MAX_LM_ITERATIONS: usize = 10_000;
 
+/// Most worker threads of a batch \[threads\]: 1024. Each worker holds one clip's run in
+/// memory (its recorded ticks, up to about 1 GB at [`RunLimits::max_ticks`]) and a thread
+/// stack; machines with more than a few hundred hardware threads are rare, and more workers
+/// than cores only share them.
+pub const MAX_JOBS: usize = 1024;
+
+/// Checks a batch's worker count `jobs` \[threads\] asked for by `name` (e.g. `"--jobs"`):
+/// within `1..=`[`MAX_JOBS`].
+pub fn check_jobs(name: &str, jobs: usize) -> Result<usize> {
+    if (1..=MAX_JOBS).contains(&jobs) {
+        Ok(jobs)
+    } else {
+        Err(Error::InvalidSetting {
+            name: name.into(),
+            value: jobs.to_string(),
+            expected: format!("a worker count in [1, {MAX_JOBS}] threads (resources::MAX_JOBS)"),
+        })
+    }
+}
+
 /// Checks an output rate `rate` \[Hz\] asked for by `name` (e.g. `"--rate"`): finite and within
 /// [`MIN_OUTPUT_RATE`]`..=`[`MAX_OUTPUT_RATE`].
 pub fn check_output_rate(name: &str, rate: f64) -> Result<f64> {
@@ -336,6 +356,27 @@ mod tests {
         match output_frames("--rate", 3600.0, MAX_OUTPUT_RATE, 1e-6) {
             Err(Error::ResourceLimit { value, .. }) => assert_eq!(value, "360000001"),
             other => panic!("{other:?}"),
+        }
+    }
+
+    /// The worker count is accepted from 1 to 1024 threads, both ends included; 0 and 1025
+    /// are errors naming the flag and the bound.
+    #[test]
+    fn worker_counts_are_bounded() {
+        assert_eq!(MAX_JOBS, 1024);
+        for ok in [1, 2, 1024] {
+            assert_eq!(check_jobs("--jobs", ok), Ok(ok));
+        }
+        for bad in [0, 1025, usize::MAX] {
+            match check_jobs("--jobs", bad) {
+                Err(e @ Error::InvalidSetting { .. }) => {
+                    let text = e.to_string();
+                    assert!(text.contains("--jobs"), "{text}");
+                    assert!(text.contains("[1, 1024] threads"), "{text}");
+                    assert!(text.contains(&bad.to_string()), "{text}");
+                }
+                other => panic!("{bad}: {other:?}"),
+            }
         }
     }
 

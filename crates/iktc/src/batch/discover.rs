@@ -302,6 +302,94 @@ mod tests {
         assert!(found.problems[0].message.contains("injected refusal"));
     }
 
+    /// Motion files by extension, in any case; a folder's other files are not clips.
+    #[test]
+    fn only_motion_files_are_taken_from_folders() {
+        for yes in ["a.bvh", "A.BVH", "x.Txt", "d/x.json", "m.amc", "c.C3d"] {
+            assert!(is_motion_file(Path::new(yes)), "{yes}");
+        }
+        for no in ["p.csv", "bvh", "x.bvh.bak", ".bvh", "x.", "x.npz"] {
+            assert!(!is_motion_file(Path::new(no)), "{no}");
+        }
+        let d = tmp("kinds");
+        for f in ["clip.bvh", "notes.csv", "README", "motion.npz"] {
+            std::fs::write(d.join(f), "x").unwrap();
+        }
+        let found = discover(&[d.display().to_string()], None);
+        let names: Vec<&str> = found.clips.iter().map(|c| c.name.as_str()).collect();
+        assert_eq!(names, ["clip"]);
+        assert!(found.problems.is_empty(), "{:?}", found.problems);
+    }
+
+    /// The batch's own output folder inside an input folder is not searched, even before it
+    /// holds any marker; its sibling folders are.
+    #[test]
+    fn the_batchs_own_output_folder_is_not_searched() {
+        let d = tmp("own-out");
+        for sub in ["out", "sub"] {
+            std::fs::create_dir_all(d.join(sub)).unwrap();
+            std::fs::write(d.join(sub).join("clip.bvh"), "x").unwrap();
+        }
+        let out = d.join("out");
+        assert!(is_output_folder(&out, Some(&out)));
+        assert!(!is_output_folder(&d.join("sub"), Some(&out)));
+        assert!(!is_output_folder(&out, Some(&d.join("missing"))));
+        let found = discover(&[d.display().to_string()], Some(&out));
+        let names: Vec<&str> = found.clips.iter().map(|c| c.name.as_str()).collect();
+        assert_eq!(names, ["sub/clip"]);
+        assert_eq!(found.output_folders, [out]);
+    }
+
+    /// An input that names no clip gives one problem naming it: a missing path its error, a
+    /// folder without motion files that none was found; each problem is the input's own.
+    #[test]
+    fn each_input_that_names_no_clip_is_one_problem() {
+        let d = tmp("none");
+        std::fs::write(d.join("notes.csv"), "x").unwrap();
+        let missing = d.join("missing.bvh").display().to_string();
+        let empty = d.display().to_string();
+        let found = discover(&[missing.clone(), empty.clone()], None);
+        assert!(found.clips.is_empty());
+        let problems: Vec<(&str, &str)> = found
+            .problems
+            .iter()
+            .map(|p| (p.path.as_str(), p.message.as_str()))
+            .collect();
+        assert_eq!(
+            problems,
+            [
+                (missing.as_str(), "no such file or folder"),
+                (
+                    empty.as_str(),
+                    "no motion file (.bvh, .amc, .c3d, .txt, .json) found"
+                )
+            ]
+        );
+    }
+
+    /// A glob pattern is searched from the folder before its first wildcard, `*` crossing
+    /// folders and `?` one character; the names are relative to that folder.
+    #[test]
+    fn glob_patterns_search_from_the_folder_before_the_first_wildcard() {
+        let d = tmp("glob");
+        for f in ["top.bvh", "a/x.bvh", "a/y.txt", "b/z.bvh", "bb/w.txt"] {
+            std::fs::create_dir_all(d.join(f).parent().unwrap()).unwrap();
+            std::fs::write(d.join(f), "x").unwrap();
+        }
+        let names = |pattern: &str| -> Vec<String> {
+            let found = discover(&[format!("{}/{pattern}", d.display())], None);
+            assert!(found.problems.is_empty(), "{pattern}: {:?}", found.problems);
+            found.clips.into_iter().map(|c| c.name).collect()
+        };
+        assert_eq!(names("*.bvh"), ["a/x", "b/z", "top"]);
+        assert_eq!(names("?/*.txt"), ["a/y"]);
+        assert_eq!(names("b*/*"), ["b/z", "bb/w"]);
+        let found = discover(&[format!("{}/*.amc", d.display())], None);
+        assert!(found.clips.is_empty());
+        assert_eq!(found.problems.len(), 1, "{:?}", found.problems);
+        assert!(found.problems[0].message.contains("no motion file"));
+    }
+
     /// An entry the listing cannot give (injected) is named by its folder; the rest is kept.
     #[test]
     fn an_unreadable_entry_is_named_by_its_folder() {

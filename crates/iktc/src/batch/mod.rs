@@ -25,7 +25,9 @@ pub use quality::{
     run_penetration, sole_penetration, trajectory_penetration, ClipQuality, JointFigures,
     KeypointFigures, Penetration, MARGIN_ROUNDING, PENETRATION_TOLERANCE,
 };
-pub use record::{clip_record, is_done, remove_leftovers, write_clip_folder};
+pub use record::{
+    clip_record, clip_state, is_done, remove_leftovers, write_clip_folder, ClipState,
+};
 pub use retarget::{
     body_frames, posture_references, BatchRetarget, ClipOutcome, ClipRun, Posture, RetargetMethod,
     DEFAULT_RETARGET_METHOD, MIN_CLIP_FRAMES,

@@ -4,8 +4,8 @@
 //! names, the profile and the maps it names), the settings and the program's version. The
 //! record is the SHA-256 digest of all of them ([`BatchRetarget::dependency_digest`] for what
 //! the clips share, [`clip_record`] with the input's bytes); a clip is done when its folder's
-//! [`RECORD_FILE`] holds that digest and every output is there ([`is_done`]). File times play
-//! no part: a changed file changes the digest whatever its time, and a touched one does not.
+//! [`RECORD_FILE`] holds that digest and every output is there ([`is_done`]); a batch run
+//! again skips it ([`clip_state`]). File times play no part: a changed file changes the digest whatever its time, and a touched one does not.
 //!
 //! A clip's folder is written as a temporary folder beside it and renamed into place whole
 //! ([`write_clip_folder`]), the record written last: a clip that fails, or a batch that is
@@ -117,6 +117,36 @@ pub fn is_done(dir: &Path, record: &str, outputs: &[&str]) -> bool {
         && outputs.iter().all(|o| dir.join(o).is_file())
 }
 
+/// What a batch does with a clip found again: skip it or run it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum ClipState {
+    /// Its folder is finished for its current record ([`is_done`]): skipped.
+    Done,
+    /// To run (never run, its input or the batch's dependencies changed since, its folder
+    /// incomplete, or forced); the record to write when its folder is whole.
+    ToRun(String),
+}
+
+/// Whether the clip read from `input`, whose folder is `dir`, is [`ClipState::Done`] under a
+/// batch whose [`BatchRetarget::dependency_digest`] is `dependencies` and which writes the
+/// files `outputs` (names in `dir`), or still to run. `force` runs every clip.
+///
+/// Errors: those of [`clip_record`] (the input cannot be read).
+pub fn clip_state(
+    dependencies: &str,
+    input: &Path,
+    dir: &Path,
+    outputs: &[&str],
+    force: bool,
+) -> Result<ClipState> {
+    let record = clip_record(dependencies, input)?;
+    Ok(if !force && is_done(dir, &record, outputs) {
+        ClipState::Done
+    } else {
+        ClipState::ToRun(record)
+    })
+}
+
 /// The name of a temporary sibling of `dir` (`.NAME.PID.KIND`).
 fn sibling(dir: &Path, kind: &str) -> PathBuf {
     let name = dir
@@ -208,4 +238,90 @@ pub fn remove_leftovers(dir: &Path) -> io::Result<()> {
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tmp(name: &str) -> PathBuf {
+        let d = std::env::temp_dir().join(format!("iktc-record-{}-{name}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).unwrap();
+        d
+    }
+
+    /// A clip is done only when its folder holds its current record and every output; a
+    /// changed input, other dependencies, a missing output or `force` make it run again,
+    /// with the record of what it now depends on.
+    #[test]
+    fn a_clip_is_skipped_only_when_its_folder_is_whole_and_current() {
+        let d = tmp("state");
+        let (input, dir) = (d.join("clip.bvh"), d.join("out/clip"));
+        std::fs::write(&input, "first").unwrap();
+        let outputs = ["motion.csv", "quality.json"];
+        let state = |deps: &str, outputs: &[&str], force: bool| {
+            clip_state(deps, &input, &dir, outputs, force).unwrap()
+        };
+        let r1 = clip_record("deps", &input).unwrap();
+        assert_eq!(state("deps", &outputs, false), ClipState::ToRun(r1.clone()));
+        write_clip_folder(&dir, &r1, |tmp| {
+            outputs
+                .iter()
+                .try_for_each(|o| std::fs::write(tmp.join(o), "x"))
+        })
+        .unwrap();
+        assert_eq!(state("deps", &outputs, false), ClipState::Done);
+        assert_eq!(state("deps", &outputs, true), ClipState::ToRun(r1.clone()));
+        let more = ["motion.csv", "quality.json", "viewer.html"];
+        assert_eq!(state("deps", &more, false), ClipState::ToRun(r1.clone()));
+        let r2 = clip_record("other", &input).unwrap();
+        assert_ne!(r2, r1);
+        assert_eq!(state("other", &outputs, false), ClipState::ToRun(r2));
+        std::fs::write(&input, "second").unwrap();
+        let r3 = clip_record("deps", &input).unwrap();
+        assert_ne!(r3, r1);
+        assert_eq!(state("deps", &outputs, false), ClipState::ToRun(r3));
+        std::fs::remove_file(&input).unwrap();
+        let e = clip_state("deps", &input, &dir, &outputs, false).unwrap_err();
+        assert!(e.to_string().contains("clip.bvh"), "{e}");
+    }
+
+    /// The record is the SHA-256 digest of three named parts, each fed as its name's length
+    /// (8 bytes, little-endian), the name, its bytes' length and the bytes, in lower-case hex;
+    /// here spelled out byte by byte.
+    #[test]
+    fn the_record_is_the_digest_of_its_named_parts() {
+        let d = tmp("digest");
+        let input = d.join("clip.bvh");
+        std::fs::write(&input, "bytes").unwrap();
+        let mut fed: Vec<u8> = Vec::new();
+        for (name, bytes) in [
+            ("layout", "iktc clip record 1"),
+            ("dependencies", "deps"),
+            ("input", "bytes"),
+        ] {
+            fed.extend((name.len() as u64).to_le_bytes());
+            fed.extend(name.bytes());
+            fed.extend((bytes.len() as u64).to_le_bytes());
+            fed.extend(bytes.bytes());
+        }
+        let expected: String = Sha256::digest(&fed)
+            .iter()
+            .map(|b| format!("{b:02x}"))
+            .collect();
+        assert_eq!(clip_record("deps", &input).unwrap(), expected);
+    }
+
+    /// A path that cannot be examined (here: below a file) is an error, not taken for one
+    /// that is not there; a missing one is removed already.
+    #[test]
+    fn an_entry_that_cannot_be_examined_is_not_taken_as_absent() {
+        let d = tmp("examine");
+        std::fs::write(d.join("file"), "x").unwrap();
+        assert!(remove_any(&d.join("missing")).is_ok());
+        let e = remove_any(&d.join("file/below")).unwrap_err();
+        assert_ne!(e.kind(), io::ErrorKind::NotFound);
+        assert!(d.join("file").is_file());
+    }
 }

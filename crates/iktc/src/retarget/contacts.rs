@@ -309,6 +309,71 @@ mod tests {
         assert_eq!(detect_ankle(0.08), vec![false; 3]);
     }
 
+    /// Speeds are central differences (one-sided at the clip's ends). A foot on the ground
+    /// moving 5 cm per 0.1 s frame, with frame times from 1 s on, moves at 0.5 m/s at every
+    /// frame: on below a limit of 0.6 m/s, off at 0.4 m/s. A foot still for three frames and
+    /// then 1 m further for three: the central differences at frames 2 and 3 span the jump,
+    /// 1 m in 0.2 s = 5 m/s (off at 1 m/s); at the others it is 0 (on).
+    #[test]
+    fn contact_speeds_are_central_differences() {
+        let times: Vec<f64> = (0..6).map(|k| 1.0 + 0.1 * k as f64).collect();
+        let moving: Vec<Vector3<f64>> = (0..6)
+            .map(|k| Vector3::new(0.05 * k as f64, 0.0, 0.0))
+            .collect();
+        let on = |speed: f64| detect(&times, &moving, None, [0.0, 0.0], 0.05, speed);
+        assert_eq!(on(0.6), vec![true; 6]);
+        assert_eq!(on(0.4), vec![false; 6]);
+        let times: Vec<f64> = (0..6).map(|k| 0.1 * k as f64).collect();
+        let jump: Vec<Vector3<f64>> = (0..6)
+            .map(|k| Vector3::new(if k < 3 { 0.0 } else { 1.0 }, 0.0, 0.0))
+            .collect();
+        let c = detect(&times, &jump, None, [0.0, 0.0], 0.05, 1.0);
+        assert_eq!(c, [true, true, false, false, true, true]);
+    }
+
+    /// Both limits are strict: a still ankle exactly `contact_height` above its ground (0.5 m
+    /// over 0.25 m with a 0.5 m limit) is off, and one 0.01 m lower on; an ankle on the ground
+    /// moving exactly at `contact_speed` (0.25 m per 0.5 s, 0.5 m/s at every frame) is off at
+    /// a 0.5 m/s limit and on at 0.51 m/s. Every number is exact in binary.
+    #[test]
+    fn a_foot_exactly_at_a_limit_is_off() {
+        let times = [0.0, 0.5, 1.0];
+        let still = |z: f64| vec![Vector3::new(0.0, 0.0, z); 3];
+        assert_eq!(
+            detect(&times, &still(0.75), None, [0.25, 0.0], 0.5, 1.0),
+            [false; 3]
+        );
+        assert_eq!(
+            detect(&times, &still(0.74), None, [0.25, 0.0], 0.5, 1.0),
+            [true; 3]
+        );
+        let moving: Vec<Vector3<f64>> = (0..3)
+            .map(|k| Vector3::new(0.25 * k as f64, 0.0, 0.0))
+            .collect();
+        assert_eq!(
+            detect(&times, &moving, None, [0.0, 0.0], 0.5, 0.5),
+            [false; 3]
+        );
+        assert_eq!(
+            detect(&times, &moving, None, [0.0, 0.0], 0.5, 0.51),
+            [true; 3]
+        );
+    }
+
+    /// Frames whose neighbours share their time (repeated time stamps, a one-frame clip) have
+    /// no measured speed: a foot on the ground there is judged by its height alone, on, even
+    /// though it moves 1 m between the frames.
+    #[test]
+    fn frames_without_time_between_them_are_judged_by_height() {
+        let moving: Vec<Vector3<f64>> = (0..3).map(|k| Vector3::new(k as f64, 0.0, 0.0)).collect();
+        assert_eq!(
+            detect(&[0.0; 3], &moving, None, [0.0, 0.0], 0.05, 0.4),
+            [true; 3]
+        );
+        let one = [Vector3::new(0.0, 0.0, 0.0)];
+        assert_eq!(detect(&[0.0], &one, None, [0.0, 0.0], 0.05, 0.4), [true]);
+    }
+
     /// A stance of 40 frames whose ankle is still for 10 frames, slides 1 cm a frame along x
     /// (and rises, which does not count) for 10, then is still again; and a still stance.
     fn sliding() -> (Vec<bool>, Vec<Vector3<f64>>) {
@@ -374,6 +439,18 @@ mod tests {
         assert_eq!(split(0.055, 0)[..2], [(0, 16), (17, 40)]);
     }
 
+    /// With a gap of 0 a slide at a stance's last frame, the clip's last, ends the stance
+    /// there for that frame: frames 0–3 still, frame 4 10 cm on (5 cm allowed).
+    #[test]
+    fn a_slide_at_the_clips_last_frame_ends_the_stance_there() {
+        let mut c = vec![true; 5];
+        let ankle: Vec<Vector3<f64>> = (0..5)
+            .map(|f| Vector3::new(if f < 4 { 0.0 } else { 0.1 }, 0.0, 0.0))
+            .collect();
+        split_slides(&mut c, &ankle, 0.05, 0);
+        assert_eq!(c, [true, true, true, true, false]);
+    }
+
     #[test]
     fn short_runs_are_removed_and_long_ones_kept() {
         let mut c = [
@@ -383,6 +460,22 @@ mod tests {
         assert_eq!(c[..5], [true; 5]);
         remove_short(&mut c, true, 3); // the final pair of contacts is dropped
         assert_eq!(runs(&c), vec![(0, 5)]);
+    }
+
+    /// Only runs shorter than `min_len` go: a flight exactly `min_len` long stays, and so
+    /// does a short flight at either end of the clip (the other value on one side only); a
+    /// short contact goes wherever it is, at the ends too.
+    #[test]
+    fn runs_of_exactly_min_len_and_flights_at_the_ends_stay() {
+        let (t, f) = (true, false);
+        let mut c = [f, t, t, t, f, f, t, t, t, f];
+        remove_short(&mut c, false, 2);
+        assert_eq!(c, [f, t, t, t, f, f, t, t, t, f]);
+        remove_short(&mut c, false, 3);
+        assert_eq!(c, [f, t, t, t, t, t, t, t, t, f]);
+        let mut c = [t, f, f, f, t, t, f, f, f, t];
+        remove_short(&mut c, true, 2);
+        assert_eq!(c, [f, f, f, f, t, t, f, f, f, f]);
     }
 
     #[test]
@@ -406,6 +499,60 @@ mod tests {
         }
         let (first, last) = (t[20] - t[19], t[40] - t[39]);
         assert!(first < 0.001 && last < 0.001, "{first} {last}");
+    }
+
+    /// The centred mean over `2 half + 1` samples, the window cut at the ends: a spike of 3
+    /// among zeros spreads to thirds with `half = 1` (the ends' windows of two hold zeros
+    /// only), and with `half = 2` to 3/3, 3/4, 3/5, 3/4, 3/3; two samples average to their
+    /// mean; `half = 0` leaves the samples.
+    #[test]
+    fn the_moving_average_is_centred_and_shrinks_at_the_ends() {
+        let average = |x: &[f64], half: usize| {
+            let mut y = x.to_vec();
+            moving_average(&mut y, half);
+            y
+        };
+        let spike = [0.0, 0.0, 3.0, 0.0, 0.0];
+        assert_eq!(average(&spike, 1), [0.0, 1.0, 1.0, 1.0, 0.0]);
+        assert_eq!(average(&spike, 2), [1.0, 0.75, 0.6, 0.75, 1.0]);
+        assert_eq!(average(&spike, 0), spike);
+        assert_eq!(average(&[0.0, 2.0], 1), [1.0, 1.0]);
+        assert_eq!(average(&[5.0], 3), [5.0]);
+    }
+
+    /// Before the first stance and after the last one the track keeps the captured motion
+    /// shifted onto the hold (0.5), its departure from the stance's end tick faded in over
+    /// `SWING_FADE` of the free run. A stance on ticks 0–4 of 25 (captured at 1), then a ramp
+    /// `1 + (k − 4)`: the free run counts 25 − 4 = 21 ticks from the stance's last tick 4, so
+    /// tick `k` is `0.5 + s((k − 4) / 5.25) (k − 4)`, `s(τ) = 10τ³ − 15τ⁴ + 6τ⁵` clamped to 1
+    /// from τ = 1 on. Mirrored, a stance on ticks 20–24 after a ramp down to it: the free run
+    /// counts 20 + 1 ticks up to the stance's first tick 20, and tick `k` is
+    /// `0.5 + s((20 − k) / 5.25) (20 − k)`.
+    #[test]
+    fn outside_the_stances_the_captured_motion_fades_in_over_a_quarter_of_the_run() {
+        let n = 25;
+        let s = |tau: f64| {
+            let tau = tau.min(1.0);
+            tau.powi(3) * (10.0 - 15.0 * tau + 6.0 * tau * tau)
+        };
+        // The stance's ticks, and its tick next to the free run.
+        for (stance, end) in [(0..5, 4.0), (20..25, 20.0)] {
+            let d = |k: usize| {
+                if stance.contains(&k) {
+                    0.0
+                } else {
+                    (k as f64 - end).abs()
+                }
+            };
+            let raw: Vec<f64> = (0..n).map(|k| 1.0 + d(k)).collect();
+            let contact: Vec<bool> = (0..n).map(|k| stance.contains(&k)).collect();
+            let mut t = raw.clone();
+            hold(&mut t, &contact, Some(0.5));
+            for (k, x) in t.iter().enumerate() {
+                let expected = 0.5 + s(d(k) / 5.25) * d(k);
+                assert!((x - expected).abs() < 1e-12, "{k}: {x} {expected}");
+            }
+        }
     }
 
     /// A stance whose yaw turns by 2 rad (at 4 rad/s) is followed no faster than the step
