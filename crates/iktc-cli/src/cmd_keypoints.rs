@@ -156,10 +156,9 @@ pub fn keypoint_settings(
         },
         reach: k.reach,
         posture_fit: k.posture_fit,
-        max_leg_extension: std::env::var("IKTC_EXP_EXT")
-            .ok()
-            .and_then(|v| v.parse().ok())
-            .unwrap_or(iktc::retarget::MAX_LEG_EXTENSION), // EXPERIMENT
+        max_leg_extension: k
+            .max_leg_extension
+            .unwrap_or(iktc::retarget::MAX_LEG_EXTENSION),
         pivot_turn: if k.no_pivot {
             None
         } else {

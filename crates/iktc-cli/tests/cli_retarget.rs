@@ -680,6 +680,46 @@ fn standing_holds_feet_and_pelvis_and_is_part_of_the_settings() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("--retarget keypoints only"));
 }
 
+/// `--max-leg-extension` reaches the run: a smaller share of the leg lowers the pelvis on a
+/// walk (the cap binds where the person's knees are straighter than the cap's knee angle, 74°
+/// at 0.8), the clip is redone (the option is part of the settings), a share outside (0, 1]
+/// is an error naming the setting, and the joint route refuses the option.
+#[test]
+fn max_leg_extension_option_lowers_the_pelvis() {
+    let dir = tmp("extension");
+    let clip = data().join("humanoid3d_walk.txt");
+    let out = dir.join("out");
+    let run = |extra: &[&str]| retarget_on_g1(&clip, &out, extra);
+    let pelvis_median_height = || {
+        let npz = read_npz(&std::fs::read(out.join("humanoid3d_walk/motion.npz")).unwrap());
+        let bodies = strings(&npz, "body_names");
+        let (shape, body) = floats(&npz, "body_pos_w");
+        let i = bodies.iter().position(|b| b == "pelvis").unwrap();
+        let nb = shape[1];
+        let mut z: Vec<f64> = (0..shape[0]).map(|k| body[3 * (nb * k + i) + 2]).collect();
+        z.sort_by(f64::total_cmp);
+        z[z.len() / 2]
+    };
+    let o = run(&[]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let default = pelvis_median_height();
+    let o = run(&["--max-leg-extension", "0.8"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(statuses(&out)["humanoid3d_walk"], "retargeted");
+    let lowered = pelvis_median_height();
+    // G1's leg is about 0.6 m: 0.12 of it is about 7 cm; at least 2 cm must show.
+    assert!(
+        default - lowered > 0.02,
+        "pelvis median {default} m by default, {lowered} m at 0.8"
+    );
+    let o = run(&["--max-leg-extension", "1.5"]);
+    assert!(!o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("max_leg_extension"), "{err}");
+    let o = run(&["--max-leg-extension", "0.9", "--retarget", "joints"]);
+    assert!(!o.status.success());
+}
+
 /// `--hands segments` places the hands along the arm instead of by the leg ratio (the default):
 /// the robot's hands move differently (centimetres apart somewhere in the clip), the option
 /// enters the settings fingerprint (the clip is redone, not skipped), and the joint route
