@@ -20,7 +20,9 @@
 //!   [`CONTACT_SPEED`] horizontally; runs of at least two frames are the contact windows. Per
 //!   window: the robot ankle centre's horizontal **slip** (the largest distance between two of
 //!   its positions in the window) and its sole's lowest corner height (**contact height**: the
-//!   foot should be on the ground). **Lowest sole**: the lowest sole corner on any tick.
+//!   foot should be on the ground). The window of the largest slip is reported with the
+//!   person's own ankle's slip there (scaled by `s`) and the robot sole's height range, so
+//!   that a slip the person made too can be told from one the robot added. **Lowest sole**: the lowest sole corner on any tick.
 //!   **Skating**: ticks on which a sole's lowest corner is within [`SKATE_HEIGHT`] of the
 //!   floor while the sole's centre moves faster than [`SKATE_SPEED`] horizontally.
 //! * **Posture**, per tick, robot against scaled person: knee and elbow flexion
@@ -144,6 +146,29 @@ pub struct ContactFigures {
     pub skate_share: f64,
     /// Horizontal distance skated, both feet \[m\].
     pub skate_distance_m: f64,
+    /// The window of the largest slip (`None`: no window), to see where and whether the
+    /// person's own foot moved there too.
+    pub worst_slip: Option<SlipWindow>,
+}
+
+/// One contact window of the person's, where the robot's foot slipped most.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SlipWindow {
+    /// `"left"` or `"right"`.
+    pub foot: &'static str,
+    /// Clip time of the window's first and last frame \[s\].
+    pub start_s: f64,
+    /// ... and last frame \[s\].
+    pub end_s: f64,
+    /// The robot ankle centre's slip there (the figure `slip_max_mm`) \[mm\].
+    pub robot_mm: f64,
+    /// The person's own ankle's slip over the window's frames, scaled to the robot by the
+    /// legs' ratio (module documentation) \[mm\]: near `robot_mm` where the person's foot slid
+    /// too, near 0 where only the robot's moved.
+    pub person_mm: f64,
+    /// Lowest and highest of the robot's lowest sole corner in the window \[mm\]: a sole well
+    /// above the floor means the robot's foot was still (or already) in the air.
+    pub sole_mm: [f64; 2],
 }
 
 /// Smoothness of the joints' commanded accelerations.
@@ -439,7 +464,7 @@ pub fn fidelity(input: &FidelityInput, limits: &FidelityLimits) -> Fidelity {
             }
         })
         .collect();
-    let contacts = contact_figures(input);
+    let contacts = contact_figures(input, scale);
     let smoothness = smoothness(input.qdd, input.dt);
     let mut f = Fidelity {
         ticks: measured,
@@ -459,13 +484,14 @@ pub fn fidelity(input: &FidelityInput, limits: &FidelityLimits) -> Fidelity {
 }
 
 /// The contact figures of `input` (module documentation).
-fn contact_figures(input: &FidelityInput) -> ContactFigures {
+fn contact_figures(input: &FidelityInput, scale: f64) -> ContactFigures {
     let kp = input.person;
     let windows = person_contacts(kp);
     let ticks = input.robot.len();
     let mut in_window = [vec![false; ticks], vec![false; ticks]];
     let (mut count, mut slip_max, mut slip_sum, mut height_max) =
         (0usize, 0.0_f64, 0.0, f64::NEG_INFINITY);
+    let mut worst: Option<SlipWindow> = None;
     for (side, ws) in windows.iter().enumerate() {
         for &(a, b) in ws {
             let (ta, tb) = (kp.times[a], kp.times[b]);
@@ -489,6 +515,23 @@ fn contact_figures(input: &FidelityInput) -> ContactFigures {
                 for &j in &ks[i + 1..] {
                     slip = slip.max((input.robot[j].centres[ankle].xy() - x).norm());
                 }
+            }
+            if worst.as_ref().is_none_or(|w| 1000.0 * slip > w.robot_mm) {
+                let person: Vec<Vector3<f64>> = (a..=b)
+                    .filter_map(|f| kp.position(f, JOINT_CENTRES[ankle]))
+                    .collect();
+                let soles = ks.iter().map(|k| input.robot[*k].sole_lowest[side]);
+                worst = Some(SlipWindow {
+                    foot: if side == 0 { "left" } else { "right" },
+                    start_s: ta,
+                    end_s: tb,
+                    robot_mm: 1000.0 * slip,
+                    person_mm: 1000.0 * scale * horizontal_diameter(&person),
+                    sole_mm: [
+                        1000.0 * soles.clone().fold(f64::INFINITY, f64::min),
+                        1000.0 * soles.fold(f64::NEG_INFINITY, f64::max),
+                    ],
+                });
             }
             slip_max = slip_max.max(slip);
             slip_sum += slip;
@@ -521,7 +564,19 @@ fn contact_figures(input: &FidelityInput) -> ContactFigures {
         lowest_sole_mm: if ticks > 0 { 1000.0 * lowest } else { 0.0 },
         skate_share: skate as f64 / foot_ticks,
         skate_distance_m: distance,
+        worst_slip: worst,
     }
+}
+
+/// The largest horizontal distance between two of `points` \[m\] (0 for fewer than two).
+fn horizontal_diameter(points: &[Vector3<f64>]) -> f64 {
+    let mut d = 0.0_f64;
+    for (i, p) in points.iter().enumerate() {
+        for q in &points[i + 1..] {
+            d = d.max((p - q).xy().norm());
+        }
+    }
+    d
 }
 
 /// Smoothness of the per-tick joint accelerations `qdd` (rows: ticks; columns: joints).
@@ -588,8 +643,14 @@ fn verdict(f: &Fidelity, l: &FidelityLimits) -> Vec<String> {
         (
             !exceeds(c.slip_max_mm, l.slip_mm),
             format!(
-                "foot slip over the person's contacts {:.0} mm > {} mm",
-                c.slip_max_mm, l.slip_mm
+                "foot slip over the person's contacts {:.0} mm > {} mm{}",
+                c.slip_max_mm,
+                l.slip_mm,
+                c.worst_slip.as_ref().map_or(String::new(), |w| format!(
+                    " ({} foot, {:.2}–{:.2} s; the person's ankle {:.0} mm there, scaled; the \
+                     robot's sole {:.0} to {:.0} mm up)",
+                    w.foot, w.start_s, w.end_s, w.person_mm, w.sole_mm[0], w.sole_mm[1]
+                ))
             ),
         ),
         (

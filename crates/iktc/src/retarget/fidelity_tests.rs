@@ -206,6 +206,16 @@ fn contacts_slip_height_and_skating_by_hand() {
     let c = &f.contacts;
     assert_eq!(c.windows, 2);
     assert!((c.slip_max_mm - 20.0).abs() < 1e-9, "{c:?}");
+    // The worst window is the left foot's, frames 0–3 (0–0.3 s); the person stood still there.
+    let w = c.worst_slip.as_ref().expect("a window");
+    assert_eq!(w.foot, "left");
+    assert_eq!((w.start_s, w.end_s), (0.0, 0.30000000000000004));
+    assert!(
+        (w.robot_mm - 20.0).abs() < 1e-9 && w.person_mm.abs() < 1e-12,
+        "{w:?}"
+    );
+    assert!((w.sole_mm[0] - 7.0).abs() < 1e-9 && (w.sole_mm[1] - 7.0).abs() < 1e-9);
+    assert!(f.failures.is_empty() || !f.failures.iter().any(|m| m.contains("slip")));
     assert!((c.height_max_mm - 7.0).abs() < 1e-9, "{c:?}");
     assert!(c.lowest_sole_mm.abs() < 1e-9, "{c:?}");
     // The left sole is 7 mm up: not on the floor, so no skating at all.
@@ -234,6 +244,53 @@ fn contacts_slip_height_and_skating_by_hand() {
         g.contacts
     );
     assert!((g.contacts.skate_distance_m - 0.06).abs() < 1e-12);
+}
+
+/// The person's left leg slides 5 cm along x over its window (frames 0–3, 0.167 m/s: still
+/// a contact; the lifted frames' shorter legs leave the median, 0.9 m, and so the scale) and the robot's, at half the person's size (leg 0.45 m against 0.9 m), slides
+/// 60 mm: the worst window reports the person's slide scaled, 25 mm, beside the robot's 60 mm,
+/// and the verdict's slip failure names the foot, the window and both.
+#[test]
+fn the_worst_slip_window_shows_the_persons_own_slide() {
+    let body = standing();
+    let frames: Vec<[Vector3<f64>; 12]> = (0..6)
+        .map(|k| {
+            let mut x = body;
+            // The whole left leg moves, so that its length (and the scale) stays exact.
+            for p in [B::LeftHip, B::LeftKnee, B::LeftAnkle] {
+                x[ix(p)].x += 0.05 * (k.min(3) as f64) / 3.0;
+            }
+            if k >= 4 {
+                x[ix(B::LeftAnkle)].z += 0.1;
+            }
+            x
+        })
+        .collect();
+    let kp = person(&frames);
+    assert_eq!(person_contacts(&kp)[0], vec![(0, 3)]);
+    let robot: Vec<RobotSample> = frames
+        .iter()
+        .enumerate()
+        .map(|(k, x)| {
+            let mut r = sample(x.map(|p| 0.5 * p));
+            r.centres[ix(B::LeftAnkle)].x = 0.06 * (k.min(3) as f64) / 3.0;
+            r
+        })
+        .collect();
+    let f = run(&kp, &robot, 0.45, &vec![vec![0.0]; 6]);
+    let w = f.contacts.worst_slip.as_ref().expect("a window");
+    assert_eq!(w.foot, "left");
+    assert!((w.robot_mm - 60.0).abs() < 1e-9, "{w:?}");
+    assert!((w.person_mm - 25.0).abs() < 1e-9, "{w:?}");
+    let why = f
+        .failures
+        .iter()
+        .find(|m| m.contains("slip"))
+        .expect("a slip failure");
+    assert!(
+        why.contains("left foot") && why.contains("0.00–0.30 s") && why.contains("25 mm"),
+        "{why}"
+    );
 }
 
 /// q̈ of one joint 10, −30, 20, 20 rad/s²: flips of 10 and 20 (min of the two sides), the
