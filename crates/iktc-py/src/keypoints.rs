@@ -49,8 +49,13 @@ pub struct PyKeypointTrajectory {
 /// ratio, `"segments"` along the arm at the robot's segment lengths
 /// (`iktc::retarget::HandScaling`). `reach`: also measure the static reach of the body points
 /// (`iktc::retarget::KeypointSettings::reach`; about doubles the time), in `quality`.
+/// `posture_fit`: where no joint map gives the posture level its angles, follow the person's
+/// posture fitted to their segments' directions (`iktc::retarget::fit`) instead of the start
+/// posture. `max_leg_extension` (0, 1]: the largest share of a leg's length the pelvis height
+/// may ask of a stance leg (`iktc::retarget::MAX_LEG_EXTENSION` by default); larger values
+/// follow straight knees closer and land the feet less exactly.
 #[pyfunction]
-#[pyo3(name = "retarget_keypoints", signature = (motion, robot, *, dt=0.005, hold_feet=false, standing=false, smoothing=None, approach_rate=0.0, hands="leg", reach=false, max_slide=Some(iktc::retarget::MAX_SLIDE)))]
+#[pyo3(name = "retarget_keypoints", signature = (motion, robot, *, dt=0.005, hold_feet=false, standing=false, smoothing=None, approach_rate=0.0, hands="leg", reach=false, max_slide=Some(iktc::retarget::MAX_SLIDE), posture_fit=false, max_leg_extension=iktc::retarget::MAX_LEG_EXTENSION))]
 #[allow(clippy::too_many_arguments)]
 pub fn py_retarget_keypoints(
     py: Python<'_>,
@@ -64,6 +69,8 @@ pub fn py_retarget_keypoints(
     hands: &str,
     reach: bool,
     max_slide: Option<f64>,
+    posture_fit: bool,
+    max_leg_extension: f64,
 ) -> PyResult<PyKeypointTrajectory> {
     let profile = robot.required_profile("keypoint retargeting", "feet, pelvis and hands")?;
     let hands = match hands {
@@ -82,6 +89,8 @@ pub fn py_retarget_keypoints(
         hands,
         reach,
         max_slide,
+        posture_fit,
+        max_leg_extension,
         ..KeypointSettings::default()
     };
     settings.bounds = settings

@@ -161,3 +161,25 @@ def test_the_quality_has_the_neutral_fidelity_figures(runs):
     mean = sum(p["mean_cm"] for p in f["points"]) / 13
     assert abs(mean - f["keypoint_mean_cm"]) < 1e-9
     assert 0.0 <= f["smoothness"]["reversal_share"] <= 1.0
+
+
+def test_posture_fit_and_leg_extension_reach_the_run():
+    # A BVH clip has no joint map onto G1: with the fit the posture level follows the person's
+    # segments (its RMS angle reported), without it nothing is fitted. A smaller share of the
+    # leg lowers the pelvis (the robot's hip height falls); a share outside (0, 1] is an error.
+    from test_controller import REPO
+    robot = iktc.Robot("g1")
+    motion = iktc.load_motion(str(REPO / "crates/iktc/tests/data/motions/cmu/131_01.bvh"))
+    plain = iktc.retarget_keypoints(motion, robot)
+    fitted = iktc.retarget_keypoints(motion, robot, posture_fit=True)
+    assert plain.quality["posture_fit_deg"] is None
+    assert 0.0 < fitted.quality["posture_fit_deg"] < 30.0
+
+    def hips(run):
+        return {p["name"]: p for p in run.quality["fidelity"]["posture"]}["hip_height"]["robot_median"]
+
+    low = iktc.retarget_keypoints(motion, robot, max_leg_extension=0.8)
+    assert hips(low) < hips(plain) - 2.0  # [cm]
+    for bad in (0.0, 1.5, float("nan")):
+        with pytest.raises(iktc.IktcError, match="max_leg_extension"):
+            iktc.retarget_keypoints(motion, robot, max_leg_extension=bad)

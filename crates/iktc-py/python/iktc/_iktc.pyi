@@ -208,7 +208,9 @@ def retarget_keypoints(motion: Motion, robot: Robot, *, dt: float = 0.005,
                        approach_rate: float = 0.0,
                        hands: str = "leg",
                        reach: bool = False,
-                       max_slide: Optional[float] = 0.05) -> KeypointTrajectory: ...
+                       max_slide: Optional[float] = 0.05,
+                       posture_fit: bool = False,
+                       max_leg_extension: float = 0.92) -> KeypointTrajectory: ...
 
 class Imitation:
     def __init__(self, robot: Robot, motion: Motion, *, map: Optional[str] = None,
