@@ -580,14 +580,14 @@ fn mjlab_npz_reads_back_with_world_poses_wxyz_and_kinematic_velocities() {
     // Every body's velocity against central differences of what the file says.
     let dt = 1.0 / RATE;
     for j in 1..FRAMES - 1 {
-        for b in 0..30 {
+        for (b, name) in names.iter().enumerate() {
             let (p0, p1) = (at3(pos, j - 1, b), at3(pos, j + 1, b));
             let fd = [0, 1, 2].map(|k| (p1[k] - p0[k]) / (2.0 * dt));
             close(
                 &at3(lin, j, b),
                 &fd,
                 CENTRAL_DIFFERENCE,
-                &format!("{} v", names[b]),
+                &format!("{name} v"),
             );
             // ω from R(t+h) R(t−h)ᵀ: the quaternion q1 q0⁻¹ = (cos θ/2, sin θ/2 n).
             let (a, c) = (at4(j - 1, b), at4(j + 1, b));
@@ -612,7 +612,7 @@ fn mjlab_npz_reads_back_with_world_poses_wxyz_and_kinematic_velocities() {
                 &at3(ang, j, b),
                 &fd,
                 CENTRAL_DIFFERENCE,
-                &format!("{} ω", names[b]),
+                &format!("{name} ω"),
             );
         }
     }
