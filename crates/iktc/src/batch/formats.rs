@@ -39,9 +39,11 @@
 //!
 //! ## `mjlab`: `motion_mjlab.npz`, the motion NPZ of mjlab / BeyondMimic
 //!
-//! The arrays `csv_to_npz.py` of mjlab (and of BeyondMimic's `whole_body_tracking`) saves and
-//! the tracking task's `MotionLoader` reads, all `float64` here (the loader converts them to
-//! `float32`), every quantity of the world frame:
+//! The arrays mjlab's `csv_to_npz.py` saves and its tracking task's `MotionLoader` reads (the
+//! BeyondMimic tracker ported to MuJoCo), all `float64` here (the loader converts them to
+//! `float32`), every quantity of the world frame. BeyondMimic's Isaac Lab original
+//! (`whole_body_tracking`) reads the same keys, but its joint and body axes follow Isaac Lab's
+//! breadth-first order, not this file's MuJoCo order:
 //!
 //! | key | shape | content |
 //! |---|---|---|
