@@ -2,7 +2,9 @@
 //! for motion files) or glob patterns; every clip runs on a pool of threads
 //! ([`iktc::batch::run_parallel`]) through [`BatchRetarget::retarget`] (keypoint retargeting
 //! by default, `--retarget joints` for the joint-angle route) and gets its own folder
-//! `OUT/<clip>/` with `motion.csv`, `motion.npz`, `quality.json` and `viewer.html`; a clip that
+//! `OUT/<clip>/` with `motion.csv`, `motion.npz` (the motion files are chosen with `--format`:
+//! also `motion_gmr.pkl`, `motion_lafan.csv`, `motion_mjlab.npz`, see
+//! [`iktc::batch::formats`]), `quality.json` and `viewer.html`; a clip that
 //! fails is listed with its error (its earlier folder removed) and the batch goes on. Clips are
 //! found by [`iktc::batch::discover`]. A clip's folder is written beside its place and renamed
 //! into it whole, its `.record` last ([`iktc::batch::write_clip_folder`]): a clip is skipped
@@ -21,7 +23,7 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 use iktc::batch::{
     clip_state, discover, longest_first, remove_leftovers, run_parallel_until, write_clip_folder,
-    BatchRetarget, ClipInput, ClipOutcome, ClipRun, ClipState, RetargetMethod,
+    BatchRetarget, ClipInput, ClipOutcome, ClipRun, ClipState, MotionFormat, RetargetMethod,
 };
 use iktc::mesh::MeshSet;
 use iktc::sim::viewer::imitation_viewer;
@@ -50,10 +52,16 @@ pub struct Args {
     /// Worker threads, 1 to 1024 (default: every core, at most 1024).
     #[arg(long)]
     pub jobs: Option<usize>,
-    /// Output rate of motion.csv and motion.npz, 1 to 100 000 Hz [Hz] (default: the control
-    /// rate, 1/--dt).
+    /// Output rate of the motion files, 1 to 100 000 Hz [Hz] (default: the control rate,
+    /// 1/--dt).
     #[arg(long)]
     pub rate: Option<f64>,
+    /// Motion files to write per clip (repeatable or a comma list): `csv` (motion.csv), `npz`
+    /// (motion.npz), `gmr` (GMR's pickle, motion_gmr.pkl), `lafan-csv` (the LAFAN1
+    /// retargeting dataset's CSV, motion_lafan.csv), `mjlab` (mjlab / BeyondMimic's motion
+    /// NPZ, motion_mjlab.npz). Default: csv,npz.
+    #[arg(long = "format", value_name = "FMT", value_delimiter = ',', value_parser = parse_format)]
+    pub formats: Vec<MotionFormat>,
     /// Redo clips whose outputs are up to date.
     #[arg(long)]
     pub force: bool,
@@ -62,9 +70,45 @@ pub struct Args {
     pub no_viewer: bool,
 }
 
-/// Files of one clip besides its viewer.
-const OUTPUTS: [&str; 3] = ["motion.csv", "motion.npz", "quality.json"];
+/// The quality file of a clip.
+const QUALITY: &str = "quality.json";
 const VIEWER: &str = "viewer.html";
+
+/// A `--format` name, with the library's error (listing the valid names).
+fn parse_format(s: &str) -> std::result::Result<MotionFormat, String> {
+    MotionFormat::parse(s).map_err(|e| e.to_string())
+}
+
+impl Args {
+    /// The motion formats chosen (`--format`, or csv and npz).
+    fn motion_formats(&self) -> Vec<MotionFormat> {
+        let mut out: Vec<MotionFormat> = Vec::new();
+        for f in &self.formats {
+            if !out.contains(f) {
+                out.push(*f);
+            }
+        }
+        if out.is_empty() {
+            out = MotionFormat::DEFAULT.to_vec();
+        }
+        out
+    }
+
+    /// The files a finished clip's folder holds: the motion files, quality.json and, unless
+    /// --no-viewer, viewer.html.
+    fn outputs(&self) -> Vec<&'static str> {
+        let mut outputs: Vec<&str> = self
+            .motion_formats()
+            .into_iter()
+            .map(MotionFormat::file_name)
+            .collect();
+        outputs.push(QUALITY);
+        if !self.no_viewer {
+            outputs.push(VIEWER);
+        }
+        outputs
+    }
+}
 
 /// What became of a clip.
 #[derive(Debug, Clone, Serialize)]
@@ -140,10 +184,7 @@ pub fn run(a: &Args) -> Result<()> {
     remove_leftovers(&a.out)?;
     let hash = batch.settings_hash();
     let dependencies = batch.dependency_digest()?;
-    let mut outputs = OUTPUTS.to_vec();
-    if !a.no_viewer {
-        outputs.push(VIEWER);
-    }
+    let outputs = a.outputs();
     let mut todo: Vec<(ClipInput, String)> = Vec::new();
     for c in found.clips {
         let dir = a.out.join(&c.name);
@@ -275,7 +316,7 @@ fn run_clips(
         |_, (c, record)| {
             let start = Instant::now();
             let dir = a.out.join(&c.name);
-            let r = retarget_one(batch, c, &dir, hash, record, viewer);
+            let r = retarget_one(batch, c, &dir, hash, record, viewer, &a.motion_formats());
             if r.is_err() {
                 // An earlier folder of a clip that now fails no longer describes its input.
                 let _ = std::fs::remove_dir_all(&dir);
@@ -370,6 +411,7 @@ fn retarget_one(
     hash: &str,
     record: &str,
     viewer: Option<Option<&MeshSet>>,
+    formats: &[MotionFormat],
 ) -> Result<(usize, serde_json::Value, Vec<String>)> {
     let outcome = batch.retarget(&c.path)?;
     let ClipOutcome {
@@ -393,14 +435,17 @@ fn retarget_one(
         "figures": figures,
         "summary": outcome.summary()?,
     });
-    let mut files: Vec<(&str, Vec<u8>)> = vec![
-        (OUTPUTS[0], trajectory.csv().into_bytes()),
-        (OUTPUTS[1], trajectory.npz()?),
-        (
-            OUTPUTS[2],
-            crate::finite::to_json("quality.json", &doc)?.into_bytes(),
-        ),
-    ];
+    let mut files: Vec<(&str, Vec<u8>)> = Vec::new();
+    for f in formats {
+        let bytes = f
+            .encode(&batch.robot, trajectory)
+            .with_context(|| format!("writing {}", f.file_name()))?;
+        files.push((f.file_name(), bytes));
+    }
+    files.push((
+        QUALITY,
+        crate::finite::to_json("quality.json", &doc)?.into_bytes(),
+    ));
     if let Some(meshes) = viewer {
         let mut data = match run {
             ClipRun::Keypoints { keypoints, run, .. } => iktc::retarget::keypoint_viewer(
@@ -440,15 +485,16 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
 }
 
 fn read_figures(dir: &Path) -> Option<serde_json::Value> {
-    let text = std::fs::read_to_string(dir.join(OUTPUTS[2])).ok()?;
+    let text = std::fs::read_to_string(dir.join(QUALITY)).ok()?;
     let v: serde_json::Value = serde_json::from_str(&text).ok()?;
     v.get("figures").cloned()
 }
 
-/// The output files (viewer and [`OUTPUTS`]) that `dir` holds.
+/// The output files (viewer, motion files of every format, quality) that `dir` holds.
 fn files_of(dir: &Path) -> Vec<String> {
     std::iter::once(VIEWER)
-        .chain(OUTPUTS)
+        .chain(MotionFormat::ALL.map(MotionFormat::file_name))
+        .chain([QUALITY])
         .filter(|f| dir.join(f).is_file())
         .map(str::to_string)
         .collect()

@@ -881,3 +881,97 @@ fn output_folders_inside_the_input_folder_are_not_searched() {
         assert!(err.contains(&note), "{err}");
     }
 }
+
+/// `--format gmr,lafan-csv --format mjlab` writes those three files (and not motion.csv or
+/// motion.npz); a second run skips the clip; a run asking for a file the folder lacks redoes
+/// it; the LAFAN1 CSV holds the columns of motion.csv but its time, the mjlab NPZ the rate and
+/// the base; an unknown format is refused with the valid names.
+#[test]
+fn formats_are_chosen_checked_by_the_skip_and_unknown_ones_refused() {
+    let dir = tmp("formats");
+    let clip = data().join("humanoid3d_walk.txt");
+    let out = dir.join("out");
+    let walk = out.join("humanoid3d_walk");
+    let chosen = [
+        "--rate",
+        "30",
+        "--format",
+        "gmr,lafan-csv",
+        "--format",
+        "mjlab",
+    ];
+    for pass in ["retargeted", "skipped"] {
+        let o = retarget_on_g1(&clip, &out, &chosen);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        assert_eq!(statuses(&out)["humanoid3d_walk"], pass);
+    }
+    for f in [
+        "motion_gmr.pkl",
+        "motion_lafan.csv",
+        "motion_mjlab.npz",
+        "quality.json",
+    ] {
+        assert!(walk.join(f).is_file(), "{f}");
+    }
+    for f in ["motion.csv", "motion.npz"] {
+        assert!(!walk.join(f).exists(), "{f}");
+    }
+    let files = batch_json(&out)["humanoid3d_walk"]["files"].clone();
+    assert!(files.to_string().contains("motion_gmr.pkl"), "{files}");
+    let lafan: Vec<Vec<f64>> = std::fs::read_to_string(walk.join("motion_lafan.csv"))
+        .unwrap()
+        .lines()
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    let quality: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(walk.join("quality.json")).unwrap()).unwrap();
+    assert_eq!(quality["output_rate_hz"], 30.0);
+    assert_eq!(lafan.len() as u64, quality["frames"].as_u64().unwrap());
+    assert!(lafan.iter().all(|r| r.len() == 7 + 29));
+    let npz = read_npz(&std::fs::read(walk.join("motion_mjlab.npz")).unwrap());
+    assert_eq!(floats(&npz, "fps"), (&[1][..], &[30.0][..]));
+    let (shape, body) = floats(&npz, "body_pos_w");
+    assert_eq!(shape, [lafan.len(), 30, 3]);
+    let (_, quat) = floats(&npz, "body_quat_w");
+    for (j, row) in lafan.iter().enumerate() {
+        assert_eq!(
+            &body[j * 90..j * 90 + 3],
+            &row[..3],
+            "pelvis = base, frame {j}"
+        );
+        let xyzw = &quat[j * 120..j * 120 + 4];
+        let wxyz_of_row = [row[6], row[3], row[4], row[5]];
+        let sign = if xyzw[0] * wxyz_of_row[0] < 0.0 {
+            -1.0
+        } else {
+            1.0
+        };
+        for k in 0..4 {
+            assert!(
+                (xyzw[k] - sign * wxyz_of_row[k]).abs() <= SAME_RUN,
+                "frame {j}"
+            );
+        }
+    }
+
+    // The default (csv, npz) is missing from the folder: the clip is redone, its folder
+    // rewritten whole; the LAFAN1 rows are motion.csv's rows without the time.
+    let o = retarget_on_g1(&clip, &out, &["--rate", "30"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(statuses(&out)["humanoid3d_walk"], "retargeted");
+    assert!(!walk.join("motion_gmr.pkl").exists());
+    let (header, rows) = read_csv(&walk.join("motion.csv"));
+    assert_eq!(header.len(), 1 + 7 + 29);
+    assert_eq!(rows.len(), lafan.len());
+    for (r, l) in rows.iter().zip(&lafan) {
+        assert_eq!(&r[1..], &l[..]);
+    }
+
+    let o = retarget_on_g1(&clip, &out, &["--format", "gmr,bvh"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("unknown output format `bvh`"), "{err}");
+    for name in ["csv", "npz", "gmr", "lafan-csv", "mjlab"] {
+        assert!(err.contains(name), "{err}");
+    }
+}

@@ -4,7 +4,7 @@
 
 use std::sync::Arc;
 
-use iktc::batch::{body_frames, posture_references, Posture, TrainingTrajectory};
+use iktc::batch::{body_frames, posture_references, MotionFormat, Posture, TrainingTrajectory};
 use iktc::model::Robot;
 use iktc::motion::DEFAULT_MAX_GAP;
 use iktc::retarget::{retarget_keypoints, HandScaling, KeypointRun, KeypointSettings, Sacrifices};
@@ -312,6 +312,53 @@ impl PyKeypointTrajectory {
         self.save(py, &path, rate, |t| Ok(t.csv().into_bytes()))
     }
 
+    /// Writes the run as `iktc retarget --format gmr` writes `motion_gmr.pkl`: GMR's motion
+    /// pickle (`pickle.load` gives a dict; see `iktc::batch::formats`): `fps` (int when whole)
+    /// [Hz], `root_pos` (frames × 3) [m], `root_rot` (frames × 4, quaternion x, y, z, w),
+    /// `dof_pos` (frames × joints) [rad], `local_body_pos` (frames × bodies × 3, float32, the
+    /// bodies' origins in the root frame) [m] and `link_body_list` (the robot's links with a
+    /// moving joint, root first: MuJoCo's bodies). Loads with NumPy 1.x and 2.x. `rate` as in
+    /// `save_npz`.
+    #[pyo3(signature = (path, rate=None))]
+    fn save_gmr(
+        &self,
+        py: Python<'_>,
+        path: std::path::PathBuf,
+        rate: Option<f64>,
+    ) -> PyResult<()> {
+        self.save_format(py, &path, rate, MotionFormat::Gmr)
+    }
+
+    /// Writes the run as `iktc retarget --format lafan-csv` writes `motion_lafan.csv`: the
+    /// LAFAN1 retargeting dataset's CSV, one row per frame, no header: base x, y, z [m],
+    /// quaternion x, y, z, w, then the joints [rad] in the robot's order (what BeyondMimic's
+    /// and mjlab's `csv_to_npz.py` read; give them the rate). `rate` as in `save_npz`.
+    #[pyo3(signature = (path, rate=None))]
+    fn save_lafan_csv(
+        &self,
+        py: Python<'_>,
+        path: std::path::PathBuf,
+        rate: Option<f64>,
+    ) -> PyResult<()> {
+        self.save_format(py, &path, rate, MotionFormat::LafanCsv)
+    }
+
+    /// Writes the run as `iktc retarget --format mjlab` writes `motion_mjlab.npz`: the motion
+    /// NPZ mjlab / BeyondMimic's tracking task loads: `fps` (1,) [Hz], `joint_pos`,
+    /// `joint_vel` (frames × joints) [rad], [rad/s], and over the robot's bodies (`body_names`,
+    /// root first) in the world frame `body_pos_w` [m], `body_quat_w` (quaternion w, x, y, z),
+    /// `body_lin_vel_w` [m/s] and `body_ang_vel_w` [rad/s] (frame Jacobians times the rates);
+    /// also `joint_names`. `rate` as in `save_npz`.
+    #[pyo3(signature = (path, rate=None))]
+    fn save_mjlab(
+        &self,
+        py: Python<'_>,
+        path: std::path::PathBuf,
+        rate: Option<f64>,
+    ) -> PyResult<()> {
+        self.save_format(py, &path, rate, MotionFormat::Mjlab)
+    }
+
     fn __len__(&self) -> usize {
         self.run.times.len()
     }
@@ -330,6 +377,18 @@ impl PyKeypointTrajectory {
         let bytes = py.detach(|| encode(&self.training(rate)?)).map_err(to_py)?;
         std::fs::write(path, bytes)
             .map_err(|e| crate::IktcError::new_err(format!("cannot write {}: {e}", path.display())))
+    }
+
+    /// Writes the run resampled at `rate` as `format`'s file.
+    fn save_format(
+        &self,
+        py: Python<'_>,
+        path: &std::path::Path,
+        rate: Option<f64>,
+        format: MotionFormat,
+    ) -> PyResult<()> {
+        let robot = Arc::clone(&self.robot);
+        self.save(py, path, rate, move |t| format.encode(&robot, t))
     }
 
     /// The run resampled at `rate` [Hz] (default the control rate).
