@@ -118,19 +118,19 @@ def test_hands_by_the_leg_ratio_move_the_hands_differently_and_bad_names_are_err
 def test_the_run_says_which_levels_the_joint_limits_cost(runs):
     robot, r = runs
     t = r[False]
-    levels = ["stance_feet", "swing_floor", "com_xy", "pelvis", "hands_swing_feet",
+    levels = ["stance_feet", "swing_floor", "com_xy", "swing_feet", "pelvis", "hands",
               "elbows_head_torso", "posture"]
     for counts, ticks in [(t.sacrificed, len(t)), (t.settle_sacrificed, 300)]:
         assert list(counts) == levels
         assert all(isinstance(n, int) and n >= 0 for n in counts.values())
         assert sum(counts.values()) <= ticks
     # JVRC-1 cannot take humanoid3d_dance_a's first frame (in the air, a foot crossed behind
-    # the other): while it settles there, the level of the hands and swing feet gives way, and
-    # no other (on 144 of 300 ticks).
+    # the other): while it settles there, the hands' level gives way on most ticks, the feet's
+    # and the COM's never.
     jvrc = iktc.retarget_keypoints(iktc.load_motion("humanoid3d_dance_a"), iktc.Robot("jvrc1"))
     settle = jvrc.settle_sacrificed
-    assert settle["hands_swing_feet"] > 0, settle
-    assert sum(settle.values()) == settle["hands_swing_feet"], settle
+    assert 2 * settle["hands"] > sum(settle.values()), settle
+    assert all(settle[k] == 0 for k in levels[:4]), settle
 
 
 def test_a_sliding_foot_steps_unless_every_stance_is_held_and_bad_slides_are_errors():

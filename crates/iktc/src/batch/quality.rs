@@ -264,7 +264,7 @@ pub struct KeypointFigures {
     /// Share of the ticks with a sole corner deeper than [`PENETRATION_TOLERANCE`] \[–\].
     pub penetration_share: f64,
     /// Share of the ticks on which IKTC sacrificed the feet's, the COM's or the pelvis' level
-    /// (the first four of [`KEYPOINT_LEVELS`]) to keep the joint limits \[–\]: the body could
+    /// (the first five of [`KEYPOINT_LEVELS`]) to keep the joint limits \[–\]: the body could
     /// not take the clip's stance or pelvis pose ([`KeypointRun::sacrificed`]).
     pub body_sacrificed_share: f64,
     /// The level IKTC sacrificed on the most ticks (empty if none).
@@ -367,7 +367,7 @@ impl KeypointFigures {
             tick_median_us: run.tick_median_us,
             penetration: p.depth,
             penetration_share: p.share,
-            body_sacrificed_share: KEYPOINT_LEVELS[..4]
+            body_sacrificed_share: KEYPOINT_LEVELS[..5]
                 .iter()
                 .map(|l| run.sacrificed.of(l))
                 .sum::<usize>() as f64

@@ -588,7 +588,7 @@ mod tests {
             summary["sacrificed"]["ticks"].as_u64(),
             Some(run.quality.ticks as u64)
         );
-        let body: usize = KEYPOINT_LEVELS[..4]
+        let body: usize = KEYPOINT_LEVELS[..5]
             .iter()
             .map(|l| run.sacrificed.of(l))
             .sum();

@@ -197,8 +197,8 @@ pub struct KeypointSettings {
     /// joints' RMS jerk from 5 940 to 5 070 rad/s³ and 6 Hz to 4 610. The quality figures
     /// still compare the robot with the captured points.
     pub smoothing: Option<f64>,
-    /// Weight of the posture rows in the `hands_swing_feet` level \[–\] (default
-    /// [`POSTURE_WEIGHT`]; 0 puts them in a seventh level of their own, below all tracking):
+    /// Weight of the posture rows in the `hands` level \[–\] (default
+    /// [`POSTURE_WEIGHT`]; 0 puts them in a level of their own, `posture`, below all tracking):
     /// a joint's acceleration 1 rad/s² off its posture reference costs as much there as a
     /// hand's `weight` m/s² off its reference. The levels above the posture level can take
     /// every coordinate (on G1 all 35), and each is then solved exactly in what the levels
@@ -210,8 +210,8 @@ pub struct KeypointSettings {
     /// level takes every coordinate, so the `elbows_head_torso` level below it moves nothing).
     pub posture_weight: f64,
     /// Weight of the elbows' and head's positions, the torso's orientation and the swing
-    /// feet's orientations in the `hands_swing_feet` level \[–\] (default [`BODY_WEIGHT`];
-    /// 0 puts them in a sixth level of their own, `elbows_head_torso`, where below the
+    /// feet's orientations in the `hands` level \[–\] (default [`BODY_WEIGHT`];
+    /// 0 puts them in a level of their own, `elbows_head_torso`, where below the
     /// posture rows they have no coordinate left to move). A unit of their error costs
     /// `weight²` as much as a hand's.
     pub body_weight: f64,
