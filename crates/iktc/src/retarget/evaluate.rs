@@ -372,8 +372,9 @@ fn joint_columns(robot: &Robot, t: &RobotTrajectory) -> Result<Vec<usize>> {
 /// The robot's configurations q (length `nq`) on the evaluation ticks of `t` at period
 /// `dt`, the ticks' times, and whether the frames were resampled (module documentation).
 ///
-/// Errors: those of [`joint_columns`]; a floating-base robot and a file without base pose; a
-/// zero base quaternion; more ticks than [`crate::resources::MAX_OUTPUT_FRAMES`].
+/// Errors: a robot joint without a column or a column that is no joint (all listed); a
+/// floating-base robot and a file without base pose; a zero base quaternion; a rate outside
+/// the output rates; more ticks than [`crate::resources::MAX_OUTPUT_FRAMES`].
 pub fn trajectory_ticks(
     robot: &Robot,
     t: &RobotTrajectory,
