@@ -4,6 +4,7 @@
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 
 mod cmd_balance;
+mod cmd_evaluate;
 mod cmd_imitate;
 mod cmd_keypoints;
 mod cmd_map;
@@ -55,6 +56,9 @@ enum Command {
     /// Retarget whole datasets on every core: per clip CSV, NPZ, quality summary and viewer,
     /// and one dataset report, OUT/index.html.
     Retarget(Box<cmd_retarget::Args>),
+    /// Score any robot trajectory (iktc's motion.csv/.npz, or a CSV of time, base pose and
+    /// joints) against the captured motion with iktc's neutral fidelity figures.
+    Evaluate(Box<cmd_evaluate::Args>),
 }
 
 /// The command line's grammar, with every option value allowed to be a negative number
@@ -89,6 +93,7 @@ fn main() -> std::process::ExitCode {
         Command::Profile(a) => cmd_profile::run(&a),
         Command::Map(a) => cmd_map::run(&a),
         Command::Retarget(a) => cmd_retarget::run(&a),
+        Command::Evaluate(a) => cmd_evaluate::run(&a),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

@@ -23,7 +23,7 @@ pub use discover::{
     MOTION_EXTENSIONS, RECORD_FILE,
 };
 pub use formats::{body_links, gmr_pickle, lafan_csv, mjlab_npz, BodyMotion, MotionFormat};
-pub use npz::{crc32, npz_bytes, zip_stored, NpyArray, NpyData};
+pub use npz::{crc32, npz_bytes, read_npz, zip_stored, NpyArray, NpyData};
 pub use pool::{longest_first, run_parallel, run_parallel_in, run_parallel_until};
 pub use quality::{
     run_penetration, sole_penetration, trajectory_penetration, ClipQuality, JointFigures,

@@ -237,6 +237,189 @@ pub fn npz_bytes(arrays: &[NpyArray]) -> Result<Vec<u8>> {
     zip_stored(&members)
 }
 
+/// The `.npz` archive `bytes` (from `source`, for errors) read back: every member whose name
+/// ends in `.npy`, as an array named without it. Members must be *stored* (`numpy.savez` and
+/// iktc write them so; `numpy.savez_compressed`'s deflated members are an error); sizes may be
+/// given in a zip64 extra field (`numpy.savez` asks for one). Arrays: `'<f8'` floats of any
+/// shape (C order) and `'<UN'` strings of one dimension.
+///
+/// Errors: [`Error::Parse`] naming the member for a truncated archive, a compressed member, a
+/// CRC-32 that does not match, an `.npy` header that is not NumPy's, or another data type.
+pub fn read_npz(bytes: &[u8], source: &str) -> Result<Vec<NpyArray>> {
+    let bad = |message: String| Error::Parse {
+        source_name: source.into(),
+        line: 0,
+        message,
+    };
+    let u16_at = |o: usize| -> Result<usize> {
+        bytes
+            .get(o..o + 2)
+            .map(|b| usize::from(u16::from_le_bytes([b[0], b[1]])))
+            .ok_or_else(|| bad(format!("truncated zip archive at byte {o}")))
+    };
+    let u32_at = |o: usize| -> Result<u32> {
+        bytes
+            .get(o..o + 4)
+            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+            .ok_or_else(|| bad(format!("truncated zip archive at byte {o}")))
+    };
+    let mut out = Vec::new();
+    let mut at = 0;
+    while u32_at(at).ok() == Some(0x0403_4b50) {
+        let (flags, method) = (u16_at(at + 6)?, u16_at(at + 8)?);
+        let crc = u32_at(at + 14)?;
+        let mut size = u32_at(at + 18)? as u64;
+        let (nlen, xlen) = (u16_at(at + 26)?, u16_at(at + 28)?);
+        let name_bytes = bytes
+            .get(at + 30..at + 30 + nlen)
+            .ok_or_else(|| bad("truncated zip member name".into()))?;
+        let name = String::from_utf8_lossy(name_bytes).to_string();
+        let extra = bytes
+            .get(at + 30 + nlen..at + 30 + nlen + xlen)
+            .ok_or_else(|| bad(format!("member `{name}`: truncated extra field")))?;
+        if method != 0 {
+            return Err(bad(format!(
+                "member `{name}` is compressed (zip method {method}); only stored members are \
+                 read (numpy.savez, not savez_compressed)"
+            )));
+        }
+        if flags & 0x8 != 0 {
+            return Err(bad(format!(
+                "member `{name}` gives its size after its data (zip flag 3); expected sizes in \
+                 its header"
+            )));
+        }
+        if size == u64::from(u32::MAX) {
+            // The zip64 extra field (id 1): uncompressed size, then compressed size.
+            let mut e = 0;
+            while e + 4 <= extra.len() {
+                let id = u16::from_le_bytes([extra[e], extra[e + 1]]);
+                let len = usize::from(u16::from_le_bytes([extra[e + 2], extra[e + 3]]));
+                if id == 1 && len >= 8 && e + 12 <= extra.len() {
+                    let mut b = [0u8; 8];
+                    b.copy_from_slice(&extra[e + 4..e + 12]);
+                    size = u64::from_le_bytes(b);
+                }
+                e += 4 + len;
+            }
+        }
+        let start = at + 30 + nlen + xlen;
+        let data = usize::try_from(size)
+            .ok()
+            .and_then(|n| bytes.get(start..start.checked_add(n)?))
+            .ok_or_else(|| bad(format!("member `{name}`: truncated data ({size} bytes)")))?;
+        if crc32(data) != crc {
+            return Err(bad(format!(
+                "member `{name}`: CRC-32 does not match its data"
+            )));
+        }
+        if let Some(stem) = name.strip_suffix(".npy") {
+            out.push(read_npy(stem, data).map_err(|m| bad(format!("member `{name}`: {m}")))?);
+        }
+        at = start + data.len();
+    }
+    if out.is_empty() {
+        return Err(bad("no .npy member: not an .npz archive".into()));
+    }
+    Ok(out)
+}
+
+/// One `.npy` file named `name` (module documentation); the error in words.
+fn read_npy(name: &str, b: &[u8]) -> std::result::Result<NpyArray, String> {
+    if b.len() < 10 || &b[..6] != b"\x93NUMPY" {
+        return Err("not an .npy array (no \\x93NUMPY magic)".into());
+    }
+    let (hlen, hstart) = match b[6] {
+        1 => (usize::from(u16::from_le_bytes([b[8], b[9]])), 10),
+        2 | 3 if b.len() >= 12 => (u32::from_le_bytes([b[8], b[9], b[10], b[11]]) as usize, 12),
+        v => return Err(format!(".npy version {v} is not read (1, 2 or 3 expected)")),
+    };
+    let header = b
+        .get(hstart..hstart + hlen)
+        .map(|h| String::from_utf8_lossy(h).to_string())
+        .ok_or("truncated .npy header")?;
+    let field = |key: &str| -> Option<String> {
+        let i = header.find(&format!("'{key}'"))? + key.len() + 2;
+        let rest = header[i..].trim_start().strip_prefix(':')?.trim_start();
+        Some(rest.to_string())
+    };
+    let descr = field("descr")
+        .and_then(|r| {
+            r.strip_prefix('\'')
+                .and_then(|r| r.split('\'').next().map(String::from))
+        })
+        .ok_or("no 'descr' in the .npy header")?;
+    if field("fortran_order").is_some_and(|r| r.starts_with("True")) {
+        return Err("Fortran-ordered arrays are not read (C order expected)".into());
+    }
+    let shape_text = field("shape")
+        .and_then(|r| {
+            r.strip_prefix('(')
+                .and_then(|r| r.split(')').next().map(String::from))
+        })
+        .ok_or("no 'shape' in the .npy header")?;
+    let shape = shape_text
+        .split(',')
+        .map(str::trim)
+        .filter(|s| !s.is_empty())
+        .map(|s| {
+            s.parse::<usize>()
+                .map_err(|_| format!("shape ({shape_text}) is not sizes"))
+        })
+        .collect::<std::result::Result<Vec<_>, _>>()?;
+    let count = shape
+        .iter()
+        .try_fold(1usize, |a, d| a.checked_mul(*d))
+        .ok_or("shape too large")?;
+    let data = &b[hstart + hlen..];
+    let array = if descr == "<f8" {
+        let need = count.checked_mul(8).ok_or("shape too large")?;
+        if data.len() < need {
+            return Err(format!("{} data bytes, expected {need}", data.len()));
+        }
+        let v = data[..need]
+            .chunks_exact(8)
+            .map(|c| {
+                let mut x = [0u8; 8];
+                x.copy_from_slice(c);
+                f64::from_le_bytes(x)
+            })
+            .collect();
+        NpyData::F64(v)
+    } else if let Some(w) = descr.strip_prefix("<U") {
+        let w: usize = w.parse().map_err(|_| format!("dtype {descr}"))?;
+        if shape.len() != 1 {
+            return Err(format!(
+                "string arrays of shape {shape:?} are not read (one dimension)"
+            ));
+        }
+        let need = count.checked_mul(4 * w).ok_or("shape too large")?;
+        if data.len() < need || w == 0 && count > 0 {
+            return Err(format!("{} data bytes, expected {need}", data.len()));
+        }
+        let v = data[..need]
+            .chunks_exact(4 * w)
+            .map(|s| {
+                s.chunks_exact(4)
+                    .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+                    .take_while(|&c| c != 0)
+                    .map(|c| char::from_u32(c).ok_or(format!("code point {c} is not a character")))
+                    .collect::<std::result::Result<String, String>>()
+            })
+            .collect::<std::result::Result<Vec<_>, _>>()?;
+        NpyData::Str(v)
+    } else {
+        return Err(format!(
+            "dtype {descr} is not read ('<f8' or '<UN' expected)"
+        ));
+    };
+    Ok(NpyArray {
+        name: name.into(),
+        shape,
+        data: array,
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

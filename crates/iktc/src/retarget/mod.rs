@@ -37,6 +37,8 @@ pub mod centres;
 mod com;
 mod contacts;
 mod drift;
+#[cfg(feature = "json")]
+pub mod evaluate;
 pub mod fidelity;
 pub mod fit;
 mod floor;
@@ -50,6 +52,11 @@ mod viewer;
 pub use body::{BodyFrameNames, RobotBody, MIN_HEAD_HEIGHT};
 pub use centres::RobotJointCentres;
 pub use contacts::{PIVOT_RATE, PIVOT_SMOOTHING, PIVOT_TURN};
+#[cfg(feature = "json")]
+pub use evaluate::{
+    evaluate_trajectory, read_trajectory_csv, read_trajectory_npz, RobotTrajectory,
+    TrajectoryEvaluation,
+};
 pub use fidelity::{Fidelity, FidelityLimits};
 pub use floor::FLOOR_ENGAGE;
 pub use quality::{
@@ -632,11 +639,8 @@ fn setup(
         });
     }
     let cfg = profile.imitate_config(ImitateConfig::default())?;
-    let names = frame_names(profile, &cfg)?;
-    let state0 = State::neutral(&robot);
-    let mut kin = Kinematics::new(&robot, &state0)?;
-    let body = RobotBody::find(&robot, &kin, &names)?;
-    let centres = RobotJointCentres::find(&robot, &body)?;
+    let (body, centres, _) = measured_body(&robot, profile)?;
+    let mut kin = Kinematics::new(&robot, &State::neutral(&robot))?;
     let (robot, body) = if s.track_joint_centres {
         centres.frames(&robot, body)?
     } else {
@@ -887,7 +891,7 @@ pub fn retarget_keypoints_on(
         (&body, &centres),
         &support,
         kp,
-        (&times, &trajectory, &accelerations),
+        (&times, &trajectory, &joint_qdd(&robot, &accelerations)),
         s.dt,
     )?);
     quality.posture_fit_deg = fit_error.map(f64::to_degrees);
@@ -925,32 +929,50 @@ pub fn retarget_keypoints_on(
 }
 
 /// The neutral fidelity figures ([`fidelity`]) of a run on `robot`: per tick its clip time,
-/// configuration and applied q̈ (base and joints; the joints' are measured).
+/// configuration and the joints' q̈ (active joints only).
 fn measure_fidelity(
     robot: &Robot,
     (body, centres): (&RobotBody, &RobotJointCentres),
     support: &SupportSettings,
     kp: &Keypoints,
-    (times, trajectory, accelerations): (&[f64], &[Vec<f64>], &[Vec<f64>]),
+    (times, trajectory, qdd): (&[f64], &[Vec<f64>], &[Vec<f64>]),
     dt: f64,
 ) -> Result<Fidelity> {
     let samples = fidelity::robot_samples(robot, centres, body.feet, support, trajectory)?;
-    let b = robot.base_nv();
-    let qdd: Vec<Vec<f64>> = accelerations
-        .iter()
-        .map(|a| a.get(b..).unwrap_or_default().to_vec())
-        .collect();
     Ok(fidelity::fidelity(
         &fidelity::FidelityInput {
             person: kp,
             times,
             robot: &samples,
             robot_leg: fidelity::robot_leg(robot, centres)?,
-            qdd: &qdd,
+            qdd,
             dt,
         },
         &FidelityLimits::default(),
     ))
+}
+
+/// The joints' part of every applied q̈ (base and joints) of a run on `robot`.
+fn joint_qdd(robot: &Robot, accelerations: &[Vec<f64>]) -> Vec<Vec<f64>> {
+    let b = robot.base_nv();
+    accelerations
+        .iter()
+        .map(|a| a.get(b..).unwrap_or_default().to_vec())
+        .collect()
+}
+
+/// What the fidelity figures measure on the robot of `profile` (`robot` built from it): its
+/// body frames, joint centres and soles, as a retargeting run finds them.
+fn measured_body(
+    robot: &Robot,
+    profile: &RobotProfile,
+) -> Result<(RobotBody, RobotJointCentres, SupportSettings)> {
+    let cfg = profile.imitate_config(ImitateConfig::default())?;
+    let names = frame_names(profile, &cfg)?;
+    let kin = Kinematics::new(robot, &State::neutral(robot))?;
+    let body = RobotBody::find(robot, &kin, &names)?;
+    let centres = RobotJointCentres::find(robot, &body)?;
+    Ok((body, centres, cfg.support))
 }
 
 /// Whether the solve of `r` corrected the prioritized solution into the box: IKTC corrected a
@@ -1013,7 +1035,7 @@ pub fn joint_route_quality(
         (&setup.body, &setup.centres),
         &setup.support,
         kp,
-        (&times, &trajectory, &accelerations),
+        (&times, &trajectory, &joint_qdd(robot, &accelerations)),
         s.dt,
     )?);
     Ok(quality)
