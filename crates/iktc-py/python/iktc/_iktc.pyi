@@ -14,7 +14,8 @@ class IktcError(ValueError): ...
 
 class Robot:
     """A robot model: a built-in name ("jvrc1", "g1" with their profiles; "planar3r"), a robot
-    profile file (.toml) or a URDF file (.urdf, no profile)."""
+    profile file (.toml), a URDF file (.urdf, no profile) or a MuJoCo MJCF file (.xml, no
+    profile; floating when it has a free joint unless `floating` says otherwise)."""
     def __init__(self, spec: str, *, floating: Optional[bool] = None,
                  lock: Optional[Sequence[Tuple[str, float]]] = None,
                  accel: Optional[Sequence[Tuple[str, float]]] = None) -> None: ...

@@ -10,8 +10,9 @@ use super::spec::{numbers, Compiler};
 use super::xml::El;
 use crate::error::Result;
 
-/// The mesh assets by name (a mesh without `name` is named after its file's stem) and the
-/// material colours by name.
+/// The mesh assets by name (a mesh without `name` is named after its file's stem; its file
+/// under `meshdir`, from the folder of the file declaring it: the model `main` in `dir`, or an
+/// included file) and the material colours by name.
 ///
 /// Errors: a mesh without `file` or `vertex`, a scale of other than 3 numbers, a bad `rgba`.
 #[allow(clippy::type_complexity)]
@@ -19,6 +20,8 @@ pub(crate) fn read(
     root: &El,
     c: &Compiler,
     d: &Defaults,
+    main: &str,
+    dir: Option<&Path>,
 ) -> Result<(HashMap<String, MeshAsset>, HashMap<String, [f64; 4]>)> {
     let mut meshes = HashMap::new();
     let mut materials = HashMap::new();
@@ -41,10 +44,18 @@ pub(crate) fn read(
                             .unwrap_or_else(|| file.to_string()),
                     };
                     let s = numbers(&a, "scale", Some(3))?.unwrap_or_else(|| vec![1.0; 3]);
+                    // An included file's folder, relative to the model's.
+                    let from = match (dir, Path::new(&*el.file).parent()) {
+                        (Some(dir), Some(from)) if &*el.file != main => {
+                            from.strip_prefix(dir).unwrap_or(from).to_path_buf()
+                        }
+                        _ => Default::default(),
+                    };
                     meshes.insert(
                         name,
                         MeshAsset {
-                            file: Path::new(&c.meshdir)
+                            file: from
+                                .join(&c.meshdir)
                                 .join(file)
                                 .to_string_lossy()
                                 .into_owned(),

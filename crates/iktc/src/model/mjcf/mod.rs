@@ -27,8 +27,8 @@
 //! * **Classes**: `<default>` classes, nested (a class inherits its parent's attributes),
 //!   `class=` on an element, `childclass` on bodies and frames; for joints, geoms, sites,
 //!   meshes, inertials, equalities and actuators (the actuator shortcuts share one default).
-//! * **`<include file>`**: spliced in, its path relative to the model's folder (a model read
-//!   from text without a folder cannot include).
+//! * **`<include file>`**: spliced in, its path relative to the including file's folder (else
+//!   the model's); a model read from text without a folder cannot include.
 //! * **Inertia**: `<inertial>` `pos`, orientation, `mass`, and `diaginertia` or
 //!   `fullinertia` (Ixx Iyy Izz Ixy Ixz Iyz, in the inertial's axes). Without `<inertial>`
 //!   (with `inertiafromgeom="auto"`, the default, or `"true"`, which ignores `<inertial>`),
@@ -48,7 +48,7 @@
 //!   connect, non-linear, one-joint) are left out with a warning.
 //! * **Geometry** (for `iktc profile init`'s soles and the viewer, through the same URDF-tree
 //!   readers as a URDF's): box, sphere, capsule, cylinder and mesh geoms (`<asset><mesh file
-//!   scale>` under `<compiler meshdir>`); geoms that do not collide (`contype` and
+//!   scale>` under `<compiler meshdir>`, from the folder of the file declaring the mesh); geoms that do not collide (`contype` and
 //!   `conaffinity` 0) are the visuals when a body has any, the colliding ones the collisions.
 //!   A mesh file that is missing is a warning: the model loads for kinematics. `<site>`s are
 //!   frames.
@@ -107,7 +107,7 @@ pub(crate) fn read_mjcf(
     let root = xml::parse(text, source, dir, limits.max_xml_depth)?;
     let c = spec::Compiler::of(&root)?;
     let d = defaults::Defaults::of(&root)?;
-    let (meshes, materials) = assets::read(&root, &c, &d)?;
+    let (meshes, materials) = assets::read(&root, &c, &d, source, dir)?;
     let x = body::Ctx {
         c: &c,
         defaults: &d,

@@ -84,7 +84,8 @@ pub(crate) fn root_tag(text: &str) -> Option<&str> {
 
 /// Parses the MJCF `text` (read from `name`, in the folder `dir` when known) into a tree whose
 /// root is `<mujoco>`, every `<include file>` replaced by the children of the included file's
-/// `<mujoco>` (its path taken relative to `dir`, the main model's folder, as MuJoCo does).
+/// `<mujoco>` (its path taken relative to the including file's folder, else to `dir`, the main
+/// model's folder).
 ///
 /// Errors ([`Error::Parse`] naming the file and line): malformed XML, a root that is not
 /// `<mujoco>`, an element nested deeper than `max_depth`, an `<include>` without `file`, that
@@ -163,12 +164,22 @@ impl Reader<'_> {
         let Some(rel) = inc.attr("file") else {
             return Err(inc.error("has no `file` attribute (expected the file to include)"));
         };
-        let Some(dir) = self.dir else {
+        let Some(main_dir) = self.dir else {
             return Err(inc.error(format!(
                 "cannot include `{rel}` from text with no folder: read the model with Robot::from_mjcf_file (or give its folder)"
             )));
         };
-        let path = dir.join(rel);
+        // Relative to the including file's folder (as MuJoCo does for nested includes), else
+        // to the main model's.
+        let here = self
+            .stack
+            .last()
+            .and_then(|p| p.parent())
+            .unwrap_or(main_dir);
+        let path = [here.join(rel), main_dir.join(rel)]
+            .into_iter()
+            .find(|p| p.is_file())
+            .unwrap_or_else(|| here.join(rel));
         if self.stack.contains(&path) || self.stack.len() >= MAX_INCLUDE_DEPTH {
             return Err(inc.error(format!(
                 "`{rel}` is already being included (a cycle, or more than {MAX_INCLUDE_DEPTH} nested includes)"
