@@ -17,6 +17,7 @@ import iktc  # noqa: E402
 
 REPO = pathlib.Path(__file__).resolve().parents[3]
 HUMANOID = REPO / "crates" / "iktc" / "tests" / "data" / "mjcf" / "humanoid.xml"
+T1 = REPO / "crates" / "iktc" / "tests" / "data" / "mjcf" / "booster_t1" / "t1_mocap.xml"
 G1_MJCF = REPO / "crates" / "iktc" / "data" / "robots" / "g1" / "g1_29dof_rev_1_0.xml"
 
 # Largest difference of a body position [m], of a rotation matrix entry [-], of the total
@@ -32,7 +33,8 @@ UNLIMITED_RANGE = np.pi
 
 def without_meshes(path, out):
     """A copy of the MJCF `path` without mesh assets and mesh geoms (the crate ships the G1's
-    MJCF without its meshes; its bodies have explicit inertials, so their mass is unchanged)."""
+    and the T1's MJCF without their meshes; their bodies have explicit inertials, so their
+    masses are unchanged)."""
     tree = ET.parse(path)
     root = tree.getroot()
     for asset in root.iter("asset"):
@@ -71,9 +73,10 @@ def to_iktc(qpos):
 @pytest.mark.parametrize("model, mujoco_file", [
     ("humanoid", None),
     ("g1", "strip"),
+    ("t1", "strip"),
 ])
 def test_iktc_and_mujoco_agree_on_bodies_com_and_jacobians(model, mujoco_file, tmp_path):
-    path = HUMANOID if model == "humanoid" else G1_MJCF
+    path = {"humanoid": HUMANOID, "g1": G1_MJCF, "t1": T1}[model]
     robot = iktc.Robot(str(path))
     mj_path = path if mujoco_file is None else without_meshes(path, tmp_path / "m.xml")
     m = mujoco.MjModel.from_xml_path(str(mj_path))
