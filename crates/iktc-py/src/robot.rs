@@ -295,7 +295,7 @@ impl PyRobot {
     }
 }
 
-/// A starting robot profile for the URDF file `urdf` (TOML text, every guess marked
+/// A starting robot profile for the URDF or MJCF file `urdf` (TOML text, every guess marked
 /// `# guessed`), as `iktc profile init` writes it: feet and soles (from collision shapes or
 /// meshes), pelvis, torso, head and hands (a frame at the end of a bare forearm), finger locks.
 /// With `out` the profile is also written there, its `urdf` key relative to `out`'s folder.

@@ -133,3 +133,13 @@ def test_a_jacobian_column_moves_the_body_as_mujoco_integrates_the_velocity():
     mujoco.mj_kinematics(m, d)
     predicted = robot.frame_jacobian(to_iktc(qpos), "hand_left")[:3] @ v
     assert np.abs((moved - d.xpos[b]) / h - predicted).max() < 1e-4 * (1 + np.abs(predicted).max())
+
+
+def test_profile_init_reads_an_mjcf_model_and_the_robot_loads_its_profile(tmp_path):
+    out = tmp_path / "t1.toml"
+    text = iktc.profile_init(str(T1), out=str(out))
+    assert 'frame = "left_foot_link"' in text and 'frame = "right_foot_link"' in text
+    robot = iktc.Robot(str(out))
+    assert robot.has_profile and robot.floating
+    assert robot.nv == mujoco.MjModel.from_xml_path(
+        str(without_meshes(T1, tmp_path / "m.xml"))).nv

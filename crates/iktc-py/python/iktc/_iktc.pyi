@@ -274,6 +274,6 @@ class Walking:
     def feet0(self) -> List[FloatArray]: ...
 
 def profile_init(urdf: str, *, out: Optional[str] = None) -> str:
-    """A starting robot profile (TOML) for a URDF, guesses marked ``# guessed``, as
-    ``iktc profile init`` writes it; with ``out`` also written there."""
+    """A starting robot profile (TOML) for a URDF or MJCF model, guesses marked
+    ``# guessed``, as ``iktc profile init`` writes it; with ``out`` also written there."""
     ...
