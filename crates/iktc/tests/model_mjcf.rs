@@ -1,7 +1,8 @@
-//! The G1's MJCF (`data/robots/g1/g1_29dof_rev_1_0.xml`) read by iktc against the same robot's
-//! URDF (the built-in G1): same joints, ranges and efforts, and the same link poses and centre
-//! of mass at seeded random configurations. The two files were exported separately: their
-//! numbers differ by rounding (~3e-7).
+//! MJCF models read by iktc. The G1's MJCF (`data/robots/g1/g1_29dof_rev_1_0.xml`) against
+//! the same robot's URDF (the built-in G1): same joints, ranges and efforts, and the same link
+//! poses and centre of mass at seeded random configurations (the two files were exported
+//! separately: their numbers differ by rounding, ~3e-7). `iktc profile init` on MuJoCo's
+//! humanoid. (The Python test `test_mjcf.py` compares iktc with MuJoCo itself.)
 #![cfg(feature = "mjcf")]
 
 use std::path::Path;
@@ -141,4 +142,27 @@ fn the_g1_mjcf_places_every_link_where_the_urdf_does() {
         worst.1
     );
     assert!(worst.2 < COM_TOL, "centre of mass differs by {} m", worst.2);
+}
+
+/// `iktc profile init` on MuJoCo's humanoid (`tests/data/mjcf/humanoid.xml`): two feet, their
+/// soles from the capsules under them. The ankle joints sit 4 cm above the foot bodies, so the
+/// foot frames are the chain links `foot_*__ankle_x_*` at the ankle joint; in that frame the
+/// capsules' end spheres (radius 0.027 m, centres at x = −0.07 and 0.14 m, y = ±0.01 and ±0.03
+/// m, 0.04 m below) touch the ground at z = −0.067 m.
+#[test]
+fn profile_init_guesses_the_humanoids_feet_and_soles_from_its_capsules() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/mjcf/humanoid.xml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let toml = iktc::profile::init_profile_toml_at(&text, "humanoid.xml", path.parent()).unwrap();
+    assert!(toml.contains("base = \"floating\""), "{toml}");
+    assert!(
+        toml.contains("frame = \"foot_left__ankle_x_left\""),
+        "{toml}"
+    );
+    assert!(
+        toml.contains("sole = { length = 0.21, width = 0.06, offset_x = 0.035 }"),
+        "{toml}"
+    );
+    assert!(toml.contains("ankle_height = 0.067"), "{toml}");
+    assert!(toml.contains("left_hand = \"hand_left\""), "{toml}");
 }
