@@ -345,3 +345,46 @@ fn a_linear_joint_equality_is_a_mimic() {
     }
     assert!(r.warnings().iter().any(|w| w.contains("not linear")));
 }
+
+/// Largest error of a vertex after the viewer's 16-bit quantization \[m\]: half a step over
+/// the 2 m bounding box, 2/65535/2 ≈ 1.5e-5 m, plus f32 round-off.
+const QUANTIZED: f64 = 1e-4;
+
+/// A binary STL of the triangle (0,0,0), (1,0,0), (0,1,0).
+fn triangle_stl() -> Vec<u8> {
+    let mut b = vec![0u8; 80];
+    b.extend(1u32.to_le_bytes());
+    let corners = [0f32, 0., 0., 0., 0., 0., 1., 0., 0., 0., 1., 0.];
+    for x in corners {
+        b.extend(x.to_le_bytes());
+    }
+    b.extend([0u8, 0]);
+    b
+}
+
+#[test]
+fn visual_mesh_geoms_reach_the_viewer_placed_by_the_geom_and_scaled_by_the_asset() {
+    let dir = std::env::temp_dir().join(format!("iktc_mjcf_viewer_{}", std::process::id()));
+    std::fs::create_dir_all(dir.join("assets")).unwrap();
+    std::fs::write(dir.join("assets/t.stl"), triangle_stl()).unwrap();
+    // The mesh scaled by 2 along x, turned 90° about z, lifted by 1 m; a colliding box on the
+    // same body is not a visual (the body has a visual-only geom).
+    let xml = r#"<mujoco><compiler meshdir="assets"/><asset><mesh file="t.stl" scale="2 1 1"/>
+        <material name="red" rgba="1 0 0 1"/></asset>
+        <worldbody><body name="base"><inertial mass="1" diaginertia="1 1 1"/>
+          <geom type="mesh" mesh="t" pos="0 0 1" euler="0 0 90" contype="0" conaffinity="0" material="red"/>
+          <geom type="box" size="0.1 0.1 0.1"/></body></worldbody></mujoco>"#;
+    let m = crate::mesh::urdf::meshes_from_urdf(xml, &dir, 0.001).unwrap();
+    assert!(m.warnings.is_empty(), "{:?}", m.warnings);
+    assert_eq!(m.set.meshes.len(), 1);
+    let lm = &m.set.meshes[0];
+    assert_eq!((lm.link.as_str(), lm.color), ("base", [255, 0, 0]));
+    // (1,0,0) → (2,0,0) → (0,2,0) → (0,2,1); (0,1,0) → (−1,0,1).
+    let want = [[0.0, 0.0, 1.0], [0.0, 2.0, 1.0], [-1.0, 0.0, 1.0]];
+    for (a, b) in lm.mesh.vertices().iter().zip(want) {
+        for k in 0..3 {
+            assert!((f64::from(a[k]) - b[k]).abs() < QUANTIZED, "{a:?} vs {b:?}");
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
