@@ -143,3 +143,71 @@ def test_profile_init_reads_an_mjcf_model_and_the_robot_loads_its_profile(tmp_pa
     assert robot.has_profile and robot.floating
     assert robot.nv == mujoco.MjModel.from_xml_path(
         str(without_meshes(T1, tmp_path / "m.xml"))).nv
+
+
+# A model written for this test: every orientation form, an Euler sequence mixing moving and
+# fixed axes, degrees, a <frame>, classes with childclass, hinge and slide joints with `ref`
+# and off-origin `pos`, a body with two joints, fullinertia, and masses from primitive geoms.
+FEATURES = """<mujoco model="features">
+  <compiler angle="degree" eulerseq="zXy"/>
+  <default>
+    <joint range="-90 90"/>
+    <default class="arm"><joint axis="0 1 0" damping="1"/><geom type="capsule" size="0.03"/></default>
+  </default>
+  <worldbody>
+    <body name="base" pos="0.1 0.2 1" euler="10 20 30">
+      <freejoint name="root"/>
+      <geom type="box" size="0.1 0.15 0.05" pos="0 0 0.02" euler="5 0 -15"/>
+      <geom type="ellipsoid" size="0.05 0.08 0.03" pos="0.1 0 0"/>
+      <body name="upper" pos="0 0.2 0" axisangle="1 1 0 35" childclass="arm">
+        <joint name="shoulder_y" pos="0 0.01 0.02" ref="12"/>
+        <joint name="shoulder_x" axis="1 0 0.3" pos="0 0 0.05"/>
+        <geom fromto="0 0 0 0.25 0 -0.05"/>
+        <frame pos="0.3 0 0" xyaxes="0 1 0 -1 0 0.2">
+          <body name="lower" pos="0 0 -0.02">
+            <joint name="elbow" class="arm" ref="-20"/>
+            <inertial pos="0.1 0 0" mass="0.7" fullinertia="0.003 0.004 0.002 0.0004 -0.0002 0.0001"/>
+            <body name="slider" zaxis="1 0.5 -0.2">
+              <joint name="slide" type="slide" axis="0 0 1" range="-0.1 0.2" ref="0.05"/>
+              <geom type="cylinder" size="0.02 0.04"/>
+              <geom type="sphere" size="0.03" pos="0 0 0.05"/>
+            </body>
+          </body>
+        </frame>
+      </body>
+      <body name="leg" pos="0 -0.1 -0.2" quat="0.9 0.1 -0.2 0.3">
+        <joint name="hip" axis="1 0 0" limited="false"/>
+        <geom type="capsule" fromto="0 0 0 0 0 -0.4" size="0.04"/>
+      </body>
+    </body>
+  </worldbody>
+</mujoco>"""
+
+
+def test_every_orientation_form_and_joint_option_agrees_with_mujoco(tmp_path):
+    path = tmp_path / "features.xml"
+    path.write_text(FEATURES)
+    robot = iktc.Robot(str(path))
+    m = mujoco.MjModel.from_xml_path(str(path))
+    d = mujoco.MjData(m)
+    assert robot.joint_names == [m.joint(j).name for j in range(1, m.njnt)]
+    assert robot.total_mass == pytest.approx(m.body_mass.sum(), rel=1e-12)
+    rng = np.random.default_rng(2)
+    for _ in range(10):
+        qpos = random_qpos(m, rng)
+        d.qpos[:] = qpos
+        mujoco.mj_kinematics(m, d)
+        mujoco.mj_comPos(m, d)
+        q = to_iktc(qpos)
+        assert np.abs(robot.com(q) - d.subtree_com[0]).max() < COM_TOL
+        r_base = d.xmat[1].reshape(3, 3)
+        for b in range(1, m.nbody):
+            name = m.body(b).name
+            pose = robot.frame_pose(q, name)
+            assert np.abs(pose[:3, 3] - d.xpos[b]).max() < POSITION_TOL, name
+            assert np.abs(pose[:3, :3] - d.xmat[b].reshape(3, 3)).max() < ROTATION_TOL, name
+            jacp, jacr = np.zeros((3, m.nv)), np.zeros((3, m.nv))
+            mujoco.mj_jacBody(m, d, jacp, jacr, b)
+            j_mj = np.vstack([jacp, jacr])
+            j_mj[:, 0:3] = j_mj[:, 0:3] @ r_base
+            assert np.abs(robot.frame_jacobian(q, name) - j_mj).max() < JACOBIAN_TOL, name
