@@ -20,11 +20,11 @@ pub enum ProfileCommand {
         /// The built-in profile's name.
         name: String,
     },
-    /// Write a starting profile for a URDF: feet, soles, pelvis, torso, head and hands guessed
-    /// from the shape of its tree, each guess marked `# guessed`; the flags give parts instead.
-    /// A URDF the model loader rejects gets no profile.
+    /// Write a starting profile for a URDF or MuJoCo MJCF model: feet, soles, pelvis, torso,
+    /// head and hands guessed from the shape of its tree, each guess marked `# guessed`; the
+    /// flags give parts instead. A model the loader rejects gets no profile.
     Init {
-        /// The URDF file.
+        /// The URDF (.urdf) or MJCF (.xml) file.
         urdf: PathBuf,
         /// Write the profile to this file (its `urdf` key relative to the file's directory)
         /// instead of standard output.

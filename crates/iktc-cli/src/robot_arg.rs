@@ -1,11 +1,11 @@
-//! Turning a `--robot NAME|profile.toml|robot.urdf` argument and the profile flags into a robot
+//! Turning a `--robot NAME|profile.toml|robot.urdf|model.xml` argument and the profile flags into a robot
 //! profile and its model. Every error names its source: the flag, or the profile key (and the
 //! profile it is in) that produced a wrong or missing value.
 
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
-use iktc::model::{builtin_robot, BaseKind, Robot};
+use iktc::model::{builtin_robot, declared_base, BaseKind, Robot};
 use iktc::profile::{
     Feet, Foot, LockRule, ProfileOrigin, RobotProfile, Sole, BUILTIN_PROFILES, MISSING,
 };
@@ -15,7 +15,8 @@ use crate::pairs::{number, parse_assignments, range};
 /// Robot-level options of every command that loads a robot; they override the profile.
 #[derive(clap::Args, Debug, Clone, Default)]
 pub struct RobotOptions {
-    /// Floating base (profile key `base`); a URDF without a profile is fixed otherwise.
+    /// Floating base (profile key `base`); a URDF without a profile is fixed otherwise, an MJCF
+    /// model floats when it has a free joint.
     #[arg(long)]
     pub floating: bool,
     /// Lock joints at a value [rad or m]: PATTERN=VALUE, PATTERN a glob (`*` any run, `?` one
@@ -111,15 +112,27 @@ fn base_profile(spec: &str) -> Result<(RobotProfile, String)> {
         let p = RobotProfile::load(path).with_context(|| format!("loading profile {spec}"))?;
         return Ok((p, format!("profile file {spec}")));
     }
-    if ext.as_deref() == Some("urdf") || (path.is_file() && ext.as_deref() != Some("toml")) {
+    let description = matches!(ext.as_deref(), Some("urdf") | Some("xml"));
+    if description || (path.is_file() && ext.as_deref() != Some("toml")) {
         let name = path
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_else(|| "robot".into());
+        // An MJCF model with a free joint floats; a URDF (which does not say) is fixed.
+        let base = match std::fs::read_to_string(path) {
+            Ok(text) => declared_base(&text, path.parent())
+                .with_context(|| format!("reading {spec}"))?
+                .unwrap_or(BaseKind::Fixed),
+            Err(_) => BaseKind::Fixed,
+        };
+        let kind = match ext.as_deref() {
+            Some("xml") => "MJCF",
+            _ => "URDF",
+        };
         let p = RobotProfile {
             name,
             urdf: spec.to_string(),
-            base: BaseKind::Fixed,
+            base,
             lock: Vec::new(),
             feet: None,
             added_frames: Vec::new(),
@@ -132,10 +145,10 @@ fn base_profile(spec: &str) -> Result<(RobotProfile, String)> {
             walk: Default::default(),
             origin: ProfileOrigin::Directory(PathBuf::new()),
         };
-        return Ok((p, format!("URDF {spec}")));
+        return Ok((p, format!("{kind} {spec}")));
     }
     anyhow::bail!(
-        "--robot `{spec}` is neither a built-in robot ({}, planar3r) nor a profile (.toml) nor a URDF file (.urdf)",
+        "--robot `{spec}` is neither a built-in robot ({}, planar3r) nor a profile (.toml) nor a URDF (.urdf) or MJCF (.xml) file",
         BUILTIN_PROFILES.join(", ")
     )
 }
@@ -289,9 +302,10 @@ fn explain(source: &str, flag_keys: &[(String, &'static str)], e: iktc::Error) -
         // A URDF without a profile: `iktc profile init` guesses feet, soles, pelvis and hands.
         let init = source
             .strip_prefix("URDF ")
+            .or_else(|| source.strip_prefix("MJCF "))
             .map(|u| {
                 format!(
-                    "; or write a profile with its keys guessed from the URDF: `iktc profile init {u} --out {}`",
+                    "; or write a profile with its keys guessed from the model: `iktc profile init {u} --out {}`",
                     Path::new(u).with_extension("toml").display()
                 )
             })

@@ -15,8 +15,8 @@ use crate::robot_arg::{resolve_robot, ProfileFlags, ResolvedRobot, RobotOptions}
 /// Robot, motion and solver options of `iktc imitate` and `iktc walk`.
 #[derive(clap::Args, Debug)]
 pub struct ScenarioArgs {
-    /// Robot: a built-in profile (jvrc1, g1), a robot profile (.toml) or a URDF file (.urdf,
-    /// floating base; its feet, pelvis and posture from --feet, --sole, --ankle-height,
+    /// Robot: a built-in profile (jvrc1, g1), a robot profile (.toml) or a URDF (.urdf) or
+    /// MuJoCo MJCF (.xml) file (floating base; its feet, pelvis and posture from --feet, --sole, --ankle-height,
     /// --pelvis, --posture).
     #[arg(long, default_value = "jvrc1")]
     pub robot: String,
@@ -115,7 +115,7 @@ pub fn prepare_config(a: &ScenarioArgs) -> Result<(ResolvedRobot, ImitateConfig)
     let path = std::path::Path::new(&a.robot);
     if path
         .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("urdf"))
+        .is_some_and(|e| e.eq_ignore_ascii_case("urdf") || e.eq_ignore_ascii_case("xml"))
     {
         // The imitation moves a free-floating humanoid.
         ro.floating = true;

@@ -1,10 +1,12 @@
-//! `iktc.Robot`: an immutable robot model from a built-in name, a robot profile (TOML) or a
-//! URDF file.
+//! `iktc.Robot`: an immutable robot model from a built-in name, a robot profile (TOML), a
+//! URDF or a MuJoCo MJCF file.
 
 use std::path::Path;
 use std::sync::Arc;
 
-use iktc::model::{builtin_robot, BaseKind, Kinematics, ModelOptions, Robot, State};
+use iktc::model::{
+    builtin_robot, declared_base, BaseKind, Kinematics, ModelOptions, Robot, State,
+};
 use iktc::profile::{RobotProfile, BUILTIN_PROFILES};
 use numpy::{PyArray1, PyArray2, PyReadonlyArray2};
 use pyo3::prelude::*;
@@ -18,7 +20,9 @@ use crate::to_py;
 /// pelvis, posture, locks, acceleration limits, retargeting maps), like the command line's
 /// `--robot g1`; `Robot("planar3r")` is the 3R arm (no profile); `Robot("my_robot.toml")` reads
 /// a profile file; `Robot("path/to/robot.urdf", floating=True, lock=[("finger", 0.0)],
-/// accel=[("knee", 30.0)])` reads a bare URDF file (no profile). q is (base position [m], base
+/// accel=[("knee", 30.0)])` reads a bare URDF file (no profile), and `Robot("model.xml")` a
+/// MuJoCo MJCF model (floating when it has a free joint, unless `floating` says otherwise;
+/// q's joint part is MuJoCo's qpos after the free joint, the quaternion (x, y, z, w)). q is (base position [m], base
 /// quaternion (x, y, z, w), joints [rad]) and v (base linear and angular velocity in base axes,
 /// joint rates), as in the Rust library.
 #[pyclass(name = "Robot", module = "iktc", frozen)]
@@ -59,17 +63,27 @@ impl PyRobot {
             });
         }
         let robot = if is_urdf {
+            // Unless told: an MJCF model floats when it has a free joint, a URDF floats.
+            let base = match floating {
+                Some(true) => BaseKind::Floating,
+                Some(false) => BaseKind::Fixed,
+                None => {
+                    let path = Path::new(spec);
+                    let text = std::fs::read_to_string(path).map_err(|e| {
+                        crate::IktcError::new_err(format!("cannot read {spec}: {e}"))
+                    })?;
+                    declared_base(&text, path.parent())
+                        .map_err(to_py)?
+                        .unwrap_or(BaseKind::Floating)
+                }
+            };
             let options = ModelOptions {
-                base: if floating.unwrap_or(true) {
-                    BaseKind::Floating
-                } else {
-                    BaseKind::Fixed
-                },
+                base,
                 locked: lock.unwrap_or_default(),
                 acceleration_limits: accel.unwrap_or_default(),
                 ..ModelOptions::default()
             };
-            Robot::from_urdf_file(Path::new(spec), &options).map_err(to_py)?
+            Robot::from_description_file(Path::new(spec), &options).map_err(to_py)?
         } else {
             builtin_robot(spec).map_err(to_py)?
         };
@@ -281,7 +295,7 @@ impl PyRobot {
     }
 }
 
-/// A starting robot profile for the URDF file `urdf` (TOML text, every guess marked
+/// A starting robot profile for the URDF or MJCF file `urdf` (TOML text, every guess marked
 /// `# guessed`), as `iktc profile init` writes it: feet and soles (from collision shapes or
 /// meshes), pelvis, torso, head and hands (a frame at the end of a bare forearm), finger locks.
 /// With `out` the profile is also written there, its `urdf` key relative to `out`'s folder.

@@ -14,7 +14,8 @@ class IktcError(ValueError): ...
 
 class Robot:
     """A robot model: a built-in name ("jvrc1", "g1" with their profiles; "planar3r"), a robot
-    profile file (.toml) or a URDF file (.urdf, no profile)."""
+    profile file (.toml), a URDF file (.urdf, no profile) or a MuJoCo MJCF file (.xml, no
+    profile; floating when it has a free joint unless `floating` says otherwise)."""
     def __init__(self, spec: str, *, floating: Optional[bool] = None,
                  lock: Optional[Sequence[Tuple[str, float]]] = None,
                  accel: Optional[Sequence[Tuple[str, float]]] = None) -> None: ...
@@ -279,6 +280,6 @@ class Walking:
     def feet0(self) -> List[FloatArray]: ...
 
 def profile_init(urdf: str, *, out: Optional[str] = None) -> str:
-    """A starting robot profile (TOML) for a URDF, guesses marked ``# guessed``, as
-    ``iktc profile init`` writes it; with ``out`` also written there."""
+    """A starting robot profile (TOML) for a URDF or MJCF model, guesses marked
+    ``# guessed``, as ``iktc profile init`` writes it; with ``out`` also written there."""
     ...

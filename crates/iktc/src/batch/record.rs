@@ -77,7 +77,9 @@ impl BatchRetarget {
 /// The files of the `<mesh filename>`s of the URDF `text` whose folder is `dir`, as the
 /// viewer finds them ([`crate::mesh::urdf::resolve`]); none if the URDF cannot be read.
 fn mesh_files(text: &str, dir: &Path) -> Vec<PathBuf> {
-    let Ok((u, _)) = crate::model::read_urdf(text, &crate::resources::ReadLimits::default()) else {
+    let Ok(u) =
+        crate::model::read_description(text, Some(dir), &crate::resources::ReadLimits::default())
+    else {
         return Vec::new();
     };
     u.links

@@ -181,12 +181,14 @@ fn link_mesh(
     Ok((Some(QuantizedMesh::new(&d)?), warnings))
 }
 
-/// The visual meshes of the URDF `text` whose folder is `dir`, decimated on `cell` \[m\].
+/// The visual meshes of the URDF (or MJCF: its visual mesh geoms, see
+/// [`crate::model::mjcf`]) `text` whose folder is `dir`, decimated on `cell` \[m\].
 ///
 /// # Errors
 /// [`Error::Urdf`] when the URDF cannot be parsed; every problem with one mesh is a warning.
 pub fn meshes_from_urdf(text: &str, dir: &Path, cell: f64) -> Result<UrdfMeshes> {
-    let (u, _) = crate::model::read_urdf(text, &crate::resources::ReadLimits::default())?;
+    let u =
+        crate::model::read_description(text, Some(dir), &crate::resources::ReadLimits::default())?;
     let mut out = UrdfMeshes::default();
     for link in &u.links {
         for v in &link.visual {

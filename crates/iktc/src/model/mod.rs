@@ -1,7 +1,8 @@
 //! Robot model (immutable), state and kinematics.
 //!
 //! * [`Robot`]: links, joints, frames, the layout of q and q̇; from URDF
-//!   ([`Robot::from_urdf_str`]), built in code ([`RobotBuilder`]) or built in ([`planar3r`],
+//!   ([`Robot::from_urdf_str`]), MuJoCo MJCF ([`Robot::from_mjcf_file`], subset in [`mjcf`]),
+//!   either by its root element ([`Robot::from_description_file`]), built in code ([`RobotBuilder`]) or built in ([`planar3r`],
 //!   [`jvrc1`]).
 //! * [`State`]: q and q̇, and their integration over a control period.
 //! * [`Kinematics`]: link poses, frame Jacobians and drifts, centre of mass, computed once per
@@ -9,8 +10,12 @@
 
 mod builtin;
 mod config;
+#[cfg(feature = "urdf")]
+mod description;
 mod joint;
 mod kinematics;
+#[cfg(feature = "mjcf")]
+pub mod mjcf;
 pub mod plausible;
 mod robot;
 pub mod spatial;
@@ -20,6 +25,10 @@ mod urdf;
 #[cfg(feature = "urdf")]
 mod urdf_check;
 
+#[cfg(feature = "urdf")]
+pub(crate) use description::read_description;
+#[cfg(feature = "urdf")]
+pub use description::{declared_base, description_format, DescriptionFormat};
 #[cfg(feature = "urdf")]
 pub(crate) use urdf::{pose as urdf_pose, read_urdf};
 

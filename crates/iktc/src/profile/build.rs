@@ -162,8 +162,10 @@ impl RobotProfile {
     /// ([`RobotProfile::check_robot`]).
     pub fn robot(&self) -> Result<Robot> {
         let text = self.urdf_text()?;
-        let bare = Robot::from_urdf_str(
+        let dir = self.urdf_dir();
+        let bare = Robot::from_description_str(
             &text,
+            dir.as_deref(),
             &ModelOptions {
                 base: self.base,
                 ..ModelOptions::default()
@@ -210,7 +212,7 @@ impl RobotProfile {
             jerk_per_acceleration: self.jerk.per_acceleration.unwrap_or(f64::INFINITY),
             ..ModelOptions::default()
         };
-        let mut robot = Robot::from_urdf_str(&text, &options)
+        let mut robot = Robot::from_description_str(&text, dir.as_deref(), &options)
             .map_err(|e| profile_error("urdf", &self.urdf, e.to_string()))?;
         for (i, f) in self.added_frames.iter().enumerate() {
             let offset = Isometry3::from_parts(

@@ -164,13 +164,18 @@ fn held(joints: usize, ep: Vector3<f64>, er: Vector3<f64>) -> (Vector3<f64>, Vec
 /// to the base that the leg can hold ([`foot_rows`]), each joint within its range. `None` when
 /// the URDF does not build, a leg has fewer than three such joints, or the solve does not
 /// reach the held rows within 1 mm and 0.01 rad.
-fn crouch_posture(text: &str, u: &urdf_rs::Robot, feet: &[&str]) -> Option<Vec<(String, f64)>> {
+fn crouch_posture(
+    text: &str,
+    dir: Option<&std::path::Path>,
+    u: &urdf_rs::Robot,
+    feet: &[&str],
+) -> Option<Vec<(String, f64)>> {
     use crate::model::{BaseKind, Kinematics, ModelOptions, Robot, State};
     let options = ModelOptions {
         base: BaseKind::Floating,
         ..ModelOptions::default()
     };
-    let robot = Robot::from_urdf_str(text, &options).ok()?;
+    let robot = Robot::from_description_str(text, dir, &options).ok()?;
     let mut state = State::neutral(&robot);
     // Per leg: its foot frame and its joints (name, q index, v index, lower, upper, the link
     // the joint moves), foot first.
@@ -433,8 +438,8 @@ pub fn init_profile_toml_with(
     options: &InitOptions,
 ) -> Result<String> {
     // The model first: a URDF it rejects gets no profile.
-    crate::model::Robot::from_urdf_str(text, &crate::model::ModelOptions::default())?;
-    let (u, _) = crate::model::read_urdf(text, &crate::resources::ReadLimits::default())?;
+    crate::model::Robot::from_description_str(text, dir, &crate::model::ModelOptions::default())?;
+    let u = crate::model::read_description(text, dir, &crate::resources::ReadLimits::default())?;
     let is_child = |name: &str| u.joints.iter().any(|j| j.child.link == name);
     let roots: Vec<&urdf_rs::Link> = u.links.iter().filter(|l| !is_child(&l.name)).collect();
     let [root] = roots.as_slice() else {
@@ -841,7 +846,7 @@ fn write_profile(
             )),
         }
     }
-    write_posture(&mut out, text, u, &foot_frames);
+    write_posture(&mut out, text, dir, u, &foot_frames);
     out.push_str(
         "\n# Default narrowed ranges [rad] (joint = [lower, upper]).\n[narrow]\n\n\
          [acceleration]\nper_velocity = 10.0 # guessed: the paper's ratio (180°/s, 1800°/s²)\n\n\
@@ -856,13 +861,19 @@ fn write_profile(
 }
 
 /// The `[posture]` table: the crouch for a floating biped ([`crouch_posture`]).
-fn write_posture(out: &mut String, text: &str, u: &urdf_rs::Robot, feet: &[String]) {
+fn write_posture(
+    out: &mut String,
+    text: &str,
+    dir: Option<&std::path::Path>,
+    u: &urdf_rs::Robot,
+    feet: &[String],
+) {
     out.push_str(
         "\n# Initial joint angles [rad] (joint = angle), e.g. bent knees for a humanoid.\n[posture]\n",
     );
     let names: Vec<&str> = feet.iter().map(String::as_str).collect();
     match (names.len() == 2)
-        .then(|| crouch_posture(text, u, &names))
+        .then(|| crouch_posture(text, dir, u, &names))
         .flatten()
     {
         Some(posture) => {

@@ -142,8 +142,21 @@ impl RobotProfile {
         }
     }
 
-    /// The URDF text the profile names (key `urdf`).
+    /// The robot description's text (URDF or MJCF) the profile names (key `urdf`).
     pub fn urdf_text(&self) -> Result<String> {
         self.read_relative("urdf", &self.urdf)
+    }
+
+    /// The folder of the robot description the profile names (key `urdf`), where an MJCF
+    /// model's `<include>`s and meshes are found; `None` for a built-in profile.
+    pub fn urdf_dir(&self) -> Option<PathBuf> {
+        match &self.origin {
+            ProfileOrigin::Builtin => None,
+            ProfileOrigin::Directory(dir) => Some(
+                dir.join(&self.urdf)
+                    .parent()
+                    .map_or_else(PathBuf::new, Path::to_path_buf),
+            ),
+        }
     }
 }

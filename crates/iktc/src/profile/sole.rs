@@ -1,8 +1,8 @@
 //! A foot's sole guessed from its geometry (`iktc profile init`).
 //!
 //! The points of the foot link and of the links fixed below it, in the foot's frame: the
-//! corners of collision boxes, the lowest point of spheres, points around both rims of
-//! cylinders, the vertices of meshes (read from the URDF's folder); from the collision
+//! corners of collision boxes, the lowest point of spheres and of capsules' end spheres,
+//! points around both rims of cylinders, the vertices of meshes (read from the URDF's folder); from the collision
 //! geometry, else from the visual geometry. The ankle height is the depth of the lowest point
 //! below the foot's origin; the sole is the bounding rectangle (in x and y) of the points
 //! within [`SOLE_BAND`] of the lowest one.
@@ -50,7 +50,8 @@ pub(super) fn sole_from_points(v: &[Vector3<f64>]) -> Option<SoleGuess> {
 }
 
 /// The points of one primitive shape `g` posed at `at` (box corners, a sphere's lowest point,
-/// cylinder rims); meshes and other shapes give none.
+/// the lowest points of a capsule's end spheres, cylinder rims); meshes and other shapes give
+/// none.
 fn primitive_points(g: &urdf_rs::Geometry, at: &Isometry3<f64>) -> Vec<Vector3<f64>> {
     let mut out = Vec::new();
     match g {
@@ -66,6 +67,12 @@ fn primitive_points(g: &urdf_rs::Geometry, at: &Isometry3<f64>) -> Vec<Vector3<f
                         out.push((at * Point3::from(corner)).coords);
                     }
                 }
+            }
+        }
+        urdf_rs::Geometry::Capsule { radius, length } => {
+            // The lowest points of its two end spheres.
+            for z in [-0.5 * length, 0.5 * length] {
+                out.push((at * Point3::new(0.0, 0.0, z)).coords - Vector3::z() * *radius);
             }
         }
         urdf_rs::Geometry::Cylinder { radius, length } => {
