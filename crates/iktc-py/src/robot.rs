@@ -4,9 +4,7 @@
 use std::path::Path;
 use std::sync::Arc;
 
-use iktc::model::{
-    builtin_robot, declared_base, BaseKind, Kinematics, ModelOptions, Robot, State,
-};
+use iktc::model::{builtin_robot, declared_base, BaseKind, Kinematics, ModelOptions, Robot, State};
 use iktc::profile::{RobotProfile, BUILTIN_PROFILES};
 use numpy::{PyArray1, PyArray2, PyReadonlyArray2};
 use pyo3::prelude::*;
