@@ -31,7 +31,7 @@
 //! foot still in the air or sliding in where the person's was down. On the development set of
 //! ten clips of six rigs (Bandai Namco, CMU, Mixamo, mocap-bank, PyMO) the neutral slip over
 //! the person's contacts (mean over the clips) fell from 58 to 36 mm on G1 and from 21 to
-//! 15 mm on JVRC-1, and by 40–75 % on seven robots brought in by `profile init`. The floor rows
+//! 15 mm on JVRC-1, and by 9–72 % on seven robots brought in by `profile init`. The floor rows
 //! moved to the first level with it: in the second level, below nothing but the held feet,
 //! two landing feet whose holds the legs could not both reach traded their heights, and a
 //! sole went up to 12 mm under the ground.
