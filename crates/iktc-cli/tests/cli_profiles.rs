@@ -164,11 +164,7 @@ fn g1_retargets_the_default_clip_by_keypoints_beside_the_joint_route() {
     ] {
         assert_eq!(s[key]["ticks"].as_u64(), Some(ticks), "{key}");
         let levels = s[key]["levels"].as_object().unwrap();
-        assert_eq!(
-            levels.len(),
-            iktc::retarget::KEYPOINT_LEVELS.len(),
-            "{key}"
-        );
+        assert_eq!(levels.len(), iktc::retarget::KEYPOINT_LEVELS.len(), "{key}");
         let total: u64 = levels.values().map(|v| v.as_u64().unwrap()).sum();
         assert!(total <= ticks, "{key}: {total} of {ticks}");
     }

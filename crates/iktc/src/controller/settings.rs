@@ -9,8 +9,10 @@ use crate::solver::{Method, SolverSettings};
 pub struct ControllerSettings {
     /// The solver: IKTC (default), the GF cascade, clamping or the plain prioritized solution.
     pub method: Method,
-    /// How joint limits become the acceleration box (default: the viable bounds, safe in
-    /// discrete time; [`BoundMethod::Paper`] is eq. 14 as printed).
+    /// How joint limits become the acceleration box (default: [`BoundMethod::Quiet`], the
+    /// discrete-time-safe bounds that brake evenly toward a range end;
+    /// [`BoundMethod::Viable`] brakes at the last moment; [`BoundMethod::Paper`] is eq. 14 as
+    /// printed).
     pub bounds: BoundMethod,
     /// Damping, rank threshold, box tolerance and QP settings of the solver.
     pub solver: SolverSettings,
