@@ -10,9 +10,9 @@ pub struct ControllerSettings {
     /// The solver: IKTC (default), the GF cascade, clamping or the plain prioritized solution.
     pub method: Method,
     /// How joint limits become the acceleration box (default: [`BoundMethod::Quiet`], the
-    /// discrete-time-safe bounds that brake evenly toward a range end;
-    /// [`BoundMethod::Viable`] brakes at the last moment; [`BoundMethod::Paper`] is eq. 14 as
-    /// printed).
+    /// discrete-time-safe bounds of [`BoundMethod::Viable`] with a discrete braking curve, on
+    /// which a joint driven into a limit comes to rest instead of chattering;
+    /// [`BoundMethod::Paper`] is eq. 14 as printed).
     pub bounds: BoundMethod,
     /// Damping, rank threshold, box tolerance and QP settings of the solver.
     pub solver: SolverSettings,
