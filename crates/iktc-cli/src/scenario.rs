@@ -39,7 +39,7 @@ pub struct ScenarioArgs {
     /// Solver.
     #[arg(long, value_enum, default_value = "iktc")]
     pub solver: SolverArg,
-    /// Joint bounds (default: quiet; viable for keypoint retargeting).
+    /// Joint bounds (default: quiet).
     #[arg(long, value_enum)]
     pub bounds: Option<BoundsArg>,
     /// Start even if a joint is outside its (narrowed) range, and bring it back at the
@@ -87,8 +87,8 @@ fn choose_map(spec: Option<&str>, format: MotionFormat, r: &ResolvedRobot) -> Re
 
 /// The robot and the run configuration the arguments describe (robot flags, profile, solver,
 /// bounds, control period, recovery, run checks).
-/// The joint bounds of keypoint retargeting: `--bounds`, else its own default (viable, unlike
-/// the rest of the command line); `--recover` applies to them too.
+/// The joint bounds of keypoint retargeting: `--bounds`, else its own default
+/// (`KeypointSettings::default().bounds`); `--recover` applies to them too.
 pub fn keypoint_bounds(a: &ScenarioArgs) -> Result<BoundMethod> {
     let mut bounds = a.bounds.map_or_else(
         || iktc::retarget::KeypointSettings::default().bounds,

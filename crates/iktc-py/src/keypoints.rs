@@ -32,7 +32,7 @@ pub struct PyKeypointTrajectory {
 /// Runs the keypoint retargeting of `motion` on `robot` (which must have a profile) as
 /// `iktc imitate` does by default (see `iktc::retarget`): the clip's body points scaled to the
 /// robot, stance feet held, the COM reference kept over the support polygon, the strict-priority
-/// keypoint stack solved by IKTC under the viable bounds, integrated with constant acceleration
+/// keypoint stack solved by IKTC under the quiet bounds, integrated with constant acceleration
 /// over `dt` [s]; the posture level follows the joint route's references where the profile has
 /// a map for the motion's format. `hold_feet`: every frame counts as stance, so both feet are
 /// held where they stand for the whole clip (a standing imitation), at their yaw, instead of

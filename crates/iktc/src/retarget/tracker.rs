@@ -80,7 +80,7 @@
 //! ([`super::drift`]).
 //!
 //! Each level is linearised as in the controller (`J_i q̈ = ẍ_d + k_v(ẋ_d − ẋ) + k_p(x_d − x)
-//! − J̇_i q̇`, eqs. 3, 11) and solved under the viable box of the robot's own joint limits with
+//! − J̇_i q̇`, eqs. 3, 11) and solved under the quiet box of the robot's own joint limits with
 //! IKTC (eqs. 19–25); q̈ is integrated as is, nothing is clipped afterwards.
 
 use std::sync::Arc;
