@@ -139,6 +139,7 @@ fn base_profile(spec: &str) -> Result<(RobotProfile, String)> {
             frames: Default::default(),
             posture: Default::default(),
             narrow: Default::default(),
+            velocity: Default::default(),
             acceleration: Default::default(),
             jerk: Default::default(),
             imitate: Default::default(),

@@ -75,6 +75,11 @@ pub struct ModelOptions {
     /// Joints held at a value \[rad\] or \[m\]: they drop out of q. Locking a mimic master also
     /// locks its mimics.
     pub locked: Vec<(String, f64)>,
+    /// Velocity limits \[rad/s\] or \[m/s\] by joint name, replacing the description's.
+    pub velocity_limits: Vec<(String, f64)>,
+    /// Velocity limit \[rad/s\] or \[m/s\] of the joints whose description gives none and
+    /// `velocity_limits` does not name (MJCF gives none). Default +∞ (no limit).
+    pub fallback_velocity: f64,
     /// Acceleration limits \[rad/s²\] or \[m/s²\] by joint name (URDF has none).
     pub acceleration_limits: Vec<(String, f64)>,
     /// Default acceleration limit as a multiple of the joint's velocity limit \[1/s\]: the joint
@@ -100,6 +105,8 @@ impl Default for ModelOptions {
         Self {
             base: BaseKind::Fixed,
             locked: Vec::new(),
+            velocity_limits: Vec::new(),
+            fallback_velocity: f64::INFINITY,
             acceleration_limits: Vec::new(),
             acceleration_per_velocity: 10.0,
             fallback_acceleration: f64::INFINITY,
@@ -415,6 +422,7 @@ impl Robot {
             }
             Ok(out)
         };
+        let velocity = by_joint(&options.velocity_limits, "velocity", "rad/s")?;
         let accel = by_joint(&options.acceleration_limits, "acceleration", "rad/s²")?;
         let jerk = by_joint(&options.jerk_limits, "jerk", "rad/s³")?;
         // Roles. First pass: active / locked / fixed; mimics resolved after.
@@ -444,6 +452,11 @@ impl Robot {
                 }
             };
             let mut limit = s.limit;
+            if let Some(v) = velocity.get(&j) {
+                limit.velocity = *v;
+            } else if !limit.velocity.is_finite() && !matches!(s.kind, JointKind::Fixed) {
+                limit.velocity = options.fallback_velocity;
+            }
             if let Some(a) = accel.get(&j) {
                 limit.acceleration = *a;
             } else if !limit.acceleration.is_finite() && !matches!(s.kind, JointKind::Fixed) {

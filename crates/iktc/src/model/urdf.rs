@@ -166,7 +166,7 @@ fn checked_limit(j: &urdf_rs::Joint, raw: &RawJoint, b: &mut RobotBuilder) -> Re
             }
             Some(_) => limit.velocity = l.velocity,
             None => b.warn(format!(
-                "joint `{}`: <limit> has no velocity; read as unbounded (URDF 1.2), so its acceleration limit comes from ModelOptions::fallback_acceleration",
+                "joint `{}`: <limit> has no velocity; read as unbounded (URDF 1.2) unless ModelOptions::fallback_velocity or a robot profile's `velocity.default` sets one",
                 j.name
             )),
         }

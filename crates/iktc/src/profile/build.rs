@@ -102,6 +102,17 @@ impl RobotProfile {
                 ));
             }
         }
+        if let Some(v) = self.velocity.default {
+            check_number("velocity.default", v, v > 0.0, "a limit > 0 [rad/s or m/s]")?;
+        }
+        for (j, v) in &self.velocity.limits {
+            check_number(
+                &format!("velocity.limits.{j}"),
+                *v,
+                *v > 0.0,
+                "a limit > 0 [rad/s or m/s]",
+            )?;
+        }
         let a = &self.acceleration;
         check_number(
             "acceleration.per_velocity",
@@ -183,6 +194,7 @@ impl RobotProfile {
             .limits
             .keys()
             .map(|j| ("acceleration", j))
+            .chain(self.velocity.limits.keys().map(|j| ("velocity", j)))
             .chain(self.jerk.limits.keys().map(|j| ("jerk", j)));
         for (key, j) in limited {
             if !movable.contains(j) {
@@ -202,6 +214,13 @@ impl RobotProfile {
                 .iter()
                 .map(|(k, v)| (k.clone(), *v))
                 .collect(),
+            velocity_limits: self
+                .velocity
+                .limits
+                .iter()
+                .map(|(k, v)| (k.clone(), *v))
+                .collect(),
+            fallback_velocity: self.velocity.default.unwrap_or(f64::INFINITY),
             acceleration_per_velocity: self.acceleration.per_velocity,
             jerk_limits: self
                 .jerk

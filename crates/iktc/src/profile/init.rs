@@ -847,6 +847,7 @@ fn write_profile(
         }
     }
     write_posture(&mut out, text, dir, u, &foot_frames);
+    write_velocity(&mut out, text, dir);
     out.push_str(
         "\n# Default narrowed ranges [rad] (joint = [lower, upper]).\n[narrow]\n\n\
          [acceleration]\nper_velocity = 10.0 # guessed: the paper's ratio (180°/s, 1800°/s²)\n\n\
@@ -858,6 +859,37 @@ fn write_profile(
          [imitate.maps]\n# deepmimic = \"my_deepmimic_map.toml\"\n",
     );
     out
+}
+
+/// Velocity limit written by `profile init` for the joints whose file gives none \[rad/s\]:
+/// about G1's knee (20 rad/s in its URDF; its other joints 22–37 rad/s, H1's 9–23 rad/s).
+/// With the profile's default ratio its acceleration limit is 200 rad/s².
+pub const GUESSED_VELOCITY: f64 = 20.0;
+
+/// The `[velocity]` table when some movable joint has no velocity limit in the file (MJCF
+/// never gives one): `default = GUESSED_VELOCITY`, marked as guessed and naming how many
+/// joints it covers. Nothing when every joint has one or the file does not build.
+fn write_velocity(out: &mut String, text: &str, dir: Option<&std::path::Path>) {
+    use crate::model::{ModelOptions, Robot};
+    let Ok(robot) = Robot::from_description_str(text, dir, &ModelOptions::default()) else {
+        return;
+    };
+    let unlimited: Vec<&str> = robot
+        .active_joints()
+        .filter(|j| !j.limit.velocity.is_finite())
+        .map(|j| j.name.as_str())
+        .collect();
+    if unlimited.is_empty() {
+        return;
+    }
+    out.push_str(&format!(
+        "\n# Velocity limits [rad/s] of the joints the file gives none (velocity.limits = {{ joint = limit }}\n\
+         # for each joint); the acceleration limits follow (acceleration.per_velocity).\n\
+         [velocity]\ndefault = {GUESSED_VELOCITY:.1} # guessed: the file gives no velocity limit for {} of {} joints (the first: {}); set your robot's\n",
+        unlimited.len(),
+        robot.n_active(),
+        unlimited[0]
+    ));
 }
 
 /// The `[posture]` table: the crouch for a floating biped ([`crouch_posture`]).

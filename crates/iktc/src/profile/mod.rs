@@ -37,6 +37,10 @@
 //! [narrow]                                       # default narrowed ranges [rad]
 //! left_knee_joint = [0.3, 0.9]
 //!
+//! [velocity]                                    # for files without velocity limits (MJCF)
+//! default = 20.0                                 # joints the file gives none [rad/s]
+//! limits = { left_knee_joint = 14.0 }            # [rad/s], replacing the file's
+//!
 //! [acceleration]
 //! per_velocity = 10.0                            # default limit / velocity limit [1/s]
 //! limits = { left_knee_joint = 200.0 }           # [rad/s²]
@@ -90,12 +94,13 @@ pub use build::{check_map_joints, MISSING};
 pub use glob::glob_match;
 pub use init::{
     init_profile_toml, init_profile_toml_at, init_profile_toml_with, urdf_key, InitOptions, CROUCH,
-    FOREARM_JOINTS,
+    FOREARM_JOINTS, GUESSED_VELOCITY,
 };
 pub use load::{builtin_profile_text, BUILTIN_PROFILES};
 pub use schema::{
     AccelerationProfile, AddedFrame, BodyFrames, Feet, Foot, ImitateProfile, JerkProfile, LockRule,
-    ProfileOrigin, PushProfile, RobotProfile, Sole, WalkProfile, DEFAULT_ACCELERATION_PER_VELOCITY,
+    ProfileOrigin, PushProfile, RobotProfile, Sole, VelocityProfile, WalkProfile,
+    DEFAULT_ACCELERATION_PER_VELOCITY,
 };
 pub use shape::{MIDLINE, MIN_ARM_JOINTS, MIN_DROP, MIN_LEG_JOINTS};
 pub use sole::{LONG_SOLE, NARROW_SOLE, SOLE_BAND};

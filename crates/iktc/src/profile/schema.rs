@@ -40,6 +40,9 @@ pub struct RobotProfile {
     /// (sorted by name).
     #[serde(default, skip_serializing_if = "Vec::is_empty", with = "narrow_table")]
     pub narrow: Vec<NarrowedJoint>,
+    /// Velocity limits the robot's file does not give (key `velocity`; none by default).
+    #[serde(default, skip_serializing_if = "VelocityProfile::is_empty")]
+    pub velocity: VelocityProfile,
     /// Acceleration limits (key `acceleration`).
     #[serde(default)]
     pub acceleration: AccelerationProfile,
@@ -163,6 +166,30 @@ pub struct BodyFrames {
     /// The right hand (key `frames.right_hand`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub right_hand: Option<String>,
+}
+
+/// Velocity limits (key `velocity`) for robots whose file gives none (MJCF never does; a URDF
+/// `<limit>` may leave it out): without one, a joint has no velocity limit and, unless
+/// `acceleration.limits` names it, no acceleration limit either.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct VelocityProfile {
+    /// Velocity limit \[rad/s\] or \[m/s\] of every movable joint whose file gives none and
+    /// that `limits` does not name, `> 0` (key `velocity.default`). Absent: such joints stay
+    /// unlimited.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub default: Option<f64>,
+    /// Velocity limits by joint name \[rad/s\] or \[m/s\], `> 0`, replacing the file's (key
+    /// `velocity.limits`).
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub limits: BTreeMap<String, f64>,
+}
+
+impl VelocityProfile {
+    /// Whether the profile states no velocity limit.
+    pub fn is_empty(&self) -> bool {
+        self.default.is_none() && self.limits.is_empty()
+    }
 }
 
 /// The default acceleration limit as a multiple of the velocity limit \[1/s\] (the ratio of the

@@ -623,6 +623,24 @@ fn frame_names(profile: &RobotProfile, cfg: &ImitateConfig) -> Result<BodyFrameN
     })
 }
 
+/// Every active joint of `robot` has a finite acceleration limit (the box of the keypoint
+/// route bounds every joint; a joint with neither a velocity nor an acceleration limit, as in
+/// an MJCF file, lets the solver's answer grow without bound near a singularity). Errors: the
+/// first joint without one, and the profile keys that give one.
+fn check_acceleration_limits(robot: &Robot) -> Result<()> {
+    match robot
+        .active_joints()
+        .find(|j| !j.limit.acceleration.is_finite())
+    {
+        None => Ok(()),
+        Some(j) => Err(Error::InvalidSetting {
+            name: format!("acceleration limit of joint `{}`", j.name),
+            value: "none (the robot's file gives it no velocity limit either)".into(),
+            expected: "a finite limit for every joint the keypoint route moves: set `velocity.default` [rad/s] (or `velocity.limits`) or `acceleration.limits` [rad/s²] in the robot's profile (`iktc profile init` writes a guessed `velocity.default` for such files)".into(),
+        }),
+    }
+}
+
 fn setup(
     robot: Arc<Robot>,
     profile: &RobotProfile,
@@ -640,6 +658,7 @@ fn setup(
             ),
         });
     }
+    check_acceleration_limits(&robot)?;
     let cfg = profile.imitate_config(ImitateConfig::default())?;
     let (body, centres, _) = measured_body(&robot, profile)?;
     let mut kin = Kinematics::new(&robot, &State::neutral(&robot))?;

@@ -123,7 +123,7 @@ pub(crate) fn read_mjcf(
         .any(|j| !matches!(j.kind, super::JointKind::Fixed))
     {
         tree.warnings.push(
-            "MJCF gives no joint velocity limits: every joint's is read as unbounded, so its acceleration limit comes from ModelOptions::fallback_acceleration".into(),
+            "MJCF gives no joint velocity limits: every joint's is read as unbounded (ModelOptions::fallback_velocity, or a robot profile's `velocity.default`, which `iktc profile init` writes, sets one; the acceleration limits follow from it)".into(),
         );
     }
     if let Some(dir) = dir {
