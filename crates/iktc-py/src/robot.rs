@@ -18,7 +18,10 @@ use crate::to_py;
 /// pelvis, posture, locks, acceleration limits, retargeting maps), like the command line's
 /// `--robot g1`; `Robot("planar3r")` is the 3R arm (no profile); `Robot("my_robot.toml")` reads
 /// a profile file; `Robot("path/to/robot.urdf", floating=True, lock=[("finger", 0.0)],
-/// accel=[("knee", 30.0)])` reads a bare URDF file (no profile), and `Robot("model.xml")` a
+/// accel=[("knee", 30.0)], velocity=[("knee", 14.0)], default_velocity=20.0)` reads a bare
+/// URDF file (no profile; `velocity` [rad/s] replaces a joint's velocity limit,
+/// `default_velocity` [rad/s] is the limit of the joints the file gives none, with the
+/// acceleration limits 10 × these unless `accel` names the joint), and `Robot("model.xml")` a
 /// MuJoCo MJCF model (floating when it has a free joint, unless `floating` says otherwise;
 /// q's joint part is MuJoCo's qpos after the free joint, the quaternion (x, y, z, w)). q is (base position [m], base
 /// quaternion (x, y, z, w), joints [rad]) and v (base linear and angular velocity in base axes,
@@ -33,18 +36,32 @@ pub struct PyRobot {
 #[pymethods]
 impl PyRobot {
     #[new]
-    #[pyo3(signature = (spec, *, floating=None, lock=None, accel=None))]
+    #[pyo3(signature = (spec, *, floating=None, lock=None, accel=None, velocity=None, default_velocity=None))]
     fn new(
         spec: &str,
         floating: Option<bool>,
         lock: Option<Vec<(String, f64)>>,
         accel: Option<Vec<(String, f64)>>,
+        velocity: Option<Vec<(String, f64)>>,
+        default_velocity: Option<f64>,
     ) -> PyResult<Self> {
         let is_urdf = spec.ends_with(".urdf") || spec.ends_with(".xml");
-        if !is_urdf && (floating.is_some() || lock.is_some() || accel.is_some()) {
+        let options_given = floating.is_some()
+            || lock.is_some()
+            || accel.is_some()
+            || velocity.is_some()
+            || default_velocity.is_some();
+        if !is_urdf && options_given {
             return Err(crate::IktcError::new_err(format!(
-                "`{spec}` is a built-in robot or a profile: floating, lock and accel apply to URDF files only (a profile sets them with its keys `base`, `lock` and `acceleration`)"
+                "`{spec}` is a built-in robot or a profile: floating, lock, accel, velocity and default_velocity apply to URDF and MJCF files only (a profile sets them with its keys `base`, `lock`, `acceleration` and `velocity`)"
             )));
+        }
+        if let Some(v) = default_velocity {
+            if !(v > 0.0) {
+                return Err(crate::IktcError::new_err(format!(
+                    "default_velocity = {v}: expected a velocity limit > 0 [rad/s] (or +inf for none)"
+                )));
+            }
         }
         let profile = if spec.ends_with(".toml") {
             Some(RobotProfile::load(Path::new(spec)).map_err(to_py)?)
@@ -79,6 +96,8 @@ impl PyRobot {
                 base,
                 locked: lock.unwrap_or_default(),
                 acceleration_limits: accel.unwrap_or_default(),
+                velocity_limits: velocity.unwrap_or_default(),
+                fallback_velocity: default_velocity.unwrap_or(f64::INFINITY),
                 ..ModelOptions::default()
             };
             Robot::from_description_file(Path::new(spec), &options).map_err(to_py)?

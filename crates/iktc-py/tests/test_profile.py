@@ -4,6 +4,9 @@ import os
 import subprocess
 import tempfile
 
+import numpy as np
+import pytest
+
 import iktc
 from test_controller import REPO, iktc_binary
 
@@ -40,3 +43,30 @@ def test_a_urdf_without_a_profile_points_to_profile_init():
         assert "iktc.profile_init" in str(e), str(e)
     else:
         raise AssertionError("a robot without a profile retargeted")
+
+
+T1_MJCF = REPO / "crates" / "iktc" / "tests" / "data" / "mjcf" / "booster_t1" / "t1_mocap.xml"
+
+
+def test_an_mjcf_file_without_velocity_limits_gets_them_from_the_keywords_or_its_profile():
+    # MJCF gives no velocity limits: every joint is unlimited unless told.
+    bare = iktc.Robot(str(T1_MJCF))
+    _, _, vel, acc = bare.limits()
+    assert np.all(np.isinf(vel)) and np.all(np.isinf(acc))
+    knee = bare.v_index("Left_Knee_Pitch")
+    robot = iktc.Robot(str(T1_MJCF), default_velocity=20.0, velocity=[("Left_Knee_Pitch", 7.5)])
+    _, _, vel, acc = robot.limits()
+    joints = np.arange(6, robot.nv)
+    others = joints[joints != knee]
+    # The acceleration limits follow at 10 × the velocity limit (ModelOptions' default ratio).
+    assert np.all(vel[others] == 20.0) and np.all(acc[others] == 200.0)
+    assert vel[knee] == 7.5 and acc[knee] == 75.0
+    with pytest.raises(iktc.IktcError, match="default_velocity"):
+        iktc.Robot(str(T1_MJCF), default_velocity=-1.0)
+    # profile_init writes a guessed default the profile's robot applies.
+    out = tempfile.mkdtemp()
+    path = os.path.join(out, "t1.toml")
+    text = iktc.profile_init(str(T1_MJCF), out=path)
+    assert "[velocity]\ndefault = 20.0 # guessed" in text
+    _, _, vel, _ = iktc.Robot(path).limits()
+    assert np.all(vel[6:] == 20.0)

@@ -18,7 +18,9 @@ class Robot:
     profile; floating when it has a free joint unless `floating` says otherwise)."""
     def __init__(self, spec: str, *, floating: Optional[bool] = None,
                  lock: Optional[Sequence[Tuple[str, float]]] = None,
-                 accel: Optional[Sequence[Tuple[str, float]]] = None) -> None: ...
+                 accel: Optional[Sequence[Tuple[str, float]]] = None,
+                 velocity: Optional[Sequence[Tuple[str, float]]] = None,
+                 default_velocity: Optional[float] = None) -> None: ...
     @property
     def name(self) -> str: ...
     @property
