@@ -1,6 +1,6 @@
 //! Standard base64 (RFC 4648 §4, with `=` padding): every 3 bytes become 4 characters of
 //! `A–Z a–z 0–9 + /`. Used to put binary data (meshes, link orientations) inside the viewer page;
-//! the coding is the [`base64`](::base64) crate's standard engine.
+//! the coding is the `base64` crate's standard engine.
 
 use ::base64::engine::general_purpose::STANDARD;
 use ::base64::Engine as _;
