@@ -500,8 +500,9 @@ fn files_of(dir: &Path) -> Vec<String> {
         .collect()
 }
 
-/// Progress on standard error: a bar redrawn in place with the ETA on a terminal, a log line
-/// per clip otherwise. The ETA scales the elapsed time by the input bytes left over those done.
+/// Progress on standard error: an [`indicatif`] bar redrawn in place with the ETA on a
+/// terminal (failed clips printed above it), a log line per clip otherwise. The ETA scales the
+/// elapsed time by the input bytes left over those done.
 struct Progress {
     start: Instant,
     bytes: Vec<u64>,
@@ -511,7 +512,8 @@ struct Progress {
     done_bytes: u64,
     left_bytes: u64,
     frames: usize,
-    tty: bool,
+    /// The bar, on a terminal only.
+    bar: Option<indicatif::ProgressBar>,
 }
 
 impl Progress {
@@ -520,10 +522,23 @@ impl Progress {
             .iter()
             .map(|c| std::fs::metadata(&c.path).map_or(1, |m| m.len().max(1)))
             .collect();
-        let tty = std::io::stderr().is_terminal();
         if skipped > 0 {
             eprintln!("{skipped} clips up to date (skipped; --force redoes them)");
         }
+        let bar = (std::io::stderr().is_terminal() && !todo.is_empty()).then(|| {
+            let bar = indicatif::ProgressBar::with_draw_target(
+                Some(todo.len() as u64),
+                indicatif::ProgressDrawTarget::stderr(),
+            );
+            // The template is a constant: a mistake in it shows as the default style.
+            if let Ok(style) =
+                indicatif::ProgressStyle::with_template("[{bar:30}] {pos}/{len} clips, {msg}")
+            {
+                bar.set_style(style.progress_chars("#>."));
+            }
+            bar.set_message("0 failed, ETA ?");
+            bar
+        });
         Self {
             start: Instant::now(),
             left_bytes: bytes.iter().sum(),
@@ -533,7 +548,7 @@ impl Progress {
             failed: 0,
             done_bytes: 0,
             frames: 0,
-            tty,
+            bar,
         }
     }
 
@@ -555,22 +570,17 @@ impl Progress {
         if c.status == "failed" {
             self.failed += 1;
         }
-        if self.tty {
-            let width = 30;
-            let filled = width * self.done / self.total.max(1);
+        if let Some(bar) = &self.bar {
             if let Some(e) = &c.error {
-                eprintln!("\r\x1b[2K{}: FAILED: {e}", c.name);
+                bar.println(format!("{}: FAILED: {e}", c.name));
             }
-            eprint!(
-                "\r\x1b[2K[{}{}] {}/{} clips, {} failed, {:.0} frames/s, ETA {}",
-                "#".repeat(filled),
-                ".".repeat(width - filled),
-                self.done,
-                self.total,
+            bar.set_message(format!(
+                "{} failed, {:.0} frames/s, ETA {}",
                 self.failed,
                 self.frames as f64 / self.start.elapsed().as_secs_f64().max(1e-9),
                 self.eta()
-            );
+            ));
+            bar.set_position(self.done as u64);
         } else {
             match &c.error {
                 Some(e) => eprintln!("[{}/{}] {}: FAILED: {e}", self.done, self.total, c.name),
@@ -586,9 +596,10 @@ impl Progress {
         }
     }
 
+    /// Leaves the bar's last state on screen, the output that follows on its own line.
     fn finish(&self) {
-        if self.tty && self.total > 0 {
-            eprintln!();
+        if let Some(bar) = &self.bar {
+            bar.finish();
         }
     }
 }

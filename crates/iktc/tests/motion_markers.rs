@@ -46,41 +46,81 @@ fn pig_markers() -> Vec<(&'static str, [f64; 3])> {
 /// A C3D file (Intel) of `frames` frames at `rate` Hz: float samples when `scale < 0`, else
 /// 16-bit integers times `scale`; `None` marks a marker not seen (residual −1).
 fn c3d_bytes(labels: &[&str], frames: &[Vec<Option<[f64; 3]>>], rate: f32, scale: f32) -> Vec<u8> {
+    c3d_bytes_as(84, labels, frames, rate, scale)
+}
+
+/// The 4 bytes of `v` as processor type `processor` stores a float: Intel (84) IEEE
+/// little-endian, DEC (85) VAX F-floating (the IEEE bits of `4v` with their 16-bit words
+/// swapped), MIPS (86) IEEE big-endian.
+fn float_as(processor: u8, v: f32) -> [u8; 4] {
+    match processor {
+        85 if v == 0.0 => [0; 4],
+        85 => {
+            let b = (4.0 * v).to_le_bytes();
+            [b[2], b[3], b[0], b[1]]
+        }
+        86 => v.to_be_bytes(),
+        _ => v.to_le_bytes(),
+    }
+}
+
+/// As [`c3d_bytes`], for processor type `processor` (84 Intel, 85 DEC, 86 MIPS); more than 255
+/// labels continue in `POINT:LABELS2`, `POINT:LABELS3`, ….
+fn c3d_bytes_as(
+    processor: u8,
+    labels: &[&str],
+    frames: &[Vec<Option<[f64; 3]>>],
+    rate: f32,
+    scale: f32,
+) -> Vec<u8> {
+    let i16_as = |v: i16| {
+        if processor == 86 {
+            v.to_be_bytes()
+        } else {
+            v.to_le_bytes()
+        }
+    };
     let mut b = vec![0u8; 512];
     b[0] = 2;
     b[1] = 0x50;
     let put16 =
-        |b: &mut Vec<u8>, at: usize, v: u16| b[at..at + 2].copy_from_slice(&v.to_le_bytes());
+        |b: &mut Vec<u8>, at: usize, v: u16| b[at..at + 2].copy_from_slice(&i16_as(v as i16));
     put16(&mut b, 2, labels.len() as u16);
     put16(&mut b, 4, 0);
     put16(&mut b, 6, 1);
     put16(&mut b, 8, frames.len() as u16);
-    b[12..16].copy_from_slice(&scale.to_le_bytes());
+    b[12..16].copy_from_slice(&float_as(processor, scale));
     put16(&mut b, 16, 0); // data start block, set below
-    b[20..24].copy_from_slice(&rate.to_le_bytes());
+    b[20..24].copy_from_slice(&float_as(processor, rate));
     // Parameters.
-    let mut p: Vec<u8> = vec![1, 0x50, 0, 84];
+    let mut p: Vec<u8> = vec![1, 0x50, 0, processor];
     p.extend([5u8, (-1i8) as u8]);
     p.extend(b"POINT");
-    p.extend(3i16.to_le_bytes());
+    p.extend(i16_as(3));
     p.push(0);
     let len = 4usize;
-    p.extend([6u8, 1]);
-    p.extend(b"LABELS");
-    let data = len * labels.len();
-    p.extend(((2 + 1 + 1 + 2 + data + 1) as i16).to_le_bytes());
-    p.extend([(-1i8) as u8, 2, len as u8, labels.len() as u8]);
-    for l in labels {
-        let mut s = l.as_bytes().to_vec();
-        s.resize(len, b' ');
-        p.extend(s);
+    for (k, chunk) in labels.chunks(255).enumerate() {
+        let name = match k {
+            0 => "LABELS".to_string(),
+            _ => format!("LABELS{}", k + 1),
+        };
+        p.extend([name.len() as u8, 1]);
+        p.extend(name.as_bytes());
+        let data = len * chunk.len();
+        p.extend(i16_as((2 + 1 + 1 + 2 + data + 1) as i16));
+        p.extend([(-1i8) as u8, 2, len as u8, chunk.len() as u8]);
+        for l in chunk {
+            let mut s = l.as_bytes().to_vec();
+            s.resize(len, b' ');
+            p.extend(s);
+        }
+        p.push(0);
     }
-    p.push(0);
     p.extend([4u8, 1]);
     p.extend(b"RATE");
-    p.extend(0i16.to_le_bytes());
+    p.extend(i16_as(0));
     p.extend([4u8, 0]);
-    p.extend(rate.to_le_bytes());
+    p.extend(float_as(processor, rate));
     p.push(0);
     let blocks = p.len().div_ceil(512);
     p[2] = blocks as u8;
@@ -95,14 +135,14 @@ fn c3d_bytes(labels: &[&str], frames: &[Vec<Option<[f64; 3]>>], rate: f32, scale
             };
             for v in xyz.iter().chain(std::iter::once(&residual)) {
                 if scale < 0.0 {
-                    b.extend((*v as f32).to_le_bytes());
+                    b.extend(float_as(processor, *v as f32));
                 } else {
                     let i = if *v < 0.0 && std::ptr::eq(v, &residual) {
                         -1
                     } else {
                         (*v / scale as f64).round() as i16
                     };
-                    b.extend(i.to_le_bytes());
+                    b.extend(i16_as(i));
                 }
             }
         }
@@ -267,15 +307,51 @@ fn a_bad_c3d_header_or_truncated_data_is_an_error_naming_the_file() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("cut.c3d") && e.contains("truncated"), "{e}");
-    let mut dec = good.clone();
-    dec[512 + 3] = 85;
-    assert!(read_c3d(&dec, "dec.c3d")
-        .unwrap_err()
-        .to_string()
-        .contains("DEC"));
+    let mut other = good.clone();
+    other[512 + 3] = 87;
+    let e = read_c3d(&other, "cpu.c3d").unwrap_err().to_string();
+    assert!(
+        e.contains("cpu.c3d") && e.contains("processor type 87"),
+        "{e}"
+    );
     // Every prefix of the file fails cleanly or reads: never a panic.
     for n in (0..good.len()).step_by(7) {
         let _ = read_c3d(&good[..n], "prefix.c3d");
+    }
+}
+
+/// DEC (VAX floats, little-endian words) and MIPS (big-endian) files read as the Intel file
+/// of the same points does, float and integer samples alike; more than 255 points take their
+/// names from `POINT:LABELS2` and `POINT:LABELS3`.
+#[test]
+fn dec_and_mips_c3d_files_and_more_than_255_labels_read() {
+    let (labels, frames) = pig_frames(3, &|f, m| f == 1 && m == "LKNE");
+    for scale in [-1.0, 0.5] {
+        let intel = read_c3d(&c3d_bytes(&labels, &frames, 120.0, scale), "i.c3d").unwrap();
+        for processor in [85u8, 86] {
+            let bytes = c3d_bytes_as(processor, &labels, &frames, 120.0, scale);
+            let set = read_c3d(&bytes, "p.c3d").unwrap();
+            assert_eq!(set.names, intel.names, "processor {processor}");
+            assert_eq!(set.times, intel.times, "processor {processor}");
+            assert_eq!(set.positions, intel.positions, "processor {processor}");
+        }
+    }
+    // 600 points: 255 names in LABELS, 255 in LABELS2, 90 in LABELS3.
+    let names: Vec<String> = (0..600).map(|k| format!("M{k:03}")).collect();
+    let names: Vec<&str> = names.iter().map(String::as_str).collect();
+    let frames: Frames = (0..2)
+        .map(|f| (0..600).map(|k| Some([k as f64, f as f64, 1.0])).collect())
+        .collect();
+    for processor in [84u8, 85, 86] {
+        let set = read_c3d(
+            &c3d_bytes_as(processor, &names, &frames, 100.0, -1.0),
+            "m.c3d",
+        )
+        .unwrap();
+        assert_eq!(set.names, names, "processor {processor}");
+        let at = set.names.len() + 599;
+        let p = set.positions[at].expect("seen");
+        assert_eq!((p.x, p.y, p.z), (599.0, 1.0, 1.0));
     }
 }
 

@@ -12,6 +12,7 @@ pub mod discover;
 pub mod formats;
 pub mod npz;
 pub mod pickle;
+#[cfg(feature = "parallel")]
 pub mod pool;
 pub mod quality;
 pub mod record;
@@ -24,6 +25,7 @@ pub use discover::{
 };
 pub use formats::{body_links, gmr_pickle, lafan_csv, mjlab_npz, BodyMotion, MotionFormat};
 pub use npz::{crc32, npz_bytes, read_npz, zip_stored, NpyArray, NpyData};
+#[cfg(feature = "parallel")]
 pub use pool::{longest_first, run_parallel, run_parallel_in, run_parallel_until};
 pub use quality::{
     run_penetration, sole_penetration, trajectory_penetration, ClipQuality, JointFigures,

@@ -1,7 +1,7 @@
-//! A fixed pool of worker threads over a list of jobs (std scoped threads, no dependency):
-//! each worker takes the next job from a shared counter, so long and short clips spread over
-//! the workers without a plan; results come back to the calling thread in the order they
-//! finish.
+//! A fixed pool of worker threads over a list of jobs, on a [`rayon`] thread pool of its own
+//! (the user's job count, not rayon's global pool): the jobs are queued in a given order and
+//! each idle worker takes the next, so long and short clips spread over the workers without a
+//! plan; results come back to the calling thread in the order they finish.
 //!
 //! The order the jobs are taken in matters when one job is a large share of the batch: taken
 //! last, it runs alone while the other workers idle. [`longest_first`] orders jobs by an
@@ -10,7 +10,7 @@
 //! arbitrary order).
 
 use std::panic::{catch_unwind, AssertUnwindSafe};
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc;
 
 /// Runs `work(i, &items[i])` for every item on `jobs` threads (at least 1, at most the
@@ -51,6 +51,10 @@ where
 /// As [`run_parallel_in`], no job taken once `stop` is set (e.g. by a signal handler): the
 /// jobs running then finish and are reported, the jobs not yet taken are not run (nor
 /// reported).
+///
+/// The jobs are spawned from the calling thread, outside the pool, into a rayon FIFO scope:
+/// they enter the pool's queue in `order` and its workers take them from its front. Should
+/// the pool's threads fail to start, the jobs run one after the other on the calling thread.
 pub fn run_parallel_until<T, R, W, D>(
     items: &[T],
     order: &[usize],
@@ -64,28 +68,34 @@ pub fn run_parallel_until<T, R, W, D>(
     W: Fn(usize, &T) -> R + Sync,
     D: FnMut(usize, Result<R, String>),
 {
-    let next = AtomicUsize::new(0);
     let workers = jobs.clamp(1, order.len().max(1));
+    let job = |i: usize| -> Option<Result<R, String>> {
+        if stop.load(Ordering::SeqCst) {
+            return None;
+        }
+        let item = items.get(i)?;
+        Some(catch_unwind(AssertUnwindSafe(|| work(i, item))).map_err(panic_message))
+    };
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(workers)
+        .thread_name(|k| format!("iktc-batch-{k}"))
+        .build();
+    let Ok(pool) = pool else {
+        for &i in order {
+            if let Some(r) = job(i) {
+                done(i, r);
+            }
+        }
+        return;
+    };
     let (tx, rx) = mpsc::channel();
-    std::thread::scope(|scope| {
-        for _ in 0..workers {
-            let tx = tx.clone();
-            let (next, work) = (&next, &work);
-            scope.spawn(move || {
-                while !stop.load(Ordering::SeqCst) {
-                    let Some(&i) = order.get(next.fetch_add(1, Ordering::Relaxed)) else {
-                        break;
-                    };
-                    let Some(item) = items.get(i) else { continue };
-                    let r = catch_unwind(AssertUnwindSafe(|| work(i, item))).map_err(|p| {
-                        p.downcast_ref::<&str>()
-                            .map(|s| s.to_string())
-                            .or_else(|| p.downcast_ref::<String>().cloned())
-                            .unwrap_or_else(|| "a worker panicked".into())
-                    });
-                    if tx.send((i, r)).is_err() {
-                        break;
-                    }
+    pool.in_place_scope_fifo(|scope| {
+        for &i in order {
+            let (tx, job) = (tx.clone(), &job);
+            scope.spawn_fifo(move |_| {
+                if let Some(r) = job(i) {
+                    // The receiver lives until every job has ended.
+                    let _ = tx.send((i, r));
                 }
             });
         }
@@ -94,6 +104,14 @@ pub fn run_parallel_until<T, R, W, D>(
             done(i, r);
         }
     });
+}
+
+/// The message of a caught panic: its `&str` or `String` payload, or a generic one.
+fn panic_message(p: Box<dyn std::any::Any + Send>) -> String {
+    p.downcast_ref::<&str>()
+        .map(|s| s.to_string())
+        .or_else(|| p.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "a worker panicked".into())
 }
 
 #[cfg(test)]

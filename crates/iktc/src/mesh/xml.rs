@@ -1,9 +1,7 @@
 //! The small XML tree the Collada reader walks ([`super::collada`]): every element with its
-//! attributes, text, children and the 1-based line of its start tag, parsed by `quick-xml`;
+//! attributes, text, children and the 1-based line of its start tag, parsed by `roxmltree`;
 //! and the readers of the numbers and attributes Collada keeps in it. Errors are
 //! [`Error::Parse`] naming the file, the line, the element and what was expected.
-
-use quick_xml::events::{BytesStart, Event};
 
 use super::collada::MAX_DEPTH;
 use crate::error::{Error, Result};
@@ -61,131 +59,95 @@ pub(super) fn line_at(text: &str, pos: usize) -> usize {
         + 1
 }
 
-pub(super) fn start_element(e: &BytesStart<'_>, line: usize, name: &str) -> Result<Element> {
-    let tag = String::from_utf8_lossy(e.local_name().as_ref()).into_owned();
-    let mut attrs = Vec::new();
-    for a in e.attributes() {
-        let a = a.map_err(|err| bad(name, line, format!("not well-formed XML: <{tag}>: {err}")))?;
-        let key = String::from_utf8_lossy(a.key.local_name().as_ref()).into_owned();
-        let value = a
-            .unescape_value()
-            .map_err(|err| {
-                bad(
+/// The element tree of `text`, parsed by `roxmltree` and walked in document order without
+/// recursion (the depth is checked as each element opens). A document type declaration is allowed (its
+/// entities are expanded under `roxmltree`'s bounds); text and CDATA directly inside an
+/// element are joined into its `text`.
+pub(super) fn parse_tree(text: &str, name: &str) -> Result<Element> {
+    if !text.contains('<') {
+        return Err(bad(name, 0, "not a Collada file: no XML element at all"));
+    }
+    let options = roxmltree::ParsingOptions {
+        allow_dtd: true,
+        ..roxmltree::ParsingOptions::default()
+    };
+    let doc = roxmltree::Document::parse_with_options(text, options)
+        .map_err(|e| xml_error(&e, text, name))?;
+    // The open elements with their node ids, outermost first; nodes come in document order
+    // (pre-order), so an element closes when a node that is not inside it comes.
+    let mut stack: Vec<(roxmltree::NodeId, Element)> = Vec::new();
+    let mut root: Option<Element> = None;
+    let close_until = |stack: &mut Vec<(roxmltree::NodeId, Element)>,
+                       root: &mut Option<Element>,
+                       parent: Option<roxmltree::NodeId>| {
+        while stack.last().is_some_and(|(id, _)| Some(*id) != parent) {
+            if let Some((_, done)) = stack.pop() {
+                match stack.last_mut() {
+                    Some((_, up)) => up.children.push(done),
+                    None => *root = Some(done),
+                }
+            }
+        }
+    };
+    // Elements open in document order: their lines are counted on from the previous one.
+    let (mut line, mut counted) = (1usize, 0usize);
+    for node in doc.root_element().descendants() {
+        if node.is_element() {
+            close_until(&mut stack, &mut root, node.parent().map(|p| p.id()));
+            let pos = node.range().start.min(text.len());
+            line += text.as_bytes()[counted.min(pos)..pos]
+                .iter()
+                .filter(|&&b| b == b'\n')
+                .count();
+            counted = counted.max(pos);
+            let el = Element {
+                tag: node.tag_name().name().to_string(),
+                attrs: node
+                    .attributes()
+                    .map(|a| (a.name().to_string(), a.value().to_string()))
+                    .collect(),
+                line,
+                ..Element::default()
+            };
+            if stack.len() >= MAX_DEPTH {
+                return Err(bad(
                     name,
                     line,
-                    format!("not well-formed XML: <{tag} {key}>: {err}"),
-                )
-            })?
-            .into_owned();
-        attrs.push((key, value));
-    }
-    Ok(Element {
-        tag,
-        attrs,
-        line,
-        ..Element::default()
-    })
-}
-
-/// The element tree of `text` (without a loop of recursion: the depth is checked first).
-pub(super) fn parse_tree(text: &str, name: &str) -> Result<Element> {
-    let mut reader = quick_xml::Reader::from_str(text);
-    let mut stack: Vec<Element> = Vec::new();
-    let mut root: Option<Element> = None;
-    let (mut line, mut counted) = (1usize, 0usize);
-    loop {
-        let pos = (reader.buffer_position() as usize).min(text.len());
-        let event = reader.read_event().map_err(|e| {
-            let at = line_at(text, reader.error_position() as usize);
-            bad(
-                name,
-                at,
-                format!("not a Collada file: not well-formed XML: {e}"),
-            )
-        })?;
-        let (start, empty) = match &event {
-            Event::Start(e) => (e, false),
-            Event::Empty(e) => (e, true),
-            Event::Text(t) => {
-                if let Some(top) = stack.last_mut() {
-                    let s = t.decode().map_err(|e| bad(name, line, e.to_string()))?;
-                    top.text.push_str(&s);
-                }
-                continue;
+                    format!(
+                        "<{}> is nested {} elements deep; at most {MAX_DEPTH} are read",
+                        el.tag,
+                        stack.len() + 1
+                    ),
+                ));
             }
-            Event::CData(t) => {
-                if let Some(top) = stack.last_mut() {
-                    let s = t.decode().map_err(|e| bad(name, line, e.to_string()))?;
-                    top.text.push_str(&s);
-                }
-                continue;
+            stack.push((node.id(), el));
+        } else if let Some(t) = node.text().filter(|_| node.is_text()) {
+            close_until(&mut stack, &mut root, node.parent().map(|p| p.id()));
+            if let Some((_, top)) = stack.last_mut() {
+                top.text.push_str(t);
             }
-            Event::End(_) => {
-                if let Some(done) = stack.pop() {
-                    attach(&mut stack, &mut root, done, name)?;
-                }
-                continue;
-            }
-            Event::Eof => break,
-            _ => continue,
-        };
-        line += text.as_bytes()[counted..pos]
-            .iter()
-            .filter(|&&b| b == b'\n')
-            .count();
-        counted = pos;
-        let el = start_element(start, line, name)?;
-        if stack.len() >= MAX_DEPTH {
-            return Err(bad(
-                name,
-                line,
-                format!(
-                    "<{}> is nested {} elements deep; at most {MAX_DEPTH} are read",
-                    el.tag,
-                    stack.len() + 1
-                ),
-            ));
-        }
-        if empty {
-            attach(&mut stack, &mut root, el, name)?;
-        } else {
-            stack.push(el);
         }
     }
-    if let Some(open) = stack.last() {
-        return Err(bad(
-            name,
-            open.line,
-            format!(
-                "not a Collada file: <{}> is never closed (truncated?)",
-                open.tag
-            ),
-        ));
-    }
+    close_until(&mut stack, &mut root, None);
     root.ok_or_else(|| bad(name, 0, "not a Collada file: no XML element at all"))
 }
 
-pub(super) fn attach(
-    stack: &mut [Element],
-    root: &mut Option<Element>,
-    el: Element,
-    name: &str,
-) -> Result<()> {
-    if let Some(parent) = stack.last_mut() {
-        parent.children.push(el);
-    } else if root.is_none() {
-        *root = Some(el);
-    } else {
-        return Err(bad(
+/// A parse error of `roxmltree` as an [`Error::Parse`] at its line.
+fn xml_error(e: &roxmltree::Error, text: &str, name: &str) -> Error {
+    use roxmltree::Error as X;
+    match e {
+        X::NoRootNode => bad(name, 0, "not a Collada file: no XML element at all"),
+        X::UnclosedRootNode | X::UnexpectedEndOfStream => bad(
             name,
-            el.line,
-            format!(
-                "not a Collada file: a second root element <{}> after the first",
-                el.tag
-            ),
-        ));
+            line_at(text, text.len()),
+            "not a Collada file: an element is never closed (truncated?)",
+        ),
+        _ => bad(
+            name,
+            e.pos().row as usize,
+            format!("not a Collada file: not well-formed XML: {e}"),
+        ),
     }
-    Ok(())
 }
 
 /// The finite numbers of `el`'s text, exactly `want` of them when given.

@@ -2,14 +2,13 @@
 //!
 //! Supported: the header block (number of points, analog values per frame, first and last
 //! frame, scale factor, data start block, frame rate), the parameter section (groups and
-//! parameters of any type; `POINT:LABELS` names the points, `POINT:RATE` overrides the
-//! header's rate when present), and the data section with integer (scale factor > 0: every
-//! coordinate is `value · scale`) or floating-point (scale factor < 0) samples, for Intel
-//! (processor type 84, little-endian) and MIPS/SGI (86, big-endian) files. A point whose
-//! residual word is negative is missing in that frame (a gap). Analog samples are skipped.
-//!
-//! Not supported (an error): DEC files (processor type 85); more than 255 labels
-//! (`POINT:LABELS2`) name the extra points `P256`, `P257`, ….
+//! parameters of any type; `POINT:LABELS` names the points, continued by `POINT:LABELS2`,
+//! `POINT:LABELS3`, … past 255 points; `POINT:RATE` overrides the header's rate when present),
+//! and the data section with integer (scale factor > 0: every coordinate is `value · scale`) or
+//! floating-point (scale factor < 0) samples, for Intel (processor type 84, little-endian),
+//! DEC (85: little-endian integers, VAX F-floating numbers) and MIPS/SGI (86, big-endian)
+//! files. A point whose residual word is negative is missing in that frame (a gap). Analog
+//! samples are skipped.
 //!
 //! Layout (C3D.org, "The C3D File Format User Guide"): 512-byte blocks; header words are 16-bit;
 //! a parameter entry is `[name length (i8, < 0 if locked), group id (i8, < 0 for a group),
@@ -26,7 +25,12 @@ const BLOCK: usize = 512;
 
 #[derive(Clone, Copy)]
 enum Endian {
+    /// Intel: IEEE 754 numbers, little-endian.
     Little,
+    /// DEC (VAX): little-endian integers; F-floating numbers, stored as two little-endian
+    /// 16-bit words, the one with the sign and exponent first.
+    Dec,
+    /// MIPS/SGI: IEEE 754 numbers, big-endian.
     Big,
 }
 
@@ -60,7 +64,7 @@ impl Reader<'_> {
     fn u16(&self, at: usize) -> Result<u16> {
         let b = self.get::<2>(at)?;
         Ok(match self.endian {
-            Endian::Little => u16::from_le_bytes(b),
+            Endian::Little | Endian::Dec => u16::from_le_bytes(b),
             Endian::Big => u16::from_be_bytes(b),
         })
     }
@@ -68,7 +72,7 @@ impl Reader<'_> {
     fn i16(&self, at: usize) -> Result<i16> {
         let b = self.get::<2>(at)?;
         Ok(match self.endian {
-            Endian::Little => i16::from_le_bytes(b),
+            Endian::Little | Endian::Dec => i16::from_le_bytes(b),
             Endian::Big => i16::from_be_bytes(b),
         })
     }
@@ -77,8 +81,23 @@ impl Reader<'_> {
         let b = self.get::<4>(at)?;
         Ok(match self.endian {
             Endian::Little => f32::from_le_bytes(b),
+            Endian::Dec => vax_f32(b),
             Endian::Big => f32::from_be_bytes(b),
         })
+    }
+}
+
+/// A VAX F-floating number from its 4 bytes as a C3D file stores them. With its two 16-bit
+/// words swapped it has IEEE single precision's layout (sign, 8-bit exponent, 23-bit
+/// fraction), but means `0.1f · 2^(e − 128)` where IEEE means `1.f · 2^(e − 127)`: a quarter of
+/// the IEEE reading. Exponent 0 is zero (sign 0) or a reserved operand (sign 1, NaN here).
+fn vax_f32(b: [u8; 4]) -> f32 {
+    let ieee = f32::from_le_bytes([b[2], b[3], b[0], b[1]]);
+    let exponent = (u32::from(b[1] & 0x7f) << 1) | u32::from(b[0] >> 7);
+    match (exponent, b[1] >> 7) {
+        (0, 0) => 0.0,
+        (0, _) => f32::NAN,
+        _ => ieee / 4.0,
     }
 }
 
@@ -115,21 +134,17 @@ pub fn read_c3d(bytes: &[u8], source: &str) -> Result<MarkerSet> {
     }
     let param_at = (param_block - 1) * BLOCK;
     let processor = r.get::<4>(param_at)?[3];
-    r.endian =
-        match processor {
-            84 => Endian::Little,
-            86 => Endian::Big,
-            85 => return Err(r.error(
+    r.endian = match processor {
+        84 => Endian::Little,
+        86 => Endian::Big,
+        85 => Endian::Dec,
+        other => {
+            return Err(r.error(
                 param_at + 3,
-                "DEC (VAX) C3D files are not supported; convert the file to the PC (Intel) format",
-            )),
-            other => {
-                return Err(r.error(
-                    param_at + 3,
-                    format!("processor type {other}; expected 84 (Intel), 86 (MIPS) or 85 (DEC)"),
-                ))
-            }
-        };
+                format!("processor type {other}; expected 84 (Intel), 86 (MIPS) or 85 (DEC)"),
+            ))
+        }
+    };
     let points = r.u16(2)? as usize;
     let analog_per_frame = r.u16(4)? as usize;
     let first = r.u16(6)? as usize;
@@ -158,19 +173,30 @@ pub fn read_c3d(bytes: &[u8], source: &str) -> Result<MarkerSet> {
             .iter()
             .find(|p| p.group.eq_ignore_ascii_case(g) && p.name.eq_ignore_ascii_case(n))
     };
-    let mut names: Vec<String> = match find("POINT", "LABELS") {
-        Some(p) if p.kind == -1 && p.dims.len() == 2 => {
-            let (len, count) = (p.dims[0], p.dims[1]);
-            (0..count)
-                .map(|k| {
-                    let at = p.data_at + k * len;
+    // POINT:LABELS holds at most 255 names (a dimension is one byte); LABELS2, LABELS3, …
+    // continue the list.
+    let mut names: Vec<String> = Vec::new();
+    for k in 1.. {
+        let key = if k == 1 {
+            "LABELS".to_string()
+        } else {
+            format!("LABELS{k}")
+        };
+        match find("POINT", &key) {
+            Some(p) if p.kind == -1 && p.dims.len() == 2 => {
+                let (len, count) = (p.dims[0], p.dims[1]);
+                names.extend((0..count).map(|j| {
+                    let at = p.data_at + j * len;
                     let raw = bytes.get(at..at + len).unwrap_or(&[]);
                     String::from_utf8_lossy(raw).trim().to_string()
-                })
-                .collect()
+                }));
+            }
+            _ => break,
         }
-        _ => Vec::new(),
-    };
+        if names.len() >= points {
+            break;
+        }
+    }
     names.truncate(points);
     for k in names.len()..points {
         names.push(format!("P{}", k + 1));
