@@ -27,6 +27,11 @@ pub struct MotionArgs {
     /// Longest clip accepted from a file [s].
     #[arg(long, default_value_t = iktc::resources::ReadLimits::default().max_clip_duration)]
     pub max_clip_duration: f64,
+    /// Body model of AMASS archives (.npz): the SMPL-H or SMPL-X model file of the subject's
+    /// gender, as its authors distribute it (iktc ships none). With it, folders are also
+    /// searched for AMASS archives.
+    #[arg(long, value_name = "PATH")]
+    pub body_model: Option<PathBuf>,
 }
 
 impl MotionArgs {
@@ -40,6 +45,7 @@ impl MotionArgs {
                 max_clip_duration: self.max_clip_duration,
                 ..iktc::resources::ReadLimits::default()
             },
+            body_model: self.body_model.clone(),
             ..MotionOptions::default()
         })
     }
@@ -84,7 +90,8 @@ pub enum MapCommand {
     /// and write them as an editable body map; when some required points are not found, the
     /// map holds those found and a commented entry for each missing one, to fill in.
     Init {
-        /// The motion file (.bvh, .amc, .asf, DeepMimic, .c3d, .csv).
+        /// The motion file (.bvh, .amc, .asf, DeepMimic, .c3d, .csv, AMASS .npz with
+        /// --body-model).
         #[arg(long)]
         motion: PathBuf,
         #[command(flatten)]

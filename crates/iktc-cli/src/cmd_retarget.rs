@@ -22,8 +22,9 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use iktc::batch::{
-    clip_state, discover, longest_first, remove_leftovers, run_parallel_until, write_clip_folder,
-    BatchRetarget, ClipInput, ClipOutcome, ClipRun, ClipState, MotionFormat, RetargetMethod,
+    clip_state, discover_motions, longest_first, remove_leftovers, run_parallel_until,
+    write_clip_folder, BatchRetarget, ClipInput, ClipOutcome, ClipRun, ClipState, MotionFormat,
+    RetargetMethod,
 };
 use iktc::mesh::MeshSet;
 use iktc::sim::viewer::imitation_viewer;
@@ -34,8 +35,9 @@ use crate::scenario::{prepare_config, ScenarioArgs};
 /// Arguments of `iktc retarget`.
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// Motion files, folders (searched recursively for .bvh, .amc, .c3d, .txt and .json files) or
-    /// glob patterns (`*` and `?`, quoted so the shell leaves them; `*` also crosses folders).
+    /// Motion files, folders (searched recursively for .bvh, .amc, .c3d, .txt and .json files,
+    /// and AMASS .npz archives with --body-model) or glob patterns (`*` and `?`, quoted so the
+    /// shell leaves them; `*` also crosses folders).
     #[arg(required = true, value_name = "INPUT")]
     pub inputs: Vec<String>,
     #[command(flatten)]
@@ -162,7 +164,8 @@ pub fn run(a: &Args) -> Result<()> {
         iktc::resources::check_output_rate("--rate", r)?;
     }
     let (batch, robot) = batch_of(a)?;
-    let found = discover(&a.inputs, Some(&a.out));
+    let archives = a.scenario.motion_options.body_model.is_some();
+    let found = discover_motions(&a.inputs, Some(&a.out), archives);
     if !found.output_folders.is_empty() {
         let names: Vec<String> = found
             .output_folders

@@ -25,8 +25,8 @@ pub struct ScenarioArgs {
     #[command(flatten)]
     pub profile: ProfileFlags,
     /// Motion: a built-in DeepMimic clip (humanoid3d_dance_a, humanoid3d_dance_b,
-    /// humanoid3d_punch, humanoid3d_walk) or a skeleton motion file (.bvh, .amc, DeepMimic),
-    /// its format detected from its content and extension.
+    /// humanoid3d_punch, humanoid3d_walk) or a skeleton motion file (.bvh, .amc, DeepMimic,
+    /// AMASS .npz with --body-model), its format detected from its content and extension.
     #[arg(long, default_value = iktc::sim::experiment::DEFAULT_CLIP)]
     pub motion: String,
     #[command(flatten)]

@@ -2,7 +2,7 @@
 //! `iktc::motion::load_motion` reads, or a built-in DeepMimic clip), the body keypoints, and
 //! `iktc.retarget` (the joint-route retargeting of Section 5.3) returning numpy arrays.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use iktc::motion::{
     builtin_clip, builtin_map, load_motion, motion_from_content, retarget, Clip, Motion,
@@ -28,12 +28,21 @@ pub struct PyMotion {
 
 /// Reads a motion: a built-in DeepMimic clip name (`humanoid3d_dance_a`, `humanoid3d_dance_b`,
 /// `humanoid3d_punch`, `humanoid3d_walk`) or a file of any format the library reads (BVH, ASF,
-/// AMC, DeepMimic JSON, C3D, points CSV; detected by content, then by extension), with the
-/// library's automatic units, up axis and body-point recognition.
+/// AMC, DeepMimic JSON, C3D, points CSV, AMASS `.npz`; detected by content, then by
+/// extension), with the library's automatic units, up axis and body-point recognition.
+/// `body_model`: the SMPL-H or SMPL-X body model file (`.npz`) an AMASS archive is read with
+/// (iktc ships none; without it, an AMASS archive is an error naming the model it needs).
 #[pyfunction]
-#[pyo3(name = "load_motion")]
-pub fn py_load_motion(py: Python<'_>, spec: &str) -> PyResult<PyMotion> {
-    let options = MotionOptions::default();
+#[pyo3(name = "load_motion", signature = (spec, *, body_model=None))]
+pub fn py_load_motion(
+    py: Python<'_>,
+    spec: &str,
+    body_model: Option<PathBuf>,
+) -> PyResult<PyMotion> {
+    let options = MotionOptions {
+        body_model,
+        ..MotionOptions::default()
+    };
     let (motion, builtin) = py
         .detach(|| -> iktc::Result<(Motion, Option<Clip>)> {
             if BUILTIN_CLIP_NAMES.contains(&spec) {
@@ -65,7 +74,8 @@ impl PyMotion {
         &self.motion.source
     }
 
-    /// The format: "BVH", "ASF", "AMC", "DeepMimic JSON", "C3D" or "points CSV".
+    /// The format: "BVH", "ASF", "AMC", "DeepMimic JSON", "C3D", "points CSV" or
+    /// "AMASS (SMPL-H/SMPL-X)".
     #[getter]
     fn format(&self) -> &'static str {
         self.motion.format.name()

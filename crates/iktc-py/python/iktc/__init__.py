@@ -12,8 +12,9 @@ Quick start::
     ctrl.set_com_reference(com, robot.com(q) + [0.02, 0.0, 0.0])
     report = ctrl.step(q, v, 0.005)     # q and v advanced in place
 
-Motions (``load_motion``: a built-in DeepMimic clip or a BVH, ASF/AMC, DeepMimic, C3D or
-points-CSV file) retarget to a robot with ``retarget`` (joint angles) or ``retarget_keypoints`` (body points,
+Motions (``load_motion``: a built-in DeepMimic clip or a BVH, ASF/AMC, DeepMimic, C3D,
+points-CSV file, or an AMASS ``.npz`` archive with ``body_model=`` the SMPL-H / SMPL-X model
+file) retarget to a robot with ``retarget`` (joint angles) or ``retarget_keypoints`` (body points,
 the robot's q, v, q̈ per tick), numpy arrays; ``Imitation`` steps the
 imitation of Section 5.3 tick by tick.
 

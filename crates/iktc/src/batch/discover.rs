@@ -6,6 +6,12 @@
 //! the first name in sorted order. An entry that cannot be read (a folder whose listing
 //! fails, a dangling link) is reported by name in [`Discovery::problems`] and the walk goes
 //! on with the others. Folders of iktc's own output ([`is_output_folder`]) are not searched.
+//!
+//! AMASS archives (`.npz`) are taken from folders only when asked ([`discover_motions`], the
+//! CLI's `--body-model`), and only those whose zip directory names `poses.npy` and
+//! `trans.npy` ([`is_amass_file`](crate::motion::is_amass_file)): the NPZ files iktc writes,
+//! body model files and other arrays beside the clips are left out, as they are from the
+//! matches of a glob pattern.
 
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
@@ -54,11 +60,26 @@ pub struct Discovery {
     pub output_folders: Vec<PathBuf>,
 }
 
+/// The extension of the AMASS archives [`discover_motions`] takes from folders when asked.
+pub const ARCHIVE_EXTENSION: &str = "npz";
+
 /// Whether `p` has one of the [`MOTION_EXTENSIONS`].
 pub fn is_motion_file(p: &Path) -> bool {
     p.extension()
         .and_then(|e| e.to_str())
         .is_some_and(|e| MOTION_EXTENSIONS.contains(&e.to_ascii_lowercase().as_str()))
+}
+
+/// Whether `p` is an AMASS archive: the extension [`ARCHIVE_EXTENSION`] and a zip naming
+/// `poses.npy` and `trans.npy` ([`is_amass_file`](crate::motion::is_amass_file)).
+pub fn is_archive_file(p: &Path) -> bool {
+    has_archive_extension(p) && crate::motion::is_amass_file(p)
+}
+
+fn has_archive_extension(p: &Path) -> bool {
+    p.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case(ARCHIVE_EXTENSION))
 }
 
 /// Whether `dir` holds what iktc writes: the batch's output folder `out`, a folder of an
@@ -160,10 +181,21 @@ impl Walk<'_> {
 /// name it is found by; a second file whose output name is taken is a problem, as is every
 /// input that names no clip and every entry that cannot be read.
 pub fn discover(inputs: &[String], out: Option<&Path>) -> Discovery {
-    discover_with(inputs, out, &read_dir)
+    discover_with(inputs, out, false, &read_dir)
 }
 
-fn discover_with(inputs: &[String], out: Option<&Path>, read: ReadDir<'_>) -> Discovery {
+/// [`discover`], and with `archives` also the AMASS archives found in folders and patterns
+/// ([`is_archive_file`]; read with a body model).
+pub fn discover_motions(inputs: &[String], out: Option<&Path>, archives: bool) -> Discovery {
+    discover_with(inputs, out, archives, &read_dir)
+}
+
+fn discover_with(
+    inputs: &[String],
+    out: Option<&Path>,
+    archives: bool,
+    read: ReadDir<'_>,
+) -> Discovery {
     let mut found = Discovery::default();
     let mut seen: HashSet<PathBuf> = HashSet::new();
     for input in inputs {
@@ -175,14 +207,22 @@ fn discover_with(inputs: &[String], out: Option<&Path>, read: ReadDir<'_>) -> Di
             problems: Vec::new(),
             output_folders: Vec::new(),
         };
-        let clips = input_clips(input, &mut walk);
+        let clips = input_clips(input, &mut walk, archives);
         let named_none = clips.is_empty();
         found.problems.append(&mut walk.problems);
         found.output_folders.append(&mut walk.output_folders);
         if named_none && !found.problems.iter().any(|p| p.path == *input) {
+            let archive = if archives {
+                format!(", AMASS .{ARCHIVE_EXTENSION}")
+            } else {
+                String::new()
+            };
             found.problems.push(DiscoveryProblem {
                 path: input.clone(),
-                message: format!("no motion file (.{}) found", MOTION_EXTENSIONS.join(", .")),
+                message: format!(
+                    "no motion file (.{}{archive}) found",
+                    MOTION_EXTENSIONS.join(", .")
+                ),
             });
         }
         for c in clips {
@@ -213,8 +253,9 @@ fn add_clip(found: &mut Discovery, seen: &mut HashSet<PathBuf>, c: ClipInput) {
 }
 
 /// The clips of one input, its unreadable entries left in `walk.problems`.
-fn input_clips(input: &str, walk: &mut Walk<'_>) -> Vec<ClipInput> {
+fn input_clips(input: &str, walk: &mut Walk<'_>, archives: bool) -> Vec<ClipInput> {
     let p = Path::new(input);
+    let taken = |f: &Path| is_motion_file(f) || (archives && is_archive_file(f));
     if p.is_file() {
         return vec![ClipInput {
             path: p.to_path_buf(),
@@ -225,7 +266,7 @@ fn input_clips(input: &str, walk: &mut Walk<'_>) -> Vec<ClipInput> {
         walk.folder(p);
         return std::mem::take(&mut walk.files)
             .into_iter()
-            .filter(|f| is_motion_file(f))
+            .filter(|f| taken(f))
             .map(|f| ClipInput {
                 name: clip_name(&f, p),
                 path: f,
@@ -250,6 +291,11 @@ fn input_clips(input: &str, walk: &mut Walk<'_>) -> Vec<ClipInput> {
     std::mem::take(&mut walk.files)
         .into_iter()
         .filter(|f| {
+            // A pattern's `.npz` matches that are no AMASS archive (body models, iktc's
+            // own arrays) are left out.
+            if has_archive_extension(f) && !is_archive_file(f) {
+                return false;
+            }
             let s = if base.as_os_str().is_empty() {
                 f.strip_prefix(".").unwrap_or(f)
             } else {
@@ -294,7 +340,7 @@ mod tests {
                 read_dir(p)
             }
         };
-        let found = discover_with(&[d.display().to_string()], None, &refuse);
+        let found = discover_with(&[d.display().to_string()], None, false, &refuse);
         let names: Vec<&str> = found.clips.iter().map(|c| c.name.as_str()).collect();
         assert_eq!(names, ["a/clip", "c/clip"]);
         assert_eq!(found.problems.len(), 1, "{:?}", found.problems);
@@ -319,6 +365,37 @@ mod tests {
         let names: Vec<&str> = found.clips.iter().map(|c| c.name.as_str()).collect();
         assert_eq!(names, ["clip"]);
         assert!(found.problems.is_empty(), "{:?}", found.problems);
+    }
+
+    /// AMASS archives are taken from folders when asked, and only they among `.npz` files:
+    /// not a body model, not iktc's own arrays (in a clip folder of an earlier batch, or
+    /// beside the clips).
+    #[test]
+    fn amass_archives_are_taken_when_asked_and_other_npz_files_never() {
+        use super::super::npz::{npz_bytes, NpyArray};
+        let d = tmp("amass");
+        let array = |name: &str| NpyArray::f64(name, vec![1, 3], vec![0.0; 3]);
+        let archive = npz_bytes(&[array("trans"), array("poses")]).unwrap();
+        let other = npz_bytes(&[array("v_template"), array("J_regressor")]).unwrap();
+        std::fs::create_dir_all(d.join("old")).unwrap();
+        std::fs::write(d.join("old").join(RECORD_FILE), "x").unwrap();
+        std::fs::write(d.join("old").join("motion.npz"), &archive).unwrap();
+        std::fs::write(d.join("walk.npz"), &archive).unwrap();
+        std::fs::write(d.join("SMPLX_NEUTRAL.npz"), &other).unwrap();
+        std::fs::write(d.join("motion.npz"), &other).unwrap();
+        std::fs::write(d.join("clip.bvh"), "x").unwrap();
+        let names = |found: &Discovery| -> Vec<String> {
+            found.clips.iter().map(|c| c.name.clone()).collect()
+        };
+        let inputs = [d.display().to_string()];
+        assert_eq!(names(&discover(&inputs, None)), ["clip"]);
+        let found = discover_motions(&inputs, None, true);
+        assert_eq!(names(&found), ["clip", "walk"]);
+        assert_eq!(found.output_folders, [d.join("old")]);
+        let pattern = [format!("{}/*.npz", d.display())];
+        assert_eq!(names(&discover_motions(&pattern, None, true)), ["walk"]);
+        assert!(is_archive_file(&d.join("walk.npz")));
+        assert!(!is_archive_file(&d.join("SMPLX_NEUTRAL.npz")));
     }
 
     /// The batch's own output folder inside an input folder is not searched, even before it
@@ -400,7 +477,7 @@ mod tests {
             v.push(Err(std::io::Error::other("injected entry error")));
             Ok(v)
         };
-        let found = discover_with(&[d.display().to_string()], None, &broken);
+        let found = discover_with(&[d.display().to_string()], None, false, &broken);
         assert_eq!(found.clips.len(), 1);
         assert_eq!(found.problems.len(), 1);
         assert_eq!(found.problems[0].path, d.display().to_string());

@@ -20,8 +20,8 @@ pub mod retarget;
 pub mod training;
 
 pub use discover::{
-    discover, is_motion_file, is_output_folder, ClipInput, Discovery, DiscoveryProblem,
-    MOTION_EXTENSIONS, RECORD_FILE,
+    discover, discover_motions, is_archive_file, is_motion_file, is_output_folder, ClipInput,
+    Discovery, DiscoveryProblem, MOTION_EXTENSIONS, RECORD_FILE,
 };
 pub use formats::{body_links, gmr_pickle, lafan_csv, mjlab_npz, BodyMotion, MotionFormat};
 pub use npz::{crc32, npz_bytes, read_npz, zip_stored, NpyArray, NpyData};

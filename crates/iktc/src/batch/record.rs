@@ -44,8 +44,9 @@ fn part(h: &mut Sha256, name: &str, bytes: &[u8]) {
 impl BatchRetarget {
     /// The SHA-256 digest (64 hex digits) of what every clip's outputs depend on besides its
     /// input: the program's version and [`Self::settings_text`] (method, profile, map,
-    /// settings, rate), the maps the profile names (read now), the URDF's text and the bytes
-    /// of every mesh file it names (a file that cannot be read enters as its error).
+    /// settings, rate), the maps the profile names (read now), the URDF's text, the bytes
+    /// of every mesh file it names and those of the body model AMASS archives are read with
+    /// (a file that cannot be read enters as its error).
     ///
     /// Errors: those of reading the URDF ([`crate::profile::RobotProfile::urdf_text`]).
     pub fn dependency_digest(&self) -> Result<String> {
@@ -59,6 +60,10 @@ impl BatchRetarget {
                 Err(e) => format!("error: {e}"),
             };
             part(&mut h, &format!("map {key}"), map.as_bytes());
+        }
+        if let Some(model) = &self.motion_options.body_model {
+            let bytes = std::fs::read(model).unwrap_or_else(|e| format!("{e}").into_bytes());
+            part(&mut h, &format!("body model {}", model.display()), &bytes);
         }
         let urdf = self.profile.urdf_text()?;
         part(&mut h, "urdf", urdf.as_bytes());

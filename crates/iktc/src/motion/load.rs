@@ -5,9 +5,15 @@
 //! Format detection: by content first — BVH starts with `HIERARCHY`; ASF has `:version`,
 //! `:units`, `:root` or `:bonedata` keywords; AMC has `:FULLY-SPECIFIED`, `:DEGREES` or
 //! `:RADIANS` before its first frame; DeepMimic is JSON with `"Frames"`; C3D has `0x50` as its
-//! second byte; a points CSV has a header whose columns end in `_x`, `_y`, `_z` — then by the
-//! extension (`.bvh`, `.asf`, `.amc`, `.txt`/`.json`, `.c3d`, `.csv`). A file read by its
-//! extension alone that fails says so and lists the signatures its content did not match.
+//! second byte; a points CSV has a header whose columns end in `_x`, `_y`, `_z`; an AMASS
+//! archive is a zip (`PK\x03\x04`) whose directory names `poses.npy` and `trans.npy` — then by
+//! the extension (`.bvh`, `.asf`, `.amc`, `.txt`/`.json`, `.c3d`, `.csv`, `.npz`). A file read
+//! by its extension alone that fails says so and lists the signatures its content did not
+//! match.
+//!
+//! AMASS archives are read with the user's body model file ([`MotionOptions::body_model`];
+//! see [`amass`](super::amass)); their units and up axis are the format's, metres and Z up
+//! ([`MotionFormat::fixed_frame`]), unless given.
 
 use std::path::{Path, PathBuf};
 
@@ -41,6 +47,8 @@ pub enum MotionFormat {
     C3d,
     /// A CSV of named 3D points.
     PointsCsv,
+    /// An AMASS motion archive (`.npz`, SMPL-H or SMPL-X poses), read with a body model file.
+    Amass,
 }
 
 impl MotionFormat {
@@ -53,6 +61,17 @@ impl MotionFormat {
             MotionFormat::DeepMimic => "DeepMimic JSON",
             MotionFormat::C3d => "C3D",
             MotionFormat::PointsCsv => "points CSV",
+            MotionFormat::Amass => "AMASS (SMPL-H/SMPL-X)",
+        }
+    }
+
+    /// The length unit and up axis the format itself states, if it does: AMASS's are metres
+    /// and Z up (its rest pose stands Y up in the body model's frame, so measuring it would
+    /// mislead). `None`: the format leaves them to the file, decided when not given.
+    pub fn fixed_frame(self) -> Option<(LengthUnit, UpAxis)> {
+        match self {
+            MotionFormat::Amass => Some((LengthUnit::Metres, UpAxis::Z)),
+            _ => None,
         }
     }
 }
@@ -74,8 +93,12 @@ pub struct MotionOptions {
     pub max_gap: f64,
     /// Frame rate of AMC files, which do not carry one \[Hz\] (default [`AMC_DEFAULT_RATE`]).
     pub amc_frame_rate: f64,
-    /// Most frames and longest duration accepted from a BVH or DeepMimic file.
+    /// Most frames and longest duration accepted from a BVH, DeepMimic or AMASS file.
     pub limits: crate::resources::ReadLimits,
+    /// The body model file (`.npz`, SMPL-H or SMPL-X, of the subject's gender) an AMASS
+    /// archive is read with (default: none, and an AMASS archive is an error saying which
+    /// model it needs).
+    pub body_model: Option<PathBuf>,
 }
 
 impl Default for MotionOptions {
@@ -89,6 +112,7 @@ impl Default for MotionOptions {
             max_gap: DEFAULT_MAX_GAP,
             amc_frame_rate: AMC_DEFAULT_RATE,
             limits: crate::resources::ReadLimits::default(),
+            body_model: None,
         }
     }
 }
@@ -203,8 +227,54 @@ pub fn strip_bom(text: &str) -> &str {
     text.strip_prefix(BOM).unwrap_or(text)
 }
 
+/// How many bytes at the end of a file [`is_amass_archive`] searches: a zip's directory of a
+/// few members and its end record, whose comment may take up to 65 535 bytes.
+const ZIP_TAIL: usize = 70_000;
+
+/// How many bytes at the start of a file [`is_amass_archive`] searches (the first members'
+/// local headers, when the directory at the end is missing).
+const ZIP_HEAD: usize = 4_096;
+
+/// Whether a file whose first bytes are `head` and last bytes `tail` looks like an AMASS
+/// archive: a zip (`PK\x03\x04`) naming the members `poses.npy` and `trans.npy` (searched
+/// in the first [`ZIP_HEAD`] and last [`ZIP_TAIL`] bytes).
+fn amass_signature(head: &[u8], tail: &[u8]) -> bool {
+    let names = |b: &[u8]| {
+        let has = |n: &[u8]| b.windows(n.len()).any(|w| w == n);
+        has(b"poses.npy") && has(b"trans.npy")
+    };
+    head.starts_with(b"PK\x03\x04")
+        && (names(&tail[tail.len().saturating_sub(ZIP_TAIL)..])
+            || names(&head[..head.len().min(ZIP_HEAD)]))
+}
+
+/// Whether `bytes` look like an AMASS archive (see the module documentation).
+pub fn is_amass_archive(bytes: &[u8]) -> bool {
+    amass_signature(bytes, bytes)
+}
+
+/// Whether the file at `path` looks like an AMASS archive, reading only its first and last
+/// bytes (see the module documentation); `false` when it cannot be read.
+pub fn is_amass_file(path: &Path) -> bool {
+    use std::io::{Read, Seek, SeekFrom};
+    let read = || -> std::io::Result<bool> {
+        let mut f = std::fs::File::open(path)?;
+        let len = f.metadata()?.len();
+        let mut head = Vec::new();
+        (&mut f).take(ZIP_HEAD as u64).read_to_end(&mut head)?;
+        f.seek(SeekFrom::Start(len.saturating_sub(ZIP_TAIL as u64)))?;
+        let mut tail = Vec::new();
+        f.take(ZIP_TAIL as u64).read_to_end(&mut tail)?;
+        Ok(amass_signature(&head, &tail))
+    };
+    read().unwrap_or(false)
+}
+
 /// The format a file's content shows, if any (a leading UTF-8 byte-order mark is skipped).
 pub fn detect_format(bytes: &[u8]) -> Option<MotionFormat> {
+    if is_amass_archive(bytes) {
+        return Some(MotionFormat::Amass);
+    }
     if bytes.len() >= 512 && bytes.get(1) == Some(&0x50) && bytes[0] < 0x20 {
         return Some(MotionFormat::C3d);
     }
@@ -258,13 +328,14 @@ fn format_from_extension(path: &Path) -> Option<MotionFormat> {
         "txt" | "json" => MotionFormat::DeepMimic,
         "c3d" => MotionFormat::C3d,
         "csv" => MotionFormat::PointsCsv,
+        "npz" => MotionFormat::Amass,
         _ => return None,
     })
 }
 
 const SIGNATURES: &str = "BVH `HIERARCHY`, ASF `:version`/`:units`/`:root`/`:bonedata`, AMC \
     `:FULLY-SPECIFIED`/`:DEGREES`, DeepMimic JSON with \"Frames\", C3D (second byte 0x50), CSV \
-    header with `_x/_y/_z` columns";
+    header with `_x/_y/_z` columns, AMASS zip with `poses.npy` and `trans.npy`";
 
 /// The ASF beside an AMC file: same stem, else the only `.asf` in its folder.
 pub fn find_asf(amc: &Path) -> Result<PathBuf> {
@@ -315,7 +386,7 @@ pub fn load_motion(path: &Path, options: &MotionOptions) -> Result<Motion> {
             line: 0,
             message: format!(
                 "unknown motion format: the extension is not one of .bvh .asf .amc .txt .json \
-                 .c3d .csv and the content matched none of: {SIGNATURES}"
+                 .c3d .csv .npz and the content matched none of: {SIGNATURES}"
             ),
         })?;
     let content = read_content(path, &bytes, format, options).map_err(|e| {
@@ -397,6 +468,21 @@ fn read_content(
         MotionFormat::C3d => MotionContent::Markers(super::c3d::read_c3d(bytes, &source)?),
         MotionFormat::PointsCsv => {
             MotionContent::Markers(super::points_csv::read_points_csv(text()?, &source)?)
+        }
+        #[cfg(feature = "amass")]
+        MotionFormat::Amass => MotionContent::Skeleton(super::amass::read_amass(
+            bytes,
+            &source,
+            options.body_model.as_deref(),
+            &options.limits,
+        )?),
+        #[cfg(not(feature = "amass"))]
+        MotionFormat::Amass => {
+            return Err(Error::Parse {
+                source_name: source,
+                line: 0,
+                message: "AMASS archives need iktc built with its `amass` feature".to_string(),
+            })
         }
     })
 }
@@ -484,12 +570,26 @@ pub fn motion_from_content(
         },
     };
     let (ankles_to_head, rest, measured_on) = rest_measure(&content, body_map.as_ref().ok())?;
-    if options.up == UpChoice::Auto && ankles_to_head.is_none() {
+    if options.up == UpChoice::Auto && format.fixed_frame().is_none() && ankles_to_head.is_none() {
         // The recognition error says what is missing and how to write a map.
         body_map.clone()?;
     }
-    let up = decide_up(options.up, ankles_to_head, measured_on, &source)?;
-    let units = decide_units(options.units, extent_along(&rest, up.up), &source)?;
+    let up = match (format.fixed_frame(), options.up) {
+        (Some((_, up)), UpChoice::Auto) => UpDecision {
+            up,
+            automatic: true,
+            measured_on: Measured::Format,
+        },
+        _ => decide_up(options.up, ankles_to_head, measured_on, &source)?,
+    };
+    let units = match (format.fixed_frame(), options.units) {
+        (Some((unit, _)), Units::Auto) => UnitsDecision {
+            unit,
+            automatic: true,
+            standing_height: None,
+        },
+        _ => decide_units(options.units, extent_along(&rest, up.up), &source)?,
+    };
     let times = match &content {
         MotionContent::Skeleton(clip) => clip.times(),
         MotionContent::Markers(m) => &m.times,

@@ -8,11 +8,13 @@
 //!   (Y-up; convert with [`Clip::to_z_up`] / [`y_up_to_z_up`]).
 //! * [`read_bvh`], [`write_bvh`], [`BvhClip`] — Biovision hierarchy files with any hierarchy
 //!   and channel order, in centimetres, metres or any length unit.
-//! * [`load_motion`] — any motion file (BVH, ASF/AMC, DeepMimic, C3D, points CSV), its format
+//! * [`load_motion`] — any motion file (BVH, ASF/AMC, DeepMimic, C3D, points CSV, AMASS
+//!   archives with a body model file), its format
 //!   detected, its units and up axis given or decided ([`Units`], [`UpChoice`]), its body
 //!   points recognised without a map ([`recognise_skeleton`], [`recognise_markers`], or a
 //!   [`BodyMap`] TOML), reduced to [`Keypoints`]: named body points per frame in metres, Z up.
-//! * [`read_asf`], [`read_amc`], [`read_c3d`], [`read_points_csv`] — the readers behind it.
+//! * [`read_asf`], [`read_amc`], [`read_c3d`], [`read_points_csv`], [`amass`] (feature
+//!   `amass`) — the readers behind it.
 //! * [`decompose_rotation`] — a rotation as a product of rotations about 1–3 given joint axes
 //!   (generalised Euler / Davenport angles in closed form, least squares otherwise).
 //! * [`retarget`], [`RetargetMap`], [`builtin_map`] — a clip to robot joint, pelvis height and
@@ -42,6 +44,8 @@
 //! # Ok::<(), iktc::Error>(())
 //! ```
 
+#[cfg(feature = "amass")]
+pub mod amass;
 mod amc;
 mod angles;
 mod asf;
@@ -90,8 +94,8 @@ pub use deepmimic::{
 };
 pub use keypoints::{clip_keypoints, marker_keypoints, Keypoints};
 pub use load::{
-    detect_format, find_asf, load_motion, motion_from_content, scale_clip, strip_bom, Motion,
-    MotionContent, MotionFormat, MotionOptions,
+    detect_format, find_asf, is_amass_archive, is_amass_file, load_motion, motion_from_content,
+    scale_clip, strip_bom, Motion, MotionContent, MotionFormat, MotionOptions,
 };
 pub use lowpass::{check_smoothing, lowpass, lowpass_track, PAD_PERIODS};
 pub use markers::{FilledGap, MarkerSet, DEFAULT_MAX_GAP};

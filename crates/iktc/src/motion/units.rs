@@ -120,7 +120,8 @@ pub struct UnitsDecision {
     pub unit: LengthUnit,
     /// Whether it was decided automatically.
     pub automatic: bool,
-    /// The standing height in file units it was decided from (`None` if given).
+    /// The standing height in file units it was decided from (`None` if given or stated by
+    /// the format).
     pub standing_height: Option<f64>,
 }
 
@@ -134,6 +135,7 @@ impl std::fmt::Display for UnitsDecision {
                 "{name} ({m:.6} m/unit), decided from the standing height {h:.4} units = {:.3} m",
                 h * m
             ),
+            (true, None) => write!(f, "{name} ({m:.6} m/unit), stated by the format"),
             _ => write!(f, "{name} ({m:.6} m/unit), given"),
         }
     }
@@ -161,6 +163,8 @@ pub enum Measured {
     FirstFrame,
     /// The marker file's frame with the most markers.
     MostCompleteFrame,
+    /// Nothing: the format states it ([`MotionFormat::fixed_frame`](super::MotionFormat::fixed_frame)).
+    Format,
 }
 
 impl std::fmt::Display for UpDecision {
@@ -178,6 +182,7 @@ impl std::fmt::Display for UpDecision {
             (true, Measured::MostCompleteFrame) => {
                 "decided from the most complete frame (ankles to head)"
             }
+            (true, Measured::Format) => "stated by the format",
         };
         write!(f, "{axis}, {how}")
     }
