@@ -57,7 +57,7 @@ impl PyRobot {
             )));
         }
         if let Some(v) = default_velocity {
-            if !(v > 0.0) {
+            if v.is_nan() || v <= 0.0 {
                 return Err(crate::IktcError::new_err(format!(
                     "default_velocity = {v}: expected a velocity limit > 0 [rad/s] (or +inf for none)"
                 )));
