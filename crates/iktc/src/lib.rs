@@ -50,7 +50,7 @@
 #![warn(missing_docs)]
 
 pub mod balance;
-#[cfg(all(feature = "urdf", feature = "json", feature = "toml"))]
+#[cfg(all(feature = "urdf", feature = "json", feature = "toml", feature = "npz"))]
 pub mod batch;
 mod buffer;
 pub mod controller;
@@ -60,6 +60,8 @@ pub mod mesh;
 pub mod model;
 #[cfg(all(feature = "urdf", feature = "json", feature = "toml"))]
 pub mod motion;
+#[cfg(feature = "npz")]
+pub(crate) mod npz;
 pub mod prelude;
 #[cfg(all(feature = "urdf", feature = "toml"))]
 pub mod profile;

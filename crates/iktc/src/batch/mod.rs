@@ -24,7 +24,7 @@ pub use discover::{
     Discovery, DiscoveryProblem, MOTION_EXTENSIONS, RECORD_FILE,
 };
 pub use formats::{body_links, gmr_pickle, lafan_csv, mjlab_npz, BodyMotion, MotionFormat};
-pub use npz::{crc32, npz_bytes, read_npz, zip_stored, NpyArray, NpyData};
+pub use npz::{npz_bytes, read_npz, zip_stored, NpyArray, NpyData, MAX_NPZ_ELEMENTS};
 #[cfg(feature = "parallel")]
 pub use pool::{longest_first, run_parallel, run_parallel_in, run_parallel_until};
 pub use quality::{

@@ -398,8 +398,8 @@ fn bad_trajectories_are_named_errors() {
     assert!(err.contains("appears twice"), "{err}");
 }
 
-/// NPZ: arrays read back as written; a compressed member, a corrupted one and a missing array
-/// are named errors.
+/// NPZ: arrays read back as written, stored or deflated; a corrupted member, a truncated
+/// archive and a missing array are named errors.
 #[test]
 fn npz_reading_round_trips_and_names_bad_archives() {
     let arrays = vec![
@@ -419,24 +419,40 @@ fn npz_reading_round_trips_and_names_bad_archives() {
         vec![vec![1.0, 2.0], vec![3.0, 4.0], vec![5.0, 6.0]]
     );
     assert!(t.base.is_none());
-    // The first member's method field (offset 8) set to deflate.
-    let mut deflated = bytes.clone();
-    deflated[8] = 8;
-    let err = crate::batch::read_npz(&deflated, "c.npz")
-        .unwrap_err()
-        .to_string();
-    assert!(
-        err.contains("compressed") && err.contains("savez_compressed"),
-        "{err}"
+    // Deflated members (numpy.savez_compressed) read the same.
+    let deflated = {
+        use std::io::Write;
+        let mut zip = zip::ZipWriter::new(std::io::Cursor::new(Vec::new()));
+        let options = zip::write::SimpleFileOptions::default()
+            .compression_method(zip::CompressionMethod::Deflated);
+        for a in &arrays {
+            zip.start_file(format!("{}.npy", a.name), options)
+                .expect("member");
+            zip.write_all(&a.npy_bytes().expect("npy")).expect("write");
+        }
+        zip.finish().expect("zip").into_inner()
+    };
+    assert_eq!(
+        crate::batch::read_npz(&deflated, "c.npz").expect("deflated"),
+        arrays
     );
-    // The last byte of the first member's data (after its 30-byte header and name).
+    // A byte of the first member's data flipped: its CRC-32 no longer matches (the member's
+    // data is stored, so the value 1.0 of `time` is found as is).
     let mut corrupt = bytes.clone();
-    let last_data = 30 + "time.npy".len() + arrays[0].npy_bytes().expect("npy").len() - 1;
-    corrupt[last_data] ^= 0xff;
+    let at = bytes
+        .windows(8)
+        .position(|w| w == 0.1_f64.to_le_bytes())
+        .expect("0.1 in the stored data");
+    corrupt[at] ^= 0xff;
     let err = crate::batch::read_npz(&corrupt, "k.npz")
         .unwrap_err()
         .to_string();
-    assert!(err.contains("time.npy") && err.contains("CRC-32"), "{err}");
+    assert!(err.contains("k.npz") && err.contains("`time`"), "{err}");
+    // Cut short: the archive's directory (at its end) is missing.
+    let err = crate::batch::read_npz(&bytes[..bytes.len() / 2], "h.npz")
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("h.npz") && err.contains("cut short"), "{err}");
     let only_time =
         zip_stored(&[("time.npy".into(), arrays[0].npy_bytes().expect("npy"))]).expect("zip");
     let err = read_trajectory_npz(&only_time, "t.npz")

@@ -37,7 +37,7 @@ pub mod centres;
 mod com;
 mod contacts;
 mod drift;
-#[cfg(feature = "json")]
+#[cfg(all(feature = "json", feature = "npz"))]
 pub mod evaluate;
 pub mod fidelity;
 pub mod fit;
@@ -52,7 +52,7 @@ mod viewer;
 pub use body::{BodyFrameNames, RobotBody, MIN_HEAD_HEIGHT};
 pub use centres::RobotJointCentres;
 pub use contacts::{PIVOT_RATE, PIVOT_SMOOTHING, PIVOT_TURN};
-#[cfg(feature = "json")]
+#[cfg(all(feature = "json", feature = "npz"))]
 pub use evaluate::{
     evaluate_trajectory, read_trajectory_csv, read_trajectory_npz, RobotTrajectory,
     TrajectoryEvaluation,

@@ -6,9 +6,9 @@ use std::io::{Read, Seek};
 
 use nalgebra::Vector3;
 
-use super::npz::Npz;
 use super::SmplLayout;
 use crate::error::{Error, Result};
+use crate::npz::Npz;
 use crate::resources::ReadLimits;
 
 /// The keys AMASS uses for the frame rate \[Hz\]: `mocap_framerate` (SMPL-H releases) and

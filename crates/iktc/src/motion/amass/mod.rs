@@ -27,7 +27,6 @@
 mod archive;
 mod layout;
 mod model;
-mod npz;
 
 use std::io::Cursor;
 use std::path::Path;

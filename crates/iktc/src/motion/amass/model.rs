@@ -14,9 +14,9 @@ use std::path::Path;
 
 use nalgebra::Vector3;
 
-use super::npz::Npz;
 use super::SmplLayout;
 use crate::error::{Error, Result};
+use crate::npz::Npz;
 
 /// Most vertices accepted in a body model \[vertices\]: ten times SMPL-X's 10 475, so that a
 /// malformed header cannot make the reader allocate without bound.

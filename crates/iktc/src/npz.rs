@@ -81,6 +81,15 @@ impl<R: Read + Seek> Npz<R> {
         v
     }
 
+    /// The array names (members ending in `.npy`, without it) in the archive's order.
+    pub fn names_in_order(&self) -> Vec<String> {
+        self.zip
+            .file_names()
+            .filter_map(|n| n.strip_suffix(".npy"))
+            .map(str::to_string)
+            .collect()
+    }
+
     /// Whether the archive holds the array `name`.
     pub fn has(&self, name: &str) -> bool {
         self.zip.index_for_name(&format!("{name}.npy")).is_some()
@@ -117,6 +126,26 @@ impl<R: Read + Seek> Npz<R> {
             line: 0,
             message: format!("array `{name}`: not a NumPy .npy array: {e}"),
         })
+    }
+
+    /// Reads the member of the array `name` to its end, which makes the `zip` crate compare its
+    /// data with its CRC-32 (a typed read stops at the last element and never gets there).
+    ///
+    /// Errors: [`Error::Parse`] naming the array when the data is damaged or cut short.
+    fn verify(&mut self, name: &str) -> Result<()> {
+        let source = self.source.clone();
+        let mut member = self
+            .zip
+            .by_name(&format!("{name}.npy"))
+            .map_err(|e| array_error(&source, name, format!("cannot open the member: {e}")))?;
+        std::io::copy(&mut member, &mut std::io::sink()).map_err(|e| {
+            array_error(
+                &source,
+                name,
+                format!("its data is damaged or cut short (CRC-32 or length): {e}"),
+            )
+        })?;
+        Ok(())
     }
 
     /// The shape of the array `name` (its header only).
@@ -238,6 +267,7 @@ impl<R: Read + Seek> Npz<R> {
                 )))
             }
         }
+        self.verify(name)?;
         Ok(shape)
     }
 
@@ -258,6 +288,61 @@ impl<R: Read + Seek> Npz<R> {
             return Err(self.error(name, format!("{count} values for {len} elements")));
         }
         Ok(Array { shape, values })
+    }
+
+    /// Whether the array `name` holds unicode strings (`'<U…'`).
+    ///
+    /// Errors: those of opening it ([`Npz::shape`]).
+    pub fn is_unicode(&mut self, name: &str) -> Result<bool> {
+        let npy = self.open(name)?;
+        Ok(matches!(npy.dtype(), DType::Plain(t) if t.type_char() == TypeChar::UnicodeStr))
+    }
+
+    /// Reads the unicode string array `name` (`'<U…'`, C order), each string trimmed of its NUL
+    /// padding, after checking that it holds at most `max_len` strings.
+    ///
+    /// Errors: [`Error::Parse`] for a missing array, another dtype, data cut short or a
+    /// character that is not a Unicode scalar value, more than `max_len` strings.
+    pub fn strings(&mut self, name: &str, max_len: usize) -> Result<(Vec<usize>, Vec<String>)> {
+        let source = self.source.clone();
+        let npy = self.open(name)?;
+        let shape = usize_shape(&source, name, npy.shape())?;
+        let len = checked_len(&source, name, &shape, max_len)?;
+        let unicode =
+            matches!(npy.dtype(), DType::Plain(t) if t.type_char() == TypeChar::UnicodeStr);
+        if !unicode || npy.order() != Order::C && shape.len() > 1 {
+            return Err(array_error(
+                &source,
+                name,
+                format!(
+                    "dtype `{}` is not a C-order unicode string array ('<U…')",
+                    npy.dtype().descr()
+                ),
+            ));
+        }
+        let mut out = Vec::with_capacity(len);
+        let data = npy
+            .data::<String>()
+            .map_err(|e| array_error(&source, name, format!("cannot read its strings: {e}")))?;
+        for (k, v) in data.enumerate() {
+            let v = v.map_err(|e| {
+                array_error(
+                    &source,
+                    name,
+                    format!("cut short or unreadable at string {k} of {len}: {e}"),
+                )
+            })?;
+            out.push(v.trim_end_matches(char::from(0)).to_string());
+        }
+        if out.len() != len {
+            return Err(array_error(
+                &source,
+                name,
+                format!("{} strings for {len} elements", out.len()),
+            ));
+        }
+        self.verify(name)?;
+        Ok((shape, out))
     }
 
     /// The text of the array `name` if it is a string scalar or a one-element string array
