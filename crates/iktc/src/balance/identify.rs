@@ -4,7 +4,7 @@
 //! parameter positive and make the steps relative) with the residual
 //! `rᵢ = H(jωᵢ; x) / Hᵢ − 1` split into real and imaginary parts: for small errors it is the
 //! relative magnitude error and the phase error \[rad\], equally weighted at every frequency and
-//! insensitive to ±2π phase wrapping. Solved with [`levenberg_marquardt`].
+//! insensitive to ±2π phase wrapping. Solved with [`levenberg_marquardt()`].
 //!
 //! The initial guess is automatic, from the shape of the data:
 //! 1. `w_n` = frequency of the largest magnitude;

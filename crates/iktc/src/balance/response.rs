@@ -4,7 +4,7 @@
 //! The dominant mode is fitted over a window after the push by
 //! `y(t) ≈ e^{−ζ w τ} (a cos(w √(1−ζ²) τ) + b sin(w √(1−ζ²) τ))`, `τ = t − t₀`, by variable
 //! projection (`a`, `b` by linear least squares for each `(ζ, w)`): a coarse grid over
-//! `(ζ, w)` then [`levenberg_marquardt`] on `(logit ζ, ln w)`. The window starts a little
+//! `(ζ, w)` then [`levenberg_marquardt()`] on `(logit ζ, ln w)`. The window starts a little
 //! after the push so that the fastest modes (lag, delay) have died out. With
 //! [`ResponseSettings::modes`] = 2 the sum of two such modes is fitted (the grid then moves the
 //! pair `(ζ, w)`, `(ζ, r w)` together before the free refinement) and the
