@@ -7,7 +7,7 @@
 //! multiple of 64 bytes, then the data in C order): little-endian `f64` (`'<f8'`) or
 //! fixed-width UTF-32 strings (`'<UN'`, N the longest string's length). The archive is
 //! written by the `zip` crate with every member *stored*, as `numpy.savez` does; reading takes
-//! stored or deflated members (`numpy.savez_compressed`) through [`crate::npz::Npz`].
+//! stored or deflated members (`numpy.savez_compressed`) through the reader AMASS archives use (`npyz` and `zip`).
 
 use std::io::{Cursor, Write};
 
