@@ -28,7 +28,7 @@ def test_a_robot_from_a_builtin_name_a_profile_file_and_a_urdf_agree():
     # The profile's acceleration limits (10 × the velocity limit) replace the URDF's none.
     _, _, vel, acc = by_profile.limits()
     assert np.allclose(acc[6:], 10.0 * vel[6:])
-    with pytest.raises(iktc.IktcError, match="apply to URDF files only"):
+    with pytest.raises(iktc.IktcError, match="apply to URDF and MJCF files only"):
         iktc.Robot("g1", floating=True)
     with pytest.raises(iktc.IktcError, match="cannot read the profile"):
         iktc.Robot("no_such_profile.toml")
