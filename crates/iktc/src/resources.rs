@@ -215,9 +215,10 @@ pub const MAX_OUTPUT_FRAMES: usize = 1_000_000;
 /// distance from the support (see `WalkingController::correct_zmp`).
 pub const MAX_ZMP_PASSES: usize = 10;
 
-/// Most iterations of the Levenberg–Marquardt fit of the balance identification
-/// \[iterations\]: 10 000 (the default is 200; each iteration simulates the identification
-/// run once per parameter).
+/// Most trial steps of the Levenberg–Marquardt fit of the balance identification
+/// (`LmSettings::max_iterations`) \[steps\]: 10 000 (the default is 200; each step evaluates
+/// the residual once, and each new Jacobian simulates the identification run twice per
+/// parameter).
 pub const MAX_LM_ITERATIONS: usize = 10_000;
 
 /// Most worker threads of a batch \[threads\]: 1024. Each worker holds one clip's run in
