@@ -12,6 +12,9 @@ use pyo3::prelude::*;
 use crate::convert::{array, matrix, pose_matrix, vector};
 use crate::to_py;
 
+/// A state as numpy arrays: (q, v).
+type StateArrays<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>);
+
 /// A robot model (immutable), with its robot profile when it has one.
 ///
 /// `Robot("jvrc1")` or `Robot("g1")` loads a built-in robot through its built-in profile (feet,
@@ -188,6 +191,21 @@ impl PyRobot {
     ) -> (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>) {
         let s = State::neutral(&self.robot);
         (array(py, s.q.as_slice()), array(py, s.qd.as_slice()))
+    }
+
+    /// The robot standing in its profile's start posture: (q, v) with the joints at the
+    /// profile's `posture`, at rest, the base upright above the origin and raised so that the
+    /// lower foot's sole is on the ground (z = 0), the state the keypoint route starts from
+    /// (`neutral()` has the base at the origin). Needs a profile with feet.
+    fn standing<'py>(&self, py: Python<'py>) -> PyResult<StateArrays<'py>> {
+        let profile = self.profile.as_ref().ok_or_else(|| {
+            crate::IktcError::new_err(format!(
+                "robot `{}` has no profile, so no standing posture: load a built-in robot or a profile file (`iktc.profile_init` writes one)",
+                self.robot.name()
+            ))
+        })?;
+        let s = profile.standing_state(&self.robot).map_err(to_py)?;
+        Ok((array(py, s.q.as_slice()), array(py, s.qd.as_slice())))
     }
 
     /// Pose of a frame at configuration q, as a 4 × 4 homogeneous matrix (world axes, [m]).

@@ -70,3 +70,18 @@ def test_an_mjcf_file_without_velocity_limits_gets_them_from_the_keywords_or_its
     assert "[velocity]\ndefault = 20.0 # guessed" in text
     _, _, vel, _ = iktc.Robot(path).limits()
     assert np.all(vel[6:] == 20.0)
+
+
+def test_standing_puts_the_profile_posture_on_the_ground():
+    robot = iktc.Robot("g1")
+    q, v = robot.standing()
+    assert q.shape == (robot.nq,) and np.all(v == 0.0)
+    # The profile's bent knees (G1's built-in profile: 0.6 rad), the rest of its posture alike.
+    assert q[robot.q_index("left_knee_joint")] == q[robot.q_index("right_knee_joint")] > 0.0
+    # The base upright above the origin, raised so that the lower foot frame is at the
+    # profile's ankle height (G1: 0.035 m): its sole on the ground.
+    assert np.allclose(q[:2], 0.0) and np.allclose(q[3:7], [0.0, 0.0, 0.0, 1.0])
+    feet = [robot.frame_pose(q, f)[2, 3] for f in ("left_ankle_roll_link", "right_ankle_roll_link")]
+    assert min(feet) == pytest.approx(0.035, abs=1e-12)
+    with pytest.raises(iktc.IktcError, match="no profile"):
+        iktc.Robot(str(G1_URDF)).standing()

@@ -6,7 +6,7 @@ use super::schema::{Feet, Foot, RobotProfile};
 use crate::error::{Error, Result};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 
-use crate::model::{JointKind, ModelOptions, Robot};
+use crate::model::{JointKind, Kinematics, ModelOptions, Robot, State};
 use crate::motion::RetargetMap;
 use crate::sim::imitate::SupportSettings;
 use crate::sim::ImitateConfig;
@@ -250,6 +250,39 @@ impl RobotProfile {
         }
         self.check_robot(&robot)?;
         Ok(robot)
+    }
+
+    /// The robot standing in the profile's start posture: the joints at `posture` (0 where it
+    /// names none), at rest, the base upright at the origin's vertical and raised so that the
+    /// lower foot frame is `ankle_height` above the ground (z = 0), its sole on it. The state
+    /// the keypoint route starts from; `State::neutral` instead has the base at the origin.
+    ///
+    /// Errors: no feet in the profile, a posture joint or a foot frame `robot` lacks (`robot`
+    /// is this profile's robot, [`RobotProfile::robot`]), a fixed-base robot (it does not
+    /// stand: key `base`).
+    pub fn standing_state(&self, robot: &Robot) -> Result<State> {
+        let cfg = self.imitate_config(ImitateConfig::default())?;
+        if robot.base() != crate::model::BaseKind::Floating {
+            return Err(profile_error(
+                "base",
+                "fixed",
+                "a standing state needs a floating base: the robot is raised onto its feet",
+            ));
+        }
+        let mut state = State::neutral(robot);
+        for (name, value) in &cfg.initial_posture {
+            state.set_joint(robot, name, *value)?;
+        }
+        let kin = Kinematics::new(robot, &state)?;
+        let mut lowest = f64::INFINITY;
+        for foot in &cfg.feet {
+            let id = robot.frame_id(foot)?;
+            lowest = lowest.min(kin.frame_pose(robot, id)?.translation.z);
+        }
+        let mut base = state.base_pose(robot);
+        base.translation.vector.z += cfg.support.ankle_height - lowest;
+        state.set_base_pose(robot, &base)?;
+        Ok(state)
     }
 
     /// Checks every frame and joint the profile names against `robot`: feet and body frames

@@ -82,7 +82,7 @@ mod tests {
         let names = super::super::frame_names(&profile, &cfg).unwrap();
         let kin = Kinematics::new(&robot, &State::neutral(&robot)).unwrap();
         let body = super::super::body::RobotBody::find(&robot, &kin, &names).unwrap();
-        let start = super::super::start_state(&robot, &cfg, &body).unwrap();
+        let start = profile.standing_state(&robot).unwrap();
         (robot, body.pelvis, start)
     }
 

@@ -565,26 +565,6 @@ struct Setup {
     fit_error: Option<f64>,
 }
 
-/// The robot's start state: the profile's posture, the lowest sole on z = 0.
-fn start_state(robot: &Robot, cfg: &ImitateConfig, body: &RobotBody) -> Result<State> {
-    let mut state = State::neutral(robot);
-    for (name, value) in &cfg.initial_posture {
-        state.set_joint(robot, name, *value)?;
-    }
-    let kin = Kinematics::new(robot, &state)?;
-    let lowest = body
-        .feet
-        .iter()
-        .map(|f| kin.frame_pose(robot, *f).map(|p| p.translation.z))
-        .collect::<Result<Vec<_>>>()?
-        .into_iter()
-        .fold(f64::INFINITY, f64::min);
-    let mut base = state.base_pose(robot);
-    base.translation.vector.z += cfg.support.ankle_height - lowest;
-    state.set_base_pose(robot, &base)?;
-    Ok(state)
-}
-
 /// Refuses a start state outside the robot's joint ranges (the profile's `posture` against
 /// the URDF's limits) with [`Error::StateOutsideLimits`] naming the joint, its value and its
 /// range, unless `bounds` asks for [`OutsideLimits::Recover`](crate::limits::OutsideLimits)
@@ -667,7 +647,7 @@ fn setup(
     } else {
         (robot, body)
     };
-    let state = start_state(&robot, &cfg, &body)?;
+    let state = profile.standing_state(&robot)?;
     check_start(&robot, &state, &s.bounds)?;
     kin.update(&robot, &state)?;
     let clip = scale::scale_clip(&robot, &kin, &body, kp, cfg.support.ankle_height, s.hands)?;

@@ -793,7 +793,7 @@ mod tests {
         let names = super::super::frame_names(&profile, &cfg).unwrap();
         let mut kin = Kinematics::new(&robot, &crate::model::State::neutral(&robot)).unwrap();
         let body = RobotBody::find(&robot, &kin, &names).unwrap();
-        let state = super::super::start_state(&robot, &cfg, &body).unwrap();
+        let state = profile.standing_state(&robot).unwrap();
         kin.update(&robot, &state).unwrap();
         let kp = super::super::builtin_motion(clip)
             .unwrap()
@@ -1002,8 +1002,7 @@ mod tests {
         };
         let (robot, mut kin, body, _, free, _) = plans_with("g1", "humanoid3d_walk", &s);
         let profile = RobotProfile::builtin("g1").unwrap();
-        let cfg = profile.imitate_config(ImitateConfig::default()).unwrap();
-        let mut state = super::super::start_state(&robot, &cfg, &body).unwrap();
+        let mut state = profile.standing_state(&robot).unwrap();
         let base_in_pelvis =
             kin.frame_pose(&robot, body.pelvis).unwrap().inverse() * state.base_pose(&robot);
         let (mut with, mut without) = (0, 0);
