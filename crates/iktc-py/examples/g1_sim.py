@@ -507,8 +507,12 @@ def plan_chatter(qs: np.ndarray, dt: float = CONTROL_PERIOD) -> dict:
 
 
 def planned_zmp(plant: Plant, qs: list, dt: float = CONTROL_PERIOD,
-                per_tick: bool = False) -> np.ndarray:
-    """The ZMP the kinematic plan asks for [m], one row per tick (NaN at the two ends).
+                per_tick: bool = False, min_support: float = 0.0) -> np.ndarray:
+    """The ZMP the kinematic plan asks for [m], one row per tick (NaN at the two ends, and where
+    the plan asks the ground to pull: a vertical ground force F_z ≤ 0, the body falling at least
+    as fast as gravity, has no ZMP — as ``iktc.Robot.zmp`` rules; with `min_support` > 0 [–],
+    also where F_z is under that share of the robot's weight, where dividing by F_z turns
+    centimetres of moment into metres of ZMP).
 
     The plan's configurations `qs` (iktc's q per tick) are put into MuJoCo's coordinates; rates
     and accelerations by central differences (``mj_differentiatePos``; with `per_tick` the
@@ -525,12 +529,13 @@ def planned_zmp(plant: Plant, qs: list, dt: float = CONTROL_PERIOD,
     flags = m.opt.disableflags
     m.opt.disableflags = flags | mujoco.mjtDisableBit.mjDSBL_CONSTRAINT
     try:
-        return _planned_zmp(plant, m, d, qs, dt, per_tick)
+        return _planned_zmp(plant, m, d, qs, dt, per_tick, min_support)
     finally:
         m.opt.disableflags = flags
 
 
-def _planned_zmp(plant, m, d, qs, dt, per_tick=False):
+def _planned_zmp(plant, m, d, qs, dt, per_tick=False, min_support=0.0):
+    weight = float(np.sum(m.body_mass)) * -float(m.opt.gravity[2])
     qpos = [to_mujoco_qpos(plant, q) for q in qs]
     n = len(qpos)
     out = np.full((n, 2), np.nan)
@@ -556,7 +561,8 @@ def _planned_zmp(plant, m, d, qs, dt, per_tick=False):
         f = d.qfrc_inverse[:3]  # free joint: linear part in world axes
         tau = r @ d.qfrc_inverse[3:6]  # angular part in the body's axes
         o = d.qpos[:3]
-        out[k] = [o[0] - (tau[1] + o[2] * f[0]) / f[2], o[1] + (tau[0] - o[2] * f[1]) / f[2]]
+        if f[2] > 0.0 and f[2] >= min_support * weight:
+            out[k] = [o[0] - (tau[1] + o[2] * f[0]) / f[2], o[1] + (tau[0] - o[2] * f[1]) / f[2]]
     return out
 
 

@@ -356,6 +356,14 @@ def test_iktc_computes_the_plans_zmp_as_mujocos_inverse_dynamics_does():
     snap = qs[:3].copy()
     snap[1, 2] += 0.01
     assert np.isnan(robot.zmp(snap, g1_sim.CONTROL_PERIOD)).all()
+    # MuJoCo's inverse dynamics of the same snap: no ZMP either (not kilometres).
+    plant = g1_sim.Plant(robot)
+    assert np.isnan(g1_sim.planned_zmp(plant, list(snap), per_tick=True)).all()
+    # Standing still the ground carries the whole weight: a ZMP with any share up to 1 asked,
+    # none above it.
+    still = [qs[0]] * 3
+    assert np.all(np.isfinite(g1_sim.planned_zmp(plant, still, per_tick=True, min_support=0.99)[1]))
+    assert np.isnan(g1_sim.planned_zmp(plant, still, per_tick=True, min_support=1.01)[1]).all()
     with pytest.raises(ValueError, match="columns"):
         robot.zmp(qs[:, :10], g1_sim.CONTROL_PERIOD)
     with pytest.raises(iktc.IktcError, match="at least 3"):
