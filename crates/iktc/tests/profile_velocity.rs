@@ -145,3 +145,18 @@ fn the_keypoint_route_refuses_a_joint_without_any_limit_and_runs_with_the_guesse
         }
     }
 }
+
+#[test]
+fn a_fallback_velocity_that_is_not_positive_is_refused_by_the_model() {
+    let (text, path) = t1();
+    for bad in [0.0, -1.0, f64::NAN] {
+        let options = iktc::model::ModelOptions {
+            fallback_velocity: bad,
+            ..iktc::model::ModelOptions::default()
+        };
+        let err = iktc::model::Robot::from_description_str(&text, path.parent(), &options)
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("fallback_velocity"), "{bad}: {err}");
+    }
+}

@@ -241,6 +241,13 @@ impl Robot {
                 expected: "a positive number [1/s]".into(),
             });
         }
+        if options.fallback_velocity.is_nan() || options.fallback_velocity <= 0.0 {
+            return Err(Error::InvalidSetting {
+                name: "fallback_velocity".into(),
+                value: options.fallback_velocity.to_string(),
+                expected: "a positive velocity limit [rad/s or m/s], or +inf for none".into(),
+            });
+        }
         if options.jerk_per_acceleration.is_nan() || options.jerk_per_acceleration <= 0.0 {
             return Err(Error::InvalidSetting {
                 name: "jerk_per_acceleration".into(),

@@ -438,7 +438,11 @@ pub fn init_profile_toml_with(
     options: &InitOptions,
 ) -> Result<String> {
     // The model first: a URDF it rejects gets no profile.
-    crate::model::Robot::from_description_str(text, dir, &crate::model::ModelOptions::default())?;
+    let robot = crate::model::Robot::from_description_str(
+        text,
+        dir,
+        &crate::model::ModelOptions::default(),
+    )?;
     let u = crate::model::read_description(text, dir, &crate::resources::ReadLimits::default())?;
     let is_child = |name: &str| u.joints.iter().any(|j| j.child.link == name);
     let roots: Vec<&urdf_rs::Link> = u.links.iter().filter(|l| !is_child(&l.name)).collect();
@@ -461,7 +465,9 @@ pub fn init_profile_toml_with(
     let t = Tree::new(&u, &root.name);
     let parts = find_parts(&t);
     let guess = Guessed::new(&t, &parts, options, dir, &u)?;
-    Ok(write_profile(text, &u, &t, &guess, options, urdf_path, dir))
+    Ok(write_profile(
+        text, &robot, &u, &t, &guess, options, urdf_path, dir,
+    ))
 }
 
 /// Everything guessed or given, ready to write.
@@ -762,8 +768,10 @@ fn write_feet(
 }
 
 /// The profile's text (see [`init_profile_toml_with`]).
+#[allow(clippy::too_many_arguments)]
 fn write_profile(
     text: &str,
+    robot: &crate::model::Robot,
     u: &urdf_rs::Robot,
     t: &Tree,
     g: &Guessed,
@@ -847,7 +855,7 @@ fn write_profile(
         }
     }
     write_posture(&mut out, text, dir, u, &foot_frames);
-    write_velocity(&mut out, text, dir);
+    write_velocity(&mut out, robot);
     out.push_str(
         "\n# Default narrowed ranges [rad] (joint = [lower, upper]).\n[narrow]\n\n\
          [acceleration]\nper_velocity = 10.0 # guessed: the paper's ratio (180°/s, 1800°/s²)\n\n\
@@ -866,14 +874,11 @@ fn write_profile(
 /// With the profile's default ratio its acceleration limit is 200 rad/s².
 pub const GUESSED_VELOCITY: f64 = 20.0;
 
-/// The `[velocity]` table when some movable joint has no velocity limit in the file (MJCF
-/// never gives one): `default = GUESSED_VELOCITY`, marked as guessed and naming how many
-/// joints it covers. Nothing when every joint has one or the file does not build.
-fn write_velocity(out: &mut String, text: &str, dir: Option<&std::path::Path>) {
-    use crate::model::{ModelOptions, Robot};
-    let Ok(robot) = Robot::from_description_str(text, dir, &ModelOptions::default()) else {
-        return;
-    };
+/// The `[velocity]` table when some movable joint of `robot` (built from the file with the
+/// default options) has no velocity limit (MJCF never gives one): `default =
+/// GUESSED_VELOCITY`, marked as guessed and naming how many joints it covers. Nothing when
+/// every joint has one.
+fn write_velocity(out: &mut String, robot: &crate::model::Robot) {
     let unlimited: Vec<&str> = robot
         .active_joints()
         .filter(|j| !j.limit.velocity.is_finite())
