@@ -16,7 +16,7 @@ pub struct Args {
     pub robot: String,
     #[command(flatten)]
     pub robot_options: RobotOptions,
-    /// Print JSON instead of text (schema in the README).
+    /// Print JSON instead of text (schema in the user guide, book/src/cli.md).
     #[arg(long)]
     pub json: bool,
     /// A configuration file (JSON or TOML): joint values by name, base pose, velocities.

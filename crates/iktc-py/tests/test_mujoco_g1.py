@@ -61,9 +61,9 @@ def test_standing_imitation_of_the_default_clip_stays_up():
 
 # The plan is not dynamically feasible: MuJoCo's inverse dynamics of it puts the ZMP outside
 # the polygon on 127 of 503 ticks (MuJoCo 4.0.1), the legs at their acceleration limit (200
-# rad/s²); with the clip's pelvis held the slip is 17 mm (README, `mujoco_g1.py causes`).
+# rad/s²); with the clip's pelvis held the slip is 17 mm (book/src/mujoco.md, `mujoco_g1.py causes`).
 @pytest.mark.xfail(strict=True, reason="G1 on MuJoCo rocks and its feet slip 28 mm "
-                   "while imitating humanoid3d_dance_b (see the example's README section)")
+                   "while imitating humanoid3d_dance_b (see book/src/mujoco.md)")
 def test_standing_imitation_of_the_default_clip_keeps_the_feet_within_5_mm():
     s = g1_sim.run_standing().summary()
     assert s["foot_slip_max_m"] <= 5e-3, s
@@ -72,10 +72,10 @@ def test_standing_imitation_of_the_default_clip_keeps_the_feet_within_5_mm():
 # The keypoint route (body points scaled to G1, feet held, COM over the polygon), its q and v
 # the servos' set points, is no gentler: its joint accelerations (second differences) change
 # sign every 4–5 ticks (rms 81 rad/s² against the joint route's 30), its ZMP is outside on 391
-# of 504 ticks, and G1 falls (README).
+# of 504 ticks, and G1 falls (book/src/mujoco.md).
 @pytest.mark.xfail(strict=True, raises=AssertionError,
                    reason="G1 on MuJoCo falls following the keypoint route's plan "
-                   "of humanoid3d_dance_b with its feet held (see the example's README section)")
+                   "of humanoid3d_dance_b with its feet held (see book/src/mujoco.md)")
 def test_standing_imitation_by_the_keypoint_route_keeps_the_feet_within_5_mm():
     s = g1_sim.run_standing_keypoints().summary()
     assert s["foot_slip_max_m"] <= 5e-3, s
@@ -444,7 +444,7 @@ def test_a_forward_push_in_single_support_while_walking_is_absorbed(tmp_path):
     # (4 N·s) forward at the pelvis in the middle of the first single support (1.1 s, right
     # foot standing). Open loop (no damping controller) G1 walks on, the ZMP inside the loaded
     # feet's polygon on every tick (MuJoCo 4.0.0: tilt at most 0.065 rad). Backward or outward
-    # pushes are not absorbed that well (README).
+    # pushes are not absorbed that well (book/src/mujoco.md).
     held = g1_sim.held_clip(tmp_path / "held_dance_b.txt")
     s = g1_sim.run_walking(clip=held, push=(1.1, (80.0, 0.0, 0.0), 0.05))
     assert s["stayed_up"] and s["zmp_inside"], s
@@ -463,7 +463,7 @@ def test_walking_while_dancing_stays_up_with_the_zmp_correction():
 # (by up to 6 cm): the plan's ZMP is still outside on 111 of 480 single-support ticks, where
 # the correction's move of the COM is more than the cart-table's ZMP can follow in time.
 @pytest.mark.xfail(strict=True, reason="walking while dancing, the plan's ZMP is still outside "
-                   "on 111 of 480 single-support ticks after the correction (README)")
+                   "on 111 of 480 single-support ticks after the correction (book/src/mujoco.md)")
 def test_walking_while_dancing_keeps_the_zmp_inside():
     s = g1_sim.run_walking()
     assert s["zmp_inside"], s
