@@ -93,7 +93,7 @@ impl PyWalking {
         cfg.damping = damping;
         if let Some(c) = cases {
             let [xz_ssp, xz_dsp, yz_ssp, yz_dsp] = c.as_slice() else {
-                return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                return Err(crate::IktcError::new_err(format!(
                     "cases: expected four PlaneModels (xz SSP, xz DSP, yz SSP, yz DSP), got {}",
                     c.len()
                 )));

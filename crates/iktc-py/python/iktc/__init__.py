@@ -35,6 +35,7 @@ from ._iktc import (
     DampingController,
     measure_zmp,
     identify,
+    dominant_mode,
     Motion,
     Retargeted,
     References,
@@ -45,6 +46,7 @@ from ._iktc import (
     retarget_keypoints,
     KeypointTrajectory,
     profile_init,
+    builtin_text,
 )
 
 __all__ = [
@@ -61,6 +63,7 @@ __all__ = [
     "DampingController",
     "measure_zmp",
     "identify",
+    "dominant_mode",
     "Motion",
     "Retargeted",
     "References",
@@ -71,4 +74,5 @@ __all__ = [
     "retarget_keypoints",
     "KeypointTrajectory",
     "profile_init",
+    "builtin_text",
 ]

@@ -15,7 +15,9 @@ class IktcError(ValueError): ...
 class Robot:
     """A robot model: a built-in name ("jvrc1", "g1" with their profiles; "planar3r"), a robot
     profile file (.toml), a URDF file (.urdf, no profile) or a MuJoCo MJCF file (.xml, no
-    profile; floating when it has a free joint unless `floating` says otherwise)."""
+    profile; floating when it has a free joint unless `floating` says otherwise). With a
+    profile, `accel`, `velocity` and `default_velocity` replace its acceleration and velocity
+    limits for the joints they name."""
     def __init__(self, spec: str, *, floating: Optional[bool] = None,
                  lock: Optional[Sequence[Tuple[str, float]]] = None,
                  accel: Optional[Sequence[Tuple[str, float]]] = None,
@@ -134,6 +136,13 @@ def measure_zmp(left: Tuple[Vec, Vec, Vec], right: Tuple[Vec, Vec, Vec],
 def identify(omega: Sequence[float], magnitude: Sequence[float],
              phase: Sequence[float]) -> Tuple[PlaneModel, Dict[str, float]]: ...
 
+def dominant_mode(t: Vec, y: Vec, *, smoothing: int = 8, decimation: int = 4,
+                  order: int = 8) -> Tuple[float, float]:
+    """(damping ratio [–], natural frequency [rad/s]) of the dominant oscillatory mode of the
+    response y sampled at the uniformly spaced times t [s], by Prony's method; NaN, NaN if no
+    pair oscillates."""
+    ...
+
 class Motion:
     @property
     def source(self) -> str: ...
@@ -224,6 +233,7 @@ def retarget_keypoints(motion: Motion, robot: Robot, *, dt: float = 0.005,
 
 class Imitation:
     def __init__(self, robot: Robot, motion: Motion, *, map: Optional[str] = None,
+                 root_scales: Optional[Dict[str, float]] = None,
                  dt: float = 0.005, method: str = "iktc", bounds: str = "quiet",
                  duration: Optional[float] = None, time_scale: float = 1.0,
                  level_hold: Optional[int] = None, rebase_release: float = 1.0,
@@ -283,6 +293,11 @@ class Walking:
     def support_margin(self, point: Tuple[float, float],
                        feet: Optional[Sequence[FloatArray]] = None) -> float: ...
     def feet0(self) -> List[FloatArray]: ...
+
+def builtin_text(kind: str, name: str) -> str:
+    """The text of a data file built into iktc: kind "urdf" (jvrc1, g1), "mjcf" (g1),
+    "profile" (jvrc1, g1), "map" or "clip", and the item's name."""
+    ...
 
 def profile_init(urdf: str, *, out: Optional[str] = None) -> str:
     """A starting robot profile (TOML) for a URDF or MJCF model, guesses marked
