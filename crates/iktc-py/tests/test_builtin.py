@@ -1,8 +1,10 @@
 """What the iktc module itself provides in place of repository files: the built-in data files'
 text (``iktc.builtin_text``), a profile robot with other acceleration and velocity limits
 (``iktc.Robot(profile, accel=…)``), an imitation with the map's pelvis scales replaced
-(``root_scales``)."""
+(``root_scales``); and ``iktc.mujoco`` without MuJoCo."""
 import json
+import subprocess
+import sys
 import xml.etree.ElementTree as ET
 
 import numpy as np
@@ -86,3 +88,16 @@ def test_root_scales_replace_the_maps_pelvis_scales():
     with pytest.raises(iktc.IktcError, match="root_scales\\[\"height_scale\"\\]"):
         iktc.Imitation(robot, motion, root_scales={"height_scale": float("nan")})
 
+
+def test_iktc_imports_without_mujoco_and_its_mujoco_subpackage_says_how_to_install_it():
+    code = ("import sys; sys.modules['mujoco'] = None\n"
+            "import iktc\n"
+            "assert 'iktc.mujoco' not in sys.modules\n"
+            "try:\n"
+            "    import iktc.mujoco\n"
+            "except ImportError as e:\n"
+            "    print(e)\n"
+            "else:\n"
+            "    raise SystemExit('imported without mujoco')\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert "pip install mujoco" in out.stdout, out

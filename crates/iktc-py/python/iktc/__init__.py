@@ -20,6 +20,9 @@ imitation of Section 5.3 tick by tick.
 
 Every error of the library is raised as ``iktc.IktcError`` (a ``ValueError``) with the
 library's message.
+
+``iktc.mujoco`` (needs ``pip install mujoco``) runs the Unitree G1 in MuJoCo under iktc: the
+plant, the closed loop, the identification and push test of the damping controller, walking.
 """
 from ._iktc import (
     __version__,
