@@ -22,7 +22,8 @@ of the feet carrying load and against the pattern's. `causes` prints the
 figures behind the expected failures: the standing run with the knees narrowed, the viable
 bounds and Algorithm 2's level as printed,
 the pelvis held, the clip slower, the arms frozen in the plan; the walking plan's ZMP and knees
-with and without narrowed knees; the walk in MuJoCo with stiffer servos. See ``g1_sim.py``.
+with and without narrowed knees; the walk in MuJoCo with stiffer servos. The plant, the loop
+and the runs are ``iktc.mujoco``'s.
 """
 import argparse
 import json
@@ -30,12 +31,12 @@ import pathlib
 
 import numpy as np
 
-import g1_sim
 import iktc
+import iktc.mujoco as g1
 
 
 def balance(a) -> dict:
-    model, fit, (omega, mag, phase) = g1_sim.identify_on_plant()
+    model, fit, (omega, mag, phase) = g1.identify_on_plant()
     wn, zeta = model.modal()
     out = {
         "sweep_hz": [float(w / (2 * np.pi)) for w in omega],
@@ -48,8 +49,8 @@ def balance(a) -> dict:
         "design_damping_ratio": a.damping,
     }
     for name, m in (("open_loop", None), ("damped", model)):
-        loop, t, y = g1_sim.push_test(model=m, damping=a.damping)
-        z, w = g1_sim.damping_ratio(t, y)
+        loop, t, y = g1.push_test(model=m, damping=a.damping)
+        z, w = iktc.dominant_mode(t, y)
         s = loop.summary()
         out[f"push_{name}"] = {"damping_ratio": z, "natural_frequency_rad_s": w,
                                "zmp_peak_m": float(np.abs(y).max()),
@@ -58,36 +59,33 @@ def balance(a) -> dict:
     if a.designs:
         out["push_damped_by_design"] = {}
         for z in (float(x) for x in a.designs.split(",")):
-            loop, t, y = g1_sim.push_test(model=model, damping=z)
-            out["push_damped_by_design"][str(z)] = g1_sim.damping_ratio(t, y)[0]
+            loop, t, y = g1.push_test(model=model, damping=z)
+            out["push_damped_by_design"][str(z)] = iktc.dominant_mode(t, y)[0]
     return out
 
 
 def causes(a) -> dict:
     """The figures behind the expected failures (diagnostic settings, not defaults)."""
-    import tempfile
-    tmp = pathlib.Path(tempfile.mkdtemp())
     names = iktc.Robot("g1").joint_names
-    slow = iktc.Robot(g1_sim.g1_profile_with_acceleration(tmp / "g1_accel_1x.toml", 1.0))
+    slow = g1.robot_with_acceleration(1.0)
     upper = [n for n in names if any(x in n for x in ("shoulder", "elbow", "wrist"))]
-    held = g1_sim.held_pelvis_map(tmp / "held_pelvis.toml")
     runs = {
         "default": {},
         "arms_frozen_in_the_plan": {"frozen": upper},
-        "knees_narrowed": {"narrow": g1_sim.G1_KNEES},
-        "knees_narrowed_accel_1x_velocity_limit": {"narrow": g1_sim.G1_KNEES, "robot": slow},
+        "knees_narrowed": {"narrow": g1.G1_KNEES},
+        "knees_narrowed_accel_1x_velocity_limit": {"narrow": g1.G1_KNEES, "robot": slow},
         "viable_bounds_algorithm2": {"bounds": "viable", "level_hold": 1},
-        "pelvis_held": {"map": held},
+        "pelvis_held": {"root_scales": g1.PELVIS_HELD},
         "clip_4x_slower": {"time_scale": 4.0},
     }
-    out = {"standing": {k: g1_sim.standing_figures(**kw) for k, kw in runs.items()}}
+    out = {"standing": {k: g1.standing_figures(**kw) for k, kw in runs.items()}}
     out["walking_plan"] = {f"{clip} {'knees narrowed' if n else 'default'}":
-                           g1_sim.walking_plan_figures(clip, n)
+                           g1.walking_plan_figures(clip, n)
                            for clip in ("humanoid3d_dance_b", "humanoid3d_walk")
-                           for n in (None, g1_sim.G1_KNEES)}
+                           for n in (None, g1.G1_KNEES)}
     out["walking_mujoco_walk_clip_knees_narrowed"] = {
-        f"kp {kp}": g1_sim.run_walking(clip="humanoid3d_walk", narrow=g1_sim.G1_KNEES, kp=kp,
-                                       kv=kv)["stayed_up"]
+        f"kp {kp}": g1.run_walking(clip="humanoid3d_walk", narrow=g1.G1_KNEES, kp=kp,
+                                   kv=kv)["stayed_up"]
         for kp, kv in ((500.0, 20.0), (2000.0, 40.0), (5000.0, 100.0))}
     return out
 
@@ -127,9 +125,9 @@ def main() -> None:
         clip = a.clip
         if a.hold_upper_body:
             import tempfile
-            clip = g1_sim.held_clip(pathlib.Path(tempfile.mkdtemp()) / f"held_{a.clip}.txt", a.clip)
-        s = g1_sim.run_walking(steps=a.steps, clip=clip, feedforward=not a.no_feedforward,
-                               replay=a.replay, zmp_passes=a.zmp_passes)
+            clip = g1.held_clip(pathlib.Path(tempfile.mkdtemp()) / f"held_{a.clip}.txt", a.clip)
+        s = g1.run_walking(steps=a.steps, clip=clip, feedforward=not a.no_feedforward,
+                           replay=a.replay, zmp_passes=a.zmp_passes)
     else:
         s = standing(a)
     print(json.dumps(s, indent=1))
@@ -149,32 +147,32 @@ def standing(a) -> dict:
     if a.plan in ("keypoints", "upper-body"):
         if a.time_scale != 1.0:
             raise SystemExit("--time-scale applies to --plan joints only")
-        loop = g1_sim.run_standing_keypoints(clip=a.clip, settle=a.settle,
-                                             robot=iktc.Robot(a.robot),
-                                             standing=a.plan == "upper-body")
+        loop = g1.run_standing_keypoints(clip=a.clip, settle=a.settle,
+                                         robot=iktc.Robot(a.robot),
+                                         standing=a.plan == "upper-body")
     else:
-        loop = g1_sim.Loop(clip=a.clip, time_scale=a.time_scale, robot=iktc.Robot(a.robot))
+        loop = g1.Loop(clip=a.clip, time_scale=a.time_scale, robot=iktc.Robot(a.robot))
         loop.settle(a.settle)
         for _ in range(loop.sim.ticks):
             loop.step()
     s = loop.summary()
     s["plan"] = a.plan
-    s.update(g1_sim.plan_chatter(loop.log.q_cmd))
+    s.update(g1.plan_chatter(loop.log.q_cmd))
     # The plan's ZMP where the ground carries at least PLANNED_MIN_SUPPORT of the weight; the
     # ticks (the two at each end aside) where it carries less, or would have to pull, counted.
-    plan = g1_sim.planned_zmp(loop.plant, loop.log.q_cmd, min_support=PLANNED_MIN_SUPPORT)
-    pulls = g1_sim.planned_zmp(loop.plant, loop.log.q_cmd)
-    feet = [loop.robot.frame_pose(loop.log.q_cmd[0], f) for f in g1_sim.FEET]  # held
+    plan = g1.planned_zmp(loop.plant, loop.log.q_cmd, min_support=PLANNED_MIN_SUPPORT)
+    pulls = g1.planned_zmp(loop.plant, loop.log.q_cmd)
+    feet = [loop.robot.frame_pose(loop.log.q_cmd[0], f) for f in g1.FEET]  # held
     margins = [loop.sim.support_margin(tuple(p), feet) for p in plan if np.all(np.isfinite(p))]
     s["planned_zmp_margin_min_m"] = float(min(margins))
     s["planned_zmp_ticks_outside"] = int(sum(m < 0 for m in margins))
     s["planned_light_support_ticks"] = int(np.isnan(plan[2:-2, 0]).sum())
     s["planned_ground_pulls_ticks"] = int(np.isnan(pulls[2:-2, 0]).sum())
     if a.replay:
-        g1_sim.write_replay(a.replay, loop.plant, loop.log.qpos, loop.log.q_cmd,
-                            f"G1 in MuJoCo imitating {a.clip} (time scale {a.time_scale})")
-    s["plant"] = {"kp_Nm_per_rad": g1_sim.KP, "kv_Nms_per_rad": g1_sim.KV,
-                  "physics_step_s": g1_sim.PHYSICS_STEP, "control_period_s": g1_sim.CONTROL_PERIOD,
+        g1.write_replay(a.replay, loop.plant, loop.log.qpos, loop.log.q_cmd,
+                        f"G1 in MuJoCo imitating {a.clip} (time scale {a.time_scale})")
+    s["plant"] = {"kp_Nm_per_rad": g1.KP, "kv_Nms_per_rad": g1.KV,
+                  "physics_step_s": g1.PHYSICS_STEP, "control_period_s": g1.CONTROL_PERIOD,
                   "integrator": "implicitfast"}
     return s
 

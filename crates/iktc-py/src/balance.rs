@@ -3,9 +3,9 @@
 //! eq. 31), pole placement (eqs. 32–33) and the per-tick controller of one plane.
 
 use iktc::balance::{
-    design_discrete, identify, measure_zmp, DampingController, DiscreteSettings, FootSensor,
-    FrequencyData, FullModelParams, IdentifySettings, IpcjParams, PoleSpec, ZmpSettings, ZmpStatus,
-    STANDARD_GRAVITY,
+    design_discrete, dominant_mode, identify, measure_zmp, DampingController, DiscreteSettings,
+    FootSensor, FrequencyData, FullModelParams, IdentifySettings, IpcjParams, PoleSpec,
+    PronySettings, ZmpSettings, ZmpStatus, STANDARD_GRAVITY,
 };
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -159,6 +159,35 @@ fn py_identify<'py>(
     Ok((model, fit))
 }
 
+/// The dominant oscillatory mode of a response y [m] sampled at the uniformly spaced times t
+/// [s] (e.g. the ZMP after a push), by Prony's method (`iktc::balance::dominant_mode`: y
+/// low-passed by a moving average of `smoothing` samples applied twice, every
+/// `decimation`-th sample kept, a linear prediction of order `order`; of the pairs that turn
+/// by half a cycle over the record, the one with the most energy). Returns (damping ratio ζ
+/// [–], natural frequency ω_n [rad/s]), both NaN if no pair oscillates.
+#[pyfunction]
+#[pyo3(name = "dominant_mode", signature = (t, y, *, smoothing=8, decimation=4, order=8))]
+fn py_dominant_mode(
+    py: Python<'_>,
+    t: Vec<f64>,
+    y: Vec<f64>,
+    smoothing: usize,
+    decimation: usize,
+    order: usize,
+) -> PyResult<(f64, f64)> {
+    let settings = PronySettings {
+        smoothing,
+        decimation,
+        order,
+    };
+    let mode = py
+        .detach(|| dominant_mode(&t, &y, &settings))
+        .map_err(to_py)?;
+    Ok(mode.map_or((f64::NAN, f64::NAN), |m| {
+        (m.damping_ratio, m.natural_frequency)
+    }))
+}
+
 /// The damping controller of one plane (Section 4.3): observer on the full model and state
 /// feedback placing the IPCJ poles at damping ratio `damping_ratio` and natural frequency
 /// `natural_frequency` [rad/s] (None keeps the open-loop w_n, so only damping is added),
@@ -214,6 +243,7 @@ impl PyDampingController {
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(py_measure_zmp, m)?)?;
     m.add_function(wrap_pyfunction!(py_identify, m)?)?;
+    m.add_function(wrap_pyfunction!(py_dominant_mode, m)?)?;
     m.add_class::<PyPlaneModel>()?;
     m.add_class::<PyDampingController>()?;
     Ok(())

@@ -4,6 +4,8 @@
 //! controller's output) and the support-polygon margin of a measured ZMP is computed from the
 //! profile's soles.
 
+use std::collections::BTreeMap;
+
 use iktc::limits::{BoundMethod, NarrowedJoint};
 use iktc::motion::Clip;
 use iktc::sim::imitate::support_polygon;
@@ -141,15 +143,19 @@ impl PyImitation {
     /// differentiated (`iktc::sim::ImitateConfig::smoothing`; default 6 Hz, None: as captured).
     /// `approach_rate` [1/s]: the soft approach to the range ends with viable or quiet bounds
     /// (`iktc::limits::ViableSettings::approach_rate`; default None: the imitation's, the tasks'
-    /// rate √k_p = 10 /s; 0 turns it off).
+    /// rate √k_p = 10 /s; 0 turns it off). `root_scales`: keys of the map's `[root]` table
+    /// (`height_scale`, `yaw_scale`, `pitch_scale`, `roll_scale` [–]) replacing the map's, e.g.
+    /// `{"height_scale": 0.0, "pitch_scale": 0.0, "roll_scale": 0.0}` holds the pelvis at its
+    /// start.
     #[new]
-    #[pyo3(signature = (robot, motion, *, map=None, dt=0.005, method="iktc", bounds="quiet", duration=None, time_scale=1.0, level_hold=None, rebase_release=1.0, continuity=0.0, narrow=None, smoothing=Some(iktc::sim::IMITATE_SMOOTHING), approach_rate=None))]
+    #[pyo3(signature = (robot, motion, *, map=None, root_scales=None, dt=0.005, method="iktc", bounds="quiet", duration=None, time_scale=1.0, level_hold=None, rebase_release=1.0, continuity=0.0, narrow=None, smoothing=Some(iktc::sim::IMITATE_SMOOTHING), approach_rate=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
         robot: &PyRobot,
         motion: &PyMotion,
         map: Option<&str>,
+        root_scales: Option<BTreeMap<String, f64>>,
         dt: f64,
         method: &str,
         bounds: &str,
@@ -185,7 +191,26 @@ impl PyImitation {
             cfg.narrow = narrowed(n);
         }
         cfg.smoothing = smoothing;
-        let map = resolve_map(robot, motion, map)?;
+        let mut map = resolve_map(robot, motion, map)?;
+        for (key, value) in root_scales.unwrap_or_default() {
+            let scale = match key.as_str() {
+                "height_scale" => &mut map.root.height_scale,
+                "yaw_scale" => &mut map.root.yaw_scale,
+                "pitch_scale" => &mut map.root.pitch_scale,
+                "roll_scale" => &mut map.root.roll_scale,
+                other => {
+                    return Err(IktcError::new_err(format!(
+                        "root_scales: unknown key `{other}`; expected height_scale, yaw_scale, pitch_scale or roll_scale"
+                    )))
+                }
+            };
+            if !value.is_finite() {
+                return Err(IktcError::new_err(format!(
+                    "root_scales[{key:?}] = {value}: expected a finite scale [–]"
+                )));
+            }
+            *scale = value;
+        }
         let clip = motion.clip()?;
         let part = clip_part(clip, time_scale, duration).map_err(to_py)?;
         let clip = part.as_ref().unwrap_or(clip);

@@ -77,8 +77,8 @@ pub fn py_retarget_keypoints(
         "leg" => HandScaling::Leg,
         "segments" => HandScaling::Segments,
         other => {
-            return Err(pyo3::exceptions::PyValueError::new_err(format!(
-                "unknown hands `{other}`; expected \"leg\" or \"segments\""
+            return Err(crate::IktcError::new_err(format!(
+                "hands = `{other}`: expected \"leg\" or \"segments\""
             )))
         }
     };

@@ -12,6 +12,7 @@ use pyo3::prelude::*;
 mod balance;
 mod controller;
 mod convert;
+mod data;
 mod imitate;
 mod keypoints;
 mod motion;
@@ -44,6 +45,7 @@ fn _iktc(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<imitate::PyImitation>()?;
     m.add_class::<walk::PyWalking>()?;
     m.add_function(wrap_pyfunction!(robot::profile_init, m)?)?;
+    m.add_function(wrap_pyfunction!(data::builtin_text, m)?)?;
     motion::register(m)?;
     keypoints::register(m)?;
     balance::register(m)?;

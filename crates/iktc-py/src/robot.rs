@@ -20,7 +20,9 @@ type StateArrays<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>);
 /// `Robot("jvrc1")` or `Robot("g1")` loads a built-in robot through its built-in profile (feet,
 /// pelvis, posture, locks, acceleration limits, retargeting maps), like the command line's
 /// `--robot g1`; `Robot("planar3r")` is the 3R arm (no profile); `Robot("my_robot.toml")` reads
-/// a profile file; `Robot("path/to/robot.urdf", floating=True, lock=[("finger", 0.0)],
+/// a profile file; with a profile, `accel` [rad/s²] and `velocity` [rad/s] (joint, limit) pairs
+/// and `default_velocity` replace its keys `acceleration.limits`, `velocity.limits` and
+/// `velocity.default` for the joints they name; `Robot("path/to/robot.urdf", floating=True, lock=[("finger", 0.0)],
 /// accel=[("knee", 30.0)], velocity=[("knee", 14.0)], default_velocity=20.0)` reads a bare
 /// URDF file (no profile; `velocity` [rad/s] replaces a joint's velocity limit,
 /// `default_velocity` [rad/s] is the limit of the joints the file gives none, with the
@@ -49,14 +51,16 @@ impl PyRobot {
         default_velocity: Option<f64>,
     ) -> PyResult<Self> {
         let is_urdf = spec.ends_with(".urdf") || spec.ends_with(".xml");
-        let options_given = floating.is_some()
-            || lock.is_some()
-            || accel.is_some()
-            || velocity.is_some()
-            || default_velocity.is_some();
-        if !is_urdf && options_given {
+        let is_profile = spec.ends_with(".toml") || BUILTIN_PROFILES.contains(&spec);
+        let limits_given = accel.is_some() || velocity.is_some() || default_velocity.is_some();
+        if is_profile && (floating.is_some() || lock.is_some()) {
             return Err(crate::IktcError::new_err(format!(
-                "`{spec}` is a built-in robot or a profile: floating, lock, accel, velocity and default_velocity apply to URDF and MJCF files only (a profile sets them with its keys `base`, `lock`, `acceleration` and `velocity`)"
+                "`{spec}` is a profile: floating and lock apply to URDF and MJCF files only (a profile sets them with its keys `base` and `lock`)"
+            )));
+        }
+        if !is_urdf && !is_profile && (floating.is_some() || lock.is_some() || limits_given) {
+            return Err(crate::IktcError::new_err(format!(
+                "`{spec}` is a built-in robot without a profile: floating, lock, accel, velocity and default_velocity apply to URDF and MJCF files only (accel, velocity and default_velocity also to profiles)"
             )));
         }
         if let Some(v) = default_velocity {
@@ -73,7 +77,26 @@ impl PyRobot {
         } else {
             None
         };
-        if let Some(p) = profile {
+        if let Some(mut p) = profile {
+            if limits_given {
+                // The keywords replace the profile's keys for the joints they name.
+                p.acceleration.limits.extend(accel.unwrap_or_default());
+                p.velocity.limits.extend(velocity.unwrap_or_default());
+                if default_velocity.is_some() {
+                    p.velocity.default = default_velocity;
+                }
+                let keywords = |e: iktc::Error| {
+                    crate::IktcError::new_err(format!(
+                        "accel, velocity or default_velocity given to the profile `{spec}` (they set its keys acceleration.limits, velocity.limits and velocity.default): {e}"
+                    ))
+                };
+                p.check_values().map_err(keywords)?;
+                let robot = p.robot().map_err(keywords)?;
+                return Ok(Self {
+                    robot: Arc::new(robot),
+                    profile: Some(Arc::new(p)),
+                });
+            }
             let robot = p.robot().map_err(to_py)?;
             return Ok(Self {
                 robot: Arc::new(robot),
@@ -262,7 +285,7 @@ impl PyRobot {
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let a = qs.as_array();
         if a.ncols() != self.robot.nq() {
-            return Err(pyo3::exceptions::PyValueError::new_err(format!(
+            return Err(crate::IktcError::new_err(format!(
                 "qs: expected {} columns (nq), got {}",
                 self.robot.nq(),
                 a.ncols()

@@ -30,7 +30,7 @@ type PatternZmp = (Vector2<f64>, f64);
 /// (xz SSP, xz DSP, yz SSP, yz DSP, `PlaneModel`s; their length is replaced by the COM height),
 /// None the synthetic ones of `iktc::balance::CaseParams::synthetic`; `offset_feedforward`
 /// False gives the COM task the controller's offset without its rates fed forward (as
-/// `g1_sim`'s identification sweeps it); `smoothing` [Hz] and `approach_rate` [1/s] as in
+/// `iktc.mujoco`'s identification sweeps it); `smoothing` [Hz] and `approach_rate` [1/s] as in
 /// `Imitation` (default 6 Hz and the imitation's approach, √k_p = 10 /s; None and 0 turn
 /// them off); `zmp_passes` passes of the ZMP correction (`WalkingController::correct_zmp`:
 /// where the plan's own multibody ZMP comes within 5 mm of the support polygon's edge, the COM
@@ -93,7 +93,7 @@ impl PyWalking {
         cfg.damping = damping;
         if let Some(c) = cases {
             let [xz_ssp, xz_dsp, yz_ssp, yz_dsp] = c.as_slice() else {
-                return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                return Err(crate::IktcError::new_err(format!(
                     "cases: expected four PlaneModels (xz SSP, xz DSP, yz SSP, yz DSP), got {}",
                     c.len()
                 )));

@@ -1,18 +1,14 @@
-"""The MuJoCo closed loop of the G1 (crates/iktc-py/examples/g1_sim.py), run briefly, headless."""
-import pathlib
-import sys
-
+"""The MuJoCo closed loop of the G1 (``iktc.mujoco``), run briefly, headless."""
 import mujoco
 import numpy as np
 import pytest
 
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "examples"))
-import g1_sim  # noqa: E402
-import iktc  # noqa: E402
+import iktc
+import iktc.mujoco as g1
 
 
 def test_the_plant_stands_and_its_ankle_sensors_carry_the_weight():
-    loop = g1_sim.Loop(duration=0.1)
+    loop = g1.Loop(duration=0.1)
     p = loop.plant
     q = loop.sim.q
     for _ in range(200):  # 1 s holding the initial posture
@@ -32,7 +28,7 @@ def test_the_plant_stands_and_its_ankle_sensors_carry_the_weight():
 
 
 def test_the_sensor_zmp_is_the_centre_of_pressure_of_the_contact_forces():
-    loop = g1_sim.Loop(duration=0.1)
+    loop = g1.Loop(duration=0.1)
     loop.settle(0.5)
     p, m, d = loop.plant, loop.plant.model, loop.plant.data
     # Centre of pressure from MuJoCo's contact forces (an independent route to the ZMP).
@@ -51,7 +47,7 @@ def test_the_sensor_zmp_is_the_centre_of_pressure_of_the_contact_forces():
 
 
 def test_standing_imitation_of_the_default_clip_stays_up():
-    loop = g1_sim.run_standing()
+    loop = g1.run_standing()
     s = loop.summary()
     assert s["ticks"] == loop.sim.ticks == 507
     assert s["stayed_up"], s
@@ -65,7 +61,7 @@ def test_standing_imitation_of_the_default_clip_stays_up():
 @pytest.mark.xfail(strict=True, reason="G1 on MuJoCo rocks and its feet slip 28 mm "
                    "while imitating humanoid3d_dance_b (see book/src/mujoco.md)")
 def test_standing_imitation_of_the_default_clip_keeps_the_feet_within_5_mm():
-    s = g1_sim.run_standing().summary()
+    s = g1.run_standing().summary()
     assert s["foot_slip_max_m"] <= 5e-3, s
 
 
@@ -77,7 +73,7 @@ def test_standing_imitation_of_the_default_clip_keeps_the_feet_within_5_mm():
                    reason="G1 on MuJoCo falls following the keypoint route's plan "
                    "of humanoid3d_dance_b with its feet held (see book/src/mujoco.md)")
 def test_standing_imitation_by_the_keypoint_route_keeps_the_feet_within_5_mm():
-    s = g1_sim.run_standing_keypoints().summary()
+    s = g1.run_standing_keypoints().summary()
     assert s["foot_slip_max_m"] <= 5e-3, s
 
 
@@ -87,7 +83,7 @@ def test_standing_imitation_by_the_keypoint_route_keeps_the_feet_within_5_mm():
 # ZMP (inverse dynamics) outside the polygon on 3 of 504 ticks, by at most 18 mm (the joint
 # route's: outside on 127).
 def test_standing_imitation_of_the_upper_body_stays_up_and_level():
-    loop = g1_sim.run_standing_keypoints(standing=True)
+    loop = g1.run_standing_keypoints(standing=True)
     s = loop.summary()
     assert s["stayed_up"], s
     assert s["pelvis_height_min_m"] > 0.74 and s["base_tilt_max_rad"] < 0.1, s
@@ -99,10 +95,10 @@ def test_standing_imitation_of_the_upper_body_stays_up_and_level():
 # Its feet slip 2.6 mm; the servos trail the plan by 0.024 rad rms (MuJoCo 4.0.1, 2026-12-06).
 # At a 1 ms physics step: 9.0 mm and 0.094 rad rms, the light arm servos (the wrists and the
 # shoulders' yaw most) flipping between their force limits on 141 of 508 ticks (see
-# g1_sim.PHYSICS_STEP). The feet turn by up to 28 mrad and back: MuJoCo's soft friction on its
+# g1.PHYSICS_STEP). The feet turn by up to 28 mrad and back: MuJoCo's soft friction on its
 # pyramidal cone.
 def test_standing_imitation_of_the_upper_body_keeps_the_feet_within_5_mm():
-    s = g1_sim.run_standing_keypoints(standing=True).summary()
+    s = g1.run_standing_keypoints(standing=True).summary()
     assert s["foot_slip_max_m"] <= 5e-3, s
     assert s["upper_body_error_rms_rad"] < 0.05, s
 
@@ -111,9 +107,9 @@ def test_the_upper_body_standing_imitation_has_converged_in_the_physics_step():
     # Halving the physics step changes the figures little (0.1 → 0.05 ms: slip 2.6 → 2.6 mm,
     # servo error 0.0240 → 0.0238 rad rms, MuJoCo 4.0.1, 2026-12-06); at 1 ms they are 9.0 mm
     # and 0.094 rad.
-    a = g1_sim.run_standing_keypoints(standing=True).summary()
-    b = g1_sim.run_standing_keypoints(standing=True,
-                                      physics_step=g1_sim.PHYSICS_STEP / 2).summary()
+    a = g1.run_standing_keypoints(standing=True).summary()
+    b = g1.run_standing_keypoints(standing=True,
+                                  physics_step=g1.PHYSICS_STEP / 2).summary()
     assert abs(a["foot_slip_max_m"] - b["foot_slip_max_m"]) < 0.5e-3, (a, b)
     assert abs(a["upper_body_error_rms_rad"] - b["upper_body_error_rms_rad"]) < 5e-3, (a, b)
 
@@ -126,8 +122,8 @@ def _hinge(physics_step: float, inertia: float, limit: float = 25.0) -> list:
       <worldbody><body><joint name="j" axis="0 0 1" actuatorfrcrange="{-limit} {limit}"/>
         <inertial pos="0 0 0" mass="1" diaginertia="{inertia} {inertia} {inertia}"/>
       </body></worldbody>
-      <actuator><general joint="j" gainprm="{g1_sim.KV}" biastype="affine"
-        biasprm="0 0 {-g1_sim.KV}"/></actuator></mujoco>"""
+      <actuator><general joint="j" gainprm="{g1.KV}" biastype="affine"
+        biasprm="0 0 {-g1.KV}"/></actuator></mujoco>"""
     m = mujoco.MjModel.from_xml_string(xml)
     d = mujoco.MjData(m)
     d.ctrl[0] = 3.0
@@ -145,15 +141,15 @@ def test_a_saturated_rate_servo_on_a_light_link_needs_a_short_physics_step():
     # the rate flips between 0 and 13.9 rad/s for good; at PHYSICS_STEP it settles on 3 rad/s.
     coarse = _hinge(1e-3, 1.8e-3)
     assert sorted(coarse[-2:]) == pytest.approx([0.0, 13.889], abs=1e-3), coarse
-    assert _hinge(g1_sim.PHYSICS_STEP, 1.8e-3)[-1] == pytest.approx(3.0, abs=1e-3)
+    assert _hinge(g1.PHYSICS_STEP, 1.8e-3)[-1] == pytest.approx(3.0, abs=1e-3)
 
 
 def test_the_planned_zmp_is_the_com_standing_and_shifts_by_z_a_over_g_when_accelerated():
-    loop = g1_sim.Loop(duration=0.1)
+    loop = g1.Loop(duration=0.1)
     q0 = loop.sim.q
     com = loop.robot.com(q0)
     # Standing still: the ZMP is under the COM (iktc's COM, an independent computation).
-    z = g1_sim.planned_zmp(loop.plant, [q0] * 7)
+    z = g1.planned_zmp(loop.plant, [q0] * 7)
     assert np.allclose(z[2:5], com[:2], atol=1e-6)
     # The whole robot translated with a constant horizontal acceleration a [m/s²]: the
     # cart-table closed form x_zmp = x_com − z_com a / g holds exactly for a pure translation.
@@ -161,99 +157,21 @@ def test_the_planned_zmp_is_the_com_standing_and_shifts_by_z_a_over_g_when_accel
     qs = []
     for k in range(7):
         q = q0.copy()
-        q[0] += 0.5 * a * (k * g1_sim.CONTROL_PERIOD) ** 2
+        q[0] += 0.5 * a * (k * g1.CONTROL_PERIOD) ** 2
         qs.append(q)
-    z = g1_sim.planned_zmp(loop.plant, qs)
+    z = g1.planned_zmp(loop.plant, qs)
     g = -loop.plant.model.opt.gravity[2]
     for k in range(2, 5):
-        expected = com[0] + 0.5 * a * (k * g1_sim.CONTROL_PERIOD) ** 2 - com[2] * a / g
+        expected = com[0] + 0.5 * a * (k * g1.CONTROL_PERIOD) ** 2 - com[2] * a / g
         assert z[k, 0] == pytest.approx(expected, abs=1e-6)
         assert z[k, 1] == pytest.approx(com[1], abs=1e-6)
-
-
-@pytest.mark.parametrize("zeta,wn", [(0.15, 4.8), (0.55, 4.5), (0.72, 5.0)])
-def test_the_damping_ratio_estimate_recovers_a_known_damped_sinusoid(zeta, wn):
-    t = np.arange(0.0, 2.0, g1_sim.CONTROL_PERIOD)
-    wd = wn * np.sqrt(1 - zeta ** 2)
-    y = 0.003 + 0.02 * np.exp(-zeta * wn * t) * np.cos(wd * t + 0.4)
-    z, w = g1_sim.damping_ratio(t, y)
-    assert z == pytest.approx(zeta, abs=0.01) and w == pytest.approx(wn, rel=0.01)
-
-
-def test_the_damping_ratio_estimate_picks_the_dominant_mode_of_several():
-    # The shape of a damped closed loop after a push: the designed pair, the observer's pair at
-    # twice its frequency, a real lag pole, a lightly damped faster resonance and an offset.
-    t = np.arange(0.0, 2.0, g1_sim.CONTROL_PERIOD)
-
-    def mode(zeta, wn, amp, phase):
-        return amp * np.exp(-zeta * wn * t) * np.cos(wn * np.sqrt(1 - zeta ** 2) * t + phase)
-
-    y = (0.002 + mode(0.72, 4.9, 0.02, 0.3) + mode(0.72, 9.8, -0.006, 1.0)
-         + 0.008 * np.exp(-6.0 * t) + mode(0.15, 30.0, 0.001, 0.0))
-    z, w = g1_sim.damping_ratio(t, y)
-    assert z == pytest.approx(0.72, abs=0.01) and w == pytest.approx(4.9, rel=0.01)
-
-
-def test_the_damping_ratio_estimate_passes_over_a_pair_that_does_not_oscillate_in_the_record():
-    # Two nearly equal real decays can come out of Prony's fit as a barely complex pair with a
-    # large amplitude (−9.25 ± 0.62j rad/s: a tenth of a cycle in 2 s). It outweighs the
-    # designed pair (ζ = 0.7, 5.5 rad/s) in energy but is no oscillation.
-    t = np.arange(0.0, 2.0, g1_sim.CONTROL_PERIOD)
-    slow = 0.05 * np.exp(-9.25 * t) * np.cos(0.62 * t + 0.2)
-    wn, zeta = 5.5, 0.7
-    pair = 0.02 * np.exp(-zeta * wn * t) * np.cos(wn * np.sqrt(1 - zeta ** 2) * t + 0.5)
-    z, w = g1_sim.damping_ratio(t, 0.002 + slow + pair)
-    assert z == pytest.approx(zeta, abs=0.01) and w == pytest.approx(wn, rel=0.01)
-
-
-def _expm(m):
-    """exp(m) by scaling and squaring of the Taylor series (small, well-scaled matrices)."""
-    s = max(0, int(np.ceil(np.log2(max(np.linalg.norm(m, 1), 1e-300)))) + 1)
-    a, e, term = m / 2 ** s, np.eye(len(m)), np.eye(len(m))
-    for k in range(1, 20):
-        term = term @ a / k
-        e = e + term
-    for _ in range(s):
-        e = e @ e
-    return e
-
-
-@pytest.mark.parametrize("design", [0.3, 0.5, 0.72, 0.9])
-def test_the_damping_controller_on_its_own_model_measures_its_design_ratio(design):
-    # Plant = the model itself (eq. 31 written out here from the corrected eqs. 27–28: IPCJ,
-    # lag τ_s driven by its ZMP, Padé (−s + 1/T)/(s + 1/T)), discretised exactly (ZOH) at
-    # 5 ms; a push = an initial θ̇. The estimate of the closed loop's dominant pair must be the
-    # design: this checks the pole placement and the estimate, with no MuJoCo in between.
-    l, km, bm, ts, tp, g = 0.62, 15.5, 0.55, 0.17, 0.002, 9.81
-    a = np.zeros((4, 4))
-    a[0, 1] = 1.0
-    a[1] = [g / l - km / l ** 2, -bm / l ** 2, 0.0, 0.0]
-    a[2] = [km / g / ts, bm / g / ts, -1.0 / ts, 0.0]
-    a[3, 2:] = [2.0 / tp, -1.0 / tp]
-    b = np.array([0.0, km / l ** 2, -km / g / ts, 0.0])
-    c = np.array([0.0, 0.0, -1.0, 1.0])
-    m = np.zeros((5, 5))
-    m[:4, :4], m[:4, 4] = a, b
-    e = _expm(m * g1_sim.CONTROL_PERIOD)
-    ad, bd = e[:4, :4], e[:4, 4]
-    ctrl = iktc.DampingController(iktc.PlaneModel(l, km, bm, ts, tp), damping_ratio=design)
-    x = np.array([0.0, 0.05, 0.0, 0.0])
-    ys = []
-    for _ in range(400):
-        y = float(c @ x)
-        ys.append(y)
-        x = ad @ x + bd * ctrl.step(0.0, y)[0]
-    t = np.arange(len(ys)) * g1_sim.CONTROL_PERIOD
-    z, w = g1_sim.damping_ratio(t, np.array(ys))
-    wn = np.sqrt(km / l ** 2 - g / l)  # errata eq. 32: the design keeps w_n
-    assert z == pytest.approx(design, abs=0.01) and w == pytest.approx(wn, rel=0.01)
 
 
 @pytest.fixture(scope="module")
 def identified():
     """The IPCJ model identified on MuJoCo by a short sweep (6 frequencies over the band)."""
-    return g1_sim.identify_on_plant(freqs=np.geomspace(*g1_sim.SWEEP_BAND, 6), settle=2.5,
-                                    cycles=3, min_time=1.5)
+    return g1.identify_on_plant(freqs=np.geomspace(*g1.SWEEP_BAND, 6), settle=2.5,
+                                cycles=3, min_time=1.5)
 
 
 def test_identification_on_mujoco_fits_the_measured_frequency_response(identified):
@@ -271,10 +189,10 @@ def test_a_push_in_double_support_is_damped_more_with_the_damping_controller(ide
     model = identified[0]
     ratios = {}
     for name, m in (("open", None), ("damped", model)):
-        loop, t, y = g1_sim.push_test(model=m)
+        loop, t, y = g1.push_test(model=m)
         s = loop.summary()
         assert s["stayed_up"] and s["foot_slip_max_m"] < 5e-3 and s["zmp_inside"], s
-        ratios[name] = g1_sim.damping_ratio(t, y)[0]
+        ratios[name] = iktc.dominant_mode(t, y)[0]
     assert ratios["damped"] > ratios["open"] + 0.2, ratios
 
 
@@ -283,8 +201,8 @@ def test_a_push_in_double_support_is_damped_more_with_the_damping_controller(ide
 # estimate on the identified model's own closed loop reads 0.72; designs 0.3, 0.5 and 0.9 read
 # 0.32, 0.53 and 0.69 (MuJoCo 4.0.1, 2026-12-06).
 def test_a_push_in_double_support_is_damped_to_the_design_ratio(identified):
-    loop, t, y = g1_sim.push_test(model=identified[0], damping=0.72)
-    assert abs(g1_sim.damping_ratio(t, y)[0] - 0.72) <= 0.15
+    loop, t, y = g1.push_test(model=identified[0], damping=0.72)
+    assert abs(iktc.dominant_mode(t, y)[0] - 0.72) <= 0.15
 
 
 def test_the_walking_binding_moves_the_feet_as_the_pattern_says():
@@ -294,9 +212,9 @@ def test_the_walking_binding_moves_the_feet_as_the_pattern_says():
     worst = 0.0
     for _ in range(walk.ticks):
         walk.tick()
-        for name, ref in zip(g1_sim.FEET, walk.feet_references()):
+        for name, ref in zip(g1.FEET, walk.feet_references()):
             worst = max(worst, float(np.abs(robot.frame_pose(walk.q, name)[:3, 3] - ref[:3, 3]).max()))
-    end = [robot.frame_pose(walk.q, f)[:3, 3] for f in g1_sim.FEET]
+    end = [robot.frame_pose(walk.q, f)[:3, 3] for f in g1.FEET]
     # Four steps of 0.1 m, the last closing the feet side by side: both feet 0.3 m ahead.
     for s, e in zip(start, end):
         assert e[0] - s[0] == pytest.approx(0.3, abs=2e-3) and abs(e[1] - s[1]) < 2e-3
@@ -343,8 +261,8 @@ def test_iktc_computes_the_plans_zmp_as_mujocos_inverse_dynamics_does():
         walk.tick()
         qs.append(walk.q.copy())
     qs = np.array(qs)
-    ours = robot.zmp(qs, g1_sim.CONTROL_PERIOD)
-    theirs = g1_sim.planned_zmp(g1_sim.Plant(robot), list(qs), per_tick=True)
+    ours = robot.zmp(qs, g1.CONTROL_PERIOD)
+    theirs = g1.planned_zmp(g1.Plant(robot), list(qs), per_tick=True)
     both = np.all(np.isfinite(theirs), axis=1)
     assert both.sum() == len(qs) - 2
     d = np.abs(ours[both] - theirs[both])
@@ -355,19 +273,19 @@ def test_iktc_computes_the_plans_zmp_as_mujocos_inverse_dynamics_does():
     # the ground would have to pull, there is no ZMP.
     snap = qs[:3].copy()
     snap[1, 2] += 0.01
-    assert np.isnan(robot.zmp(snap, g1_sim.CONTROL_PERIOD)).all()
+    assert np.isnan(robot.zmp(snap, g1.CONTROL_PERIOD)).all()
     # MuJoCo's inverse dynamics of the same snap: no ZMP either (not kilometres).
-    plant = g1_sim.Plant(robot)
-    assert np.isnan(g1_sim.planned_zmp(plant, list(snap), per_tick=True)).all()
+    plant = g1.Plant(robot)
+    assert np.isnan(g1.planned_zmp(plant, list(snap), per_tick=True)).all()
     # Standing still the ground carries the whole weight: a ZMP with any share up to 1 asked,
     # none above it.
     still = [qs[0]] * 3
-    assert np.all(np.isfinite(g1_sim.planned_zmp(plant, still, per_tick=True, min_support=0.99)[1]))
-    assert np.isnan(g1_sim.planned_zmp(plant, still, per_tick=True, min_support=1.01)[1]).all()
+    assert np.all(np.isfinite(g1.planned_zmp(plant, still, per_tick=True, min_support=0.99)[1]))
+    assert np.isnan(g1.planned_zmp(plant, still, per_tick=True, min_support=1.01)[1]).all()
     with pytest.raises(ValueError, match="columns"):
-        robot.zmp(qs[:, :10], g1_sim.CONTROL_PERIOD)
+        robot.zmp(qs[:, :10], g1.CONTROL_PERIOD)
     with pytest.raises(iktc.IktcError, match="at least 3"):
-        robot.zmp(qs[:2], g1_sim.CONTROL_PERIOD)
+        robot.zmp(qs[:2], g1.CONTROL_PERIOD)
 
 
 def test_the_fed_forward_torques_hold_the_standing_robot_where_it_is_commanded():
@@ -378,9 +296,9 @@ def test_the_fed_forward_torques_hold_the_standing_robot_where_it_is_commanded()
     q = iktc.Walking(robot, iktc.load_motion("humanoid3d_dance_b")).q
     errors = []
     for feed in (False, True):
-        plant = g1_sim.Plant(robot)
+        plant = g1.Plant(robot)
         plant.set_state(q)
-        ff = g1_sim.Feedforward(plant)
+        ff = g1.Feedforward(plant)
         for _ in range(200):
             plant.command(q, None, ff.torques(q, (True, True)) if feed else None)
             plant.advance()
@@ -390,8 +308,8 @@ def test_the_fed_forward_torques_hold_the_standing_robot_where_it_is_commanded()
 
 @pytest.fixture(scope="module")
 def walking_without_the_dance(tmp_path_factory):
-    held = g1_sim.held_clip(tmp_path_factory.mktemp("walk") / "held_dance_b.txt")
-    return g1_sim.run_walking(clip=held)
+    held = g1.held_clip(tmp_path_factory.mktemp("walk") / "held_dance_b.txt")
+    return g1.run_walking(clip=held)
 
 
 def test_walking_without_the_dance_plans_a_zmp_inside_the_support_polygon(walking_without_the_dance):
@@ -405,7 +323,7 @@ def test_walking_without_the_dance_plans_a_zmp_inside_the_support_polygon(walkin
 
 
 def test_walking_four_steps_in_mujoco_stays_up_with_the_zmp_inside(walking_without_the_dance):
-    # The servos get the plan's joint torques (``g1_sim.Feedforward``). MuJoCo 4.0.0: G1 walks
+    # The servos get the plan's joint torques (``g1.Feedforward``). MuJoCo 4.0.0: G1 walks
     # the four steps (the pelvis 0.29 m ahead), tilts at most 0.04 rad, and the measured ZMP is
     # inside the polygon of the feet carrying load on all 861 ticks (at least 2.0 mm).
     s = walking_without_the_dance
@@ -420,8 +338,8 @@ def test_walking_needs_the_plans_torques_fed_forward(tmp_path):
     # Without them the servos (K_P 500 N·m/rad) trail the plan's weight shift: at the first
     # lift-off the measured ZMP is 8 cm inside of the plan's, through the first single support
     # it sits on the stance sole's outer edge and G1 falls (at 2.84 s with MuJoCo 4.0.0).
-    held = g1_sim.held_clip(tmp_path / "held_dance_b.txt")
-    s = g1_sim.run_walking(clip=held, feedforward=False)
+    held = g1.held_clip(tmp_path / "held_dance_b.txt")
+    s = g1.run_walking(clip=held, feedforward=False)
     assert not s["stayed_up"], s
 
 
@@ -431,9 +349,9 @@ def test_walking_while_imitating_the_walk_clip_keeps_the_zmp_inside():
     # ticks and G1's soles reach their edges (MuJoCo 4.0.0: 53 ticks, at most 3.7 mm past the
     # rectangle of the contact spheres' centres). One pass of the ZMP correction (the default
     # of ``run_walking``) moves the COM there: the measured ZMP is inside on every tick.
-    plain = g1_sim.run_walking(clip="humanoid3d_walk", zmp_passes=0)
+    plain = g1.run_walking(clip="humanoid3d_walk", zmp_passes=0)
     assert plain["stayed_up"] and not plain["zmp_inside"], plain
-    s = g1_sim.run_walking(clip="humanoid3d_walk")
+    s = g1.run_walking(clip="humanoid3d_walk")
     assert s["stayed_up"] and s["zmp_inside"], s
     assert s["zmp_ticks_measured"] == s["ticks"], s
     assert 0.25 < s["forward_progress_m"] < 0.35, s
@@ -445,8 +363,8 @@ def test_a_forward_push_in_single_support_while_walking_is_absorbed(tmp_path):
     # foot standing). Open loop (no damping controller) G1 walks on, the ZMP inside the loaded
     # feet's polygon on every tick (MuJoCo 4.0.0: tilt at most 0.065 rad). Backward or outward
     # pushes are not absorbed that well (book/src/mujoco.md).
-    held = g1_sim.held_clip(tmp_path / "held_dance_b.txt")
-    s = g1_sim.run_walking(clip=held, push=(1.1, (80.0, 0.0, 0.0), 0.05))
+    held = g1.held_clip(tmp_path / "held_dance_b.txt")
+    s = g1.run_walking(clip=held, push=(1.1, (80.0, 0.0, 0.0), 0.05))
     assert s["stayed_up"] and s["zmp_inside"], s
 
 
@@ -454,8 +372,8 @@ def test_walking_while_dancing_stays_up_with_the_zmp_correction():
     # The dance's upper body: without the correction the plan's ZMP is outside on 264 of 480
     # single-support ticks and G1 falls (2.48 s); with one pass it is outside on 111 and G1
     # walks on (MuJoCo 4.0.0: tilt at most 0.37 rad, the pelvis 0.24 m ahead).
-    assert not g1_sim.run_walking(zmp_passes=0)["stayed_up"]
-    s = g1_sim.run_walking()
+    assert not g1.run_walking(zmp_passes=0)["stayed_up"]
+    s = g1.run_walking()
     assert s["stayed_up"], s
 
 
@@ -465,14 +383,14 @@ def test_walking_while_dancing_stays_up_with_the_zmp_correction():
 @pytest.mark.xfail(strict=True, reason="walking while dancing, the plan's ZMP is still outside "
                    "on 111 of 480 single-support ticks after the correction (book/src/mujoco.md)")
 def test_walking_while_dancing_keeps_the_zmp_inside():
-    s = g1_sim.run_walking()
+    s = g1.run_walking()
     assert s["zmp_inside"], s
 
 
 def test_the_walking_replay_holds_both_runs_tick_by_tick(tmp_path):
     import json
     path = tmp_path / "walk.html"
-    s = g1_sim.run_walking(steps=1, clip="humanoid3d_walk", replay=str(path))
+    s = g1.run_walking(steps=1, clip="humanoid3d_walk", replay=str(path))
     data = json.loads(path.read_text().split("const D = ", 1)[1].split(";\n", 1)[0])
     assert len(data["physics"]) == len(data["plan"]) == s["ticks"]
     # Both start where the plan starts: the physics run's first tick follows a settle at rest.
@@ -481,18 +399,18 @@ def test_the_walking_replay_holds_both_runs_tick_by_tick(tmp_path):
 
 def test_the_replay_holds_both_runs_tick_by_tick(tmp_path):
     import json
-    loop = g1_sim.Loop(duration=0.1)
+    loop = g1.Loop(duration=0.1)
     for _ in range(loop.sim.ticks):
         loop.step()
     path = tmp_path / "replay.html"
-    g1_sim.write_replay(path, loop.plant, loop.log.qpos, loop.log.q_cmd, "test")
+    g1.write_replay(path, loop.plant, loop.log.qpos, loop.log.q_cmd, "test")
     text = path.read_text()
     data = json.loads(text.split("const D = ", 1)[1].split(";\n", 1)[0])
     n = loop.sim.ticks
     assert len(data["physics"]) == len(data["plan"]) == n
     # The plan's feet are where iktc puts them (MuJoCo's kinematics of the plan = iktc's).
     m = loop.plant.model
-    for i, name in enumerate(g1_sim.FEET):
+    for i, name in enumerate(g1.FEET):
         b = m.body(name).id - 1
         assert np.allclose(data["plan"][-1][b], loop.robot.frame_pose(loop.log.q_cmd[-1], name)[:3, 3],
                            atol=1e-4)
@@ -509,9 +427,9 @@ def test_the_walking_plan_straightens_a_knee_unless_the_knees_are_narrowed_or_ap
     # 6 Hz) keep both knees off their limits (right at least 0.11 rad) and the plan's ZMP is
     # outside on 33 and 2.
     hard = dict(smoothing=None, approach_rate=0.0)
-    plain = g1_sim.walking_plan_figures("humanoid3d_walk", **hard)
-    narrowed = g1_sim.walking_plan_figures("humanoid3d_walk", g1_sim.G1_KNEES, **hard)
-    soft = g1_sim.walking_plan_figures("humanoid3d_walk")
+    plain = g1.walking_plan_figures("humanoid3d_walk", **hard)
+    narrowed = g1.walking_plan_figures("humanoid3d_walk", g1.G1_KNEES, **hard)
+    soft = g1.walking_plan_figures("humanoid3d_walk")
     assert plain["right_knee_straight_from_s"] is not None, plain
     assert narrowed["right_knee_straight_from_s"] is None, narrowed
     assert min(narrowed["left_knee_min_rad"], narrowed["right_knee_min_rad"]) >= 0.3 - 1e-6
@@ -523,3 +441,56 @@ def test_the_walking_plan_straightens_a_knee_unless_the_knees_are_narrowed_or_ap
 
     assert outside(plain) < 0.25, plain
     assert outside(soft) < outside(plain) and outside(soft, "double") < outside(plain, "double"), (soft, plain)
+
+
+def test_the_plant_reads_a_given_mjcf_file_as_the_builtin_one(tmp_path):
+    # The built-in model (``iktc.builtin_text("mjcf", "g1")``) and the same file given by path
+    # make the same plant.
+    path = tmp_path / "g1.xml"
+    path.write_text(iktc.builtin_text("mjcf", "g1"))
+    robot = iktc.Robot("g1")
+    a, b = g1.Plant(robot), g1.Plant(robot, mjcf=path)
+    assert g1.plant_xml() == g1.plant_xml(path)
+    assert a.model.nq == b.model.nq == robot.nq and a.model.nu == b.model.nu == 3 * 29
+    assert np.sum(a.model.body_mass) == pytest.approx(robot.total_mass, rel=1e-9)
+
+
+def test_bad_input_to_the_subpackage_is_an_iktc_error_naming_it(tmp_path):
+    robot = iktc.Robot("g1")
+    with pytest.raises(iktc.IktcError, match="mjcf = .*no_such.xml"):
+        g1.plant_xml(tmp_path / "no_such.xml")
+    with pytest.raises(iktc.IktcError, match="physics_step"):
+        g1.Plant(robot, physics_step=0.01)
+    with pytest.raises(iktc.IktcError, match="kp"):
+        g1.plant_xml(kp=float("nan"))
+    with pytest.raises(iktc.IktcError, match="no joint"):
+        g1.Plant(iktc.Robot("jvrc1"))
+    p = g1.Plant(robot)
+    q, v = robot.standing()
+    with pytest.raises(iktc.IktcError, match="q: expected 36"):
+        p.command(q[:10])
+    with pytest.raises(iktc.IktcError, match="v: expected 35"):
+        p.command(q, q)
+    with pytest.raises(iktc.IktcError, match="side = 'middle'"):
+        p.sensor_reading("middle")
+    with pytest.raises(iktc.IktcError, match="foot i = 2"):
+        p.foot_pose(2)
+    with pytest.raises(iktc.IktcError, match="on_ground"):
+        g1.Feedforward(p).torques(q, (True,))
+    with pytest.raises(iktc.IktcError, match="min_support"):
+        g1.planned_zmp(p, [q] * 3, min_support=-1.0)
+    with pytest.raises(iktc.IktcError, match="push = "):
+        g1.run_walking(push=(1.0, (80.0, 0.0), 0.05))
+    with pytest.raises(iktc.IktcError, match="humanoid3d_walk"):
+        g1.held_clip(tmp_path / "x.txt", "no_such_clip")
+    with pytest.raises(iktc.IktcError, match="per_velocity"):
+        g1.robot_with_acceleration(0.0)
+    with pytest.raises(iktc.IktcError, match="axis"):
+        g1.push_test(axis=2)
+    with pytest.raises(iktc.IktcError, match="qs"):
+        g1.plan_chatter(np.zeros((2, 36)))
+
+
+def test_the_diagnostic_robot_has_its_acceleration_limits_at_the_velocity_limits():
+    _, _, vel, acc = g1.robot_with_acceleration(1.0).limits()
+    assert np.allclose(acc[6:], vel[6:])

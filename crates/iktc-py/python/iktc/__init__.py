@@ -20,6 +20,9 @@ imitation of Section 5.3 tick by tick.
 
 Every error of the library is raised as ``iktc.IktcError`` (a ``ValueError``) with the
 library's message.
+
+``iktc.mujoco`` (needs ``pip install mujoco``) runs the Unitree G1 in MuJoCo under iktc: the
+plant, the closed loop, the identification and push test of the damping controller, walking.
 """
 from ._iktc import (
     __version__,
@@ -35,6 +38,7 @@ from ._iktc import (
     DampingController,
     measure_zmp,
     identify,
+    dominant_mode,
     Motion,
     Retargeted,
     References,
@@ -45,6 +49,7 @@ from ._iktc import (
     retarget_keypoints,
     KeypointTrajectory,
     profile_init,
+    builtin_text,
 )
 
 __all__ = [
@@ -61,6 +66,7 @@ __all__ = [
     "DampingController",
     "measure_zmp",
     "identify",
+    "dominant_mode",
     "Motion",
     "Retargeted",
     "References",
@@ -71,4 +77,5 @@ __all__ = [
     "retarget_keypoints",
     "KeypointTrajectory",
     "profile_init",
+    "builtin_text",
 ]

@@ -14,7 +14,9 @@
 //!   in both support phases with a smooth hand-over; output `Δc = l (u − u_ref)`;
 //! * [`sim`], [`sweep`], [`response`], [`scenario`]: a simulated robot with a true delay,
 //!   noise and pushes, the sine-sweep experiment, response metrics and the three scenarios
-//!   (identify, design, push).
+//!   (identify, design, push);
+//! * [`prony`]: the dominant mode of a measured response (a physics simulation's or a
+//!   robot's push), its damping ratio and natural frequency.
 //!
 //! Sign conventions: `θ` and `u` are positive toward `+x̃` (`+ỹ`); `y` is the ZMP deviation
 //! from nominal \[m\]; the feedback is `u = N u_ref − K_f x`.
@@ -26,6 +28,7 @@ pub mod identify;
 pub mod lm;
 pub mod model;
 pub mod poly;
+pub mod prony;
 pub mod response;
 pub mod scenario;
 pub mod sim;
@@ -43,6 +46,7 @@ pub use identify::{identify, initial_guess, FrequencyData, Identification, Ident
 pub use lm::{levenberg_marquardt, LmResult, LmSettings, LmStatus};
 pub use model::{Bode, FullModelParams, IpcjParams, Modal, TransferFunction, STANDARD_GRAVITY};
 pub use poly::Polynomial;
+pub use prony::{dominant_mode, PronySettings};
 pub use response::{analyse_response, ResponseMetrics, ResponseSettings};
 pub use scenario::{
     run_design, run_identify, run_push, BodeSeries, DesignResult, DesignScenario, IdentifyResult,

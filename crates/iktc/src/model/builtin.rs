@@ -23,6 +23,14 @@ pub const JVRC1_URDF: &str = include_str!("../../data/robots/jvrc1/jvrc1.urdf");
 #[cfg(feature = "urdf")]
 pub const G1_URDF: &str = include_str!("../../data/robots/g1/g1_29dof_rev_1_0.urdf");
 
+/// The Unitree G1 MuJoCo model, 29 joints (`g1_29dof_rev_1_0.xml`, Unitree Robotics; BSD
+/// 3-Clause, see the crate's `data/robots/g1/LICENSE` and `data/NOTICE.md`), embedded: the
+/// same robot as [`G1_URDF`], with the feet's contact spheres, joint force ranges and
+/// actuators of MuJoCo. Its mesh geoms name files that are not shipped (every body has its
+/// own inertial, so a simulation may drop them).
+#[cfg(feature = "mjcf")]
+pub const G1_MJCF: &str = include_str!("../../data/robots/g1/g1_29dof_rev_1_0.xml");
+
 /// The names accepted by [`builtin_robot`].
 #[cfg(feature = "urdf")]
 pub const BUILTIN_ROBOTS: &[&str] = &["planar3r", "jvrc1", "g1"];

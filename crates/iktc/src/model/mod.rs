@@ -32,6 +32,8 @@ pub use description::{declared_base, description_format, DescriptionFormat};
 #[cfg(feature = "urdf")]
 pub(crate) use urdf::{pose as urdf_pose, read_urdf};
 
+#[cfg(feature = "mjcf")]
+pub use builtin::G1_MJCF;
 pub use builtin::{builtin_robot, planar3r, BUILTIN_ROBOTS};
 #[cfg(feature = "urdf")]
 pub use builtin::{g1, jvrc1, G1_URDF, JVRC1_FINGERS, JVRC1_URDF};

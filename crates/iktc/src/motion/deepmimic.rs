@@ -399,10 +399,10 @@ fn frame_lines(text: &str) -> Vec<usize> {
     lines
 }
 
-/// One of the four DeepMimic clips shipped with the library (see `crates/iktc/data/NOTICE.md`), by name:
-/// see [`BUILTIN_CLIP_NAMES`]. Unknown names give [`Error::UnknownName`] listing the valid ones.
-pub fn builtin_clip(name: &str) -> Result<Clip> {
-    let text = BUILTIN_CLIP_NAMES
+/// The JSON text of one of the four DeepMimic clips shipped with the library, by name (see
+/// [`builtin_clip`]): to write a changed copy. Unknown names give [`Error::UnknownName`].
+pub fn builtin_clip_text(name: &str) -> Result<&'static str> {
+    BUILTIN_CLIP_NAMES
         .iter()
         .zip(BUILTIN_CLIP_TEXTS.iter())
         .find(|(n, _)| **n == name)
@@ -411,6 +411,11 @@ pub fn builtin_clip(name: &str) -> Result<Clip> {
             kind: "built-in motion clip",
             name: name.to_string(),
             valid: BUILTIN_CLIP_NAMES.iter().map(|s| s.to_string()).collect(),
-        })?;
-    read_deepmimic(text, name)
+        })
+}
+
+/// One of the four DeepMimic clips shipped with the library (see `crates/iktc/data/NOTICE.md`), by name:
+/// see [`BUILTIN_CLIP_NAMES`]. Unknown names give [`Error::UnknownName`] listing the valid ones.
+pub fn builtin_clip(name: &str) -> Result<Clip> {
+    read_deepmimic(builtin_clip_text(name)?, name)
 }

@@ -89,8 +89,9 @@ pub use decompose::{
 };
 #[cfg(all(feature = "urdf", feature = "json"))]
 pub use deepmimic::{
-    builtin_clip, deepmimic_skeleton, read_deepmimic, read_deepmimic_with, DeepMimicSettings,
-    BUILTIN_CLIP_NAMES, DEEPMIMIC_FRAME_LEN, DEEPMIMIC_URDF, DEEPMIMIC_URDF_SCALE,
+    builtin_clip, builtin_clip_text, deepmimic_skeleton, read_deepmimic, read_deepmimic_with,
+    DeepMimicSettings, BUILTIN_CLIP_NAMES, DEEPMIMIC_FRAME_LEN, DEEPMIMIC_URDF,
+    DEEPMIMIC_URDF_SCALE,
 };
 pub use keypoints::{clip_keypoints, marker_keypoints, Keypoints};
 pub use load::{

@@ -256,7 +256,7 @@ pub struct KeypointSettings {
     /// clips (`tests/retarget_keypoints.rs`) it brings G1's wrists within a mean 2.7–4.8 cm of
     /// the captured ones instead of 5.2–6.8 cm with [`HandScaling::Segments`] on three
     /// DeepMimic clips and lowers the mean keypoint error on all twelve runs; in MuJoCo
-    /// (`crates/iktc-py/examples/g1_sim.py`, standing imitation of `humanoid3d_dance_b`) G1's
+    /// (Python `iktc.mujoco`, standing imitation of `humanoid3d_dance_b`) G1's
     /// feet slid 1.5 mm instead of 3.7 mm.
     pub hands: HandScaling,
     /// Measure the static reach of the body points after the run (default off): per tick
