@@ -118,8 +118,8 @@ def test_hands_by_the_leg_ratio_move_the_hands_differently_and_bad_names_are_err
 def test_the_run_says_which_levels_the_joint_limits_cost(runs):
     robot, r = runs
     t = r[False]
-    levels = ["stance_feet", "swing_floor", "com_xy", "swing_feet", "pelvis", "hands",
-              "elbows_head_torso", "posture"]
+    levels = ["stance_feet", "swing_floor", "com_xy", "swing_feet", "pelvis_torso", "hands",
+              "elbows_head", "posture"]
     for counts, ticks in [(t.sacrificed, len(t)), (t.settle_sacrificed, 300)]:
         assert list(counts) == levels
         assert all(isinstance(n, int) and n >= 0 for n in counts.values())

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use iktc::motion::{load_motion, BodyPoint, Keypoints, Motion, MotionOptions, DEFAULT_MAX_GAP};
 use iktc::profile::RobotProfile;
 use iktc::retarget::{
-    joint_route_quality, retarget_keypoints, HandScaling, KeypointSettings, RetargetQuality,
+    joint_route_quality, retarget_keypoints, KeypointSettings, LimbScaling, RetargetQuality,
     KEYPOINT_LEVELS,
 };
 use iktc::sim::{imitation_references, ImitateConfig};
@@ -491,9 +491,9 @@ fn g1_hands_by_the_leg_ratio_follow_the_captured_wrists_closer() {
         0.5 * (w[0] + w[1])
     };
     let leg = KeypointSettings::default();
-    assert_eq!(leg.hands, HandScaling::Leg);
+    assert_eq!(leg.hands, LimbScaling::Leg);
     let segments = KeypointSettings {
-        hands: HandScaling::Segments,
+        hands: LimbScaling::Segments,
         ..leg.clone()
     };
     let mut worse = Vec::new();
