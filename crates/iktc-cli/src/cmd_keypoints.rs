@@ -9,8 +9,8 @@ use iktc::batch::{posture_references, Posture};
 use iktc::motion::{Keypoints, MotionFormat, BUILTIN_CLIP_NAMES, DEFAULT_MAX_GAP};
 use iktc::profile::RobotProfile;
 use iktc::retarget::{
-    builtin_motion, joint_route_quality, retarget_keypoints, HandScaling, KeypointRun,
-    KeypointSettings, RetargetQuality,
+    builtin_motion, joint_route_quality, retarget_keypoints, KeypointRun, KeypointSettings,
+    LimbScaling, RetargetQuality,
 };
 use iktc::sim::ImitateConfig;
 
@@ -23,15 +23,26 @@ pub enum RetargetArg {
     Joints,
 }
 
-/// Where the keypoint route places the hands' references ([`iktc::retarget::HandScaling`]).
+/// Where the keypoint route places the hands' or the feet's references
+/// ([`iktc::retarget::LimbScaling`]).
 #[derive(clap::ValueEnum, Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum HandsArg {
-    /// From the middle of the hips by the leg ratio: the hands where the captured person's are
-    /// relative to the pelvis, scaled as a whole (hands that meet still meet).
+pub enum LimbArg {
+    /// From the middle of the hips by the leg ratio: the hands (feet) where the captured
+    /// person's are relative to the pelvis, scaled as a whole (hands that meet still meet; the
+    /// feet keep the person's stance width).
     #[default]
     Leg,
-    /// Along the arm, each segment at the robot's length: the captured arm's direction.
+    /// Along the limb, each segment at the robot's length: the captured limb's direction.
     Segments,
+}
+
+impl From<LimbArg> for LimbScaling {
+    fn from(a: LimbArg) -> Self {
+        match a {
+            LimbArg::Leg => LimbScaling::Leg,
+            LimbArg::Segments => LimbScaling::Segments,
+        }
+    }
 }
 
 /// `--max-slide`: a length \[m\] or `none`.
@@ -71,7 +82,17 @@ pub struct KeypointArgs {
     pub no_smoothing: bool,
     /// Where the keypoint route places the hands' references (default: leg).
     #[arg(long, value_enum)]
-    pub hands: Option<HandsArg>,
+    pub hands: Option<LimbArg>,
+    /// Where the keypoint route places the feet's references (default: leg, the person's
+    /// stance width; segments: along the legs from the robot's hips).
+    #[arg(long, value_enum)]
+    pub foot_scaling: Option<LimbArg>,
+    /// Keep the COM over the support polygon of the feet on the ground (a level above the
+    /// pelvis and torso): a static balance the captured person does not keep, which the robot
+    /// then keeps with its arms and loses the person's pose for (default off; standing
+    /// imitation always balances).
+    #[arg(long)]
+    pub balance: bool,
     /// Also measure the static reach: per tick sampled every 0.05 s, the least mean keypoint
     /// error of a posture within the joint ranges alone (no feet, balance or rates), beside
     /// the run's own on the same ticks. What the robot's body cannot do is about the reach;
@@ -102,14 +123,20 @@ pub struct KeypointArgs {
 impl KeypointArgs {
     /// Gives `cfg` the `--smoothing` (both routes use it; without it the joint route keeps
     /// `cfg`'s default, [`iktc::sim::IMITATE_SMOOTHING`], and the keypoint route none),
-    /// `--no-smoothing`, and refuses `--standing`, `--hands`, `--reach` and `--no-pivot` on the
-    /// joint route.
+    /// `--no-smoothing`, and refuses the keypoint route's options (`--standing`, `--hands`,
+    /// `--foot-scaling`, `--balance`, `--reach`, …) on the joint route.
     pub fn apply(&self, route: RetargetArg, cfg: &mut ImitateConfig) -> Result<()> {
         if route == RetargetArg::Joints && self.standing {
             anyhow::bail!("--standing applies to --retarget keypoints only");
         }
         if route == RetargetArg::Joints && self.hands.is_some() {
             anyhow::bail!("--hands applies to --retarget keypoints only");
+        }
+        if route == RetargetArg::Joints && self.foot_scaling.is_some() {
+            anyhow::bail!("--foot-scaling applies to --retarget keypoints only");
+        }
+        if route == RetargetArg::Joints && self.balance {
+            anyhow::bail!("--balance applies to --retarget keypoints only");
         }
         if route == RetargetArg::Joints && self.reach {
             anyhow::bail!("--reach applies to --retarget keypoints only");
@@ -150,10 +177,9 @@ pub fn keypoint_settings(
         run_limits: cfg.run_limits,
         standing: k.standing,
         smoothing: if k.no_smoothing { None } else { k.smoothing },
-        hands: match k.hands.unwrap_or_default() {
-            HandsArg::Leg => HandScaling::Leg,
-            HandsArg::Segments => HandScaling::Segments,
-        },
+        hands: k.hands.unwrap_or_default().into(),
+        feet: k.foot_scaling.unwrap_or_default().into(),
+        balance: k.balance,
         reach: k.reach,
         posture_fit: k.posture_fit,
         max_leg_extension: k

@@ -7,7 +7,7 @@ use std::sync::Arc;
 use iktc::batch::{body_frames, posture_references, MotionFormat, Posture, TrainingTrajectory};
 use iktc::model::Robot;
 use iktc::motion::DEFAULT_MAX_GAP;
-use iktc::retarget::{retarget_keypoints, HandScaling, KeypointRun, KeypointSettings, Sacrifices};
+use iktc::retarget::{retarget_keypoints, KeypointRun, KeypointSettings, LimbScaling, Sacrifices};
 use iktc::sim::ImitateConfig;
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
@@ -47,15 +47,29 @@ pub struct PyKeypointTrajectory {
 /// (`iktc::limits::ViableSettings::approach_rate`; 0, the default, leaves it out). `hands`:
 /// `"leg"` (the default) places the hands' references from the middle of the hips by the leg
 /// ratio, `"segments"` along the arm at the robot's segment lengths
-/// (`iktc::retarget::HandScaling`). `reach`: also measure the static reach of the body points
+/// (`iktc::retarget::LimbScaling`); `feet` the same for the ankles (`"leg"`, the default,
+/// keeps the person's stance width). `balance`: keep the COM over the feet's support polygon
+/// in a level above the pelvis and torso (`iktc::retarget::KeypointSettings::balance`; off by
+/// default, standing imitation always balances). `reach`: also measure the static reach of the body points
 /// (`iktc::retarget::KeypointSettings::reach`; about doubles the time), in `quality`.
 /// `posture_fit`: where no joint map gives the posture level its angles, follow the person's
 /// posture fitted to their segments' directions (`iktc::retarget::fit`) instead of the start
 /// posture. `max_leg_extension` (0, 1]: the largest share of a leg's length the pelvis height
 /// may ask of a stance leg (`iktc::retarget::MAX_LEG_EXTENSION` by default); larger values
 /// follow straight knees closer and land the feet less exactly.
+/// `"leg"` or `"segments"` of the argument `name`.
+fn limb_scaling(name: &str, value: &str) -> PyResult<LimbScaling> {
+    match value {
+        "leg" => Ok(LimbScaling::Leg),
+        "segments" => Ok(LimbScaling::Segments),
+        other => Err(crate::IktcError::new_err(format!(
+            "{name} = `{other}`: expected \"leg\" or \"segments\""
+        ))),
+    }
+}
+
 #[pyfunction]
-#[pyo3(name = "retarget_keypoints", signature = (motion, robot, *, dt=0.005, hold_feet=false, standing=false, smoothing=None, approach_rate=0.0, hands="leg", reach=false, max_slide=Some(iktc::retarget::MAX_SLIDE), posture_fit=false, max_leg_extension=iktc::retarget::MAX_LEG_EXTENSION))]
+#[pyo3(name = "retarget_keypoints", signature = (motion, robot, *, dt=0.005, hold_feet=false, standing=false, smoothing=None, approach_rate=0.0, hands="leg", feet="leg", balance=false, reach=false, max_slide=Some(iktc::retarget::MAX_SLIDE), posture_fit=false, max_leg_extension=iktc::retarget::MAX_LEG_EXTENSION))]
 #[allow(clippy::too_many_arguments)]
 pub fn py_retarget_keypoints(
     py: Python<'_>,
@@ -67,26 +81,23 @@ pub fn py_retarget_keypoints(
     smoothing: Option<f64>,
     approach_rate: f64,
     hands: &str,
+    feet: &str,
+    balance: bool,
     reach: bool,
     max_slide: Option<f64>,
     posture_fit: bool,
     max_leg_extension: f64,
 ) -> PyResult<PyKeypointTrajectory> {
     let profile = robot.required_profile("keypoint retargeting", "feet, pelvis and hands")?;
-    let hands = match hands {
-        "leg" => HandScaling::Leg,
-        "segments" => HandScaling::Segments,
-        other => {
-            return Err(crate::IktcError::new_err(format!(
-                "hands = `{other}`: expected \"leg\" or \"segments\""
-            )))
-        }
-    };
+    let hands = limb_scaling("hands", hands)?;
+    let feet = limb_scaling("feet", feet)?;
     let mut settings = KeypointSettings {
         dt,
         standing,
         smoothing,
         hands,
+        feet,
+        balance,
         reach,
         max_slide,
         posture_fit,

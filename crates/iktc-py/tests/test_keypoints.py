@@ -115,11 +115,31 @@ def test_hands_by_the_leg_ratio_move_the_hands_differently_and_bad_names_are_err
         iktc.retarget_keypoints(motion, robot, hands="elbows")
 
 
+def test_feet_by_the_leg_ratio_stand_narrower_and_balance_is_an_option():
+    # G1's hips are wider apart than the scaled person's: with the feet placed along the legs
+    # from its hips it stands wider than with the person's stance width (the default).
+    robot = iktc.Robot("g1")
+    motion = iktc.load_motion("humanoid3d_walk")
+
+    def width(t):
+        left = np.array([robot.frame_pose(q, "left_ankle_roll_link")[:3, 3] for q in t.q])
+        right = np.array([robot.frame_pose(q, "right_ankle_roll_link")[:3, 3] for q in t.q])
+        return np.median(np.linalg.norm((left - right)[:, :2], axis=1))
+
+    leg = iktc.retarget_keypoints(motion, robot)
+    seg = iktc.retarget_keypoints(motion, robot, feet="segments")
+    assert width(seg) > width(leg) + 0.02, (width(seg), width(leg))
+    balanced = iktc.retarget_keypoints(motion, robot, balance=True)
+    assert len(balanced) == len(leg)
+    with pytest.raises(iktc.IktcError, match="feet"):
+        iktc.retarget_keypoints(motion, robot, feet="toes")
+
+
 def test_the_run_says_which_levels_the_joint_limits_cost(runs):
     robot, r = runs
     t = r[False]
-    levels = ["stance_feet", "swing_floor", "com_xy", "swing_feet", "pelvis", "hands",
-              "elbows_head_torso", "posture"]
+    levels = ["stance_feet", "swing_floor", "com_xy", "swing_feet", "pelvis_torso", "hands",
+              "elbows_head", "posture"]
     for counts, ticks in [(t.sacrificed, len(t)), (t.settle_sacrificed, 300)]:
         assert list(counts) == levels
         assert all(isinstance(n, int) and n >= 0 for n in counts.values())

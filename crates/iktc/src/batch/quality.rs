@@ -263,9 +263,10 @@ pub struct KeypointFigures {
     pub penetration: f64,
     /// Share of the ticks with a sole corner deeper than [`PENETRATION_TOLERANCE`] \[–\].
     pub penetration_share: f64,
-    /// Share of the ticks on which IKTC sacrificed the feet's, the COM's or the pelvis' level
-    /// (the first five of [`KEYPOINT_LEVELS`]) to keep the joint limits \[–\]: the body could
-    /// not take the clip's stance or pelvis pose ([`KeypointRun::sacrificed`]).
+    /// Share of the ticks on which IKTC sacrificed the feet's, the COM's or the pelvis and
+    /// torso's level (the first five of [`KEYPOINT_LEVELS`]) to keep the joint limits \[–\]:
+    /// the body could not take the clip's stance, pelvis pose or trunk
+    /// ([`KeypointRun::sacrificed`]).
     pub body_sacrificed_share: f64,
     /// The level IKTC sacrificed on the most ticks (empty if none).
     pub most_sacrificed: String,

@@ -453,11 +453,11 @@ mod tests {
             .join("data/motions/deepmimic/humanoid3d_walk.txt")
     }
 
-    /// The share of the ticks that sacrifice the feet's, COM's or pelvis' level flags the clip
-    /// the robot cannot take: JVRC-1 on `humanoid3d_dance_a`, whose first frame is out of its
-    /// reach (0.2.0: a body level sacrificed on 118 of 324 ticks, a share of 0.36; 0.49
-    /// before its feet pivoted with the dancer), more than a quarter of its ticks, against
-    /// `humanoid3d_walk` (0.02).
+    /// The share of the ticks that sacrifice the feet's, COM's or pelvis and torso's level
+    /// flags the clip the robot cannot take: JVRC-1 on `humanoid3d_dance_a`, whose first frame
+    /// is out of its reach (a body level sacrificed on 0.43 of its ticks), more than a quarter
+    /// of its ticks, against `humanoid3d_walk` (0.08: the torso's twist at times faster than
+    /// the waist's bounds allow).
     #[test]
     fn the_body_sacrificed_share_flags_the_clip_the_robot_cannot_take() {
         let b = batch();
@@ -474,7 +474,7 @@ mod tests {
         let (walk, _) = share("humanoid3d_walk");
         assert!(bad > 0.25, "dance_a: {bad}");
         assert!(KEYPOINT_LEVELS.contains(&bad_level.as_str()), "{bad_level}");
-        assert!(walk < 0.1 * bad, "walk {walk} against dance_a {bad}");
+        assert!(walk < 0.25 * bad, "walk {walk} against dance_a {bad}");
     }
 
     #[test]

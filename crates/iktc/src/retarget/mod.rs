@@ -103,18 +103,20 @@ pub enum SupportArea {
     BothFeet,
 }
 
-/// Where the hands' references are placed ([`KeypointSettings::hands`]).
+/// Where the references of the hands ([`KeypointSettings::hands`]) or of the feet
+/// ([`KeypointSettings::feet`]) are placed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum HandScaling {
-    /// From the middle of the hips' reference by the leg ratio, `p'_wrist = p'_m + s_leg
-    /// (a(p_wrist) − a(m))` (`m` the middle of the hips): the hands are where the captured
-    /// person's are relative to the pelvis, scaled as a whole, so hands that meet (a clap,
-    /// hands on the hips) still meet on the robot. The quality figures' neutral targets are
-    /// placed the same way.
+pub enum LimbScaling {
+    /// From the middle of the hips' reference by the leg ratio, `p' = p'_m + s_leg (a(p) −
+    /// a(m))` (`m` the middle of the hips, `p` the wrist or the ankle): the hands and feet are
+    /// where the captured person's are relative to the pelvis, scaled as a whole, so hands
+    /// that meet (a clap, hands on the hips) still meet on the robot and the feet keep the
+    /// person's stance width. The quality figures' neutral targets are placed the same way.
     Leg,
-    /// Along the arm from the shoulder, each segment at the robot's own length: the arm keeps
-    /// the captured arm's direction, and the hands land wherever the robot's proportions put
-    /// them.
+    /// Along the limb from the shoulder (hip), each segment at the robot's own length: the
+    /// limb keeps the captured limb's direction, and the hand (foot) lands wherever the
+    /// robot's proportions put it (a robot with wider hips than the scaled person stands and
+    /// walks with its feet as much wider apart).
     Segments,
 }
 
@@ -198,6 +200,18 @@ pub struct KeypointSettings {
     /// the hands). For a robot that must keep its stance while it moves like the captured
     /// person from the waist up; the clip's steps, crouches and pelvis sway are left out.
     pub standing: bool,
+    /// Keep the COM over the support polygon of the feet on the ground, horizontally, in a
+    /// level of its own (`com_xy`) above the swing feet, the pelvis and the torso (default
+    /// false; standing imitation always does, [`KeypointSettings::standing`]). A static
+    /// balance the captured person does not keep: walking, their COM passes between the feet
+    /// instead of over the stance foot. Above a pelvis and torso that follow the person's,
+    /// the level can only move the COM with the arms (or, with the torso free, the waist),
+    /// which it swings to their limits: on the development set (2026-12-07, `devset/run.sh OUT
+    /// g1`) it raises G1's mean keypoint error from 9.13 to 13.18 cm (wrists 10.2 → 24 cm).
+    /// The robot's COM then goes where the person's body puts it, as in a whole-clip
+    /// retargeting without balance; a physical robot tracking the result balances by its own
+    /// controller.
+    pub balance: bool,
     /// Cut-off \[Hz\] of the zero-phase low-pass ([`crate::motion::lowpass`]) applied to the
     /// scaled body points before they are interpolated and differentiated into the tasks'
     /// references (default `None`: as captured; a cut-off at or above the clip's Nyquist
@@ -216,11 +230,11 @@ pub struct KeypointSettings {
     /// after 3 s) and its joints' accelerations ride the box. With them the hands' level is a
     /// least-squares compromise with the posture's `q̈_d + k_v (q̇_d − q̇) + k_p (q_d − q)`,
     /// which holds and damps the motion of an arm that leaves its hand in place (and the
-    /// level takes every coordinate, so the `elbows_head_torso` level below it moves nothing).
+    /// level takes every coordinate, so the `elbows_head` level below it moves nothing).
     pub posture_weight: f64,
-    /// Weight of the elbows' and head's positions, the torso's orientation and the swing
-    /// feet's orientations in the `hands` level \[–\] (default [`BODY_WEIGHT`];
-    /// 0 puts them in a level of their own, `elbows_head_torso`, where below the
+    /// Weight of the elbows' and head's positions and the swing feet's orientations in the
+    /// `hands` level \[–\] (default [`BODY_WEIGHT`];
+    /// 0 puts them in a level of their own, `elbows_head`, where below the
     /// posture rows they have no coordinate left to move). A unit of their error costs
     /// `weight²` as much as a hand's.
     pub body_weight: f64,
@@ -252,13 +266,21 @@ pub struct KeypointSettings {
     /// 58 → 69 mm (mean over clips), the lowest sole −2.5 → −4.1 mm, 0.4 mm below the ground
     /// on CMU 131_01. Off by default until the feet hold.
     pub posture_fit: bool,
-    /// Where the hands' references are placed (default [`HandScaling::Leg`]). On the shared
+    /// Where the feet's references are placed (default [`LimbScaling::Leg`]): the person's
+    /// ankles relative to the middle of their hips, scaled by the leg ratio; the toes keep
+    /// their offset from the ankle along the robot's foot. On the development set (2026-12-07,
+    /// `devset/run.sh OUT g1`, ten clips of six rigs, the neutral figures of [`fidelity`],
+    /// with [`KeypointSettings::balance`] off) against [`LimbScaling::Segments`]: G1's mean
+    /// keypoint error 9.64 → 9.13 cm, its slip over the person's contacts 41 → 23 mm (mean over
+    /// clips; worst clip 273 → 90 mm).
+    pub feet: LimbScaling,
+    /// Where the hands' references are placed (default [`LimbScaling::Leg`]). On the shared
     /// clips (`tests/retarget_keypoints.rs`) it brings G1's wrists within a mean 2.7–4.8 cm of
-    /// the captured ones instead of 5.2–6.8 cm with [`HandScaling::Segments`] on three
+    /// the captured ones instead of 5.2–6.8 cm with [`LimbScaling::Segments`] on three
     /// DeepMimic clips and lowers the mean keypoint error on all twelve runs; in MuJoCo
     /// (Python `iktc.mujoco`, standing imitation of `humanoid3d_dance_b`) G1's
     /// feet slid 1.5 mm instead of 3.7 mm.
-    pub hands: HandScaling,
+    pub hands: LimbScaling,
     /// Measure the static reach of the body points after the run (default off): per tick
     /// sampled every [`REACH_PERIOD`], the least mean body point error of a posture within the
     /// joint ranges alone, in [`RetargetQuality::reach_cm`] ([`mod@reach`]). It separates what the
@@ -319,7 +341,7 @@ pub const MAX_LEG_EXTENSION: f64 = 0.92;
 pub const REACH_PERIOD: f64 = 0.05;
 
 /// Default [`KeypointSettings::posture_weight`] \[–\]: 0.1 rad/s² of a joint against 1 m/s² of
-/// a hand. Against the same rows weighted 0.3 in the level below (`elbows_head_torso`, before
+/// a hand. Against the same rows weighted 0.3 in the level below (`elbows_head`, before
 /// 0.2.0), on 51 Bandai Namco clips (`iktc retarget`, the joint route's posture references):
 /// G1 comes to rest on the held first frame (fastest joint at the end of the settling, median
 /// over clips, 1.1 → 0.0002 rad/s; JVRC-1 1.0 → 0.00003 rad/s), its joints' RMS jerk falls
@@ -369,7 +391,9 @@ impl Default for KeypointSettings {
             pelvis_lean: PELVIS_LEAN,
             track_joint_centres: false,
             posture_fit: false,
-            hands: HandScaling::Leg,
+            hands: LimbScaling::Leg,
+            feet: LimbScaling::Leg,
+            balance: false,
             reach: false,
             pivot_turn: Some(PIVOT_TURN),
             max_slide: Some(MAX_SLIDE),
@@ -650,7 +674,15 @@ fn setup(
     let state = profile.standing_state(&robot)?;
     check_start(&robot, &state, &s.bounds)?;
     kin.update(&robot, &state)?;
-    let clip = scale::scale_clip(&robot, &kin, &body, kp, cfg.support.ankle_height, s.hands)?;
+    let clip = scale::scale_clip(
+        &robot,
+        &kin,
+        &body,
+        kp,
+        cfg.support.ankle_height,
+        s.hands,
+        s.feet,
+    )?;
     let mut tracks = posture_tracks(&robot, &state, posture, s.posture_margin)?;
     let plan_with = |tracks: &tracker::PostureTracks| {
         let on = plan::PlanRobot {

@@ -806,6 +806,7 @@ mod tests {
             &kp,
             cfg.support.ankle_height,
             s.hands,
+            s.feet,
         )
         .unwrap();
         let posture = super::super::posture_tracks(&robot, &state, None, s.posture_margin).unwrap();

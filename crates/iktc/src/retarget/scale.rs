@@ -16,16 +16,20 @@
 //! pelvis → head, chest, neck): `p'_c = p'_p + s_pc (a(p_c) − a(p_p))` with
 //! `s_pc = |r_c − r_p| / median_t |p_c(t) − p_p(t)|`, `r` the robot's points in its start
 //! posture. A segment without robot points takes its parent segment's ratio (toe: the shank's;
-//! chest, neck: the head's, else the leg's). With [`HandScaling::Leg`] the
-//! wrists are then placed from the middle of the hips by the leg ratio instead, `p'_wrist =
+//! chest, neck: the head's, else the leg's). With [`LimbScaling::Leg`] for the hands
+//! the wrists are then placed from the middle of the hips by the leg ratio instead, `p'_wrist =
 //! p'_m + s_leg (a(p_wrist) − a(m))` with `m` the middle of the human hips and `p'_m =
 //! (s_leg a(m)_xy, h_a + s_leg a(m)_z)` its scaled counterpart (so `p'_wrist = s_leg a(p_wrist)
 //! + h_a ẑ`): where the hands are relative to the body is kept, not the forearm's direction.
+//! With [`LimbScaling::Leg`] for the feet the ankles are placed the same way, `p'_ankle =
+//! s_leg a(p_ankle) + h_a ẑ` (a foot at the clip's lowest ankle height has its sole on the
+//! ground), and each toe moves with its ankle (`p'_toe += p'_ankle,leg − p'_ankle,segments`):
+//! the person's stance width, not the robot's hip width.
 
 use nalgebra::{Rotation3, Vector3};
 
 use super::body::RobotBody;
-use super::HandScaling;
+use super::LimbScaling;
 use crate::error::{Error, Result};
 use crate::model::{Kinematics, Robot};
 use crate::motion::{BodyPoint, Keypoints};
@@ -88,14 +92,15 @@ fn required(kp: &Keypoints, p: BodyPoint) -> Result<usize> {
 
 /// Aligns and scales `kp` onto the robot whose body points are `body` at the kinematics `kin`
 /// (start posture); `ankle_height` is the robot's ankle above its sole \[m\]; `hands` places
-/// the wrists.
+/// the wrists and `feet` the ankles and toes.
 pub(crate) fn scale_clip(
     robot: &Robot,
     kin: &Kinematics,
     body: &RobotBody,
     kp: &Keypoints,
     ankle_height: f64,
-    hands: HandScaling,
+    hands: LimbScaling,
+    feet: LimbScaling,
 ) -> Result<ScaledClip> {
     let n = kp.points.len();
     let frames = kp.frame_count();
@@ -203,7 +208,18 @@ pub(crate) fn scale_clip(
                 scaled[row + b] = scaled[row + a] + r * (aligned[row + b] - aligned[row + a]);
             }
         }
-        if hands == HandScaling::Leg {
+        if feet == LimbScaling::Leg {
+            // p'_ankle = s_leg a(p_ankle) + h_a ẑ; the toe keeps its offset from the ankle.
+            for (a, toe) in [(la, index(kp, B::LeftToe)), (ra, index(kp, B::RightToe))] {
+                let moved = leg * aligned[row + a] + Vector3::new(0.0, 0.0, ankle_height);
+                let shift = moved - scaled[row + a];
+                scaled[row + a] = moved;
+                if let Some(t) = toe {
+                    scaled[row + t] += shift;
+                }
+            }
+        }
+        if hands == LimbScaling::Leg {
             // p'_m + s_leg (a(p_wrist) − a(m)) with p'_m = (s_leg a(m)_xy, h_a + s_leg a(m)_z).
             for w in wrists.iter().flatten() {
                 scaled[row + w] = leg * aligned[row + w] + Vector3::new(0.0, 0.0, ankle_height);
@@ -253,7 +269,16 @@ mod tests {
     #[test]
     fn scaled_segments_have_the_robots_lengths() {
         let (robot, kin, body, kp) = g1_and("humanoid3d_punch");
-        let c = scale_clip(&robot, &kin, &body, &kp, 0.035, HandScaling::Segments).unwrap();
+        let c = scale_clip(
+            &robot,
+            &kin,
+            &body,
+            &kp,
+            0.035,
+            LimbScaling::Segments,
+            LimbScaling::Segments,
+        )
+        .unwrap();
         let n = kp.points.len();
         let idx = |p: BodyPoint| kp.points.iter().position(|q| *q == p).unwrap();
         let mut checked = 0;
@@ -296,8 +321,26 @@ mod tests {
             kp.positions[f * n + l] = mid;
             kp.positions[f * n + r] = mid;
         }
-        let leg = scale_clip(&robot, &kin, &body, &kp, 0.035, HandScaling::Leg).unwrap();
-        let seg = scale_clip(&robot, &kin, &body, &kp, 0.035, HandScaling::Segments).unwrap();
+        let leg = scale_clip(
+            &robot,
+            &kin,
+            &body,
+            &kp,
+            0.035,
+            LimbScaling::Leg,
+            LimbScaling::Segments,
+        )
+        .unwrap();
+        let seg = scale_clip(
+            &robot,
+            &kin,
+            &body,
+            &kp,
+            0.035,
+            LimbScaling::Segments,
+            LimbScaling::Segments,
+        )
+        .unwrap();
         // Rounding of a few additions of decimetre-sized vectors \[m\].
         let tol = 1e-12;
         let mut apart: f64 = 0.0;
@@ -342,5 +385,75 @@ mod tests {
                 assert!((got - want).norm() < tol, "frame {f}: {got} vs {want}");
             }
         }
+    }
+
+    /// With the leg ratio for the feet, each ankle is the captured ankle's offset from the
+    /// middle of the hips scaled by the leg ratio from the middle of the hips' reference, its
+    /// height above the clip's lowest ankle scaled and raised by the robot's ankle height; the
+    /// feet are as far apart as the person's, scaled; each toe keeps its offset from its
+    /// ankle; every other point is placed as along the segments.
+    #[test]
+    fn feet_by_the_leg_ratio_keep_the_persons_stance() {
+        let (robot, kin, body, kp) = g1_and("humanoid3d_walk");
+        let n = kp.points.len();
+        let idx = |p: BodyPoint| kp.points.iter().position(|q| *q == p).unwrap();
+        let h_a = 0.035;
+        let leg = scale_clip(
+            &robot,
+            &kin,
+            &body,
+            &kp,
+            h_a,
+            LimbScaling::Segments,
+            LimbScaling::Leg,
+        )
+        .unwrap();
+        let seg = scale_clip(
+            &robot,
+            &kin,
+            &body,
+            &kp,
+            h_a,
+            LimbScaling::Segments,
+            LimbScaling::Segments,
+        )
+        .unwrap();
+        let s = leg.scaling.leg;
+        // Rounding of a few additions of metre-sized vectors \[m\].
+        let tol = 1e-12;
+        let ankles = [idx(BodyPoint::LeftAnkle), idx(BodyPoint::RightAnkle)];
+        let find = |p: BodyPoint| kp.points.iter().position(|q| *q == p);
+        // The DeepMimic skeleton has no toes: the ankles alone then.
+        let toes = [find(BodyPoint::LeftToe), find(BodyPoint::RightToe)];
+        let mut narrower: f64 = 0.0;
+        for f in 0..kp.frame_count() {
+            let a = &leg.aligned;
+            for (ankle, toe) in ankles.into_iter().zip(toes) {
+                let want = s * a[f * n + ankle] + Vector3::new(0.0, 0.0, h_a);
+                let got = leg.scaled[f * n + ankle];
+                assert!((got - want).norm() < tol, "frame {f}: {got} vs {want}");
+                if let Some(toe) = toe {
+                    let offset = |c: &ScaledClip| c.scaled[f * n + toe] - c.scaled[f * n + ankle];
+                    assert!((offset(&leg) - offset(&seg)).norm() < tol, "frame {f}: toe");
+                }
+            }
+            let width =
+                |c: &ScaledClip| (c.scaled[f * n + ankles[0]] - c.scaled[f * n + ankles[1]]).norm();
+            let person = (a[f * n + ankles[0]] - a[f * n + ankles[1]]).norm();
+            assert!(
+                (width(&leg) - s * person).abs() < tol,
+                "frame {f}: stance width"
+            );
+            narrower = narrower.max(width(&seg) - width(&leg));
+            for k in (0..n).filter(|k| !ankles.contains(k) && !toes.contains(&Some(*k))) {
+                assert_eq!(leg.scaled[f * n + k], seg.scaled[f * n + k], "point {k}");
+            }
+        }
+        // G1's hips are wider apart than the scaled person's: along the segments its feet
+        // stand wider.
+        assert!(
+            narrower > 0.02,
+            "the segments' stance at most {narrower} m wider"
+        );
     }
 }

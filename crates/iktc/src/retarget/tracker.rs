@@ -8,48 +8,44 @@
 //!    the ground, and no level below can correct it away;
 //! 2. `swing_floor`: the feet the clip puts on the ground that have not landed yet, their
 //!    horizontal position and yaw towards the plan's hold;
-//! 3. `com_xy`: the COM over the support polygon, horizontal;
+//! 3. `com_xy`: only with [`KeypointSettings::balance`] (or standing imitation), the COM over
+//!    the support polygon, horizontal;
 //! 4. `swing_feet`: the positions of the feet in the air;
-//! 5. `pelvis`: the pelvis pose, 6D;
-//! 6. `hands`: the wrists' positions; the elbows' and the head's positions, the torso's
-//!    orientation and the orientations of the feet in the air with their rows weighted by
+//! 5. `pelvis_torso`: the pelvis pose, 6D, and the torso's orientation: the trunk's lean and
+//!    twist follow the person's, and no level below can trade them for a hand;
+//! 6. `hands`: the wrists' positions; the elbows' and the head's positions and the
+//!    orientations of the feet in the air with their rows weighted by
 //!    [`KeypointSettings::body_weight`]; and every active joint at its posture reference with
 //!    its rows weighted by [`KeypointSettings::posture_weight`] (a regulariser, see below).
 //!    The body points are the robot's joint centres ([`super::centres`]), the points the
 //!    fidelity figures measure;
-//! 7. `elbows_head_torso`: only with a body weight of 0, the elbows, head, torso and swing
-//!    feet's orientations in a level of their own; with weighted posture rows in the sixth
-//!    level it has no coordinate left (rank 0) and moves nothing, and only its errors are
-//!    reported;
+//! 7. `elbows_head`: only with a body weight of 0, the elbows, head and swing feet's
+//!    orientations in a level of their own; with weighted posture rows in the sixth level it
+//!    has no coordinate left (rank 0) and moves nothing, and only its errors are reported;
 //! 8. `posture`: only with a posture weight of 0, every active joint at its posture reference
 //!    in a level of its own (below the weighted rows such a level could only move what they
 //!    already move: it would have rank 0).
 //!
-//! The feet in the air have a level of their own above the pelvis, not the hands' (where they
-//! were before 0.2.0): sharing the hands' level they were traded against the posture rows and
-//! corrected away with the hands whenever the joint limits bound, and landed late, the robot's
-//! foot still in the air or sliding in where the person's was down. On the development set of
-//! ten clips of six rigs (Bandai Namco, CMU, Mixamo, mocap-bank, PyMO) the neutral slip over
-//! the person's contacts (mean over the clips) fell from 58 to 36 mm on G1 and from 21 to
-//! 15 mm on JVRC-1, and by 9–72 % on seven robots brought in by `profile init`. The floor rows
-//! moved to the first level with it: in the second level, below nothing but the held feet,
-//! two landing feet whose holds the legs could not both reach traded their heights, and a
-//! sole went up to 12 mm under the ground.
+//! The feet in the air have a level of their own above the pelvis: sharing the hands' level
+//! they would be traded against the posture rows and corrected away with the hands whenever
+//! the joint limits bind, and land late. The floor rows are in the first level: in the second,
+//! below nothing but the held feet, two landing feet whose holds the legs cannot both reach
+//! would trade their heights.
 //!
-//! The levels above the last can take every coordinate (on G1 the feet, COM, pelvis, hands,
-//! elbows and torso take all 35): each level is then solved exactly in what its betters leave
-//! it, however ill-conditioned that is, and nothing damps a joint's velocity but the tasks'
-//! own. Without the regulariser G1's arms never come to rest on a held frame (9–26 rad/s after
-//! 3 s on `humanoid3d_dance_b`, `_walk`, `_punch`), its joints' accelerations ride the box
-//! (RMS jerk 17 000–33 000 rad/s³ over the shared clips), and in MuJoCo its servos trail the
-//! arms' set points by 0.67 rad rms. In the fifth level the posture rows make the level's
+//! The torso's orientation is in the pelvis' level, above the hands: in a level below the
+//! weighted posture rows it would have rank 0, and the waist would be left to whatever the
+//! hands' least-squares compromise asks of it. Above a pelvis and a torso held to the
+//! person's, the COM level of [`KeypointSettings::balance`] can only move the COM with the
+//! arms, which is why it is off by default (see there).
+//!
+//! The levels above the last can take every coordinate (on G1 the feet, pelvis, torso, hands
+//! and elbows take all 35): each level is then solved exactly in what its betters leave it,
+//! however ill-conditioned that is, and nothing damps a joint's velocity but the tasks' own.
+//! Without the regulariser G1's arms do not come to rest on a held frame, and its joints'
+//! accelerations ride the box. In the sixth level the posture rows make the level's
 //! least-squares problem a compromise between the hands and the posture's `q̈_d + k_v (q̇_d −
 //! q̇) + k_p (q_d − q)`, which holds and damps the hands' null space: the motion of an arm
-//! that leaves its hand where it is. With the posture rows one level lower (before 0.2.0),
-//! the hands' level pushed a hand towards a reference the arm could not quite reach through
-//! a nearly singular Jacobian, and the elbow and wrist swung against each other in that null
-//! space (G1 on 51 Bandai Namco clips: the fastest joint at the end of the settling at 1.0
-//! rad/s, median over clips; now 2 · 10⁻⁴ rad/s).
+//! that leaves its hand where it is.
 //!
 //! A foot is in the first level only once it has landed, and in the second only while it
 //! lands or its floor is engaged: one stack per pair of foot modes ([`FootMode`]: stance,
@@ -114,9 +110,9 @@ pub const KEYPOINT_LEVELS: [&str; 8] = [
     "swing_floor",
     "com_xy",
     "swing_feet",
-    "pelvis",
+    "pelvis_torso",
     "hands",
-    "elbows_head_torso",
+    "elbows_head",
     "posture",
 ];
 
@@ -277,7 +273,8 @@ struct Tasks {
     feet: Vec<(usize, FrameHandle)>,
     /// Foot index and handle of the swing feet whose floor is engaged ([`super::floor`]).
     floor: Vec<(usize, FrameHandle)>,
-    com: ComHandle,
+    /// The COM's task, with [`KeypointSettings::balance`] (or standing imitation).
+    com: Option<ComHandle>,
     pelvis: FrameHandle,
     torso: Option<FrameHandle>,
     points: Vec<(FrameHandle, usize)>,
@@ -443,13 +440,15 @@ fn set_references(
         }
         ctl.set_frame_reference(*h, r)?;
     }
-    let c = p.com[k];
-    let c = if hold {
-        ComReference::hold(c.position)
-    } else {
-        c
-    };
-    ctl.set_com_reference(t.com, c)?;
+    if let Some(com) = t.com {
+        let c = p.com[k];
+        let c = if hold {
+            ComReference::hold(c.position)
+        } else {
+            c
+        };
+        ctl.set_com_reference(com, c)?;
+    }
     ctl.set_frame_reference(t.pelvis, p.pelvis[k].frame(hold))?;
     if let Some(h) = t.torso {
         ctl.set_frame_reference(h, p.torso[k].frame(hold))?;
@@ -475,8 +474,8 @@ fn frame_name(robot: &Robot, f: FrameId) -> String {
         .unwrap_or_default()
 }
 
-/// Adds the elbows' and head's positions, the torso's orientation and the swing feet's
-/// orientations to the builder's current level, their rows weighted by `w`.
+/// Adds the elbows' and head's positions and the swing feet's orientations to the builder's
+/// current level, their rows weighted by `w`.
 #[allow(clippy::too_many_arguments)]
 fn add_body_tasks(
     b: &mut ControllerBuilder,
@@ -484,7 +483,6 @@ fn add_body_tasks(
     body: &RobotBody,
     plan: &Plan,
     points: &mut Vec<(FrameHandle, usize)>,
-    torso: &mut Option<FrameHandle>,
     feet: &mut Vec<(usize, FrameHandle)>,
     swing: [bool; 2],
     w: f64,
@@ -500,9 +498,6 @@ fn add_body_tasks(
         if let Some(f) = body.frame_of(*p) {
             points.push((b.weighted_frame(&name(f), Axes::POSITION, w)?, i));
         }
-    }
-    if let Some(f) = body.torso {
-        *torso = Some(b.weighted_frame(&name(f), Axes::ORIENTATION, w)?);
     }
     for i in (0..2).filter(|i| swing[*i]) {
         feet.push((
@@ -554,7 +549,11 @@ fn build_stack(
             floor.push((i, b.frame(&name(body.feet[i]), LANDING_AXES)?));
         }
     }
-    let com = b.level(KEYPOINT_LEVELS[2]).com([true, true, false])?;
+    let com = if s.balance || s.standing {
+        Some(b.level(KEYPOINT_LEVELS[2]).com([true, true, false])?)
+    } else {
+        None
+    };
     if swing.contains(&true) {
         b.level(KEYPOINT_LEVELS[3]);
         for i in (0..2).filter(|i| swing[*i]) {
@@ -564,6 +563,10 @@ fn build_stack(
     let pelvis = b
         .level(KEYPOINT_LEVELS[4])
         .frame(&name(body.pelvis), Axes::ALL)?;
+    let torso = match body.torso {
+        Some(f) => Some(b.frame(&name(f), Axes::ORIENTATION)?),
+        None => None,
+    };
     let mut points = Vec::new();
     b.level(KEYPOINT_LEVELS[5]);
     let hand = |p: &BodyPoint| matches!(p, BodyPoint::LeftWrist | BodyPoint::RightWrist);
@@ -573,24 +576,13 @@ fn build_stack(
         }
     }
     let names: Vec<&str> = posture.iter().map(String::as_str).collect();
-    // The elbows, head, torso orientation and swing feet's orientations: weighted into the
-    // fifth level, or (weight 0) a sixth level of their own.
+    // The elbows, head and swing feet's orientations: weighted into the sixth level, or
+    // (weight 0) a seventh level of their own.
     let w = s.body_weight;
-    let mut torso = None;
     if w > 0.0 {
-        add_body_tasks(
-            &mut b,
-            robot,
-            body,
-            plan,
-            &mut points,
-            &mut torso,
-            &mut feet,
-            swing,
-            w,
-        )?;
+        add_body_tasks(&mut b, robot, body, plan, &mut points, &mut feet, swing, w)?;
     }
-    // Weighted into the fifth level, or (weight 0) a level of its own below the sixth: never
+    // Weighted into the sixth level, or (weight 0) a level of its own below the seventh: never
     // both, as a posture level below the weighted rows could only move what they already move.
     let weighted = if s.posture_weight > 0.0 {
         Some(b.weighted_joints(&names, s.posture_weight)?)
@@ -598,15 +590,14 @@ fn build_stack(
         None
     };
     if w == 0.0 {
-        // The sixth level only with a task in it (a robot without elbows, head or torso
-        // frames standing on both feet has none).
-        let sixth = body.torso.is_some()
-            || swing.contains(&true)
+        // The seventh level only with a task in it (a robot without elbows or head frames
+        // standing on both feet has none).
+        let seventh = swing.contains(&true)
             || plan
                 .points
                 .iter()
                 .any(|(p, _)| !hand(p) && body.frame_of(*p).is_some());
-        if sixth {
+        if seventh {
             b.level(KEYPOINT_LEVELS[6]);
         }
         add_body_tasks(
@@ -615,7 +606,6 @@ fn build_stack(
             body,
             plan,
             &mut points,
-            &mut torso,
             &mut feet,
             swing,
             1.0,
@@ -1187,45 +1177,58 @@ mod tests {
     /// A foot near the ground that is not held has its floor rows (height, roll, pitch) in the
     /// first level, beside the held feet; a landing foot its horizontal position and yaw in
     /// the second; a foot in the air, its floor engaged or not, its position in `swing_feet`,
-    /// between the COM and the pelvis.
+    /// before the pelvis and the torso's orientation; the COM only with `balance`, between
+    /// the feet's levels and the swing feet.
     #[test]
     fn the_floor_leads_and_the_feet_in_the_air_come_before_the_pelvis() {
         use FootMode::{Floor, Landing, Stance, Swing};
         let s = KeypointSettings::default();
         let (robot, state, body, c, names) = g1(&s);
-        let rows = |modes: [FootMode; 2]| {
-            let stack = build_stack(&robot, &state, &body, c.plan(), &names, &s, modes).unwrap();
+        let rows = |modes: [FootMode; 2], s: &KeypointSettings| {
+            let stack = build_stack(&robot, &state, &body, c.plan(), &names, s, modes).unwrap();
             levels(&stack).into_iter().take(5).collect::<Vec<_>>()
         };
         assert_eq!(
-            rows([Stance, Floor]),
+            rows([Stance, Floor], &s),
             named(&[
                 ("stance_feet", 6 + 3),
-                ("com_xy", 2),
                 ("swing_feet", 3),
-                ("pelvis", 6),
+                ("pelvis_torso", 6 + 3),
                 ("hands", 6 + 29),
+                ("elbows_head", 6 + 3),
             ])
         );
         assert_eq!(
-            rows([Landing, Swing]),
+            rows([Landing, Swing], &s),
             named(&[
                 ("stance_feet", 3),
                 ("swing_floor", 3),
-                ("com_xy", 2),
                 ("swing_feet", 3),
-                ("pelvis", 6),
+                ("pelvis_torso", 6 + 3),
+                ("hands", 6 + 29),
             ])
         );
+        let balance = KeypointSettings {
+            balance: true,
+            ..s.clone()
+        };
         assert_eq!(
-            rows([Swing, Stance]),
+            rows([Swing, Stance], &balance),
             named(&[
                 ("stance_feet", 6),
                 ("com_xy", 2),
                 ("swing_feet", 3),
-                ("pelvis", 6),
+                ("pelvis_torso", 6 + 3),
                 ("hands", 6 + 29),
             ])
+        );
+        let standing = KeypointSettings {
+            standing: true,
+            ..s
+        };
+        assert_eq!(
+            rows([Stance, Stance], &standing)[..2],
+            named(&[("stance_feet", 12), ("com_xy", 2)])[..]
         );
     }
 
@@ -1240,9 +1243,10 @@ mod tests {
     }
 
     /// With a posture weight the posture rows (one per active joint, 29 on G1) follow the
-    /// hands' positions (3 rows each) in the sixth level; the elbows (3 rows each) and the
-    /// torso's orientation (3) make the seventh, or join the sixth with a body weight. With a
-    /// posture weight of 0 the posture has a level of its own, last.
+    /// hands' positions (3 rows each) in the sixth level; the elbows (3 rows each) make the
+    /// seventh, or join the sixth with a body weight; the torso's orientation (3) is in the
+    /// pelvis' level either way. With a posture weight of 0 the posture has a level of its
+    /// own, last.
     #[test]
     fn the_posture_rows_share_the_hands_level() {
         let stance = [FootMode::Stance, FootMode::Stance];
@@ -1252,10 +1256,9 @@ mod tests {
         let stack = build_stack(&robot, &state, &body, c.plan(), &names, &s, stance).unwrap();
         let want = [
             ("stance_feet", 12),
-            ("com_xy", 2),
-            ("pelvis", 6),
+            ("pelvis_torso", 6 + 3),
             ("hands", 6 + 29),
-            ("elbows_head_torso", 6 + 3),
+            ("elbows_head", 6),
         ];
         assert_eq!(levels(&stack), named(&want));
         let weighted = KeypointSettings {
@@ -1266,9 +1269,8 @@ mod tests {
             build_stack(&robot, &state, &body, c.plan(), &names, &weighted, stance).unwrap();
         let want = [
             ("stance_feet", 12),
-            ("com_xy", 2),
-            ("pelvis", 6),
-            ("hands", 6 + 6 + 3 + 29),
+            ("pelvis_torso", 6 + 3),
+            ("hands", 6 + 6 + 29),
         ];
         assert_eq!(levels(&stack), named(&want));
         let s0 = KeypointSettings {
@@ -1278,20 +1280,20 @@ mod tests {
         let stack = build_stack(&robot, &state, &body, c.plan(), &names, &s0, stance).unwrap();
         let want = [
             ("stance_feet", 12),
-            ("com_xy", 2),
-            ("pelvis", 6),
+            ("pelvis_torso", 6 + 3),
             ("hands", 6),
-            ("elbows_head_torso", 6 + 3),
+            ("elbows_head", 6),
             ("posture", 29),
         ];
         assert_eq!(levels(&stack), named(&want));
     }
 
-    /// A body without elbows, head or torso frames has no sixth level while both feet are
-    /// held (an empty level is an error), and one with the swing foot's orientation otherwise;
-    /// a body with only a torso, or only elbows, has it.
+    /// A body without elbows or head frames has no seventh level while both feet are held
+    /// (an empty level is an error), and one with the swing foot's orientation otherwise; a
+    /// body with elbows has it. The torso's orientation is in the pelvis' level when the body
+    /// has a torso frame.
     #[test]
-    fn the_sixth_level_is_there_only_with_a_task() {
+    fn the_seventh_level_is_there_only_with_a_task() {
         let s = KeypointSettings::default();
         let (robot, state, body, c, names) = g1(&s);
         let hands_only = RobotBody {
@@ -1315,6 +1317,7 @@ mod tests {
         let names_of =
             |st: &Stack| -> Vec<String> { levels(st).into_iter().map(|l| l.0).collect() };
         assert!(!names_of(&stack).iter().any(|n| n == KEYPOINT_LEVELS[6]));
+        assert!(levels(&stack).contains(&(KEYPOINT_LEVELS[4].to_string(), 6)));
         let stack = build_stack(&robot, &state, &hands_only, c.plan(), &names, &s, swing).unwrap();
         assert_eq!(
             levels(&stack).last().unwrap(),
@@ -1325,10 +1328,8 @@ mod tests {
             ..hands_only.clone()
         };
         let stack = build_stack(&robot, &state, &torso_only, c.plan(), &names, &s, stance).unwrap();
-        assert_eq!(
-            levels(&stack).last().unwrap(),
-            &(KEYPOINT_LEVELS[6].to_string(), 3)
-        );
+        assert!(!names_of(&stack).iter().any(|n| n == KEYPOINT_LEVELS[6]));
+        assert!(levels(&stack).contains(&(KEYPOINT_LEVELS[4].to_string(), 6 + 3)));
         let elbows_only = RobotBody {
             torso: None,
             points: body
