@@ -19,12 +19,12 @@
 //! chest, neck: the head's, else the leg's). With [`LimbScaling::Leg`] for the hands
 //! the wrists are then placed from the middle of the hips by the leg ratio instead, `p'_wrist =
 //! p'_m + s_leg (a(p_wrist) − a(m))` with `m` the middle of the human hips and `p'_m =
-//! (s_leg a(m)_xy, h_a + s_leg a(m)_z)` its scaled counterpart (so `p'_wrist = s_leg a(p_wrist)
-//! + h_a ẑ`): where the hands are relative to the body is kept, not the forearm's direction.
-//! With [`LimbScaling::Leg`] for the feet the ankles are placed the same way, `p'_ankle =
-//! s_leg a(p_ankle) + h_a ẑ` (a foot at the clip's lowest ankle height has its sole on the
-//! ground), and each toe moves with its ankle (`p'_toe += p'_ankle,leg − p'_ankle,segments`):
-//! the person's stance width, not the robot's hip width.
+//! (s_leg a(m)_xy, h_a + s_leg a(m)_z)` its scaled counterpart (so that
+//! `p'_wrist = s_leg a(p_wrist) + h_a ẑ`): where the hands are relative to the body is kept,
+//! not the forearm's direction. With [`LimbScaling::Leg`] for the feet the ankles are placed
+//! the same way, `p'_ankle = s_leg a(p_ankle) + h_a ẑ` (a foot at the clip's lowest ankle
+//! height has its sole on the ground), and each toe moves with its ankle (`p'_toe +=
+//! p'_ankle,leg − p'_ankle,segments`): the person's stance width, not the robot's hip width.
 
 use nalgebra::{Rotation3, Vector3};
 
