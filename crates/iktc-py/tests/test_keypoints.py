@@ -75,19 +75,18 @@ def test_smoothing_is_checked_and_keeps_the_shapes():
         iktc.retarget_keypoints(motion, robot, smoothing=-1.0)
 
 
-def test_the_soft_approach_halves_the_plans_jerk_and_bad_rates_are_errors():
+def test_the_soft_approach_lowers_the_plans_jerk_and_bad_rates_are_errors():
     # G1, humanoid3d_punch: the joints' RMS jerk of the plan (q̈'s change over a tick, per
-    # second) is 13 550 rad/s³ with the viable bounds alone and 6 560 with the soft approach to
-    # the range ends at 10 /s (not the route's default: on CMU 131_01 G1's sole then dipped
-    # 8.7 mm below the ground). On humanoid3d_dance_b, whose joints keep off their limits, 5 000
-    # and 4 100.
+    # second) is 5 650 rad/s³ under the default quiet bounds and 4 600 with the soft approach
+    # to the range ends at 10 /s (2026-12-07; not the route's default: on CMU 131_01 G1's sole
+    # then dipped 8.7 mm below the ground).
     robot, motion = iktc.Robot("g1"), iktc.load_motion("humanoid3d_punch")
 
     def rms_jerk(**kw):
         qdd = np.asarray(iktc.retarget_keypoints(motion, robot, **kw).qdd)[:, 6:]
         return np.sqrt(np.mean((np.diff(qdd, axis=0) / 0.005) ** 2))
 
-    assert rms_jerk(approach_rate=10.0) < 0.6 * rms_jerk()
+    assert rms_jerk(approach_rate=10.0) < 0.9 * rms_jerk()
     with pytest.raises(iktc.IktcError, match="approach_rate"):
         iktc.retarget_keypoints(motion, robot, approach_rate=-1.0)
 

@@ -201,16 +201,17 @@ pub struct KeypointSettings {
     /// person from the waist up; the clip's steps, crouches and pelvis sway are left out.
     pub standing: bool,
     /// Keep the COM over the support polygon of the feet on the ground, horizontally, in a
-    /// level of its own (`com_xy`) above the swing feet, the pelvis and the torso (default
-    /// false; standing imitation always does, [`KeypointSettings::standing`]). A static
-    /// balance the captured person does not keep: walking, their COM passes between the feet
-    /// instead of over the stance foot. Above a pelvis and torso that follow the person's,
-    /// the level can only move the COM with the arms (or, with the torso free, the waist),
-    /// which it swings to their limits: on the development set (2026-12-07, `devset/run.sh OUT
-    /// g1`) it raises G1's mean keypoint error from 9.13 to 13.18 cm (wrists 10.2 → 24 cm).
-    /// The robot's COM then goes where the person's body puts it, as in a whole-clip
-    /// retargeting without balance; a physical robot tracking the result balances by its own
-    /// controller.
+    /// level of its own (`com_xy`) above the swing feet and the pelvis (default false;
+    /// standing imitation always does, [`KeypointSettings::standing`]). A static balance the
+    /// captured person does not keep: walking, their COM passes between the feet instead of
+    /// over the stance foot. With it the torso's orientation leaves the pelvis' level for the
+    /// elbows' (above a pelvis and a torso that follow the person's the level could move the
+    /// COM only with the arms, which it swings to their limits: G1's wrists 24 cm off the
+    /// person's), and the waist moves the COM, leaning the trunk off the person's. On the
+    /// development set (2026-12-07, `devset/run.sh OUT g1 [--balance]`, ten clips of six rigs)
+    /// G1's mean keypoint error is 9.14 cm without it and 11.24 cm with it, the trunk lean's
+    /// gap to the person's 3.6° and 7.9°. The robot's COM then goes where the person's body
+    /// puts it; a physical robot tracking the result balances by its own controller.
     pub balance: bool,
     /// Cut-off \[Hz\] of the zero-phase low-pass ([`crate::motion::lowpass`]) applied to the
     /// scaled body points before they are interpolated and differentiated into the tasks'

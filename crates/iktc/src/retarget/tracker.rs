@@ -11,8 +11,9 @@
 //! 3. `com_xy`: only with [`KeypointSettings::balance`] (or standing imitation), the COM over
 //!    the support polygon, horizontal;
 //! 4. `swing_feet`: the positions of the feet in the air;
-//! 5. `pelvis_torso`: the pelvis pose, 6D, and the torso's orientation: the trunk's lean and
-//!    twist follow the person's, and no level below can trade them for a hand;
+//! 5. `pelvis_torso`: the pelvis pose, 6D, and (without the COM level) the torso's
+//!    orientation: the trunk's lean and twist follow the person's, and no level below can
+//!    trade them for a hand;
 //! 6. `hands`: the wrists' positions; the elbows' and the head's positions and the
 //!    orientations of the feet in the air with their rows weighted by
 //!    [`KeypointSettings::body_weight`]; and every active joint at its posture reference with
@@ -20,7 +21,7 @@
 //!    The body points are the robot's joint centres ([`super::centres`]), the points the
 //!    fidelity figures measure;
 //! 7. `elbows_head`: only with a body weight of 0, the elbows, head and swing feet's
-//!    orientations in a level of their own; with weighted posture rows in the sixth level it
+//!    orientations (and, with the COM level, the torso's) in a level of their own; with weighted posture rows in the sixth level it
 //!    has no coordinate left (rank 0) and moves nothing, and only its errors are reported;
 //! 8. `posture`: only with a posture weight of 0, every active joint at its posture reference
 //!    in a level of its own (below the weighted rows such a level could only move what they
@@ -35,8 +36,9 @@
 //! The torso's orientation is in the pelvis' level, above the hands: in a level below the
 //! weighted posture rows it would have rank 0, and the waist would be left to whatever the
 //! hands' least-squares compromise asks of it. Above a pelvis and a torso held to the
-//! person's, the COM level of [`KeypointSettings::balance`] can only move the COM with the
-//! arms, which is why it is off by default (see there).
+//! person's, the COM level of [`KeypointSettings::balance`] could only move the COM with the
+//! arms (it is off by default, see there); with it the torso's orientation joins the elbows
+//! and the head, and the waist moves the COM as before.
 //!
 //! The levels above the last can take every coordinate (on G1 the feet, pelvis, torso, hands
 //! and elbows take all 35): each level is then solved exactly in what its betters leave it,
@@ -474,8 +476,9 @@ fn frame_name(robot: &Robot, f: FrameId) -> String {
         .unwrap_or_default()
 }
 
-/// Adds the elbows' and head's positions and the swing feet's orientations to the builder's
-/// current level, their rows weighted by `w`.
+/// Adds the elbows' and head's positions, the orientation of `torso_frame` (unless `torso` is
+/// set already) and the swing feet's orientations to the builder's current level, their rows
+/// weighted by `w`.
 #[allow(clippy::too_many_arguments)]
 fn add_body_tasks(
     b: &mut ControllerBuilder,
@@ -483,6 +486,8 @@ fn add_body_tasks(
     body: &RobotBody,
     plan: &Plan,
     points: &mut Vec<(FrameHandle, usize)>,
+    torso: &mut Option<FrameHandle>,
+    torso_frame: Option<FrameId>,
     feet: &mut Vec<(usize, FrameHandle)>,
     swing: [bool; 2],
     w: f64,
@@ -498,6 +503,9 @@ fn add_body_tasks(
         if let Some(f) = body.frame_of(*p) {
             points.push((b.weighted_frame(&name(f), Axes::POSITION, w)?, i));
         }
+    }
+    if let (Some(f), None) = (torso_frame, &*torso) {
+        *torso = Some(b.weighted_frame(&name(f), Axes::ORIENTATION, w)?);
     }
     for i in (0..2).filter(|i| swing[*i]) {
         feet.push((
@@ -563,9 +571,12 @@ fn build_stack(
     let pelvis = b
         .level(KEYPOINT_LEVELS[4])
         .frame(&name(body.pelvis), Axes::ALL)?;
-    let torso = match body.torso {
-        Some(f) => Some(b.frame(&name(f), Axes::ORIENTATION)?),
-        None => None,
+    // The torso's orientation beside the pelvis, unless the COM level above would then have
+    // only the arms to move the COM with: with it, among the elbows and the head.
+    let balanced = com.is_some();
+    let mut torso = match body.torso {
+        Some(f) if !balanced => Some(b.frame(&name(f), Axes::ORIENTATION)?),
+        _ => None,
     };
     let mut points = Vec::new();
     b.level(KEYPOINT_LEVELS[5]);
@@ -580,7 +591,18 @@ fn build_stack(
     // (weight 0) a seventh level of their own.
     let w = s.body_weight;
     if w > 0.0 {
-        add_body_tasks(&mut b, robot, body, plan, &mut points, &mut feet, swing, w)?;
+        add_body_tasks(
+            &mut b,
+            robot,
+            body,
+            plan,
+            &mut points,
+            &mut torso,
+            body.torso.filter(|_| balanced),
+            &mut feet,
+            swing,
+            w,
+        )?;
     }
     // Weighted into the sixth level, or (weight 0) a level of its own below the seventh: never
     // both, as a posture level below the weighted rows could only move what they already move.
@@ -592,7 +614,8 @@ fn build_stack(
     if w == 0.0 {
         // The seventh level only with a task in it (a robot without elbows or head frames
         // standing on both feet has none).
-        let seventh = swing.contains(&true)
+        let seventh = (balanced && body.torso.is_some())
+            || swing.contains(&true)
             || plan
                 .points
                 .iter()
@@ -606,6 +629,8 @@ fn build_stack(
             body,
             plan,
             &mut points,
+            &mut torso,
+            body.torso.filter(|_| balanced),
             &mut feet,
             swing,
             1.0,
@@ -1177,8 +1202,9 @@ mod tests {
     /// A foot near the ground that is not held has its floor rows (height, roll, pitch) in the
     /// first level, beside the held feet; a landing foot its horizontal position and yaw in
     /// the second; a foot in the air, its floor engaged or not, its position in `swing_feet`,
-    /// before the pelvis and the torso's orientation; the COM only with `balance`, between
-    /// the feet's levels and the swing feet.
+    /// before the pelvis and the torso's orientation; the COM only with `balance` (or
+    /// standing), between the feet's levels and the swing feet, the torso's orientation then
+    /// with the elbows.
     #[test]
     fn the_floor_leads_and_the_feet_in_the_air_come_before_the_pelvis() {
         use FootMode::{Floor, Landing, Stance, Swing};
@@ -1212,14 +1238,20 @@ mod tests {
             balance: true,
             ..s.clone()
         };
+        // With the COM level the torso's orientation joins the elbows in the seventh level.
+        let all = |modes: [FootMode; 2], s: &KeypointSettings| {
+            let stack = build_stack(&robot, &state, &body, c.plan(), &names, s, modes).unwrap();
+            levels(&stack)
+        };
         assert_eq!(
-            rows([Swing, Stance], &balance),
+            all([Swing, Stance], &balance),
             named(&[
                 ("stance_feet", 6),
                 ("com_xy", 2),
                 ("swing_feet", 3),
-                ("pelvis_torso", 6 + 3),
+                ("pelvis_torso", 6),
                 ("hands", 6 + 29),
+                ("elbows_head", 6 + 3 + 3),
             ])
         );
         let standing = KeypointSettings {
