@@ -109,7 +109,7 @@ pub struct KeypointArgs {
     #[arg(long)]
     pub posture_fit: bool,
     /// Largest share of a leg's length (hip–knee plus knee–ankle) the pelvis height may ask
-    /// of it, in (0, 1] (default 0.92): the pelvis is lowered instead. Larger values follow a
+    /// of it, in (0, 1] (default 0.95): the pelvis is lowered instead. Larger values follow a
     /// person's straight knees closer and land the feet less exactly.
     #[arg(long, value_name = "SHARE")]
     pub max_leg_extension: Option<f64>,

@@ -1,4 +1,4 @@
-//! Hostile command lines (issue 11, items 5 and 6): each gives an error message and exit code 1,
+//! Hostile command lines: each gives an error message and exit code 1,
 //! or, for a closed pipe, a quiet exit 0; never a panic (exit 101).
 
 use std::io::Read;

@@ -84,7 +84,7 @@ fn bench(c: &mut Criterion) {
     group.finish();
 }
 
-/// The walking tick (issue 6): walking pattern, damping controller and IK, with the ZMP of the
+/// The walking tick: walking pattern, damping controller and IK, with the ZMP of the
 /// simulated compliant robot fed back (the plant's step is outside the timed region).
 fn bench_walk(c: &mut Criterion) {
     use iktc::sim::{WalkPlants, WalkingController};

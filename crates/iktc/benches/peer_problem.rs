@@ -1,4 +1,4 @@
-//! The control tick on "the peer problem" of issue 17 (defined in `peer/problem.rs`: JVRC-1,
+//! The control tick on "the peer problem" (defined in `peer/problem.rs`: JVRC-1,
 //! Δt = 5 ms, viable bounds, a_max = 10·v_max, five levels with k_p = 400 s⁻², k_v = 40 s⁻¹,
 //! the 20 upper-body joints on sinusoids with phases from `ChaCha8Rng::seed_from_u64(17)`).
 //!

@@ -1,4 +1,4 @@
-//! Runs the peer problem of issue 17 (`benches/peer/problem.rs`) for a repeatable instruction
+//! Runs the peer problem (`benches/peer/problem.rs`) for a repeatable instruction
 //! count: the 50 warm-up steps, then the 2 000 timed steps inside [`timed`], which a profiler
 //! can select, e.g.
 //!

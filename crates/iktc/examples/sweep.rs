@@ -1,4 +1,4 @@
-//! The sweep of issue 11: every built-in clip × IKTC / GF / clamp × Δt ∈ {2, 5, 10, 20, 50} ms
+//! The robustness sweep: every built-in clip × IKTC / GF / clamp × Δt ∈ {2, 5, 10, 20, 50} ms
 //! with viable bounds on JVRC-1, one table row per case. Run it with
 //! `cargo run --release -p iktc --example sweep` (a few minutes on one core).
 

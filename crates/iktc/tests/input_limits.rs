@@ -1,4 +1,4 @@
-//! Hostile input (issue 11, items 3, 5, 6): every URDF limit attribute checked, resource bounds
+//! Hostile input: every URDF limit attribute checked, resource bounds
 //! checked before anything is allocated, configs that overflow refused. Each case asserts the
 //! error's kind and that its text names what is wrong, its value and what was expected.
 

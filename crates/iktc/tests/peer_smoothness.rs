@@ -1,6 +1,6 @@
-//! Smoothness of the commands on the peer problem of issue 17 (`benches/peer/problem.rs`, the
+//! Smoothness of the commands on the peer problem (`benches/peer/problem.rs`, the
 //! 20 upper-body joints driven into their limits), per bound method and level hold: every
-//! limit kept in every variant, and the figures of issue 13 printed (`-- --nocapture`):
+//! limit kept in every variant, and the smoothness figures printed (`-- --nocapture`):
 //! over the 2 000 timed steps, the mean over the 20 joints of the share of ticks where the
 //! change of q̈ reverses its sign, and the RMS over joints and ticks of the commanded jerk
 //! (q̈ₖ − q̈ₖ₋₁)/Δt. The quiet bounds meet the issue's targets for this problem (reversals on
@@ -21,9 +21,9 @@ use peer::{PeerProblem, DT, TIMED, UPPER_BODY, WARMUP};
 /// this is a violation \[rad/s²\].
 const BOX_TOLERANCE: f64 = 1e-9;
 
-/// Issue 13's target for the share of ticks where the change of q̈ reverses its sign \[–\].
+/// The target for the share of ticks where the change of q̈ reverses its sign \[–\].
 const REVERSAL_TARGET: f64 = 0.05;
-/// Issue 13's target for the RMS commanded jerk \[rad/s³\] (TSID 1.9 measured 2 200).
+/// The target for the RMS commanded jerk \[rad/s³\] (TSID 1.9 measured 2 200).
 const RMS_JERK_TARGET: f64 = 2000.0;
 
 /// The jerk limit of the jerk-limited variants as a multiple of each joint's acceleration limit

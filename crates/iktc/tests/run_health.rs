@@ -1,4 +1,4 @@
-//! Runs that go wrong say so (issue 11, item 4): each check of `iktc::sim::health` triggered by
+//! Runs that go wrong say so: each check of `iktc::sim::health` triggered by
 //! a constructed case, the error naming time, quantity, value and tolerance; with `keep_going`
 //! the run goes on and its summary lists the failure; the default runs pass (no false alarm);
 //! a sideways push is measured along ỹ.
@@ -72,7 +72,7 @@ fn a_foot_past_its_tolerance_stops_the_run() {
 }
 
 /// JVRC-1 read from its URDF with the fingers free (nv = 40): the run gives up the feet and
-/// now stops instead of writing 18 m of drift (issue 11).
+/// stops instead of writing 18 m of drift.
 #[test]
 fn jvrc1_urdf_with_free_fingers_stops_on_the_feet() {
     let robot = Robot::from_urdf_str(

@@ -82,7 +82,7 @@ fn paper_bound_overshoots_in_discrete_time() {
     assert!(s.worst_position_margin < 2.0 * DEG);
 }
 
-/// Issue 13: with the quiet bounds q1 rests on its limit with q̈1 = 0 from 0.7 s on, no joint's
+/// With the quiet bounds q1 rests on its limit with q̈1 = 0 from 0.7 s on, no joint's
 /// q̈ reverses its change on more than 2 % of the ticks, and every q̈ is steady (std ≤ 1 deg/s²)
 /// once the P_x reference has stopped, for IKTC and GF; limits and task outcome as with the viable
 /// bounds. The viable bounds chatter there at about ±a_stop (the figure the quiet ones fix).

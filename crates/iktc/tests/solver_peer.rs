@@ -1,4 +1,4 @@
-//! The solver on the peer problem of issue 17 (`benches/peer/problem.rs`): the warm-started
+//! The solver on the peer problem (`benches/peer/problem.rs`): the warm-started
 //! correction QP against the reference path (every QP solved from scratch) on a recorded
 //! sequence of its problems, and the limits the problem is known to bind.
 
@@ -100,7 +100,7 @@ fn the_warm_start_gives_the_reference_answers_on_the_peer_problem() {
 
 #[test]
 fn the_peer_problem_binds_the_limits_the_issue_names() {
-    // Issue 17: position limits bind on WAIST_Y, WAIST_P, R/L_SHOULDER_R, R/L_ELBOW_P and
+    // On the peer problem position limits bind on WAIST_Y, WAIST_P, R/L_SHOULDER_R, R/L_ELBOW_P and
     // velocity limits on R/L_SHOULDER_Y, R/L_ELBOW_Y, R/L_WRIST_Y; the posture level is the
     // one corrected.
     /// A joint this close to a position limit has reached it \[rad\].

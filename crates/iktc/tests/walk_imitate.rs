@@ -1,4 +1,4 @@
-//! The humanoid walks while it imitates, with the damping controller in the loop (issue 6):
+//! The humanoid walks while it imitates, with the damping controller in the loop:
 //! the ZMP stays inside the support polygon for the whole run, push included; with the
 //! controller the ZMP oscillation after the push decays faster than without; no joint limit
 //! is exceeded at any tick; the feet do not slide in stance.

@@ -252,7 +252,7 @@ def retarget_keypoints(motion: Motion, robot: Robot, *, dt: float = 0.005,
                        reach: bool = False,
                        max_slide: Optional[float] = ...,  # iktc::retarget::MAX_SLIDE, 0.05 m
                        posture_fit: bool = False,
-                       max_leg_extension: float = ...,  # iktc::retarget::MAX_LEG_EXTENSION, 0.92
+                       max_leg_extension: float = ...,  # iktc::retarget::MAX_LEG_EXTENSION, 0.95
                        ) -> KeypointTrajectory: ...
 
 @final

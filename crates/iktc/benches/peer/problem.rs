@@ -1,5 +1,6 @@
-//! "The peer problem" of issue 17, as one self-contained closed loop shared by the
-//! `peer_problem` bench and the solver tests that replay it.
+//! "The peer problem" (the five levels of the paper's Table 1 on JVRC-1, measured beside
+//! mink, Pink and TSID), as one self-contained closed loop shared by the `peer_problem` bench
+//! and the solver tests that replay it.
 //!
 //! - JVRC-1 built in (32 joints, fingers locked, floating base: n = 38), Δt = 5 ms, viable
 //!   bounds, a_max = 10·v_max (the model's default acceleration per velocity), no damping.

@@ -328,15 +328,19 @@ pub const BODY_WEIGHT: f64 = 0.0;
 /// (1.7 mm upright) and widens JVRC-1's knee gap (29° → 33°).
 pub const PELVIS_LEAN: f64 = 0.0;
 
-/// Default [`KeypointSettings::max_leg_extension`] \[–\]: 0.92, a knee bent at least 46°
-/// (equal thigh and shank, `2 acos 0.92`) under a foot right below its hip. Straighter legs
-/// follow the person's knees closer but land the feet worse: on the development set
-/// (2026-12-07, ten clips of six rigs, the neutral figures of [`fidelity`], the posture fitted
-/// to the whole body) G1's knee flexion is 23° from the person's at 0.92, 18° at 0.95 and 15°
-/// at 0.97 (mean over clips of the medians' gap; JVRC-1 30°, 23°, 18°), its mean keypoint
-/// error 10.6, 10.6 and 10.4 cm, and its feet's slip over the person's contacts 57, 91 and
-/// 88 mm (mean over clips; the worst clip 217, 345 and 306 mm).
-pub const MAX_LEG_EXTENSION: f64 = 0.92;
+/// Default [`KeypointSettings::max_leg_extension`] \[–\]: 0.95, a knee bent at least 36°
+/// (equal thigh and shank, `2 acos 0.95`) under a foot right below its hip. Straighter legs
+/// follow the person's knees closer but land the feet worse. On the development set
+/// (2026-12-07, `devset/run.sh OUT ROBOT --max-leg-extension E`, ten clips of six rigs, the
+/// neutral figures of [`fidelity`]), G1 at 0.92 / 0.94 / 0.95 / 0.96 / 0.97: knee flexion's
+/// gap to the person's 17.9 / 15.0 / 14.2 / 11.5 / 10.2° (mean over clips of the medians'
+/// gap), mean keypoint error 9.14 / 9.11 / 9.01 / 9.25 / 9.22 cm, slip over the person's
+/// contacts 23 / 30 / 27 / 32 / 44 mm (mean over clips; the worst clip 90 / 107 / 112 / 175 /
+/// 297 mm). At 0.95 against 0.92 the knee gap is lower on all 14 robots measured (built-in,
+/// GMR's and unitree_mujoco's MJCF models), the keypoint error on 9 (JVRC-1 10.54 → 10.24 cm,
+/// PM01 10.08 → 9.56, G1-23 10.93 → 10.34) and higher on 5 (N1 9.66 → 10.05, H1-2 13.77 →
+/// 14.30, the G1 MJCF models 9.04 → 9.73 and 9.30 → 9.49 cm).
+pub const MAX_LEG_EXTENSION: f64 = 0.95;
 
 /// Sample period of the static reach ([`KeypointSettings::reach`]) \[s\].
 pub const REACH_PERIOD: f64 = 0.05;

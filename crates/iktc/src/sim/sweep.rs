@@ -1,4 +1,4 @@
-//! The robustness sweep of issue 11: one imitation run per clip × solver × control period,
+//! The robustness sweep: one imitation run per clip × solver × control period,
 //! with viable bounds, reduced to what must hold — no limit exceeded (in-step peaks included),
 //! the box never empty, the fallbacks counted by kind — and the run checks' verdict.
 //!
