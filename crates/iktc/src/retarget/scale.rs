@@ -198,6 +198,10 @@ pub(crate) fn scale_clip(
         _ => 0.0,
     };
     let wrists = [index(kp, B::LeftWrist), index(kp, B::RightWrist)];
+    let ankles = [(la, index(kp, B::LeftToe)), (ra, index(kp, B::RightToe))];
+    // p'_m + s_leg (a(p) − a(m)) with p'_m = (s_leg a(m)_xy, h_a + s_leg a(m)_z), i.e.
+    // s_leg a(p) + h_a ẑ: a point placed from the middle of the hips by the leg ratio.
+    let by_leg = |i: usize| leg * aligned[i] + Vector3::new(0.0, 0.0, ankle_height);
     for f in 0..frames {
         let row = f * n;
         let hips = 0.5 * (aligned[row + lh] + aligned[row + rh]);
@@ -209,9 +213,9 @@ pub(crate) fn scale_clip(
             }
         }
         if feet == LimbScaling::Leg {
-            // p'_ankle = s_leg a(p_ankle) + h_a ẑ; the toe keeps its offset from the ankle.
-            for (a, toe) in [(la, index(kp, B::LeftToe)), (ra, index(kp, B::RightToe))] {
-                let moved = leg * aligned[row + a] + Vector3::new(0.0, 0.0, ankle_height);
+            // The ankle by the leg ratio; the toe keeps its offset from the ankle.
+            for (a, toe) in ankles {
+                let moved = by_leg(row + a);
                 let shift = moved - scaled[row + a];
                 scaled[row + a] = moved;
                 if let Some(t) = toe {
@@ -220,9 +224,8 @@ pub(crate) fn scale_clip(
             }
         }
         if hands == LimbScaling::Leg {
-            // p'_m + s_leg (a(p_wrist) − a(m)) with p'_m = (s_leg a(m)_xy, h_a + s_leg a(m)_z).
             for w in wrists.iter().flatten() {
-                scaled[row + w] = leg * aligned[row + w] + Vector3::new(0.0, 0.0, ankle_height);
+                scaled[row + w] = by_leg(row + w);
             }
         }
     }
@@ -242,6 +245,21 @@ pub(crate) fn scale_clip(
 mod tests {
     use super::*;
     use crate::profile::RobotProfile;
+
+    /// The robot's ankle height above its sole in these tests \[m\].
+    const ANKLE_HEIGHT: f64 = 0.035;
+
+    /// `kp` scaled onto the robot with the hands and feet placed by `hands` and `feet`.
+    fn scaled(
+        robot: &Robot,
+        kin: &Kinematics,
+        body: &RobotBody,
+        kp: &Keypoints,
+        hands: LimbScaling,
+        feet: LimbScaling,
+    ) -> ScaledClip {
+        scale_clip(robot, kin, body, kp, ANKLE_HEIGHT, hands, feet).unwrap()
+    }
 
     /// G1 at its neutral posture, its body points, and the keypoints of a built-in clip.
     fn g1_and(clip: &str) -> (Robot, Kinematics, RobotBody, Keypoints) {
@@ -269,16 +287,14 @@ mod tests {
     #[test]
     fn scaled_segments_have_the_robots_lengths() {
         let (robot, kin, body, kp) = g1_and("humanoid3d_punch");
-        let c = scale_clip(
+        let c = scaled(
             &robot,
             &kin,
             &body,
             &kp,
-            0.035,
             LimbScaling::Segments,
             LimbScaling::Segments,
-        )
-        .unwrap();
+        );
         let n = kp.points.len();
         let idx = |p: BodyPoint| kp.points.iter().position(|q| *q == p).unwrap();
         let mut checked = 0;
@@ -321,26 +337,22 @@ mod tests {
             kp.positions[f * n + l] = mid;
             kp.positions[f * n + r] = mid;
         }
-        let leg = scale_clip(
+        let leg = scaled(
             &robot,
             &kin,
             &body,
             &kp,
-            0.035,
             LimbScaling::Leg,
             LimbScaling::Segments,
-        )
-        .unwrap();
-        let seg = scale_clip(
+        );
+        let seg = scaled(
             &robot,
             &kin,
             &body,
             &kp,
-            0.035,
             LimbScaling::Segments,
             LimbScaling::Segments,
-        )
-        .unwrap();
+        );
         // Rounding of a few additions of decimetre-sized vectors \[m\].
         let tol = 1e-12;
         let mut apart: f64 = 0.0;
@@ -397,27 +409,23 @@ mod tests {
         let (robot, kin, body, kp) = g1_and("humanoid3d_walk");
         let n = kp.points.len();
         let idx = |p: BodyPoint| kp.points.iter().position(|q| *q == p).unwrap();
-        let h_a = 0.035;
-        let leg = scale_clip(
+        let h_a = ANKLE_HEIGHT;
+        let leg = scaled(
             &robot,
             &kin,
             &body,
             &kp,
-            h_a,
             LimbScaling::Segments,
             LimbScaling::Leg,
-        )
-        .unwrap();
-        let seg = scale_clip(
+        );
+        let seg = scaled(
             &robot,
             &kin,
             &body,
             &kp,
-            h_a,
             LimbScaling::Segments,
             LimbScaling::Segments,
-        )
-        .unwrap();
+        );
         let s = leg.scaling.leg;
         // Rounding of a few additions of metre-sized vectors \[m\].
         let tol = 1e-12;

@@ -578,6 +578,7 @@ fn build_stack(
         Some(f) if !balanced => Some(b.frame(&name(f), Axes::ORIENTATION)?),
         _ => None,
     };
+    let torso_with_elbows = body.torso.filter(|_| balanced);
     let mut points = Vec::new();
     b.level(KEYPOINT_LEVELS[5]);
     let hand = |p: &BodyPoint| matches!(p, BodyPoint::LeftWrist | BodyPoint::RightWrist);
@@ -598,7 +599,7 @@ fn build_stack(
             plan,
             &mut points,
             &mut torso,
-            body.torso.filter(|_| balanced),
+            torso_with_elbows,
             &mut feet,
             swing,
             w,
@@ -614,7 +615,7 @@ fn build_stack(
     if w == 0.0 {
         // The seventh level only with a task in it (a robot without elbows or head frames
         // standing on both feet has none).
-        let seventh = (balanced && body.torso.is_some())
+        let seventh = torso_with_elbows.is_some()
             || swing.contains(&true)
             || plan
                 .points
@@ -630,7 +631,7 @@ fn build_stack(
             plan,
             &mut points,
             &mut torso,
-            body.torso.filter(|_| balanced),
+            torso_with_elbows,
             &mut feet,
             swing,
             1.0,
