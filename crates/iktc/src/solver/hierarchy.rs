@@ -60,6 +60,7 @@
 
 use nalgebra::{DMatrix, DVector};
 
+use super::gram::GramLevel;
 use super::kernels::{axpy, axpy2, dot, reflect_columns};
 use super::reflectors::Reflectors;
 use super::selection::SelectionBlock;
@@ -124,10 +125,16 @@ pub struct Hierarchy {
     closed: Vec<f64>,
     built: Option<usize>,
     closed_level: Option<usize>,
-    /// The first level whose reduction (QR, factors) has not been run, down to the closed
-    /// level: only what needs their factors runs it ([`Hierarchy::complete`]), with the
-    /// settings of the solve.
-    deferred: Option<usize>,
+    /// The levels whose reduction (QR, factors) has not been run (first, last): those above
+    /// and at the closed level, or the level stepped by its Gram matrix. Only what needs
+    /// their factors runs it ([`Hierarchy::complete`]), with the settings of the solve.
+    deferred: Option<(usize, usize)>,
+    /// The Gram step of a bottom level of weighted joint rows ([`super::gram`]), and whether
+    /// the last solve took it (the levels below it then have rank 0).
+    gram: GramLevel,
+    gram_level: Option<usize>,
+    /// The λ² of that level's step, which its reduction then uses.
+    gram_lambda2: f64,
     settings: SolverSettings,
 }
 
@@ -170,6 +177,9 @@ impl Hierarchy {
             built: None,
             closed_level: None,
             deferred: None,
+            gram: GramLevel::new(n, mmax),
+            gram_level: None,
+            gram_lambda2: 0.0,
             settings: SolverSettings::default(),
         }
     }
@@ -192,6 +202,13 @@ impl Hierarchy {
     /// Rank kept at each level by the last [`Hierarchy::solve`].
     pub fn ranks(&self) -> &[usize] {
         &self.ranks
+    }
+
+    /// The level the last [`Hierarchy::solve`] stepped by its Gram matrix (the `gram` module:
+    /// a bottom level of weighted joint rows that completes the rank), if any. Its answer is
+    /// the QR's to rounding; its reduction runs only when its factors are asked for.
+    pub fn stepped_by_gram(&self) -> Option<usize> {
+        self.gram_level
     }
 
     /// J̄_i^{λ+} of level i (n × m_i), from the last solve. Formed on request from the
@@ -255,19 +272,20 @@ impl Hierarchy {
         self.u.fill(0.0);
         self.refl.truncate(0);
         (self.built, self.closed_level, self.deferred) = (None, None, None);
+        self.gram_level = None;
         self.settings = *settings;
         if self.solve_stack_closed(levels, settings, qdd) {
             return Ok(());
         }
         for (i, lvl) in levels.iter().enumerate() {
-            if self.closed_level.is_some() {
+            if self.closed_level.is_some() || self.gram_level.is_some() {
                 // The level solved in closed form completed the rank: no coordinate left.
                 (self.starts[i], self.ranks[i]) = (self.n, 0);
                 continue;
             }
             let p = self.refl.len();
             self.starts[i] = p;
-            if self.solve_closed(i, levels, settings) {
+            if self.solve_closed(i, levels, settings) || self.solve_gram(i, lvl, settings) {
                 continue;
             }
             self.reduce_level(i, settings);
@@ -349,7 +367,7 @@ impl Hierarchy {
             self.fac[k].direct = full;
         }
         self.closed_level = Some(i);
-        self.deferred = Some(0);
+        self.deferred = Some((0, i));
         true
     }
 
@@ -398,23 +416,47 @@ impl Hierarchy {
         self.ranks[i] = m;
         self.fac[i].direct = true;
         self.closed_level = Some(i);
-        self.deferred = Some(i);
+        self.deferred = Some((i, i));
+        true
+    }
+
+    /// Level i by its Gram matrix, when it holds weighted joint rows and completes the rank
+    /// ([`super::gram`]): its step into `u`, its rank k = n − p_i, its reduction deferred
+    /// ([`Hierarchy::complete`]). False (nothing decided) otherwise.
+    fn solve_gram(&mut self, i: usize, level: &TaskEquation, settings: &SolverSettings) -> bool {
+        let p = self.refl.len();
+        let Some(lambda2) = self.gram.step(
+            level,
+            &self.refl,
+            self.u.as_mut_slice(),
+            settings.damping,
+            settings.rank_threshold,
+        ) else {
+            return false;
+        };
+        self.gram_lambda2 = lambda2;
+        self.ranks[i] = self.n - p;
+        self.fac[i].direct = false;
+        self.gram_level = Some(i);
+        self.deferred = Some((i, i));
         true
     }
 
     /// Runs the reductions that the last [`Hierarchy::solve`] deferred (the levels from
-    /// `deferred` to the one it took in closed form), for what needs their factors (the
-    /// reflectors, R, Π: the blocks of the general construction, J̄^{λ+}). The ranks they find
-    /// are the ones decided (full, by the bounds of the `selection` module).
+    /// `deferred.0` to the one it took in closed form or by its Gram matrix), for what needs
+    /// their factors (the reflectors, R, Π: the blocks of the general construction, J̄^{λ+}).
+    /// The ranks they find are the ones decided (by the bounds of the `selection` and `gram`
+    /// modules).
     fn complete(&mut self) {
-        let (Some(from), Some(to)) = (self.deferred.take(), self.closed_level) else {
+        let Some((from, to)) = self.deferred.take() else {
             return;
         };
         let settings = self.settings;
         for k in from..=to {
             self.starts[k] = self.refl.len();
+            let decided = self.ranks[k];
             self.reduce_level(k, &settings);
-            debug_assert_eq!(self.ranks[k], self.dims[k], "level {k}: closed-form rank");
+            debug_assert_eq!(self.ranks[k], decided, "level {k}: the rank decided");
         }
     }
 
@@ -516,6 +558,8 @@ impl Hierarchy {
         // λ² from the damping rule; σ_min estimated by the last kept pivot |R_rr|.
         let sigma = self.a[(rank - 1, rank - 1)].abs();
         let lambda2 = match settings.damping {
+            // The level stepped by its Gram matrix keeps the damping it was stepped with.
+            _ if self.gram_level == Some(i) => self.gram_lambda2,
             Damping::None => 0.0,
             Damping::Fixed(l) => l * l,
             Damping::Adaptive { max, threshold } => {
@@ -834,7 +878,7 @@ fn undamped_floor(settings: &SolverSettings) -> Option<f64> {
 }
 
 /// Whether a lower bound on singular values clears 2 × `floor` (false for NaN).
-fn clears(bound: f64, floor: f64) -> bool {
+pub(super) fn clears(bound: f64, floor: f64) -> bool {
     bound > 2.0 * floor
 }
 
