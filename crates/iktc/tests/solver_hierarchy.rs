@@ -812,3 +812,59 @@ fn the_gram_step_is_damped_as_the_levels_above() {
         assert_g_is_the_derivative(&mut levels, &dims, &settings, &q, &g_all, case);
     }
 }
+
+#[test]
+fn a_stack_short_of_square_over_a_selection_gets_the_recursion_s_answer_in_closed_form() {
+    // The rows add up to n − d (d = 1, 2, 3): the bottom selection leaves d coordinates free.
+    // The solution, the bottom level's block of G and its correction-map block (built in
+    // closed form) against the projector recursion and the derivative of the solution.
+    let mut r = rng(81);
+    for case in 0..45 {
+        let n = 8 + case % 11;
+        let d = 1 + case % 3;
+        let m = 1 + case % (n - d - 2);
+        let mut levels = levels_over_a_selection(&mut r, n - d, m);
+        for l in &mut levels {
+            // d more coordinates, none selected: the upper levels' columns random.
+            let mut j = DMatrix::zeros(l.dim(), n);
+            j.columns_mut(0, n - d).copy_from(&l.jacobian);
+            l.jacobian = j;
+        }
+        let i = levels.len() - 1;
+        {
+            use rand::Rng;
+            for l in &mut levels[..i] {
+                for c in n - d..n {
+                    for row in 0..l.dim() {
+                        l.jacobian[(row, c)] = r.random_range(-1.0..1.0);
+                    }
+                }
+            }
+        }
+        let dims: Vec<usize> = levels.iter().map(|l| l.dim()).collect();
+        assert_eq!(dims.iter().sum::<usize>(), n - d);
+        let settings = SolverSettings::default();
+        let mut h = Hierarchy::new(n, &dims);
+        let mut q = DVector::zeros(n);
+        h.solve(&levels, &settings, &mut q).unwrap();
+        let want = reference_solution(&levels, 0.0);
+        let err = (&q - &want).norm() / (1.0 + want.norm());
+        assert!(err < REL_TOL, "case {case}: n {n}, dims {dims:?}: {err}");
+        assert_eq!(h.ranks(), &dims[..], "case {case}");
+        let closed = h.build_correction_map(&levels, i, i + 1);
+        assert!(closed, "case {case}: the closed form applies");
+        let map = h
+            .correction_map()
+            .columns(h.correction_offset(i), dims[i])
+            .clone_owned();
+        h.build_g_levels(0, dims.len());
+        let g_all = h.g().clone();
+        let g = g_all.columns(h.offset(i), dims[i]);
+        assert!(
+            (&map - g).amax() <= REL_TOL * g.amax().max(1.0),
+            "case {case}: {}",
+            (&map - g).amax()
+        );
+        assert_g_is_the_derivative(&mut levels, &dims, &settings, &q, &g_all, case);
+    }
+}

@@ -167,13 +167,13 @@ impl Hierarchy {
             bb: vec![0.0; mmax * mmax],
             yall: vec![0.0; n * total],
             qscratch: vec![0.0; 4 * total.max(1)],
-            res: vec![0.0; mmax],
-            x: vec![0.0; mmax],
+            res: vec![0.0; mmax.max(n)],
+            x: vec![0.0; mmax.max(n)],
             g: DMatrix::zeros(n, total.max(1)),
             gc: DMatrix::zeros(n, total.max(1)),
             pinv: dims.iter().map(|&m| DMatrix::zeros(n, m)).collect(),
             selection: SelectionBlock::new(n, mmax),
-            closed: vec![0.0; n * mmax],
+            closed: vec![0.0; n * mmax.max(n)],
             built: None,
             closed_level: None,
             deferred: None,
@@ -330,7 +330,9 @@ impl Hierarchy {
     /// when the first level that makes the rows add up to n is a selection, M_O is regular and
     /// the lower bound on σ_min of the stacked Jacobian exceeds 2 × the rank threshold (and
     /// the adaptive damping's threshold), every level keeps all its rows undamped, and
-    /// q̈ = J⁻¹ h: no level is reduced ([`Hierarchy::complete`] does it on demand). False
+    /// q̈ = J⁻¹ h: no level is reduced ([`Hierarchy::complete`] does it on demand). Also when
+    /// the rows of all levels add up to n − d, d ≤ [`MAX_SPARE`](super::selection::MAX_SPARE), the last a selection ("Stacks
+    /// short of square": d unit rows appended, the solution and block projected). False
     /// (nothing decided) otherwise.
     fn solve_stack_closed(
         &mut self,
@@ -340,26 +342,54 @@ impl Hierarchy {
     ) -> bool {
         let n = self.n;
         let nt = self.dims.len();
-        let Some(i) = (0..nt).find(|&i| self.dims[i] > 0 && self.offsets[i] + self.dims[i] == n)
-        else {
-            return false;
+        let square = (0..nt).find(|&i| self.dims[i] > 0 && self.offsets[i] + self.dims[i] == n);
+        let (i, spare) = match square {
+            Some(i) => (i, 0),
+            None => match nt.checked_sub(1) {
+                Some(i) if self.dims[i] > 0 && self.offsets[i] + self.dims[i] < n => {
+                    let spare = n - self.offsets[i] - self.dims[i];
+                    if levels.len() != nt
+                        || !self
+                            .selection
+                            .choose_spare(&levels[..i], &levels[i], spare, n)
+                    {
+                        return false;
+                    }
+                    (i, spare)
+                }
+                _ => return false,
+            },
         };
         let Some(floor) = undamped_floor(settings) else {
             return false;
         };
-        if !self.build_closed(i, levels) || !clears(self.selection.stack_sigma_lower_bound(), floor)
+        if !self.build_closed(i, levels, spare)
+            || !clears(self.selection.stack_sigma_lower_bound(), floor)
         {
+            self.built = None;
             return false;
         }
         let (m, q) = (self.dims[i], qdd.as_mut_slice());
         self.selection.solve_above(&levels[..i], q);
+        // h_i, then zero for the appended rows.
+        let h = &mut self.x[..m + spare];
+        h[..m].copy_from_slice(levels[i].rhs.as_slice());
+        h[m..].fill(0.0);
         self.selection.step(
-            levels[i].rhs.as_slice(),
-            &self.closed[..n * m],
+            h,
+            &self.closed[..n * (m + spare)],
             n,
-            &mut self.res[..m],
+            &mut self.res[..m + spare],
             q,
         );
+        if spare > 0
+            && !self
+                .selection
+                .project_spare(&mut self.closed, n, m, spare, q)
+        {
+            self.built = None;
+            return false;
+        }
         for k in 0..nt {
             let full = k <= i;
             self.starts[k] = if full { self.offsets[k] } else { n };
@@ -371,17 +401,22 @@ impl Hierarchy {
         true
     }
 
-    /// The closed-form block of level i into `closed` (once per solve); false when the
-    /// `selection` module does not cover it.
-    fn build_closed(&mut self, i: usize, levels: &[TaskEquation]) -> bool {
-        if self.built == Some(i) {
+    /// The closed-form block of level i into `closed` (once per solve), with `spare` unit rows
+    /// appended ([`SelectionBlock::build`]); false when the `selection` module does not cover
+    /// it.
+    fn build_closed(&mut self, i: usize, levels: &[TaskEquation], spare: usize) -> bool {
+        if self.built == Some(i) && spare == 0 {
             return true;
         }
-        let (n, m) = (self.n, self.dims[i]);
+        let (n, m) = (self.n, self.dims[i] + spare);
         if levels.len() != self.dims.len()
-            || !self
-                .selection
-                .build(&levels[..i], &levels[i], n, &mut self.closed[..n * m])
+            || !self.selection.build(
+                &levels[..i],
+                &levels[i],
+                spare,
+                n,
+                &mut self.closed[..n * m],
+            )
         {
             return false;
         }
@@ -410,7 +445,7 @@ impl Hierarchy {
         let Some(floor) = undamped_floor(settings) else {
             return false;
         };
-        if !self.build_closed(i, levels) || !clears(self.selection.sigma_lower_bound(), floor) {
+        if !self.build_closed(i, levels, 0) || !clears(self.selection.sigma_lower_bound(), floor) {
             return false;
         }
         self.ranks[i] = m;
@@ -790,7 +825,7 @@ impl Hierarchy {
             out.copy_from_slice(&self.closed[..n * m]);
             return true;
         }
-        self.selection.build(&levels[..i], &levels[i], n, out)
+        self.selection.build(&levels[..i], &levels[i], 0, n, out)
     }
 
     /// Columns of level i in the correction map ([`Hierarchy::build_correction_map`]): 0 when
