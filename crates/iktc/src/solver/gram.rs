@@ -65,7 +65,7 @@
 //! The normal equations square the level's condition number: with the bound above clearing
 //! the floor the two solutions agree to rounding × κ(J_i Z)², which the tests compare.
 
-use super::kernels::dot;
+use super::kernels::{axpy, dot};
 use super::reflectors::Reflectors;
 use super::settings::Damping;
 use crate::task::TaskEquation;
@@ -75,8 +75,13 @@ use crate::task::TaskEquation;
 #[derive(Debug, Clone)]
 pub(crate) struct GramLevel {
     n: usize,
-    /// The general rows of the level (indices into its rows).
+    /// The general rows of the level (indices into its rows), and the joint rows with the
+    /// coordinate each selects.
     general: Vec<usize>,
+    selections: Vec<(usize, usize)>,
+    /// Per row: its number of non-zero entries and the coordinate of the last.
+    count: Vec<usize>,
+    last: Vec<usize>,
     /// The coordinates not selected (O).
     others: Vec<usize>,
     /// Per coordinate: selected by a row of the level.
@@ -85,8 +90,10 @@ pub(crate) struct GramLevel {
     /// `rows[t * ld + r]`; the general rows first, then the unit rows e_o.
     rows: Vec<f64>,
     ld: usize,
-    /// M (lower triangle), and the Cholesky factor L (lower) of M + λ² I; k × k column-major
-    /// in n × n buffers.
+    /// The carried rows' reduced parts (J_g Z, then Z_O), row r at r · n.
+    reduced: Vec<f64>,
+    /// M (lower triangle), and the Cholesky factor L (lower) of M + λ² I; k × k, row r at
+    /// r · n, in n × n buffers.
     gram: Vec<f64>,
     m: Vec<f64>,
     /// n-vectors: q̈_{i−1}, then J_iᵀ ρ and Qᵀ J_iᵀ ρ; the comparison matrix' solve.
@@ -104,10 +111,14 @@ impl GramLevel {
         Self {
             n,
             general: Vec::with_capacity(mmax),
+            selections: Vec::with_capacity(mmax),
+            count: vec![0; mmax],
+            last: vec![0; mmax],
             others: Vec::with_capacity(n),
             selected: vec![false; n],
             rows: vec![0.0; n * ld],
             ld,
+            reduced: vec![0.0; ld * n],
             gram: vec![0.0; n * n],
             m: vec![0.0; n * n],
             v: vec![0.0; n],
@@ -126,27 +137,29 @@ impl GramLevel {
         let j = level.jacobian.as_slice();
         self.general.clear();
         self.others.clear();
+        self.selections.clear();
         self.selected.fill(false);
-        let mut weight: Option<f64> = None;
-        for r in 0..m {
-            let mut single = None;
-            let mut count = 0;
-            for t in 0..n {
-                let x = j[t * m + r];
+        // One pass over J by columns: per row, its count of non-zero entries and the last one.
+        let count = &mut self.count[..m];
+        count.fill(0);
+        for (t, col) in j.chunks_exact(m).enumerate() {
+            for (r, &x) in col.iter().enumerate() {
                 if x != 0.0 {
-                    count += 1;
-                    single = Some((t, x.abs()));
-                    if count > 1 {
-                        break;
-                    }
+                    count[r] += 1;
+                    self.last[r] = t;
                 }
             }
-            match (count, single) {
-                (1, Some((t, s))) if weight.is_none_or(|w| w == s) && !self.selected[t] => {
-                    weight = Some(s);
-                    self.selected[t] = true;
-                }
-                _ => self.general.push(r),
+        }
+        let mut weight: Option<f64> = None;
+        for r in 0..m {
+            let t = self.last[r];
+            let s = j[t * m + r].abs();
+            if count[r] == 1 && weight.is_none_or(|w| w == s) && !self.selected[t] {
+                weight = Some(s);
+                self.selected[t] = true;
+                self.selections.push((r, t));
+            } else {
+                self.general.push(r);
             }
         }
         self.others.extend((0..n).filter(|&t| !self.selected[t]));
@@ -188,33 +201,41 @@ impl GramLevel {
             }
         }
         refl.apply_forward_rows(p, &mut self.rows, ld, 0, nr, &mut self.scratch);
-        // M = (J_g Z)ᵀ (J_g Z) + w² (I − Z_Oᵀ Z_O), lower triangle, kept in `gram`; and the
-        // Gershgorin bound on ‖Z_O Z_Oᵀ‖₂.
+        // The carried rows' reduced parts, row by row (row r at r · n, k entries).
+        let tr = &mut self.reduced[..nr * n];
+        for (t, row) in self.rows[p * ld..].chunks(ld).take(k).enumerate() {
+            for (r, &x) in row[..nr].iter().enumerate() {
+                tr[r * n + t] = x;
+            }
+        }
+        // M = (J_g Z)ᵀ (J_g Z) + w² (I − Z_Oᵀ Z_O), lower triangle, kept in `gram`: one
+        // rank-one update per carried row, row a of M by a contiguous axpy.
         let w2 = w * w;
         for a in 0..k {
-            let ra = &self.rows[(p + a) * ld..(p + a) * ld + nr];
-            for b in a..k {
-                let rb = &self.rows[(p + b) * ld..(p + b) * ld + nr];
-                let mut x = dot(&ra[..mg], &rb[..mg]) - w2 * dot(&ra[mg..], &rb[mg..]);
-                if a == b {
-                    x += w2;
+            let row = &mut self.gram[a * n..a * n + a + 1];
+            row.fill(0.0);
+            row[a] = w2;
+        }
+        for r in 0..nr {
+            let sign = if r < mg { 1.0 } else { -w2 };
+            let x = &tr[r * n..r * n + k];
+            for a in 0..k {
+                let f = sign * x[a];
+                if f != 0.0 {
+                    axpy(f, &x[..=a], &mut self.gram[a * n..a * n + a + 1]);
                 }
-                self.gram[a * n + b] = x;
             }
         }
+        // The Gershgorin bound on ‖Z_O Z_Oᵀ‖₂: its largest absolute row sum.
         let no = self.others.len();
-        let mut gersh: f64 = 0.0;
-        for o1 in 0..no {
-            let mut sum = 0.0;
-            for o2 in 0..no {
-                let mut x = 0.0;
-                for t in p..n {
-                    x += self.rows[t * ld + mg + o1] * self.rows[t * ld + mg + o2];
-                }
-                sum += x.abs();
-            }
-            gersh = gersh.max(sum);
-        }
+        let zo = &tr[mg * n..];
+        let gersh = (0..no)
+            .map(|o1| {
+                (0..no)
+                    .map(|o2| dot(&zo[o1 * n..o1 * n + k], &zo[o2 * n..o2 * n + k]).abs())
+                    .sum::<f64>()
+            })
+            .fold(0.0_f64, f64::max);
         self.m[..n * k].copy_from_slice(&self.gram[..n * k]);
         if !cholesky(&mut self.m, n, k) {
             return None;
@@ -222,7 +243,13 @@ impl GramLevel {
         // λ_min(M) from below: the comparison matrix of L, and the structure.
         let x = &mut self.x[..k];
         for r in 0..k {
-            let s = 1.0 + (0..r).map(|c| self.m[c * n + r].abs() * x[c]).sum::<f64>();
+            let row = &self.m[r * n..r * n + r];
+            let s = 1.0
+                + row
+                    .iter()
+                    .zip(&x[..r])
+                    .map(|(l, x)| l.abs() * x)
+                    .sum::<f64>();
             x[r] = s / self.m[r * n + r].abs();
         }
         let inv_inf = x.iter().fold(0.0_f64, |a, &b| a.max(b));
@@ -263,18 +290,22 @@ impl GramLevel {
         q.copy_from_slice(&u[..n]);
         q[p..].fill(0.0);
         refl.apply_q(q);
-        let res = &mut self.res[..m];
-        res.copy_from_slice(level.rhs.as_slice());
-        for t in 0..n {
-            let qt = q[t];
-            if qt != 0.0 {
-                for (x, jr) in res.iter_mut().zip(&j[t * m..(t + 1) * m]) {
-                    *x -= jr * qt;
-                }
+        // ρ and J_iᵀ ρ: the general rows through J, each joint row through its one entry.
+        let (res, h) = (&mut self.res[..m], level.rhs.as_slice());
+        for &r in &self.general {
+            res[r] = h[r] - (0..n).map(|t| j[t * m + r] * q[t]).sum::<f64>();
+        }
+        for &(r, t) in &self.selections {
+            res[r] = h[r] - j[t * m + r] * q[t];
+        }
+        q.fill(0.0);
+        for &r in &self.general {
+            for (t, qt) in q.iter_mut().enumerate() {
+                *qt += j[t * m + r] * res[r];
             }
         }
-        for t in 0..n {
-            q[t] = dot(&j[t * m..(t + 1) * m], res);
+        for &(r, t) in &self.selections {
+            q[t] += j[t * m + r] * res[r];
         }
         // Zᵀ J_iᵀ ρ = (Qᵀ v)[p..n], then y = (M + λ² I)⁻¹ of it.
         refl.apply_forward_rows(p, q, 1, 0, 1, &mut self.scratch);
@@ -288,8 +319,8 @@ impl GramLevel {
 /// Steps of inverse iteration in [`smallest_singular_value`].
 const INVERSE_ITERATIONS: usize = 4;
 
-/// σ_min(J̄) estimated from M = J̄ᵀJ̄ (`gram`, lower triangle) and its Cholesky factor `l`
-/// (k × k, leading dimension `ld`) \[unit of a singular value of J\]: the square root of the
+/// σ_min(J̄) estimated from M = J̄ᵀJ̄ (`gram`, lower triangle, row r at r · `ld`) and its
+/// Cholesky factor `l` (likewise) \[unit of a singular value of J\]: the square root of the
 /// Rayleigh quotient xᵀ M x of x after [`INVERSE_ITERATIONS`] steps x ← M⁻¹ x / ‖M⁻¹ x‖ from
 /// x = 𝟙 / √k. Never below the true σ_min (a Rayleigh quotient is at least λ_min) and
 /// converging on it at the rate (λ_min / λ_2)² per step; the QR's last pivot, which the other
@@ -315,7 +346,7 @@ fn smallest_singular_value(
             .iter()
             .enumerate()
             .map(|(c, xc)| {
-                let (a, b) = if c <= r { (c, r) } else { (r, c) };
+                let (a, b) = if c <= r { (r, c) } else { (c, r) };
                 gram[a * ld + b] * xc
             })
             .sum();
@@ -323,46 +354,35 @@ fn smallest_singular_value(
     dot(x, y).max(0.0).sqrt()
 }
 
-/// In-place Cholesky factorisation of the k × k lower triangle of `a` (column-major, leading
-/// dimension `ld`): L with M = L Lᵀ in the lower triangle. False when a pivot is not positive
-/// (or not finite).
+/// In-place Cholesky factorisation of the k × k lower triangle of `a` (row r at r · `ld`,
+/// entries 0..=r): L with M = L Lᵀ in the lower triangle, row by row (each entry one dot
+/// product of two contiguous rows). False when a pivot is not positive (or not finite).
 fn cholesky(a: &mut [f64], ld: usize, k: usize) -> bool {
-    for c in 0..k {
-        let mut d = a[c * ld + c];
-        for q in 0..c {
-            d -= a[q * ld + c] * a[q * ld + c];
-        }
-        if d.is_nan() || d <= 0.0 || d.is_infinite() {
-            return false;
-        }
-        let d = d.sqrt();
-        a[c * ld + c] = d;
-        for r in c + 1..k {
-            let mut s = a[c * ld + r];
-            for q in 0..c {
-                s -= a[q * ld + r] * a[q * ld + c];
+    for r in 0..k {
+        for c in 0..=r {
+            let s = a[r * ld + c] - dot(&a[r * ld..r * ld + c], &a[c * ld..c * ld + c]);
+            if c < r {
+                a[r * ld + c] = s / a[c * ld + c];
+            } else if s.is_nan() || s <= 0.0 || s.is_infinite() {
+                return false;
+            } else {
+                a[r * ld + r] = s.sqrt();
             }
-            a[c * ld + r] = s / d;
         }
     }
     true
 }
 
-/// Solves L Lᵀ y = b in place (`y` holds b), L from [`cholesky`].
+/// Solves L Lᵀ y = b in place (`y` holds b), L from [`cholesky`]: L z = b row by row, then
+/// Lᵀ y = z by columns of Lᵀ (the rows of L), both over contiguous rows.
 fn cholesky_solve(l: &[f64], ld: usize, k: usize, y: &mut [f64]) {
     for r in 0..k {
-        let mut s = y[r];
-        for c in 0..r {
-            s -= l[c * ld + r] * y[c];
-        }
-        y[r] = s / l[r * ld + r];
+        y[r] = (y[r] - dot(&l[r * ld..r * ld + r], &y[..r])) / l[r * ld + r];
     }
     for r in (0..k).rev() {
-        let mut s = y[r];
-        for c in r + 1..k {
-            s -= l[r * ld + c] * y[c];
-        }
-        y[r] = s / l[r * ld + r];
+        y[r] /= l[r * ld + r];
+        let yr = y[r];
+        axpy(-yr, &l[r * ld..r * ld + r], &mut y[..r]);
     }
 }
 
