@@ -78,7 +78,7 @@ pub(crate) struct GramLevel {
     /// The general rows of the level (indices into its rows), and the joint rows with the
     /// coordinate each selects.
     general: Vec<usize>,
-    selections: Vec<(usize, usize)>,
+    selections: Vec<(usize, usize, f64)>,
     /// Per row: its number of non-zero entries and the coordinate of the last.
     count: Vec<usize>,
     last: Vec<usize>,
@@ -102,6 +102,24 @@ pub(crate) struct GramLevel {
     /// ρ (m_i).
     res: Vec<f64>,
     scratch: Vec<f64>,
+    /// The undamped Cholesky factor L₀ of M (row r at r · n), for the basis of the correction
+    /// map; and scratch blocks of the correction map (n × n each).
+    l0: Vec<f64>,
+    block_t: Vec<f64>,
+    block_b: Vec<f64>,
+    /// The last step taken: p, k, the general rows' count m_g, the carried rows' count, w²
+    /// and whether λ² > 0 (then `m` holds the factor of M + λ² I, else `m` equals `l0`).
+    geometry: Geometry,
+}
+
+/// Where the last step was taken (see [`GramLevel::step`]).
+#[derive(Debug, Clone, Copy, Default)]
+struct Geometry {
+    p: usize,
+    k: usize,
+    mg: usize,
+    nr: usize,
+    w2: f64,
 }
 
 impl GramLevel {
@@ -125,6 +143,10 @@ impl GramLevel {
             x: vec![0.0; n],
             res: vec![0.0; mmax],
             scratch: vec![0.0; 4 * ld],
+            l0: vec![0.0; n * n],
+            block_t: vec![0.0; ld * n.max(mmax)],
+            block_b: vec![0.0; n * n.max(mmax)],
+            geometry: Geometry::default(),
         }
     }
 
@@ -157,7 +179,7 @@ impl GramLevel {
             if count[r] == 1 && weight.is_none_or(|w| w == s) && !self.selected[t] {
                 weight = Some(s);
                 self.selected[t] = true;
-                self.selections.push((r, t));
+                self.selections.push((r, t, j[t * m + r]));
             } else {
                 self.general.push(r);
             }
@@ -275,6 +297,8 @@ impl GramLevel {
                 }
             }
         };
+        self.l0[..n * k].copy_from_slice(&self.m[..n * k]);
+        self.geometry = Geometry { p, k, mg, nr, w2 };
         if lambda2 > 0.0 {
             // M + λ² I (eqs. 8–9 in reduced coordinates: (J̄ᵀJ̄ + λ²I)⁻¹ J̄ᵀ = J̄ᵀ(J̄J̄ᵀ + λ²I)⁻¹).
             self.m[..n * k].copy_from_slice(&self.gram[..n * k]);
@@ -295,8 +319,8 @@ impl GramLevel {
         for &r in &self.general {
             res[r] = h[r] - (0..n).map(|t| j[t * m + r] * q[t]).sum::<f64>();
         }
-        for &(r, t) in &self.selections {
-            res[r] = h[r] - j[t * m + r] * q[t];
+        for &(r, t, s) in &self.selections {
+            res[r] = h[r] - s * q[t];
         }
         q.fill(0.0);
         for &r in &self.general {
@@ -304,8 +328,8 @@ impl GramLevel {
                 *qt += j[t * m + r] * res[r];
             }
         }
-        for &(r, t) in &self.selections {
-            q[t] += j[t * m + r] * res[r];
+        for &(r, t, s) in &self.selections {
+            q[t] += s * res[r];
         }
         // Zᵀ J_iᵀ ρ = (Qᵀ v)[p..n], then y = (M + λ² I)⁻¹ of it.
         refl.apply_forward_rows(p, q, 1, 0, 1, &mut self.scratch);
@@ -313,6 +337,97 @@ impl GramLevel {
         y.copy_from_slice(&q[p..n]);
         cholesky_solve(&self.m, n, k, y);
         Some(lambda2)
+    }
+
+    /// The level's columns of the correction map in reduced coordinates, for the last step
+    /// (the `hierarchy` module: a level of rank k < m_i enters the map in an orthonormal basis
+    /// U of the column space of J̄ = J_i Z): with M = L₀ L₀ᵀ, U = J̄ L₀⁻ᵀ (UᵀU = L₀⁻¹ M L₀⁻ᵀ =
+    /// I), and the change of the step for Δh_i = U z is (M + λ² I)⁻¹ J̄ᵀ U z =
+    /// (M + λ² I)⁻¹ L₀ z. Writes X = (M + λ² I)⁻¹ L₀ into rows p..n of the row-major
+    /// n × k block `y` (k columns).
+    pub(crate) fn basis_block(&mut self, y: &mut [f64]) {
+        let (n, Geometry { p, k, .. }) = (self.n, self.geometry);
+        let x = &mut self.x[..k];
+        for j in 0..k {
+            x.fill(0.0);
+            for (a, xa) in x.iter_mut().enumerate().skip(j) {
+                *xa = self.l0[a * n + j];
+            }
+            cholesky_solve(&self.m, n, k, x);
+            for (a, xa) in x.iter().enumerate() {
+                y[(p + a) * k + j] = *xa;
+            }
+        }
+    }
+
+    /// The level's response, in rows p..n of the row-major n × nc block `y`, to the changes
+    /// of the levels above in its rows `from..p` (reduced coordinates u_a): with q̈_{i−1}
+    /// moved by Q_a u_a, ρ moves by −J_i Q_a u_a and the step by
+    /// −(M + λ² I)⁻¹ Zᵀ J_iᵀ J_i Q_a u_a, where Zᵀ J_iᵀ J_i Q_a = (J_g Z)ᵀ (J_g Q_a) −
+    /// w² Z_Oᵀ (E_Oᵀ Q_a) (the joint rows contribute w² (I − E_O E_Oᵀ), and Zᵀ Q_a = 0): both
+    /// parts of the carried rows, Q_a's from the reflectors as well.
+    pub(crate) fn propagate(&mut self, y: &mut [f64], nc: usize, from: usize) {
+        let (n, Geometry { p, k, mg, nr, w2 }) = (self.n, self.geometry);
+        let ld = self.ld;
+        // T = (carried rows' Q_a part) · Y[from..p], nr × nc.
+        let t = &mut self.block_t[..nr * nc];
+        t.fill(0.0);
+        for s in from..p {
+            let ys = &y[s * nc..(s + 1) * nc];
+            for (r, &c) in self.rows[s * ld..s * ld + nr].iter().enumerate() {
+                if c != 0.0 {
+                    axpy(c, ys, &mut t[r * nc..(r + 1) * nc]);
+                }
+            }
+        }
+        // B = −Σ_r sign_r (row r's Z part) ⊗ T_r, k × nc (row-major).
+        let b = &mut self.block_b[..k * nc];
+        b.fill(0.0);
+        for r in 0..nr {
+            let sign = if r < mg { -1.0 } else { w2 };
+            let tr = &t[r * nc..(r + 1) * nc];
+            for (a, &z) in self.reduced[r * n..r * n + k].iter().enumerate() {
+                if z != 0.0 {
+                    axpy(sign * z, tr, &mut b[a * nc..(a + 1) * nc]);
+                }
+            }
+        }
+        // Each column through (M + λ² I)⁻¹.
+        let x = &mut self.x[..k];
+        for c in 0..nc {
+            for (a, xa) in x.iter_mut().enumerate() {
+                *xa = b[a * nc + c];
+            }
+            cholesky_solve(&self.m, n, k, x);
+            for (a, xa) in x.iter().enumerate() {
+                y[(p + a) * nc + c] = *xa;
+            }
+        }
+    }
+
+    /// Δh_i = U z \[task units\] for the correction `z` (k entries) of the last step's level in
+    /// the basis of [`GramLevel::basis_block`]: U z = J̄ L₀⁻ᵀ z = J_i Z t with t = L₀⁻ᵀ z, the
+    /// general rows through their reduced parts (J_g Z) t, each joint row s_c (Z t)\[C_c\]
+    /// with Z t = Q \[0; t\] (the p reflectors of the levels above in `refl`).
+    pub(crate) fn demand(&mut self, refl: &Reflectors, z: &[f64], out: &mut [f64]) {
+        let (n, Geometry { p, k, .. }) = (self.n, self.geometry);
+        let t = &mut self.x[..k];
+        t.copy_from_slice(&z[..k]);
+        for r in (0..k).rev() {
+            t[r] /= self.l0[r * n + r];
+            let tr = t[r];
+            axpy(-tr, &self.l0[r * n..r * n + r], &mut t[..r]);
+        }
+        for (a, &r) in self.general.iter().enumerate() {
+            out[r] = dot(&self.reduced[a * n..a * n + k], t);
+        }
+        let d = &mut self.v;
+        d[..p].fill(0.0);
+        d[p..].copy_from_slice(t);
+        refl.apply_q(d);
+        for &(r, c, s) in &self.selections {
+            out[r] = s * d[c];
+        }
     }
 }
 

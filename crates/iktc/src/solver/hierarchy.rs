@@ -133,6 +133,8 @@ pub struct Hierarchy {
     /// the last solve took it (the levels below it then have rank 0).
     gram: GramLevel,
     gram_level: Option<usize>,
+    /// The same level, kept after its reduction has run ([`Hierarchy::stepped_by_gram`]).
+    gram_stepped: Option<usize>,
     /// The λ² of that level's step, which its reduction then uses.
     gram_lambda2: f64,
     settings: SolverSettings,
@@ -179,6 +181,7 @@ impl Hierarchy {
             deferred: None,
             gram: GramLevel::new(n, mmax),
             gram_level: None,
+            gram_stepped: None,
             gram_lambda2: 0.0,
             settings: SolverSettings::default(),
         }
@@ -208,7 +211,7 @@ impl Hierarchy {
     /// a bottom level of weighted joint rows that completes the rank), if any. Its answer is
     /// the QR's to rounding; its reduction runs only when its factors are asked for.
     pub fn stepped_by_gram(&self) -> Option<usize> {
-        self.gram_level
+        self.gram_stepped
     }
 
     /// J̄_i^{λ+} of level i (n × m_i), from the last solve. Formed on request from the
@@ -272,7 +275,7 @@ impl Hierarchy {
         self.u.fill(0.0);
         self.refl.truncate(0);
         (self.built, self.closed_level, self.deferred) = (None, None, None);
-        self.gram_level = None;
+        (self.gram_level, self.gram_stepped) = (None, None);
         self.settings = *settings;
         if self.solve_stack_closed(levels, settings, qdd) {
             return Ok(());
@@ -470,6 +473,7 @@ impl Hierarchy {
             return false;
         };
         self.gram_lambda2 = lambda2;
+        self.gram_stepped = Some(i);
         self.ranks[i] = self.n - p;
         self.fac[i].direct = false;
         self.gram_level = Some(i);
@@ -493,6 +497,8 @@ impl Hierarchy {
             self.reduce_level(k, &settings);
             debug_assert_eq!(self.ranks[k], decided, "level {k}: the rank decided");
         }
+        // From here on the level's QR factors serve it (its reflectors are in `refl`).
+        self.gram_level = None;
     }
 
     /// Reduces level i: its rows multiplied by the reflectors of the levels above, pivoted QR
@@ -629,8 +635,23 @@ impl Hierarchy {
     }
 
     fn reduced_block_in(&mut self, i: usize, propagate: bool, in_basis: bool) -> usize {
-        self.complete();
+        // The correction map of a level stepped by its Gram matrix, and the responses of that
+        // level to the levels above, come from its Gram factors ([`super::gram`]); anything
+        // else needs its QR.
+        let gram = self
+            .gram_level
+            .filter(|&g| in_basis && self.rank_deficient(g) && i <= g);
+        if gram.is_none() {
+            self.complete();
+        }
         let (n, m, r, p) = (self.n, self.dims[i], self.ranks[i], self.starts[i]);
+        if gram == Some(i) {
+            // U_i = J̄ L₀⁻ᵀ: r = k columns, rows p..n.
+            let yb = &mut self.yb[..n * r];
+            yb[..p * r].fill(0.0);
+            self.gram.basis_block(yb);
+            return r;
+        }
         let basis = in_basis && self.rank_deficient(i);
         if basis {
             // U_i is needed only here, when a correction map is built.
@@ -674,6 +695,11 @@ impl Hierarchy {
             let (mk, rk, pk) = (self.dims[k], self.ranks[k], self.starts[k]);
             if rk == 0 {
                 continue;
+            }
+            if gram == Some(k) {
+                // Its rows p_k..n from the rows p..p_k above; the levels below it have rank 0.
+                self.gram.propagate(&mut self.yb[..n * nc], nc, p);
+                break;
             }
             let off = self.offsets[k];
             let f = &self.fac[k];
@@ -883,10 +909,14 @@ impl Hierarchy {
     /// Δh_i \[task units\] (length m_i) for the correction `z` of level i in the correction
     /// map's coordinates (length [`Hierarchy::correction_width`]`(i)`): U_i z, z itself at full
     /// rank, zero at rank 0.
-    pub fn correction_demand(&self, i: usize, z: &[f64], out: &mut [f64]) {
+    pub fn correction_demand(&mut self, i: usize, z: &[f64], out: &mut [f64]) {
         let (m, w) = (self.dims[i], self.correction_width(i));
         if w == m {
             out[..m].copy_from_slice(&z[..m]);
+            return;
+        }
+        if self.gram_level == Some(i) {
+            self.gram.demand(&self.refl, z, out);
             return;
         }
         out[..m].fill(0.0);
