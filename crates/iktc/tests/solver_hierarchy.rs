@@ -596,3 +596,275 @@ fn a_badly_scaled_stack_over_a_selection_gets_the_same_answer() {
         );
     }
 }
+
+/// Random levels above a bottom level of `g` general rows and weighted joint rows: every
+/// coordinate but `o` of them (chosen at random) selected once, each with weight ±`w`. The
+/// levels above hold `upper` random rows in two levels.
+fn levels_over_weighted_joints(
+    r: &mut rand_chacha::ChaCha8Rng,
+    n: usize,
+    upper: usize,
+    g: usize,
+    o: usize,
+    w: f64,
+) -> Vec<TaskEquation> {
+    use rand::seq::SliceRandom;
+    use rand::Rng;
+    let a = 1 + r.random_range(0..upper);
+    let dims: Vec<usize> = [a, upper - a, g + n - o]
+        .into_iter()
+        .filter(|&d| d > 0)
+        .collect();
+    let mut levels = random_levels(r, n, &dims);
+    let bottom = levels.last_mut().unwrap();
+    bottom.jacobian.rows_mut(g, n - o).fill(0.0);
+    let mut coords: Vec<usize> = (0..n).collect();
+    coords.shuffle(r);
+    for (row, &c) in coords[o..].iter().enumerate() {
+        bottom.jacobian[(g + row, c)] = if r.random_bool(0.5) { w } else { -w };
+    }
+    levels
+}
+
+/// The prioritized solution of levels whose upper levels are consistent and of full rank (so
+/// together they are solved exactly, by the least-norm q̈₀ = A⁺ h_A of their stacked rows A)
+/// and whose bottom level J has full column rank in the null space of A: with Z an
+/// orthonormal basis of that null space (the right singular vectors of A past its rank),
+/// q̈ = q̈₀ + Z y, y the least-squares solution of (J Z) y = h − J q̈₀ (a tall matrix of full
+/// column rank, solved by its SVD); and J̄⁺ = (J Z Zᵀ)⁺ = Z (J Z)⁺.
+fn completing_bottom_reference(levels: &[TaskEquation]) -> (DVector<f64>, DMatrix<f64>) {
+    let n = levels[0].nv();
+    let (bottom, upper) = levels.split_last().unwrap();
+    let rows: usize = upper.iter().map(|l| l.dim()).sum();
+    let mut a = DMatrix::zeros(rows, n);
+    let mut h = DVector::zeros(rows);
+    let mut r0 = 0;
+    for l in upper {
+        a.rows_mut(r0, l.dim()).copy_from(&l.jacobian);
+        h.rows_mut(r0, l.dim()).copy_from(&l.rhs);
+        r0 += l.dim();
+    }
+    let q0 = a.clone().pseudo_inverse(1e-12).unwrap() * h;
+    // Right singular vectors of A: the SVD of the square AᵀA-free padded matrix [A; 0].
+    let mut padded = DMatrix::zeros(n, n);
+    padded.rows_mut(0, rows).copy_from(&a);
+    let svd = padded.svd(false, true);
+    let vt = svd.v_t.unwrap();
+    let mut order: Vec<usize> = (0..n).collect();
+    order.sort_by(|&x, &y| svd.singular_values[y].total_cmp(&svd.singular_values[x]));
+    let z = DMatrix::from_fn(n, n - rows, |t, c| vt[(order[rows + c], t)]);
+    let jz_pinv = (&bottom.jacobian * &z).pseudo_inverse(1e-12).unwrap();
+    let rho = &bottom.rhs - &bottom.jacobian * &q0;
+    (q0 + &z * (&jz_pinv * rho), z * jz_pinv)
+}
+
+#[test]
+fn a_bottom_level_of_weighted_joints_completing_the_rank_is_stepped_by_its_gram_matrix() {
+    // The step, the ranks, G and J̄⁺ of the bottom level against the projector recursion, the
+    // derivative of the solution and SVD; the factors that G and J̄⁺ need come from the QR run
+    // afterwards, which must find the rank the Gram step decided. A joint row with another
+    // weight, or selecting a coordinate already selected, is one of the general rows.
+    let (mut twice, mut stepped) = (0, 0);
+    let mut r = rng(78);
+    for case in 0..60 {
+        let n = 8 + case % 11;
+        let upper = 2 + case % (n / 2);
+        let g = 1 + case % 3;
+        // Fewer coordinates left out than selected, and rows enough to complete the rank.
+        let o = 1 + case % (n / 2 - 1).min(g + upper);
+        let w = [0.1, 0.5, 2.0][case % 3];
+        let mut levels = levels_over_weighted_joints(&mut r, n, upper, g, o, w);
+        let i = levels.len() - 1;
+        let m = levels[i].dim();
+        // The rows carried through the reflectors: the general ones and a unit row per
+        // coordinate left out; the Gram step is taken when they are fewer than the level's.
+        let mut carried = g + o;
+        if case % 5 == 0 {
+            levels[i].jacobian.row_mut(m - 1).scale_mut(3.0);
+            carried += 2;
+        } else if case % 7 == 0 && m > n - upper {
+            // (With a row to spare: the two rows are parallel.)
+            let prev = levels[i].jacobian.row(m - 2).clone_owned();
+            levels[i].jacobian.row_mut(m - 1).copy_from(&prev);
+            twice += 1;
+            carried += 1;
+        }
+        let dims: Vec<usize> = levels.iter().map(|l| l.dim()).collect();
+        let settings = SolverSettings::default();
+        let mut h = Hierarchy::new(n, &dims);
+        let mut q = DVector::zeros(n);
+        h.solve(&levels, &settings, &mut q).unwrap();
+        if carried >= m {
+            assert_eq!(h.stepped_by_gram(), None, "case {case}: nothing to gain");
+        } else {
+            assert_eq!(
+                h.stepped_by_gram(),
+                Some(i),
+                "case {case}: n {n}, dims {dims:?}, o {o}"
+            );
+            stepped += 1;
+        }
+        assert_eq!(
+            h.ranks()[i],
+            n - upper,
+            "case {case}: the bottom level takes what is left"
+        );
+        let (want, pinv) = completing_bottom_reference(&levels);
+        let err = (&q - &want).norm() / (1.0 + want.norm());
+        assert!(err < REL_TOL, "case {case}: {err}");
+        check_lexicographic(&levels, &q, 1e-7);
+        let got = h.pinv(i).clone();
+        assert!(
+            (&got - &pinv).norm() < REL_TOL * (1.0 + pinv.norm()),
+            "case {case}: J̄⁺ {}",
+            (&got - &pinv).norm()
+        );
+        h.build_g_levels(0, dims.len());
+        assert_eq!(h.ranks()[i], n - upper, "case {case}: the QR's rank");
+        let g_all = h.g().clone();
+        assert_g_is_the_derivative(&mut levels, &dims, &settings, &q, &g_all, case);
+    }
+    assert!(twice >= 3, "{twice} cases with a coordinate selected twice");
+    assert!(
+        stepped >= 40,
+        "{stepped} of 60 cases stepped by the Gram matrix"
+    );
+}
+
+#[test]
+fn the_gram_step_declines_what_it_does_not_cover_and_the_answer_stays_the_recursion_s() {
+    // A level that does not complete the rank, and joint rows that miss a direction the
+    // levels above leave free (their Gram matrix singular): each solved by the QR, the
+    // projectors' answer.
+    let mut r = rng(79);
+    let n = 12;
+    for case in 0..2 {
+        let (g, o) = if case == 0 { (0, 7) } else { (2, 3) };
+        let mut levels = levels_over_weighted_joints(&mut r, n, 4, g, o, 0.5);
+        let i = levels.len() - 1;
+        if case == 1 {
+            levels[i].jacobian.rows_mut(0, g).fill(0.0);
+            for l in &mut levels[..i] {
+                l.jacobian.fill(0.0);
+                l.rhs.fill(0.0);
+            }
+        }
+        let dims: Vec<usize> = levels.iter().map(|l| l.dim()).collect();
+        let mut h = Hierarchy::new(n, &dims);
+        let mut q = DVector::zeros(n);
+        h.solve(&levels, &SolverSettings::default(), &mut q)
+            .unwrap();
+        assert_eq!(h.stepped_by_gram(), None, "case {case}");
+        let want = reference_solution(&levels, 0.0);
+        let err = (&q - &want).norm() / (1.0 + want.norm());
+        assert!(err < REL_TOL, "case {case}: {err}");
+    }
+}
+
+#[test]
+fn the_gram_step_is_damped_as_the_levels_above() {
+    // A fixed λ: the DLS formula at every level. An adaptive rule whose region no level
+    // reaches: no damping. An adaptive rule whose region holds every level, with λ_max
+    // reached within rounding (σ ≤ ‖J‖ ≈ 10 against ε = 1e9): the DLS formula with λ_max.
+    // Also G, the derivative of the solution, from the factors the QR builds afterwards with
+    // the step's λ².
+    let mut r = rng(80);
+    for case in 0..30 {
+        let n = 10 + case % 7;
+        let upper = 3 + case % 3;
+        let mut levels = levels_over_weighted_joints(&mut r, n, upper, 2, 2, 0.3);
+        let i = levels.len() - 1;
+        let (damping, l2) = match case % 3 {
+            0 => (Damping::Fixed(0.2), 0.04),
+            1 => (
+                Damping::Adaptive {
+                    max: 0.2,
+                    threshold: 1e-6,
+                },
+                0.0,
+            ),
+            _ => (
+                Damping::Adaptive {
+                    max: 0.2,
+                    threshold: 1e9,
+                },
+                0.04,
+            ),
+        };
+        let settings = SolverSettings {
+            damping,
+            ..Default::default()
+        };
+        let dims: Vec<usize> = levels.iter().map(|l| l.dim()).collect();
+        let mut h = Hierarchy::new(n, &dims);
+        let mut q = DVector::zeros(n);
+        h.solve(&levels, &settings, &mut q).unwrap();
+        assert_eq!(h.stepped_by_gram(), Some(i), "case {case}");
+        let want = if l2 == 0.0 {
+            completing_bottom_reference(&levels).0
+        } else {
+            reference_solution_damped(&levels, |_| l2)
+        };
+        let err = (&q - &want).norm() / (1.0 + want.norm());
+        assert!(err < REL_TOL, "case {case}: {err}");
+        h.build_g_levels(0, dims.len());
+        let g_all = h.g().clone();
+        assert_g_is_the_derivative(&mut levels, &dims, &settings, &q, &g_all, case);
+    }
+}
+
+#[test]
+fn a_stack_short_of_square_over_a_selection_gets_the_recursion_s_answer_in_closed_form() {
+    // The rows add up to n − d (d = 1, 2, 3): the bottom selection leaves d coordinates free.
+    // The solution, the bottom level's block of G and its correction-map block (built in
+    // closed form) against the projector recursion and the derivative of the solution.
+    let mut r = rng(81);
+    for case in 0..45 {
+        let n = 8 + case % 11;
+        let d = 1 + case % 3;
+        let m = 1 + case % (n - d - 2);
+        let mut levels = levels_over_a_selection(&mut r, n - d, m);
+        for l in &mut levels {
+            // d more coordinates, none selected: the upper levels' columns random.
+            let mut j = DMatrix::zeros(l.dim(), n);
+            j.columns_mut(0, n - d).copy_from(&l.jacobian);
+            l.jacobian = j;
+        }
+        let i = levels.len() - 1;
+        {
+            use rand::Rng;
+            for l in &mut levels[..i] {
+                for c in n - d..n {
+                    for row in 0..l.dim() {
+                        l.jacobian[(row, c)] = r.random_range(-1.0..1.0);
+                    }
+                }
+            }
+        }
+        let dims: Vec<usize> = levels.iter().map(|l| l.dim()).collect();
+        assert_eq!(dims.iter().sum::<usize>(), n - d);
+        let settings = SolverSettings::default();
+        let mut h = Hierarchy::new(n, &dims);
+        let mut q = DVector::zeros(n);
+        h.solve(&levels, &settings, &mut q).unwrap();
+        let want = reference_solution(&levels, 0.0);
+        let err = (&q - &want).norm() / (1.0 + want.norm());
+        assert!(err < REL_TOL, "case {case}: n {n}, dims {dims:?}: {err}");
+        assert_eq!(h.ranks(), &dims[..], "case {case}");
+        let closed = h.build_correction_map(&levels, i, i + 1);
+        assert!(closed, "case {case}: the closed form applies");
+        let map = h
+            .correction_map()
+            .columns(h.correction_offset(i), dims[i])
+            .clone_owned();
+        h.build_g_levels(0, dims.len());
+        let g_all = h.g().clone();
+        let g = g_all.columns(h.offset(i), dims[i]);
+        assert!(
+            (&map - g).amax() <= REL_TOL * g.amax().max(1.0),
+            "case {case}: {}",
+            (&map - g).amax()
+        );
+        assert_g_is_the_derivative(&mut levels, &dims, &settings, &q, &g_all, case);
+    }
+}

@@ -676,3 +676,110 @@ fn rebase_converges_on_the_achievable_demand_and_leaves_uncorrected_levels_alone
     let settled = ratios.iter().filter(|&&x| x <= release + 1e-6).count();
     assert!(4 * settled >= 3 * ratios.len(), "{ratios:?}");
 }
+
+/// A bottom level of general rows and weighted joint rows that takes every coordinate left is
+/// stepped by its Gram matrix, and its columns of the correction map (and its response to the
+/// levels above) come from the same factors, in a basis of its own: the correction and q̈ must
+/// be the QP's of eq. (23) over all rows with G built by the QR, level by level, with each
+/// damping rule.
+#[test]
+fn a_level_stepped_by_its_gram_matrix_is_corrected_as_the_qr_would() {
+    use rand::seq::SliceRandom;
+    use rand::Rng;
+    let mut r = rng(48);
+    let n = 16;
+    let mut checked = [0usize; 3];
+    for case in 0..240 {
+        // 4 + 3 rows above, then 2 general rows and 13 joint rows (3 coordinates left out).
+        let dims = [4, 3, 15];
+        let mut levels = random_levels(&mut r, n, &dims);
+        let bottom = &mut levels[2];
+        bottom.jacobian.rows_mut(2, 13).fill(0.0);
+        let mut coords: Vec<usize> = (0..n).collect();
+        coords.shuffle(&mut r);
+        for (row, &c) in coords[3..].iter().enumerate() {
+            bottom.jacobian[(2 + row, c)] = if r.random_bool(0.5) { 0.4 } else { -0.4 };
+        }
+        let settings = SolverSettings {
+            damping: match case % 3 {
+                0 => Damping::None,
+                1 => Damping::Fixed(0.05),
+                _ => Damping::Adaptive {
+                    max: 0.05,
+                    threshold: 10.0,
+                },
+            },
+            ..Default::default()
+        };
+        let mut s = Solver::new(n, &dims, settings).unwrap();
+        let mut q0 = DVector::zeros(n);
+        s.solve(Method::Prioritized, &levels, &wide_box(n), &mut q0)
+            .unwrap();
+        assert_eq!(s.report().ranks, vec![4, 3, 9], "case {case}");
+        // Up to 14 dofs cut: more than the bottom level's 9 coordinates can fix, so that the
+        // levels above are corrected too (the bottom level's response to them).
+        let bx = box_violated_by(&mut r, &q0, 2.0, [2, 8, 11, 14][case % 4], 0.5);
+        let mut q = DVector::zeros(n);
+        let rep = s.solve(Method::Iktc, &levels, &bx, &mut q).unwrap().clone();
+        let Some(from) = rep.corrected_from else {
+            continue;
+        };
+        // The oracle: G over all rows by the QR, the QP of eq. (23) over all m_i.
+        let mut h = Hierarchy::new(n, &dims);
+        let mut p = DVector::zeros(n);
+        h.solve(&levels, &settings, &mut p).unwrap();
+        assert_eq!(h.stepped_by_gram(), Some(2), "case {case}");
+        assert!((&p - &q0).amax() < 1e-12 * (1.0 + q0.amax()), "case {case}");
+        h.build_g_levels(0, dims.len());
+        let lo: Vec<f64> = (0..n).map(|d| bx.lower[d] - p[d]).collect();
+        let hi: Vec<f64> = (0..n).map(|d| bx.upper[d] - p[d]).collect();
+        let oracle = |i: usize| {
+            let off: usize = dims[..i].iter().sum();
+            let m: usize = dims[i..].iter().sum();
+            let g = h.g().columns(off, m);
+            let zeros = vec![0.0; m];
+            let a_eq = nalgebra::DMatrix::<f64>::zeros(0, m);
+            let problem = QpProblem {
+                hessian: Hessian::Identity,
+                c: &zeros,
+                a_eq: a_eq.rows(0, 0),
+                b_eq: &[],
+                a_in: g,
+                lower: &lo,
+                upper: &hi,
+            };
+            let mut qp = QpWorkspace::new(m, 0, n);
+            let mut x = DVector::zeros(m);
+            let rep = qp.solve(&problem, &QpSettings::default(), &mut x).unwrap();
+            (rep.status == QpStatus::Optimal).then_some(x)
+        };
+        let x = oracle(from).unwrap_or_else(|| panic!("case {case}: level {from} infeasible"));
+        if from + 1 < dims.len() {
+            assert!(
+                oracle(from + 1).is_none(),
+                "case {case}: level {} was feasible",
+                from + 1
+            );
+        }
+        let off: usize = dims[..from].iter().sum();
+        let m: usize = dims[from..].iter().sum();
+        let want = &p + h.g().columns(off, m) * &x;
+        let scale = 1.0 + want.amax();
+        assert!(
+            (&q - &want).amax() < 1e-7 * scale,
+            "case {case} from {from}: {:e}",
+            (&q - &want).amax()
+        );
+        let mut c = 0;
+        for (k, &m) in dims.iter().enumerate().skip(from) {
+            let d = (&rep.corrections[k] - x.rows(c, m)).amax();
+            assert!(d < 1e-7 * (1.0 + x.amax()), "case {case} level {k}: {d:e}");
+            c += m;
+        }
+        checked[from] += 1;
+    }
+    assert!(
+        checked[0] + checked[1] >= 15 && checked[2] >= 10,
+        "corrections from each level: {checked:?}"
+    );
+}

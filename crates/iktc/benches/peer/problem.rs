@@ -125,6 +125,19 @@ impl PeerProblem {
         bounds: BoundMethod,
         options: &ModelOptions,
     ) -> iktc::Result<Self> {
+        Self::with_upper_body(method, settings, bounds, options, &UPPER_BODY)
+    }
+
+    /// The problem with level 5 holding `upper` (joints of [`UPPER_BODY`], phases drawn in
+    /// their order): [`UPPER_BODY`]`[..19]` is the 37-row variant, whose stack leaves one
+    /// coordinate free (no longer square).
+    pub fn with_upper_body(
+        method: Method,
+        settings: SolverSettings,
+        bounds: BoundMethod,
+        options: &ModelOptions,
+        upper: &[&str],
+    ) -> iktc::Result<Self> {
         let robot = jvrc1(options)?;
         let mut state = State::neutral(&robot);
         for (name, v) in INITIAL_POSE {
@@ -142,14 +155,15 @@ impl PeerProblem {
         b.level("pelvis_attitude")
             .frame("PELVIS_S", Axes::ORIENTATION)?;
         b.level("pelvis_height").frame("PELVIS_S", Axes::Z)?;
-        let upper = b.level("upper_body").joints(&UPPER_BODY)?;
+        let joints = upper;
+        let upper = b.level("upper_body").joints(joints)?;
         let ctl = b.build()?;
-        let q0 = UPPER_BODY
+        let q0 = joints
             .iter()
             .map(|j| state.joint(ctl.robot(), j))
             .collect::<iktc::Result<Vec<_>>>()?;
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(PHASE_SEED);
-        let phases = (0..UPPER_BODY.len())
+        let phases = (0..joints.len())
             .map(|_| rng.random_range(0.0..TAU))
             .collect();
         Ok(Self {
@@ -158,7 +172,7 @@ impl PeerProblem {
             upper,
             q0,
             phases,
-            qr: std::array::from_fn(|_| vec![0.0; UPPER_BODY.len()]),
+            qr: std::array::from_fn(|_| vec![0.0; joints.len()]),
             k: 0,
         })
     }

@@ -60,6 +60,7 @@
 
 use nalgebra::{DMatrix, DVector};
 
+use super::gram::GramLevel;
 use super::kernels::{axpy, axpy2, dot, reflect_columns};
 use super::reflectors::Reflectors;
 use super::selection::SelectionBlock;
@@ -124,10 +125,18 @@ pub struct Hierarchy {
     closed: Vec<f64>,
     built: Option<usize>,
     closed_level: Option<usize>,
-    /// The first level whose reduction (QR, factors) has not been run, down to the closed
-    /// level: only what needs their factors runs it ([`Hierarchy::complete`]), with the
-    /// settings of the solve.
-    deferred: Option<usize>,
+    /// The levels whose reduction (QR, factors) has not been run (first, last): those above
+    /// and at the closed level, or the level stepped by its Gram matrix. Only what needs
+    /// their factors runs it ([`Hierarchy::complete`]), with the settings of the solve.
+    deferred: Option<(usize, usize)>,
+    /// The Gram step of a bottom level of weighted joint rows ([`super::gram`]), and whether
+    /// the last solve took it (the levels below it then have rank 0).
+    gram: GramLevel,
+    gram_level: Option<usize>,
+    /// The same level, kept after its reduction has run ([`Hierarchy::stepped_by_gram`]).
+    gram_stepped: Option<usize>,
+    /// The λ² of that level's step, which its reduction then uses.
+    gram_lambda2: f64,
     settings: SolverSettings,
 }
 
@@ -160,16 +169,20 @@ impl Hierarchy {
             bb: vec![0.0; mmax * mmax],
             yall: vec![0.0; n * total],
             qscratch: vec![0.0; 4 * total.max(1)],
-            res: vec![0.0; mmax],
-            x: vec![0.0; mmax],
+            res: vec![0.0; mmax.max(n)],
+            x: vec![0.0; mmax.max(n)],
             g: DMatrix::zeros(n, total.max(1)),
             gc: DMatrix::zeros(n, total.max(1)),
             pinv: dims.iter().map(|&m| DMatrix::zeros(n, m)).collect(),
             selection: SelectionBlock::new(n, mmax),
-            closed: vec![0.0; n * mmax],
+            closed: vec![0.0; n * mmax.max(n)],
             built: None,
             closed_level: None,
             deferred: None,
+            gram: GramLevel::new(n, mmax),
+            gram_level: None,
+            gram_stepped: None,
+            gram_lambda2: 0.0,
             settings: SolverSettings::default(),
         }
     }
@@ -192,6 +205,13 @@ impl Hierarchy {
     /// Rank kept at each level by the last [`Hierarchy::solve`].
     pub fn ranks(&self) -> &[usize] {
         &self.ranks
+    }
+
+    /// The level the last [`Hierarchy::solve`] stepped by its Gram matrix (the `gram` module:
+    /// a bottom level of weighted joint rows that completes the rank), if any. Its answer is
+    /// the QR's to rounding; its reduction runs only when its factors are asked for.
+    pub fn stepped_by_gram(&self) -> Option<usize> {
+        self.gram_stepped
     }
 
     /// J̄_i^{λ+} of level i (n × m_i), from the last solve. Formed on request from the
@@ -255,19 +275,20 @@ impl Hierarchy {
         self.u.fill(0.0);
         self.refl.truncate(0);
         (self.built, self.closed_level, self.deferred) = (None, None, None);
+        (self.gram_level, self.gram_stepped) = (None, None);
         self.settings = *settings;
         if self.solve_stack_closed(levels, settings, qdd) {
             return Ok(());
         }
         for (i, lvl) in levels.iter().enumerate() {
-            if self.closed_level.is_some() {
+            if self.closed_level.is_some() || self.gram_level.is_some() {
                 // The level solved in closed form completed the rank: no coordinate left.
                 (self.starts[i], self.ranks[i]) = (self.n, 0);
                 continue;
             }
             let p = self.refl.len();
             self.starts[i] = p;
-            if self.solve_closed(i, levels, settings) {
+            if self.solve_closed(i, levels, settings) || self.solve_gram(i, lvl, settings) {
                 continue;
             }
             self.reduce_level(i, settings);
@@ -312,7 +333,9 @@ impl Hierarchy {
     /// when the first level that makes the rows add up to n is a selection, M_O is regular and
     /// the lower bound on σ_min of the stacked Jacobian exceeds 2 × the rank threshold (and
     /// the adaptive damping's threshold), every level keeps all its rows undamped, and
-    /// q̈ = J⁻¹ h: no level is reduced ([`Hierarchy::complete`] does it on demand). False
+    /// q̈ = J⁻¹ h: no level is reduced ([`Hierarchy::complete`] does it on demand). Also when
+    /// the rows of all levels add up to n − d, d ≤ [`MAX_SPARE`](super::selection::MAX_SPARE), the last a selection ("Stacks
+    /// short of square": d unit rows appended, the solution and block projected). False
     /// (nothing decided) otherwise.
     fn solve_stack_closed(
         &mut self,
@@ -322,26 +345,54 @@ impl Hierarchy {
     ) -> bool {
         let n = self.n;
         let nt = self.dims.len();
-        let Some(i) = (0..nt).find(|&i| self.dims[i] > 0 && self.offsets[i] + self.dims[i] == n)
-        else {
-            return false;
+        let square = (0..nt).find(|&i| self.dims[i] > 0 && self.offsets[i] + self.dims[i] == n);
+        let (i, spare) = match square {
+            Some(i) => (i, 0),
+            None => match nt.checked_sub(1) {
+                Some(i) if self.dims[i] > 0 && self.offsets[i] + self.dims[i] < n => {
+                    let spare = n - self.offsets[i] - self.dims[i];
+                    if levels.len() != nt
+                        || !self
+                            .selection
+                            .choose_spare(&levels[..i], &levels[i], spare, n)
+                    {
+                        return false;
+                    }
+                    (i, spare)
+                }
+                _ => return false,
+            },
         };
         let Some(floor) = undamped_floor(settings) else {
             return false;
         };
-        if !self.build_closed(i, levels) || !clears(self.selection.stack_sigma_lower_bound(), floor)
+        if !self.build_closed(i, levels, spare)
+            || !clears(self.selection.stack_sigma_lower_bound(), floor)
         {
+            self.built = None;
             return false;
         }
         let (m, q) = (self.dims[i], qdd.as_mut_slice());
         self.selection.solve_above(&levels[..i], q);
+        // h_i, then zero for the appended rows.
+        let h = &mut self.x[..m + spare];
+        h[..m].copy_from_slice(levels[i].rhs.as_slice());
+        h[m..].fill(0.0);
         self.selection.step(
-            levels[i].rhs.as_slice(),
-            &self.closed[..n * m],
+            h,
+            &self.closed[..n * (m + spare)],
             n,
-            &mut self.res[..m],
+            &mut self.res[..m + spare],
             q,
         );
+        if spare > 0
+            && !self
+                .selection
+                .project_spare(&mut self.closed, n, m, spare, q)
+        {
+            self.built = None;
+            return false;
+        }
         for k in 0..nt {
             let full = k <= i;
             self.starts[k] = if full { self.offsets[k] } else { n };
@@ -349,21 +400,26 @@ impl Hierarchy {
             self.fac[k].direct = full;
         }
         self.closed_level = Some(i);
-        self.deferred = Some(0);
+        self.deferred = Some((0, i));
         true
     }
 
-    /// The closed-form block of level i into `closed` (once per solve); false when the
-    /// `selection` module does not cover it.
-    fn build_closed(&mut self, i: usize, levels: &[TaskEquation]) -> bool {
-        if self.built == Some(i) {
+    /// The closed-form block of level i into `closed` (once per solve), with `spare` unit rows
+    /// appended ([`SelectionBlock::build`]); false when the `selection` module does not cover
+    /// it.
+    fn build_closed(&mut self, i: usize, levels: &[TaskEquation], spare: usize) -> bool {
+        if self.built == Some(i) && spare == 0 {
             return true;
         }
-        let (n, m) = (self.n, self.dims[i]);
+        let (n, m) = (self.n, self.dims[i] + spare);
         if levels.len() != self.dims.len()
-            || !self
-                .selection
-                .build(&levels[..i], &levels[i], n, &mut self.closed[..n * m])
+            || !self.selection.build(
+                &levels[..i],
+                &levels[i],
+                spare,
+                n,
+                &mut self.closed[..n * m],
+            )
         {
             return false;
         }
@@ -392,30 +448,57 @@ impl Hierarchy {
         let Some(floor) = undamped_floor(settings) else {
             return false;
         };
-        if !self.build_closed(i, levels) || !clears(self.selection.sigma_lower_bound(), floor) {
+        if !self.build_closed(i, levels, 0) || !clears(self.selection.sigma_lower_bound(), floor) {
             return false;
         }
         self.ranks[i] = m;
         self.fac[i].direct = true;
         self.closed_level = Some(i);
-        self.deferred = Some(i);
+        self.deferred = Some((i, i));
+        true
+    }
+
+    /// Level i by its Gram matrix, when it holds weighted joint rows and completes the rank
+    /// ([`super::gram`]): its step into `u`, its rank k = n − p_i, its reduction deferred
+    /// ([`Hierarchy::complete`]). False (nothing decided) otherwise.
+    fn solve_gram(&mut self, i: usize, level: &TaskEquation, settings: &SolverSettings) -> bool {
+        let p = self.refl.len();
+        let Some(lambda2) = self.gram.step(
+            level,
+            &self.refl,
+            self.u.as_mut_slice(),
+            settings.damping,
+            settings.rank_threshold,
+        ) else {
+            return false;
+        };
+        self.gram_lambda2 = lambda2;
+        self.gram_stepped = Some(i);
+        self.ranks[i] = self.n - p;
+        self.fac[i].direct = false;
+        self.gram_level = Some(i);
+        self.deferred = Some((i, i));
         true
     }
 
     /// Runs the reductions that the last [`Hierarchy::solve`] deferred (the levels from
-    /// `deferred` to the one it took in closed form), for what needs their factors (the
-    /// reflectors, R, Π: the blocks of the general construction, J̄^{λ+}). The ranks they find
-    /// are the ones decided (full, by the bounds of the `selection` module).
+    /// `deferred.0` to the one it took in closed form or by its Gram matrix), for what needs
+    /// their factors (the reflectors, R, Π: the blocks of the general construction, J̄^{λ+}).
+    /// The ranks they find are the ones decided (by the bounds of the `selection` and `gram`
+    /// modules).
     fn complete(&mut self) {
-        let (Some(from), Some(to)) = (self.deferred.take(), self.closed_level) else {
+        let Some((from, to)) = self.deferred.take() else {
             return;
         };
         let settings = self.settings;
         for k in from..=to {
             self.starts[k] = self.refl.len();
+            let decided = self.ranks[k];
             self.reduce_level(k, &settings);
-            debug_assert_eq!(self.ranks[k], self.dims[k], "level {k}: closed-form rank");
+            debug_assert_eq!(self.ranks[k], decided, "level {k}: the rank decided");
         }
+        // From here on the level's QR factors serve it (its reflectors are in `refl`).
+        self.gram_level = None;
     }
 
     /// Reduces level i: its rows multiplied by the reflectors of the levels above, pivoted QR
@@ -516,6 +599,8 @@ impl Hierarchy {
         // λ² from the damping rule; σ_min estimated by the last kept pivot |R_rr|.
         let sigma = self.a[(rank - 1, rank - 1)].abs();
         let lambda2 = match settings.damping {
+            // The level stepped by its Gram matrix keeps the damping it was stepped with.
+            _ if self.gram_level == Some(i) => self.gram_lambda2,
             Damping::None => 0.0,
             Damping::Fixed(l) => l * l,
             Damping::Adaptive { max, threshold } => {
@@ -550,8 +635,23 @@ impl Hierarchy {
     }
 
     fn reduced_block_in(&mut self, i: usize, propagate: bool, in_basis: bool) -> usize {
-        self.complete();
+        // The correction map of a level stepped by its Gram matrix, and the responses of that
+        // level to the levels above, come from its Gram factors ([`super::gram`]); anything
+        // else needs its QR.
+        let gram = self
+            .gram_level
+            .filter(|&g| in_basis && self.rank_deficient(g) && i <= g);
+        if gram.is_none() {
+            self.complete();
+        }
         let (n, m, r, p) = (self.n, self.dims[i], self.ranks[i], self.starts[i]);
+        if gram == Some(i) {
+            // U_i = J̄ L₀⁻ᵀ: r = k columns, rows p..n.
+            let yb = &mut self.yb[..n * r];
+            yb[..p * r].fill(0.0);
+            self.gram.basis_block(yb);
+            return r;
+        }
         let basis = in_basis && self.rank_deficient(i);
         if basis {
             // U_i is needed only here, when a correction map is built.
@@ -595,6 +695,11 @@ impl Hierarchy {
             let (mk, rk, pk) = (self.dims[k], self.ranks[k], self.starts[k]);
             if rk == 0 {
                 continue;
+            }
+            if gram == Some(k) {
+                // Its rows p_k..n from the rows p..p_k above; the levels below it have rank 0.
+                self.gram.propagate(&mut self.yb[..n * nc], nc, p);
+                break;
             }
             let off = self.offsets[k];
             let f = &self.fac[k];
@@ -746,7 +851,7 @@ impl Hierarchy {
             out.copy_from_slice(&self.closed[..n * m]);
             return true;
         }
-        self.selection.build(&levels[..i], &levels[i], n, out)
+        self.selection.build(&levels[..i], &levels[i], 0, n, out)
     }
 
     /// Columns of level i in the correction map ([`Hierarchy::build_correction_map`]): 0 when
@@ -804,10 +909,14 @@ impl Hierarchy {
     /// Δh_i \[task units\] (length m_i) for the correction `z` of level i in the correction
     /// map's coordinates (length [`Hierarchy::correction_width`]`(i)`): U_i z, z itself at full
     /// rank, zero at rank 0.
-    pub fn correction_demand(&self, i: usize, z: &[f64], out: &mut [f64]) {
+    pub fn correction_demand(&mut self, i: usize, z: &[f64], out: &mut [f64]) {
         let (m, w) = (self.dims[i], self.correction_width(i));
         if w == m {
             out[..m].copy_from_slice(&z[..m]);
+            return;
+        }
+        if self.gram_level == Some(i) {
+            self.gram.demand(&self.refl, z, out);
             return;
         }
         out[..m].fill(0.0);
@@ -834,7 +943,7 @@ fn undamped_floor(settings: &SolverSettings) -> Option<f64> {
 }
 
 /// Whether a lower bound on singular values clears 2 × `floor` (false for NaN).
-fn clears(bound: f64, floor: f64) -> bool {
+pub(super) fn clears(bound: f64, floor: f64) -> bool {
     bound > 2.0 * floor
 }
 

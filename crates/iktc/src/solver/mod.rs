@@ -7,6 +7,7 @@ pub use qp::{
 };
 
 mod continuity;
+mod gram;
 mod hierarchy;
 mod kernels;
 mod rebase;

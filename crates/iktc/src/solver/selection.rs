@@ -74,11 +74,34 @@
 //! clears the rank threshold every level keeps all its rows, and the prioritized solution of a
 //! square stack solved exactly at every level is J⁻¹ h: q̈\[O\] = M_O⁻¹ h_{<i} − X S⁻¹ h_i,
 //! q̈\[C\] = S⁻¹ h_i ([`SelectionBlock::solve_above`], then [`SelectionBlock::step`]).
+//!
+//! ## Stacks short of square
+//!
+//! When the rows of every level up to the last, a selection, add up to n − d (a posture task
+//! that leaves d ≤ [`MAX_SPARE`] joints out), d unit rows selecting d coordinates the level
+//! leaves out (those the levels above move least: [`SelectionBlock::choose_spare`]) make the
+//! stack square, J_a = \[J; E\]. With every level solved exactly (the bound above, for J_a:
+//! the levels' rows are among its rows), the prioritized solution satisfies J q̈ = h and lies
+//! in the row space of J (each level's step J̄_i⁺ ρ_i lies in that of J̄_i = J_i N_{i−1}), so it
+//! is the least-norm solution of J q̈ = h. The solutions of J q̈ = h are q̈_a + V t, with
+//! q̈_a = J_a⁻¹ \[h; 0\] and V = J_a⁻¹ \[0; I\] (the appended rows' columns of the closed block,
+//! a basis of the null space of J), so
+//!
+//! ```text
+//! q̈ = (I − V (VᵀV)⁻¹ Vᵀ) q̈_a,    g_i = (I − V (VᵀV)⁻¹ Vᵀ) g_{a,i}
+//! ```
+//!
+//! ([`SelectionBlock::project_spare`]; g_i is linear in h_i the same way).
 
 use nalgebra::DMatrix;
 
 use super::kernels::{axpy, dot};
 use crate::task::TaskEquation;
+
+/// The most coordinates a stack may leave free and still be solved in closed form ("Stacks
+/// short of square" in the module docs): each costs one more column of the block and one
+/// projection.
+pub(crate) const MAX_SPARE: usize = 3;
 
 /// Scratch of the closed form, sized once.
 #[derive(Debug, Clone)]
@@ -101,6 +124,9 @@ pub(crate) struct SelectionBlock {
     nz: Vec<usize>,
     e: Vec<f64>,
     y: Vec<f64>,
+    /// The coordinates selected by the rows appended to a stack short of square
+    /// ([`SelectionBlock::choose_spare`]).
+    spare: Vec<usize>,
     /// Rows m_i and ‖X‖_F² of the last successful [`SelectionBlock::build`].
     m: usize,
     no: usize,
@@ -110,6 +136,7 @@ pub(crate) struct SelectionBlock {
 impl SelectionBlock {
     /// Room for `n` coordinates and levels of at most `mmax` rows.
     pub(crate) fn new(n: usize, mmax: usize) -> Self {
+        let mmax = mmax.max(n);
         Self {
             coord: vec![0; mmax],
             scale: vec![0.0; mmax],
@@ -122,6 +149,7 @@ impl SelectionBlock {
             nz: vec![0; n],
             e: vec![0.0; n],
             y: vec![0.0; n * n],
+            spare: vec![0; MAX_SPARE],
             m: 0,
             no: 0,
             xx: 0.0,
@@ -132,19 +160,24 @@ impl SelectionBlock {
     /// `above`, assuming the rank conditions of the module docs hold; false (and `out`
     /// unspecified) when the level is not a selection, the rows do not add up to n, or M_O has
     /// a zero or non-finite pivot. Allocates nothing.
+    ///
+    /// With `spare` > 0 the first `spare` coordinates of [`SelectionBlock::choose_spare`] are
+    /// selected by unit rows appended to the level ("Stacks short of square" in the module
+    /// docs): `out` is then n × (m_i + spare), the appended rows' columns last.
     pub(crate) fn build(
         &mut self,
         above: &[TaskEquation],
         level: &TaskEquation,
+        spare: usize,
         n: usize,
         out: &mut [f64],
     ) -> bool {
-        let m = level.dim();
+        let m = level.dim() + spare;
         let no = n.wrapping_sub(m);
-        if m == 0 || m > n || above.iter().map(TaskEquation::dim).sum::<usize>() != no {
+        if level.dim() == 0 || m > n || above.iter().map(TaskEquation::dim).sum::<usize>() != no {
             return false;
         }
-        if !self.detect(&level.jacobian, n) {
+        if !self.detect(&level.jacobian, spare, n) {
             return false;
         }
         // M_O (column-major) and B = J_{<i}[:, C] (row-major, `no` × m), level by level.
@@ -293,16 +326,22 @@ impl SelectionBlock {
         }
     }
 
-    /// Finds the coordinate and entry of each row of `j` (m × n, column-major); false unless
-    /// every row has exactly one non-zero entry and no two rows share a coordinate.
-    fn detect(&mut self, j: &DMatrix<f64>, n: usize) -> bool {
+    /// Finds the coordinate and entry of each row of `j` (m × n, column-major), then of the unit
+    /// rows selecting `extra` (rows m.., entry 1); false unless every row has exactly one
+    /// non-zero entry and no two rows share a coordinate.
+    fn detect(&mut self, j: &DMatrix<f64>, spare: usize, n: usize) -> bool {
         let m = j.nrows();
         let js = j.as_slice();
-        self.coord[..m].fill(usize::MAX);
+        self.coord[..m + spare].fill(usize::MAX);
         let mut others = 0;
         for t in 0..n {
             let col = &js[t * m..(t + 1) * m];
             let mut hit = None;
+            if let Some(e) = self.spare[..spare].iter().position(|&c| c == t) {
+                hit = Some(m + e);
+                self.coord[m + e] = t;
+                self.scale[m + e] = 1.0;
+            }
             // Most columns are all zero: one branch-free pass decides (the scan below finds the
             // row of a non-zero column).
             if col.iter().fold(false, |a, &v| a | (v != 0.0)) {
@@ -325,7 +364,86 @@ impl SelectionBlock {
                 others - 1
             };
         }
-        self.coord[..m].iter().all(|&c| c != usize::MAX)
+        self.coord[..m + spare].iter().all(|&c| c != usize::MAX)
+    }
+
+    /// Chooses `spare` coordinates that no row of `level` selects, those with the smallest
+    /// column norms in the rows `above` (the ones the levels above move least; ties to the
+    /// lower index), for [`SelectionBlock::build`]. False when fewer than `spare` are left or
+    /// `spare` exceeds [`MAX_SPARE`].
+    pub(crate) fn choose_spare(
+        &mut self,
+        above: &[TaskEquation],
+        level: &TaskEquation,
+        spare: usize,
+        n: usize,
+    ) -> bool {
+        if spare > MAX_SPARE {
+            return false;
+        }
+        let m = level.dim();
+        let js = level.jacobian.as_slice();
+        let norms = &mut self.e[..n];
+        for (t, x) in norms.iter_mut().enumerate() {
+            *x = if js[t * m..(t + 1) * m].iter().any(|v| *v != 0.0) {
+                f64::INFINITY
+            } else {
+                above
+                    .iter()
+                    .map(|l| {
+                        let c = &l.jacobian.as_slice()[t * l.dim()..(t + 1) * l.dim()];
+                        dot(c, c)
+                    })
+                    .sum()
+            };
+        }
+        for k in 0..spare {
+            let Some(best) = (0..n)
+                .filter(|&t| norms[t].is_finite())
+                .min_by(|&a, &b| norms[a].total_cmp(&norms[b]).then(a.cmp(&b)))
+            else {
+                return false;
+            };
+            self.spare[k] = best;
+            norms[best] = f64::INFINITY;
+        }
+        true
+    }
+
+    /// After [`SelectionBlock::build`] with `spare` appended rows (`g`, n × (m + spare)) and the
+    /// solution `q` of the square stack: both projected off the span V of the appended rows'
+    /// columns (the null space of the stack without them), q ← q − V (VᵀV)⁻¹ Vᵀ q and each of
+    /// the first m columns likewise (module docs). V is orthonormalised in place (modified
+    /// Gram–Schmidt). False when V is not of full rank (the build could not have succeeded).
+    pub(crate) fn project_spare(
+        &self,
+        g: &mut [f64],
+        n: usize,
+        m: usize,
+        spare: usize,
+        q: &mut [f64],
+    ) -> bool {
+        let (cols, v) = g[..n * (m + spare)].split_at_mut(n * m);
+        for j in 0..spare {
+            let (done, rest) = v.split_at_mut(j * n);
+            let vj = &mut rest[..n];
+            for u in done.chunks_exact(n) {
+                let c = dot(u, vj);
+                axpy(-c, u, vj);
+            }
+            let norm = dot(vj, vj).sqrt();
+            if !(norm.is_finite() && norm > 0.0) {
+                return false;
+            }
+            vj.iter_mut().for_each(|x| *x /= norm);
+        }
+        for x in std::iter::once(q).chain(cols.chunks_exact_mut(n)) {
+            for u in v.chunks_exact(n) {
+                let c = dot(u, x);
+                axpy(-c, u, x);
+            }
+        }
+        true
     }
 }
 
@@ -464,7 +582,7 @@ mod tests {
         let bottom = level(2, 3, &[(0, 2, 2.0), (1, 0, 1.0)]);
         let mut b = SelectionBlock::new(3, 2);
         let mut g = vec![0.0; 6];
-        assert!(b.build(&above, &bottom, 3, &mut g));
+        assert!(b.build(&above, &bottom, 0, 3, &mut g));
         let g = DMatrix::from_column_slice(3, 2, &g);
         // By hand: column 0 moves x2 by 1/2 and x1 by −(1/2)/2; column 1 moves x0 by 1 and
         // x1 by −1/2.
@@ -472,11 +590,11 @@ mod tests {
         assert!((&g - &want).amax() < 1e-15, "{g}");
         // Two rows on one coordinate, a row with two entries, rows that do not add up to n.
         let twice = level(2, 3, &[(0, 2, 2.0), (1, 2, 1.0)]);
-        assert!(!b.build(&above, &twice, 3, &mut [0.0; 6]));
+        assert!(!b.build(&above, &twice, 0, 3, &mut [0.0; 6]));
         let wide = level(2, 3, &[(0, 2, 2.0), (1, 0, 1.0), (1, 1, 1.0)]);
-        assert!(!b.build(&above, &wide, 3, &mut [0.0; 6]));
+        assert!(!b.build(&above, &wide, 0, 3, &mut [0.0; 6]));
         let short = level(1, 3, &[(0, 2, 2.0)]);
-        assert!(!b.build(&above, &short, 3, &mut [0.0; 3]));
+        assert!(!b.build(&above, &short, 0, 3, &mut [0.0; 3]));
     }
 
     #[test]

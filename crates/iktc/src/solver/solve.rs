@@ -328,6 +328,7 @@ impl Solver {
             }
         }
         // Δh of each corrected level from its coordinates in the map.
+        let (h, x) = (&mut self.hierarchy, &self.xs[i]);
         let mut c = 0;
         for (k, corr) in self.report.corrections.iter_mut().enumerate().skip(i) {
             let w = h.correction_width(k);
