@@ -154,13 +154,22 @@ def test_the_run_says_which_levels_the_joint_limits_cost(runs):
 
 def test_a_sliding_foot_steps_unless_every_stance_is_held_and_bad_slides_are_errors():
     # CMU 131_01 slides a foot on the ground: split into steps (the default 5 cm), G1 follows
-    # the captured legs more closely than with every stance held.
+    # the captured legs more closely than with every stance held, and its feet move with the
+    # person's instead of being held behind and dragged: the largest slip over the person's
+    # contacts 34 mm against 220 mm held (2026-12-07). The keypoint means are close since
+    # the hands' level is stepped by its Gram matrix (9.17 against 9.26 cm; 9.11 against
+    # 11.95 cm before), so only their order is asked.
     from test_controller import REPO
     robot = iktc.Robot("g1")
     motion = iktc.load_motion(str(REPO / "crates/iktc/tests/data/motions/cmu/131_01.bvh"))
     stepping = iktc.retarget_keypoints(motion, robot)
     held = iktc.retarget_keypoints(motion, robot, max_slide=None)
-    assert stepping.quality["mean_cm"] < held.quality["mean_cm"] - 0.5
+    assert stepping.quality["mean_cm"] < held.quality["mean_cm"]
+
+    def slip(t):
+        return t.quality["fidelity"]["contacts"]["slip_max_mm"]
+
+    assert slip(stepping) < 0.5 * slip(held), (slip(stepping), slip(held))
     assert stepping.quality["slip_mm"] <= 2.0
     for bad in (0.0, -0.05, float("nan")):
         with pytest.raises(iktc.IktcError, match="max_slide"):
