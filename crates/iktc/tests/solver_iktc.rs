@@ -133,6 +133,75 @@ fn levels_with_no_coordinate_left_change_nothing() {
     assert!(corrected.iter().all(|c| *c > 10), "{corrected:?}");
 }
 
+/// The oracle of IKTC's correction (eq. 23), independent of the correction map: G over all
+/// rows from a fresh [`Hierarchy`] (its blocks by the general construction), the QP over all
+/// m_i of levels `from..n_T` under the box shifted by the prioritized solution. Asserts that
+/// level `from` is feasible and `from + 1` is not, that `q` is the prioritized solution plus
+/// G Δh, and that the report's corrections are Δh, level by level.
+#[allow(clippy::too_many_arguments)]
+fn assert_the_least_correction(
+    levels: &[iktc::task::TaskEquation],
+    dims: &[usize],
+    settings: &SolverSettings,
+    bx: &iktc::limits::AccelerationBox,
+    q: &DVector<f64>,
+    rep: &SolveReport,
+    from: usize,
+    case: usize,
+) {
+    let n = q.len();
+    let mut h = Hierarchy::new(n, dims);
+    let mut p = DVector::zeros(n);
+    h.solve(levels, settings, &mut p).unwrap();
+    h.build_g_levels(0, dims.len());
+    let lo: Vec<f64> = (0..n).map(|d| bx.lower[d] - p[d]).collect();
+    let hi: Vec<f64> = (0..n).map(|d| bx.upper[d] - p[d]).collect();
+    let oracle = |i: usize| {
+        let off: usize = dims[..i].iter().sum();
+        let m: usize = dims[i..].iter().sum();
+        let g = h.g().columns(off, m);
+        let zeros = vec![0.0; m];
+        let a_eq = nalgebra::DMatrix::<f64>::zeros(0, m);
+        let problem = QpProblem {
+            hessian: Hessian::Identity,
+            c: &zeros,
+            a_eq: a_eq.rows(0, 0),
+            b_eq: &[],
+            a_in: g,
+            lower: &lo,
+            upper: &hi,
+        };
+        let mut qp = QpWorkspace::new(m, 0, n);
+        let mut x = DVector::zeros(m);
+        let rep = qp.solve(&problem, &QpSettings::default(), &mut x).unwrap();
+        (rep.status == QpStatus::Optimal).then_some(x)
+    };
+    let x = oracle(from).unwrap_or_else(|| panic!("case {case}: level {from} infeasible"));
+    if from + 1 < dims.len() {
+        assert!(
+            oracle(from + 1).is_none(),
+            "case {case}: level {} was feasible",
+            from + 1
+        );
+    }
+    let off: usize = dims[..from].iter().sum();
+    let m: usize = dims[from..].iter().sum();
+    let want = &p + h.g().columns(off, m) * &x;
+    let scale = 1.0 + want.amax();
+    assert!(
+        (q - &want).amax() < 1e-7 * scale,
+        "case {case} from {from}: {:e}",
+        (q - &want).amax()
+    );
+    // The same corrections Δh, level by level.
+    let mut c = 0;
+    for (k, &m) in dims.iter().enumerate().skip(from) {
+        let d = (&rep.corrections[k] - x.rows(c, m)).amax();
+        assert!(d < 1e-7 * (1.0 + x.amax()), "case {case} level {k}: {d:e}");
+        c += m;
+    }
+}
+
 /// Levels of lower rank than rows: IKTC's QP runs over the r_i corrections of each level that
 /// move q̈ (the correction map), not over all m_i. Its answer must be the least correction of
 /// eq. (23) over all m_i: checked against that QP solved directly on Algorithm 1's G
@@ -174,56 +243,7 @@ fn the_correction_over_the_row_space_is_the_least_correction_over_all_rows() {
             continue;
         };
         // The oracle: G over all rows, the QP of eq. (23) over all m_i of levels i..n_T.
-        let mut h = Hierarchy::new(n, &dims);
-        let mut p = DVector::zeros(n);
-        h.solve(&levels, &settings, &mut p).unwrap();
-        h.build_g_levels(0, dims.len());
-        let lo: Vec<f64> = (0..n).map(|d| bx.lower[d] - p[d]).collect();
-        let hi: Vec<f64> = (0..n).map(|d| bx.upper[d] - p[d]).collect();
-        let oracle = |i: usize| {
-            let off: usize = dims[..i].iter().sum();
-            let m: usize = dims[i..].iter().sum();
-            let g = h.g().columns(off, m);
-            let zeros = vec![0.0; m];
-            let a_eq = nalgebra::DMatrix::<f64>::zeros(0, m);
-            let problem = QpProblem {
-                hessian: Hessian::Identity,
-                c: &zeros,
-                a_eq: a_eq.rows(0, 0),
-                b_eq: &[],
-                a_in: g,
-                lower: &lo,
-                upper: &hi,
-            };
-            let mut qp = QpWorkspace::new(m, 0, n);
-            let mut x = DVector::zeros(m);
-            let rep = qp.solve(&problem, &QpSettings::default(), &mut x).unwrap();
-            (rep.status == QpStatus::Optimal).then_some(x)
-        };
-        let x = oracle(from).unwrap_or_else(|| panic!("case {case}: level {from} infeasible"));
-        if from + 1 < dims.len() {
-            assert!(
-                oracle(from + 1).is_none(),
-                "case {case}: level {} was feasible",
-                from + 1
-            );
-        }
-        let off: usize = dims[..from].iter().sum();
-        let m: usize = dims[from..].iter().sum();
-        let want = &p + h.g().columns(off, m) * &x;
-        let scale = 1.0 + want.amax();
-        assert!(
-            (&q - &want).amax() < 1e-7 * scale,
-            "case {case}: {:e}",
-            (&q - &want).amax()
-        );
-        // The same corrections Δh, level by level.
-        let mut c = 0;
-        for (k, &m) in dims.iter().enumerate().skip(from) {
-            let d = (&rep.corrections[k] - x.rows(c, m)).amax();
-            assert!(d < 1e-7 * (1.0 + x.amax()), "case {case} level {k}: {d:e}");
-            c += m;
-        }
+        assert_the_least_correction(&levels, &dims, &settings, &bx, &q, &rep, from, case);
         checked[from] += 1;
     }
     assert!(
@@ -724,58 +744,14 @@ fn a_level_stepped_by_its_gram_matrix_is_corrected_as_the_qr_would() {
         let Some(from) = rep.corrected_from else {
             continue;
         };
-        // The oracle: G over all rows by the QR, the QP of eq. (23) over all m_i.
+        // The Gram step was taken, and the oracle: G over all rows by the QR, the QP of
+        // eq. (23) over all m_i.
         let mut h = Hierarchy::new(n, &dims);
         let mut p = DVector::zeros(n);
         h.solve(&levels, &settings, &mut p).unwrap();
         assert_eq!(h.stepped_by_gram(), Some(2), "case {case}");
         assert!((&p - &q0).amax() < 1e-12 * (1.0 + q0.amax()), "case {case}");
-        h.build_g_levels(0, dims.len());
-        let lo: Vec<f64> = (0..n).map(|d| bx.lower[d] - p[d]).collect();
-        let hi: Vec<f64> = (0..n).map(|d| bx.upper[d] - p[d]).collect();
-        let oracle = |i: usize| {
-            let off: usize = dims[..i].iter().sum();
-            let m: usize = dims[i..].iter().sum();
-            let g = h.g().columns(off, m);
-            let zeros = vec![0.0; m];
-            let a_eq = nalgebra::DMatrix::<f64>::zeros(0, m);
-            let problem = QpProblem {
-                hessian: Hessian::Identity,
-                c: &zeros,
-                a_eq: a_eq.rows(0, 0),
-                b_eq: &[],
-                a_in: g,
-                lower: &lo,
-                upper: &hi,
-            };
-            let mut qp = QpWorkspace::new(m, 0, n);
-            let mut x = DVector::zeros(m);
-            let rep = qp.solve(&problem, &QpSettings::default(), &mut x).unwrap();
-            (rep.status == QpStatus::Optimal).then_some(x)
-        };
-        let x = oracle(from).unwrap_or_else(|| panic!("case {case}: level {from} infeasible"));
-        if from + 1 < dims.len() {
-            assert!(
-                oracle(from + 1).is_none(),
-                "case {case}: level {} was feasible",
-                from + 1
-            );
-        }
-        let off: usize = dims[..from].iter().sum();
-        let m: usize = dims[from..].iter().sum();
-        let want = &p + h.g().columns(off, m) * &x;
-        let scale = 1.0 + want.amax();
-        assert!(
-            (&q - &want).amax() < 1e-7 * scale,
-            "case {case} from {from}: {:e}",
-            (&q - &want).amax()
-        );
-        let mut c = 0;
-        for (k, &m) in dims.iter().enumerate().skip(from) {
-            let d = (&rep.corrections[k] - x.rows(c, m)).amax();
-            assert!(d < 1e-7 * (1.0 + x.amax()), "case {case} level {k}: {d:e}");
-            c += m;
-        }
+        assert_the_least_correction(&levels, &dims, &settings, &bx, &q, &rep, from, case);
         checked[from] += 1;
     }
     assert!(
