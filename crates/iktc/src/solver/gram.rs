@@ -92,8 +92,8 @@ pub(crate) struct GramLevel {
     ld: usize,
     /// The carried rows' reduced parts (J_g Z, then Z_O), row r at r · n.
     reduced: Vec<f64>,
-    /// M (lower triangle), and the Cholesky factor L (lower) of M + λ² I; k × k, row r at
-    /// r · n, in n × n buffers.
+    /// M (lower triangle), and the Cholesky factor L (lower) of M + λ² I when λ > 0; k × k,
+    /// row r at r · n, in n × n buffers.
     gram: Vec<f64>,
     m: Vec<f64>,
     /// n-vectors: q̈_{i−1}, then J_iᵀ ρ and Qᵀ J_iᵀ ρ; the comparison matrix' solve.
@@ -102,13 +102,13 @@ pub(crate) struct GramLevel {
     /// ρ (m_i).
     res: Vec<f64>,
     scratch: Vec<f64>,
-    /// The undamped Cholesky factor L₀ of M (row r at r · n), for the basis of the correction
-    /// map; and scratch blocks of the correction map (n × n each).
+    /// The undamped Cholesky factor L₀ of M (row r at r · n): the step's factor when λ = 0, and
+    /// the basis of the correction map; and scratch blocks of the correction map.
     l0: Vec<f64>,
     block_t: Vec<f64>,
     block_b: Vec<f64>,
     /// The last step taken: p, k, the general rows' count m_g, the carried rows' count, w²
-    /// and whether λ² > 0 (then `m` holds the factor of M + λ² I, else `m` equals `l0`).
+    /// and whether λ² > 0 (then `m` holds the factor of M + λ² I, else `l0` serves).
     geometry: Geometry,
 }
 
@@ -120,6 +120,7 @@ struct Geometry {
     mg: usize,
     nr: usize,
     w2: f64,
+    damped: bool,
 }
 
 impl GramLevel {
@@ -147,6 +148,15 @@ impl GramLevel {
             block_t: vec![0.0; ld * n.max(mmax)],
             block_b: vec![0.0; n * n.max(mmax)],
             geometry: Geometry::default(),
+        }
+    }
+
+    /// The Cholesky factor of M + λ² I of the last step.
+    fn factor(&self) -> &[f64] {
+        if self.geometry.damped {
+            &self.m
+        } else {
+            &self.l0
         }
     }
 
@@ -258,21 +268,21 @@ impl GramLevel {
                     .sum::<f64>()
             })
             .fold(0.0_f64, f64::max);
-        self.m[..n * k].copy_from_slice(&self.gram[..n * k]);
-        if !cholesky(&mut self.m, n, k) {
+        self.l0[..n * k].copy_from_slice(&self.gram[..n * k]);
+        if !cholesky(&mut self.l0, n, k) {
             return None;
         }
         // λ_min(M) from below: the comparison matrix of L, and the structure.
         let x = &mut self.x[..k];
         for r in 0..k {
-            let row = &self.m[r * n..r * n + r];
+            let row = &self.l0[r * n..r * n + r];
             let s = 1.0
                 + row
                     .iter()
                     .zip(&x[..r])
                     .map(|(l, x)| l.abs() * x)
                     .sum::<f64>();
-            x[r] = s / self.m[r * n + r].abs();
+            x[r] = s / self.l0[r * n + r].abs();
         }
         let inv_inf = x.iter().fold(0.0_f64, |a, &b| a.max(b));
         let by_factor = 1.0 / (k as f64 * inv_inf * inv_inf);
@@ -289,7 +299,7 @@ impl GramLevel {
             Damping::Fixed(l) => l * l,
             Damping::Adaptive { max, threshold } => {
                 let sigma =
-                    smallest_singular_value(&self.gram, &self.m, n, k, &mut self.x, &mut self.v);
+                    smallest_singular_value(&self.gram, &self.l0, n, k, &mut self.x, &mut self.v);
                 if sigma < threshold {
                     (1.0 - (sigma / threshold).powi(2)) * max * max
                 } else {
@@ -297,9 +307,16 @@ impl GramLevel {
                 }
             }
         };
-        self.l0[..n * k].copy_from_slice(&self.m[..n * k]);
-        self.geometry = Geometry { p, k, mg, nr, w2 };
-        if lambda2 > 0.0 {
+        let damped = lambda2 > 0.0;
+        self.geometry = Geometry {
+            p,
+            k,
+            mg,
+            nr,
+            w2,
+            damped,
+        };
+        if damped {
             // M + λ² I (eqs. 8–9 in reduced coordinates: (J̄ᵀJ̄ + λ²I)⁻¹ J̄ᵀ = J̄ᵀ(J̄J̄ᵀ + λ²I)⁻¹).
             self.m[..n * k].copy_from_slice(&self.gram[..n * k]);
             for a in 0..k {
@@ -335,7 +352,7 @@ impl GramLevel {
         refl.apply_forward_rows(p, q, 1, 0, 1, &mut self.scratch);
         let y = &mut u[p..n];
         y.copy_from_slice(&q[p..n]);
-        cholesky_solve(&self.m, n, k, y);
+        cholesky_solve(self.factor(), n, k, y);
         Some(lambda2)
     }
 
@@ -348,12 +365,17 @@ impl GramLevel {
     pub(crate) fn basis_block(&mut self, y: &mut [f64]) {
         let (n, Geometry { p, k, .. }) = (self.n, self.geometry);
         let x = &mut self.x[..k];
+        let factor = if self.geometry.damped {
+            &self.m
+        } else {
+            &self.l0
+        };
         for j in 0..k {
             x.fill(0.0);
             for (a, xa) in x.iter_mut().enumerate().skip(j) {
                 *xa = self.l0[a * n + j];
             }
-            cholesky_solve(&self.m, n, k, x);
+            cholesky_solve(factor, n, k, x);
             for (a, xa) in x.iter().enumerate() {
                 y[(p + a) * k + j] = *xa;
             }
@@ -367,7 +389,12 @@ impl GramLevel {
     /// w² Z_Oᵀ (E_Oᵀ Q_a) (the joint rows contribute w² (I − E_O E_Oᵀ), and Zᵀ Q_a = 0): both
     /// parts of the carried rows, Q_a's from the reflectors as well.
     pub(crate) fn propagate(&mut self, y: &mut [f64], nc: usize, from: usize) {
-        let (n, Geometry { p, k, mg, nr, w2 }) = (self.n, self.geometry);
+        let (
+            n,
+            Geometry {
+                p, k, mg, nr, w2, ..
+            },
+        ) = (self.n, self.geometry);
         let ld = self.ld;
         // T = (carried rows' Q_a part) · Y[from..p], nr × nc.
         let t = &mut self.block_t[..nr * nc];
@@ -394,11 +421,16 @@ impl GramLevel {
         }
         // Each column through (M + λ² I)⁻¹.
         let x = &mut self.x[..k];
+        let factor = if self.geometry.damped {
+            &self.m
+        } else {
+            &self.l0
+        };
         for c in 0..nc {
             for (a, xa) in x.iter_mut().enumerate() {
                 *xa = b[a * nc + c];
             }
-            cholesky_solve(&self.m, n, k, x);
+            cholesky_solve(factor, n, k, x);
             for (a, xa) in x.iter().enumerate() {
                 y[(p + a) * nc + c] = *xa;
             }
