@@ -10,6 +10,7 @@
 #[path = "tree.rs"]
 pub mod tree;
 
+use iktc::model::RobotFiles;
 use std::collections::HashSet;
 use std::path::PathBuf;
 

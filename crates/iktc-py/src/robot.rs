@@ -1,6 +1,7 @@
 //! `iktc.Robot`: an immutable robot model from a built-in name, a robot profile (TOML), a
 //! URDF or a MuJoCo MJCF file.
 
+use iktc::model::RobotFiles;
 use std::path::Path;
 use std::sync::Arc;
 

@@ -52,10 +52,9 @@
 pub mod balance;
 #[cfg(all(feature = "urdf", feature = "json", feature = "toml", feature = "npz"))]
 pub mod batch;
-mod buffer;
-pub mod controller;
-pub mod error;
-pub mod limits;
+pub use iktc_core::controller;
+pub use iktc_core::error;
+pub use iktc_core::limits;
 pub mod mesh;
 pub mod model;
 #[cfg(all(feature = "urdf", feature = "json", feature = "toml"))]
@@ -65,12 +64,12 @@ pub(crate) mod npz;
 pub mod prelude;
 #[cfg(all(feature = "urdf", feature = "toml"))]
 pub mod profile;
-pub mod resources;
+pub use iktc_core::resources;
 #[cfg(all(feature = "urdf", feature = "toml"))]
 pub mod retarget;
 pub mod sim;
-pub mod solver;
-pub mod task;
+pub use iktc_core::solver;
+pub use iktc_core::task;
 pub mod walk;
 
 pub use controller::{Controller, ControllerBuilder};

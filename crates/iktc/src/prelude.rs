@@ -1,13 +1,7 @@
-//! What a user of the controller needs, in one import: `use iktc::prelude::*;`.
+//! What a user of the controller needs, in one import: `use iktc::prelude::*;` (the core's
+//! [`iktc_core::prelude`], and the robot file readers).
 
-pub use crate::controller::{
-    ComHandle, Controller, ControllerBuilder, ControllerSettings, FrameHandle, JointsHandle,
-};
-pub use crate::error::{Error, Result};
-pub use crate::limits::{BoundMethod, DofLimits, JointLimits};
+pub use iktc_core::prelude::*;
+
 #[cfg(feature = "urdf")]
-pub use crate::model::jvrc1;
-pub use crate::model::{planar3r, Kinematics, ModelOptions, Robot, State};
-pub use crate::solver::{Damping, Method, SolveReport, SolverSettings};
-pub use crate::task::{Axes, ComReference, FrameReference, Gains};
-pub use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3, Vector6};
+pub use crate::model::{jvrc1, RobotFiles};

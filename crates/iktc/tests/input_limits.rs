@@ -2,6 +2,7 @@
 //! checked before anything is allocated, configs that overflow refused. Each case asserts the
 //! error's kind and that its text names what is wrong, its value and what was expected.
 
+use iktc::model::RobotFiles;
 use iktc::model::*;
 use iktc::motion::{
     builtin_clip, builtin_map, read_bvh, read_deepmimic, retarget, BvhReadOptions,

@@ -1,5 +1,6 @@
 //! Bad input to the model: each gives a clear error, never a panic.
 
+use iktc::model::RobotFiles;
 use iktc::model::*;
 use iktc::Error;
 use nalgebra::DVector;

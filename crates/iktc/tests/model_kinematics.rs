@@ -4,6 +4,7 @@ mod common;
 use common::model as common_model;
 use common::rng;
 use common_model::*;
+use iktc::model::RobotFiles;
 
 use iktc::model::*;
 use nalgebra::{DMatrix, DVector, Matrix4, Vector3};

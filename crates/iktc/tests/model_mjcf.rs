@@ -5,6 +5,7 @@
 //! humanoid. (The Python test `test_mjcf.py` compares iktc with MuJoCo itself.)
 #![cfg(feature = "mjcf")]
 
+use iktc::model::RobotFiles;
 use std::path::Path;
 
 use iktc::model::*;

@@ -3,6 +3,7 @@
 //! positions, bodies standing tens of metres tall, body points faster than any human limb.
 //! A UTF-8 byte-order mark is accepted.
 
+use iktc::model::RobotFiles;
 use std::path::{Path, PathBuf};
 
 use iktc::motion::plausible::{MAX_BODY_POINT_SPEED, STANDING_HEIGHT_RANGE};

@@ -3,6 +3,7 @@
 //! them the acceleration limits), and the keypoint route refuses a joint it cannot bound
 //! instead of running until its answer is not finite.
 
+use iktc::model::RobotFiles;
 use std::path::{Path, PathBuf};
 
 use iktc::motion::DEFAULT_MAX_GAP;

@@ -4,6 +4,7 @@
 //! a sideways push is measured along ỹ.
 
 use iktc::balance::{run_push, PushScenario, SupportPhase};
+use iktc::model::RobotFiles;
 use iktc::model::{jvrc1, BaseKind, ModelOptions, Robot, JVRC1_URDF};
 use iktc::motion::{builtin_clip, builtin_map, retarget, RobotReferences};
 use iktc::sim::{

@@ -19,8 +19,8 @@ use std::collections::BTreeMap;
 use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion};
 use serde::Deserialize;
 
-use super::robot::{BaseKind, Robot};
-use super::state::{State, QUATERNION_NORM_TOLERANCE};
+use super::{BaseKind, Robot};
+use super::{State, QUATERNION_NORM_TOLERANCE};
 use crate::error::{check_all_finite, check_finite, Error, Result};
 
 /// The contents of a configuration file. Unknown keys are errors.

@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use super::robot::{BaseKind, ModelOptions, Robot};
+use super::{BaseKind, ModelOptions, Robot};
 use crate::error::{Error, Result};
 use crate::resources::ReadLimits;
 
@@ -85,39 +85,35 @@ pub(crate) fn read_description(
     }
 }
 
-impl Robot {
-    /// Reads a robot from URDF or MJCF text (by its root element, see
-    /// [`description_format`]) in the folder `dir` when known (MJCF `<include>` and meshes).
-    pub fn from_description_str(
-        text: &str,
-        dir: Option<&Path>,
-        options: &ModelOptions,
-    ) -> Result<Robot> {
-        match description_format(text) {
-            DescriptionFormat::Urdf => Robot::from_urdf_str(text, options),
-            #[cfg(feature = "mjcf")]
-            DescriptionFormat::Mjcf => {
-                Robot::from_mjcf_str_with(text, dir, options, &ReadLimits::default())
-            }
-            #[cfg(not(feature = "mjcf"))]
-            DescriptionFormat::Mjcf => {
-                let _ = dir;
-                Err(no_mjcf())
-            }
+// The readers behind `RobotFiles` (its docs say what each checks).
+pub(crate) fn from_description_str(
+    text: &str,
+    dir: Option<&Path>,
+    options: &ModelOptions,
+) -> Result<Robot> {
+    match description_format(text) {
+        DescriptionFormat::Urdf => super::urdf::from_urdf_str(text, options),
+        #[cfg(feature = "mjcf")]
+        DescriptionFormat::Mjcf => {
+            super::mjcf::from_mjcf_str_with(text, dir, options, &ReadLimits::default())
+        }
+        #[cfg(not(feature = "mjcf"))]
+        DescriptionFormat::Mjcf => {
+            let _ = dir;
+            Err(no_mjcf())
         }
     }
+}
 
-    /// Reads a robot from a URDF or MJCF file (by its root element, whatever its extension).
-    pub fn from_description_file(path: &Path, options: &ModelOptions) -> Result<Robot> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::Urdf {
-            message: format!("cannot read {}: {e}", path.display()),
-        })?;
-        match description_format(&text) {
-            DescriptionFormat::Urdf => Robot::from_urdf_str(&text, options),
-            #[cfg(feature = "mjcf")]
-            DescriptionFormat::Mjcf => Robot::from_mjcf_file(path, options),
-            #[cfg(not(feature = "mjcf"))]
-            DescriptionFormat::Mjcf => Err(no_mjcf()),
-        }
+pub(crate) fn from_description_file(path: &Path, options: &ModelOptions) -> Result<Robot> {
+    let text = std::fs::read_to_string(path).map_err(|e| Error::Urdf {
+        message: format!("cannot read {}: {e}", path.display()),
+    })?;
+    match description_format(&text) {
+        DescriptionFormat::Urdf => super::urdf::from_urdf_str(&text, options),
+        #[cfg(feature = "mjcf")]
+        DescriptionFormat::Mjcf => super::mjcf::from_mjcf_file(path, options),
+        #[cfg(not(feature = "mjcf"))]
+        DescriptionFormat::Mjcf => Err(no_mjcf()),
     }
 }

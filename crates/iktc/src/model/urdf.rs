@@ -4,9 +4,9 @@ use nalgebra::{Isometry3, Matrix3, Translation3, Unit, UnitQuaternion, Vector3};
 
 use std::collections::HashMap;
 
-use super::joint::{JointKind, JointLimit};
-use super::robot::{JointSpec, Link, ModelOptions, Robot, RobotBuilder};
 use super::urdf_check::{check_raw, unnamed_materials_named, RawJoint, RawUrdf};
+use super::{JointKind, JointLimit};
+use super::{JointSpec, Link, ModelOptions, Robot, RobotBuilder};
 use crate::error::{Error, Result};
 use crate::resources::ReadLimits;
 
@@ -105,7 +105,7 @@ fn units(j: &urdf_rs::Joint) -> (&'static str, &'static str) {
 }
 
 /// The checked limits of a revolute, continuous or prismatic joint (see
-/// [`Robot::from_urdf_str_with`]); warnings go to the builder.
+/// [`Robot::from_urdf_str_with`](super::RobotFiles::from_urdf_str_with)); warnings go to the builder.
 fn checked_limit(j: &urdf_rs::Joint, raw: &RawJoint, b: &mut RobotBuilder) -> Result<JointLimit> {
     let l = &j.limit;
     let (pos_unit, vel_unit) = units(j);
@@ -254,66 +254,36 @@ fn drop_floating_root(u: &mut urdf_rs::Robot) -> Option<String> {
     ))
 }
 
-impl Robot {
-    /// Reads a robot from URDF text (revolute, continuous, prismatic and fixed joints).
-    ///
-    /// A malformed document, an unsupported joint type, an inconsistent tree or a bad number is
-    /// an [`Error`]; see [`RobotBuilder::build`].
-    ///
-    /// Every `<limit>` is checked (see [`Robot::from_urdf_str_with`]), with the default
-    /// [`ReadLimits`].
-    pub fn from_urdf_str(text: &str, options: &ModelOptions) -> Result<Robot> {
-        Self::from_urdf_str_with(text, options, &ReadLimits::default())
-    }
+// The readers behind `RobotFiles` (its docs say what each checks).
+pub(crate) fn from_urdf_str(text: &str, options: &ModelOptions) -> Result<Robot> {
+    from_urdf_str_with(text, options, &ReadLimits::default())
+}
 
-    /// [`Robot::from_urdf_str`] with explicit [`ReadLimits`] (the XML nesting depth).
-    ///
-    /// What is checked beyond the XML and the tree (each an [`Error`] naming the joint or link,
-    /// the attribute, its value and what was expected):
-    ///
-    /// * the nesting depth (at most [`ReadLimits::max_xml_depth`]), before the document is
-    ///   parsed into a tree;
-    /// * the elements inside each `<joint>` and `<inertial>` and the attributes of `<limit>`:
-    ///   an unknown one is an error, but for an element inside `<joint>` that misspells none
-    ///   URDF defines (an exporter's extension such as `<joint_properties>`), which is ignored
-    ///   with a warning;
-    /// * a revolute or prismatic joint needs a `<limit>` (URDF requires it) with a range
-    ///   `lower < upper` (a zero-width range is an error: make the joint fixed or lock it);
-    /// * `velocity` must be finite and > 0 (0 or a negative value would mean a joint that
-    ///   cannot move); a missing velocity (URDF ≥ 1.2 reads it as unbounded) is accepted with a
-    ///   warning;
-    /// * `effort` must be finite and ≥ 0; URDF allows 0 (many exporters write it for "unknown"),
-    ///   and iktc, being kinematic, does not use efforts: `effort="0"` is accepted with a
-    ///   warning ([`Robot::warnings`]);
-    /// * `acceleration` (URDF 1.2), when written, must be finite and > 0;
-    /// * masses, inertias and origins: see [`RobotBuilder::build`].
-    pub fn from_urdf_str_with(
-        text: &str,
-        options: &ModelOptions,
-        limits: &ReadLimits,
-    ) -> Result<Robot> {
-        let (u, raw) = read_urdf(text, limits)?;
-        let mut b = builder_from_urdf(&u, &raw.joints)?;
-        if let Some(note) = &raw.floating_root {
-            b.warn(note.clone());
-        }
-        for (joint, tag) in &raw.ignored {
-            b.warn(format!("joint `{joint}`: <{tag}> is not URDF; ignored"));
-        }
-        if !raw.unnamed_materials.is_empty() {
-            b.warn(format!(
-                "{} <material> element(s) without the `name` URDF requires: read as unnamed",
-                raw.unnamed_materials.len()
-            ));
-        }
-        b.build(options)
+pub(crate) fn from_urdf_str_with(
+    text: &str,
+    options: &ModelOptions,
+    limits: &ReadLimits,
+) -> Result<Robot> {
+    let (u, raw) = read_urdf(text, limits)?;
+    let mut b = builder_from_urdf(&u, &raw.joints)?;
+    if let Some(note) = &raw.floating_root {
+        b.warn(note.clone());
     }
+    for (joint, tag) in &raw.ignored {
+        b.warn(format!("joint `{joint}`: <{tag}> is not URDF; ignored"));
+    }
+    if !raw.unnamed_materials.is_empty() {
+        b.warn(format!(
+            "{} <material> element(s) without the `name` URDF requires: read as unnamed",
+            raw.unnamed_materials.len()
+        ));
+    }
+    b.build(options)
+}
 
-    /// Reads a robot from a URDF file.
-    pub fn from_urdf_file(path: &std::path::Path, options: &ModelOptions) -> Result<Robot> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::Urdf {
-            message: format!("cannot read {}: {e}", path.display()),
-        })?;
-        Self::from_urdf_str(&text, options)
-    }
+pub(crate) fn from_urdf_file(path: &std::path::Path, options: &ModelOptions) -> Result<Robot> {
+    let text = std::fs::read_to_string(path).map_err(|e| Error::Urdf {
+        message: format!("cannot read {}: {e}", path.display()),
+    })?;
+    from_urdf_str(&text, options)
 }

@@ -4,6 +4,7 @@
 use super::glob::glob_match;
 use super::schema::{Feet, Foot, RobotProfile};
 use crate::error::{Error, Result};
+use crate::model::RobotFiles;
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 
 use crate::model::{JointKind, Kinematics, ModelOptions, Robot, State};

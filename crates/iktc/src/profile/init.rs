@@ -26,6 +26,7 @@
 //! * locks: movable joints whose names contain `finger`, `thumb`, `index`, `middle`, `ring`,
 //!   `little` or `pinky`, as one glob pattern each.
 
+use crate::model::RobotFiles;
 use nalgebra::{DMatrix, DVector, Vector3};
 
 use super::shape::{find_parts, named_frame, named_like, Parts, Tree};

@@ -1,6 +1,7 @@
 //! `iktc profile init` on humanoids whose link names say nothing: the parts are found from
 //! the tree's shape, checked against the values the synthetic URDFs were built with.
 
+use crate::model::RobotFiles;
 use nalgebra::Vector3;
 
 use super::{init_profile_toml, init_profile_toml_with, InitOptions, Sole, CROUCH};

@@ -11,8 +11,8 @@ use super::geom::{combined, geom, Geom, MeshAsset};
 use super::spec::{boolean, numbers, pose, unit, Compiler};
 use super::xml::El;
 use crate::error::Result;
-use crate::model::joint::{JointKind, JointLimit};
-use crate::model::robot::{JointSpec, Link};
+use crate::model::{JointKind, JointLimit};
+use crate::model::{JointSpec, Link};
 
 /// The model read from the body tree, before `<equality>` and `<actuator>`.
 #[derive(Debug, Default)]

@@ -1,8 +1,8 @@
 //! Reading a [`Robot`] from MuJoCo MJCF (feature `mjcf`, on by default).
 //!
-//! [`Robot::from_mjcf_file`] and [`Robot::from_mjcf_str`] read the kinematic tree of a
+//! [`Robot::from_mjcf_file`](super::RobotFiles::from_mjcf_file) and [`Robot::from_mjcf_str`](super::RobotFiles::from_mjcf_str) read the kinematic tree of a
 //! `<mujoco>` model so that iktc's q is MuJoCo's qpos (but for the base quaternion's order)
-//! and every link pose is MuJoCo's body pose; [`Robot::from_description_file`] reads URDF or
+//! and every link pose is MuJoCo's body pose; [`Robot::from_description_file`](super::RobotFiles::from_description_file) reads URDF or
 //! MJCF by the document's root element. The subset read:
 //!
 //! * **Bodies**: one link per `<body>` (named after it; an unnamed body is `body<id>`, its
@@ -58,7 +58,7 @@
 
 use std::path::Path;
 
-use super::robot::{BaseKind, ModelOptions, Robot, RobotBuilder};
+use super::{BaseKind, ModelOptions, Robot, RobotBuilder};
 use crate::error::{Error, Result};
 use crate::resources::ReadLimits;
 
@@ -193,41 +193,30 @@ impl Mjcf {
     }
 }
 
-impl Robot {
-    /// Reads a robot from MJCF text (see the [module documentation](self) for what is read).
-    /// Without a folder, an `<include>` is an error and mesh files are not looked for: use
-    /// [`Robot::from_mjcf_file`] for a model on disk.
-    pub fn from_mjcf_str(text: &str, options: &ModelOptions) -> Result<Robot> {
-        Self::from_mjcf_str_with(text, None, options, &ReadLimits::default())
-    }
+// The readers behind `RobotFiles` (its docs say what each checks).
+pub(crate) fn from_mjcf_str(text: &str, options: &ModelOptions) -> Result<Robot> {
+    from_mjcf_str_with(text, None, options, &ReadLimits::default())
+}
 
-    /// [`Robot::from_mjcf_str`] for a model in the folder `dir` (for `<include>` and mesh
-    /// files), with explicit [`ReadLimits`] (the XML nesting depth, included files counted).
-    ///
-    /// Errors: malformed XML, a root other than `<mujoco>`, an unsupported element or joint
-    /// type, a bad number (each naming the element, file and line), then what
-    /// [`RobotBuilder::build`] checks.
-    pub fn from_mjcf_str_with(
-        text: &str,
-        dir: Option<&Path>,
-        options: &ModelOptions,
-        limits: &ReadLimits,
-    ) -> Result<Robot> {
-        read_mjcf(text, "MJCF text", dir, limits)?.robot(options)
-    }
+pub(crate) fn from_mjcf_str_with(
+    text: &str,
+    dir: Option<&Path>,
+    options: &ModelOptions,
+    limits: &ReadLimits,
+) -> Result<Robot> {
+    read_mjcf(text, "MJCF text", dir, limits)?.robot(options)
+}
 
-    /// Reads a robot from an MJCF file; `<include>` and mesh files are found from its folder.
-    pub fn from_mjcf_file(path: &Path, options: &ModelOptions) -> Result<Robot> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::Urdf {
-            message: format!("cannot read {}: {e}", path.display()),
-        })?;
-        let dir = path.parent().unwrap_or(Path::new("."));
-        read_mjcf(
-            &text,
-            &path.display().to_string(),
-            Some(dir),
-            &ReadLimits::default(),
-        )?
-        .robot(options)
-    }
+pub(crate) fn from_mjcf_file(path: &Path, options: &ModelOptions) -> Result<Robot> {
+    let text = std::fs::read_to_string(path).map_err(|e| Error::Urdf {
+        message: format!("cannot read {}: {e}", path.display()),
+    })?;
+    let dir = path.parent().unwrap_or(Path::new("."));
+    read_mjcf(
+        &text,
+        &path.display().to_string(),
+        Some(dir),
+        &ReadLimits::default(),
+    )?
+    .robot(options)
 }

@@ -1,5 +1,6 @@
 //! The MJCF reader on small hand-written models, against hand-computed poses and inertias.
 
+use crate::model::RobotFiles;
 use std::f64::consts::FRAC_PI_2;
 
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};

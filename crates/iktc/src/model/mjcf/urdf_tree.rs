@@ -5,7 +5,7 @@ use nalgebra::{Isometry3, Matrix3};
 
 use super::body::Tree;
 use super::geom::{Geom, MeshAsset, Shape};
-use crate::model::joint::JointKind;
+use crate::model::JointKind;
 use std::collections::HashMap;
 
 /// A URDF `<origin>` of `p` (rotation as roll, pitch, yaw \[rad\], `Rz·Ry·Rx`).

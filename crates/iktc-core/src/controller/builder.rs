@@ -24,7 +24,7 @@ use crate::task::{
 /// reference is moved.
 ///
 /// ```
-/// use iktc::prelude::*;
+/// use iktc_core::prelude::*;
 ///
 /// let robot = planar3r();
 /// let state = State::neutral(&robot);
@@ -33,7 +33,7 @@ use crate::task::{
 /// let mut ctl = b.build()?;
 /// assert_eq!(tip.level(), 0);
 /// assert_eq!(ctl.level_dims().collect::<Vec<_>>(), [3]);
-/// # Ok::<(), iktc::Error>(())
+/// # Ok::<(), iktc_core::Error>(())
 /// ```
 #[derive(Debug, Clone)]
 pub struct ControllerBuilder {

@@ -49,9 +49,8 @@ impl FrameReference {
     /// The acceleration a frame task with `gains` asks of a frame at `pose` moving with
     /// `velocity` (world axes, \[m/s\] then \[rad/s\]): `ẍ_d + k_v(ẋ_d − ẋ) + k_p e`
     /// \[m/s², rad/s²\], its rows' right-hand side before `J̇q̇` is taken off (used by the
-    /// retargeting's floor, which needs the `urdf` and `toml` features).
-    #[cfg_attr(not(all(feature = "urdf", feature = "toml")), allow(dead_code))]
-    pub(crate) fn desired_acceleration(
+    /// retargeting's floor).
+    pub fn desired_acceleration(
         &self,
         pose: &Isometry3<f64>,
         velocity: &Vector6<f64>,

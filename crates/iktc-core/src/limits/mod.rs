@@ -26,7 +26,7 @@
 //! infinite limits), and [`compute_box`] takes the state as slices.
 //!
 //! ```
-//! use iktc::limits::{compute_box, AccelerationBox, BoundMethod, DofLimits, JointLimits};
+//! use iktc_core::limits::{compute_box, AccelerationBox, BoundMethod, DofLimits, JointLimits};
 //!
 //! let joint = DofLimits {
 //!     position_min: -1.0,
@@ -40,7 +40,7 @@
 //! assert!(!bounds.is_empty());
 //! assert_eq!(bounds.upper[0], f64::INFINITY); // unlimited dof
 //! assert!(bounds.upper[1] < 0.0); // 0.05 rad from the limit at 1.2 rad/s: must brake
-//! # Ok::<(), iktc::Error>(())
+//! # Ok::<(), iktc_core::Error>(())
 //! ```
 
 mod acceleration_box;

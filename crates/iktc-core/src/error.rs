@@ -6,6 +6,8 @@
 //! reported as a *status* in the solution. The one exception is [`Error::RunFailed`]: a
 //! scenario run whose robot fell, gave up its feet or diverged stops with it by default.
 
+pub mod health;
+
 use crate::resources::fmt_value;
 
 /// Most names an error lists \[names\]; the rest are counted ([`name_list`]).
@@ -27,7 +29,7 @@ pub fn name_list<S: AsRef<str>>(names: &[S]) -> String {
 
 /// The number of single-character insertions, deletions and substitutions that turn `a` into
 /// `b` (Levenshtein distance).
-pub(crate) fn edits(a: &str, b: &str) -> usize {
+pub fn edits(a: &str, b: &str) -> usize {
     let b: Vec<char> = b.chars().collect();
     let mut row: Vec<usize> = (0..=b.len()).collect();
     for (i, ca) in a.chars().enumerate() {
@@ -181,10 +183,10 @@ pub enum Error {
     /// A scenario run went wrong and was stopped (the feet drifted past their tolerance, the
     /// state stopped being finite, the ZMP left the support polygon): the one kind of error
     /// that is not about bad input, because the run's results would be meaningless. Its
-    /// settings ([`crate::sim::HealthSettings::keep_going`]) can ask for the run to continue
+    /// settings (`HealthSettings::keep_going` of the scenarios) can ask for the run to continue
     /// and mark the failure instead.
     #[error("run failed: {0}")]
-    RunFailed(Box<crate::sim::HealthIssue>),
+    RunFailed(Box<health::HealthIssue>),
     /// Input data are insufficient for the requested computation (too few points, ...).
     #[error("insufficient data for {what}: {message}")]
     InsufficientData {

@@ -108,8 +108,7 @@ impl Controller {
     /// ([`Kinematics::update`] of this controller's robot at `state`): they are swapped in
     /// instead of computed again (`kin` receives the controller's previous ones). The same
     /// problem bit for bit, the kinematics being a function of the robot and the state.
-    #[cfg(all(feature = "urdf", feature = "toml"))]
-    pub(crate) fn prepare_with_kinematics(
+    pub fn prepare_with_kinematics(
         &mut self,
         state: &State,
         dt: f64,

@@ -83,7 +83,7 @@
 //! # Example
 //!
 //! ```
-//! use iktc::solver::{Hessian, QpProblem, QpSettings, QpStatus, QpWorkspace};
+//! use iktc_core::solver::{Hessian, QpProblem, QpSettings, QpStatus, QpWorkspace};
 //! use nalgebra::{DMatrix, DVector};
 //!
 //! // min ½‖x‖² − x₀ − x₁  s.t.  x₀ + x₁ ≤ 1  →  x = (½, ½)
@@ -104,7 +104,7 @@
 //! assert_eq!(report.status, QpStatus::Optimal);
 //! assert!((x[0] - 0.5).abs() < 1e-12 && (x[1] - 0.5).abs() < 1e-12);
 //! assert!((workspace.multipliers_in()[0] + 0.5).abs() < 1e-12); // upper end: y ≤ 0
-//! # Ok::<(), iktc::Error>(())
+//! # Ok::<(), iktc_core::Error>(())
 //! ```
 
 mod basis;
