@@ -3,6 +3,7 @@
 
 use iktc::prelude::*;
 
+#[path = "../../iktc-core/tests/common/mod.rs"]
 mod common;
 use common::alloc as counting_alloc;
 use counting_alloc::allocations;

@@ -5,6 +5,7 @@ use iktc::model::*;
 use iktc::task::*;
 use nalgebra::DMatrix;
 
+#[path = "../../iktc-core/tests/common/mod.rs"]
 mod common;
 use common::alloc as counting_alloc;
 use counting_alloc::allocations as count;

@@ -9,6 +9,7 @@ use iktc::sim::{
 };
 use iktc::solver::Method;
 
+#[path = "../../iktc-core/tests/common/mod.rs"]
 mod common;
 use common::alloc as counting_alloc;
 use counting_alloc::allocations;

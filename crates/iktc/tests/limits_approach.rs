@@ -7,6 +7,7 @@
 //! task's change and the approach bound's change `ω² |Δq| + 2ω |Δq̇|` (the bound is Lipschitz in
 //! the state: it takes over from the task without a step).
 
+#[path = "../../iktc-core/tests/common/mod.rs"]
 mod common;
 
 use common::bounds::{

@@ -9,6 +9,7 @@
 //! the stopping distance of the discrete braking profile `D(s) = a_stop Δt² (k²/2 + (s − k)(k + ½))`
 //! (`k = ⌊s⌋`, `s = q̇/(a_stop Δt)`) with a bisection.
 
+#[path = "../../iktc-core/tests/common/mod.rs"]
 mod common;
 
 use common::bounds::{

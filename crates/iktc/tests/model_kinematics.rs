@@ -1,5 +1,6 @@
 //! Kinematics against finite differences and closed forms.
 
+#[path = "../../iktc-core/tests/common/mod.rs"]
 mod common;
 use common::model as common_model;
 use common::rng;

@@ -5,6 +5,7 @@
 use iktc::profile::RobotProfile;
 use iktc::retarget::{builtin_motion, keypoint_controller, KeypointSettings};
 
+#[path = "../../iktc-core/tests/common/mod.rs"]
 mod common;
 use common::alloc as counting_alloc;
 use counting_alloc::allocations;

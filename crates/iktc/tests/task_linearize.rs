@@ -1,6 +1,7 @@
 //! Tasks: the sign conventions of h, checked by closing the loop on the error dynamics
 //! ë + k_v ė + k_p e = 0 (eq. 12), whose critically damped solution is known in closed form.
 
+#[path = "../../iktc-core/tests/common/mod.rs"]
 mod common;
 use common::model as common_model;
 use common::rng;

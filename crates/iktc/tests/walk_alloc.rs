@@ -6,6 +6,7 @@ use iktc::walk::{
     FootstepPlan, PreviewAxis, PreviewSettings, Side, SupportPolygon, WalkSettings, WalkingPattern,
 };
 
+#[path = "../../iktc-core/tests/common/mod.rs"]
 mod common;
 use common::alloc::{allocations, Counting};
 

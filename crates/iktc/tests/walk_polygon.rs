@@ -2,6 +2,7 @@
 //! hull has: every sole corner inside or on it, every vertex a sole corner, convex and
 //! counter-clockwise; and against the closed form of four equal soles on a square.
 
+#[path = "../../iktc-core/tests/common/mod.rs"]
 mod common;
 
 use iktc::walk::{sole_corners, Pose2, SupportPolygon, MAX_SOLES};

@@ -10,7 +10,7 @@ use common::rng;
 use common::solver as solver_common;
 use solver_common::*;
 
-use iktc::solver::*;
+use iktc_core::solver::*;
 use nalgebra::DVector;
 
 /// The QP's feasibility tolerance, as the other solver tests use it \[rad/s²\].

@@ -5,7 +5,7 @@
 
 use common::qp as qp_common;
 
-use iktc::solver::{QpSettings, QpStatus, QpWorkspace};
+use iktc_core::solver::{QpSettings, QpStatus, QpWorkspace};
 use nalgebra::DVector;
 use qp_common::{random_problem_sized, Kind, LARGE};
 

@@ -9,7 +9,7 @@ use common::solver as solver_common;
 use solver_common::*;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
-use iktc::solver::{Method, Solver, SolverSettings};
+use iktc_core::solver::{Method, Solver, SolverSettings};
 use nalgebra::DVector;
 use std::hint::black_box;
 

@@ -4,7 +4,7 @@
 mod common;
 use common::qp as qp_common;
 
-use iktc::solver::{QpConstraint, QpSettings, QpStatus};
+use iktc_core::solver::{QpConstraint, QpSettings, QpStatus};
 use nalgebra::DVector;
 use qp_common::{
     clarabel_solve, kkt, random_problem_sized, scale_rows, solve, tight_rows, Kind, OwnedQp, Sizes,

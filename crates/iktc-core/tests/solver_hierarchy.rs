@@ -5,8 +5,8 @@ use common::rng;
 use common::solver as solver_common;
 use solver_common::*;
 
-use iktc::solver::*;
-use iktc::task::TaskEquation;
+use iktc_core::solver::*;
+use iktc_core::task::TaskEquation;
 use nalgebra::{DMatrix, DVector};
 
 /// N_{i−1} = I − A⁺A for every level i, with A the stacked Jacobian of the levels above it

@@ -1,7 +1,7 @@
-//! Bad input to the QP solver is an `iktc::Error` naming what is wrong; one test each.
+//! Bad input to the QP solver is an `iktc_core::Error` naming what is wrong; one test each.
 
-use iktc::solver::{Hessian, QpProblem, QpSettings, QpWorkspace};
-use iktc::Error;
+use iktc_core::solver::{Hessian, QpProblem, QpSettings, QpWorkspace};
+use iktc_core::Error;
 use nalgebra::{DMatrix, DVector};
 
 /// A valid problem with n = 2, one equality and two inequality rows, as owned data.
@@ -41,13 +41,13 @@ impl Data {
     }
 }
 
-fn solve_with(problem: &QpProblem<'_>, settings: &QpSettings) -> iktc::Result<()> {
+fn solve_with(problem: &QpProblem<'_>, settings: &QpSettings) -> iktc_core::Result<()> {
     let mut ws = QpWorkspace::new(2, 1, 2);
     let mut x = DVector::zeros(problem.c.len());
     ws.solve(problem, settings, &mut x).map(|_| ())
 }
 
-fn solve(problem: &QpProblem<'_>) -> iktc::Result<()> {
+fn solve(problem: &QpProblem<'_>) -> iktc_core::Result<()> {
     solve_with(problem, &QpSettings::default())
 }
 

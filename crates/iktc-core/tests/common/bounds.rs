@@ -3,12 +3,12 @@
 //! the multi-joint case, three joints under two levels of linear tasks `x = J q` (1 and 2
 //! rows, random J) solved by IKTC, the references asking for joint 0 beyond a limit.
 
-use iktc::limits::{
+use iktc_core::limits::{
     compute_box, integrate_constant_acceleration, peak_in_step, AccelerationBox, BoundMethod,
     DofLimits, JointLimits,
 };
-use iktc::solver::{Method, Solver, SolverSettings};
-use iktc::task::TaskEquation;
+use iktc_core::solver::{Method, Solver, SolverSettings};
+use iktc_core::task::TaskEquation;
 use nalgebra::{DMatrix, DVector};
 use proptest::test_runner::{Config, RngAlgorithm, RngSeed};
 use rand::Rng;

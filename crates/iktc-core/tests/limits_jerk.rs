@@ -1,10 +1,10 @@
-//! Jerk limits (`iktc::limits::jerk`): on 10⁴ random joints driven back and forth into their
+//! Jerk limits (`iktc_core::limits::jerk`): on 10⁴ random joints driven back and forth into their
 //! limits by a reference that jumps, the position (in-step peak included) and velocity limits
 //! are kept exactly as without a jerk limit, the box never empties, and every tick whose box
 //! did not relax the jerk source keeps `|q̈ − q̈₋| ≤ j_max Δt`; a jerk limit at least
 //! `2 a_max/Δt` (a change across the whole acceleration range in one tick) never binds.
 
-use iktc::limits::{
+use iktc_core::limits::{
     compute_box, integrate_constant_acceleration, limit_jerk, peak_in_step, AccelerationBox,
     BoundMethod, DofLimits, JointLimits,
 };

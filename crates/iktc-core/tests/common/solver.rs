@@ -1,7 +1,7 @@
 //! Random task hierarchies for solver tests and benchmarks.
 
-use iktc::limits::AccelerationBox;
-use iktc::task::TaskEquation;
+use iktc_core::limits::AccelerationBox;
+use iktc_core::task::TaskEquation;
 use nalgebra::{DMatrix, DVector};
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;

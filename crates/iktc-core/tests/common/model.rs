@@ -1,6 +1,6 @@
 //! Shared helpers for model tests: random trees and finite differences.
 
-use iktc::model::*;
+use iktc_core::model::*;
 use nalgebra::{DMatrix, DVector, Isometry3, Translation3, Unit, UnitQuaternion, Vector3};
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;

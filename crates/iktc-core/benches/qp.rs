@@ -6,7 +6,7 @@
 //! * GF cascade level: `H = JᵀJ + λ²I` (38 variables), 38 box rows, 18 equality rows (the
 //!   higher levels' tasks).
 //!
-//! Run: `cargo bench -p iktc --bench qp -- --warm-up-time 1 --measurement-time 3`.
+//! Run: `cargo bench -p iktc-core --bench qp -- --warm-up-time 1 --measurement-time 3`.
 
 #[path = "../tests/common/mod.rs"]
 mod common;
@@ -16,7 +16,7 @@ use common::rng;
 use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use iktc::solver::{QpSettings, QpStatus, QpWorkspace};
+use iktc_core::solver::{QpSettings, QpStatus, QpWorkspace};
 use nalgebra::{DMatrix, DVector};
 use qp_common::{clarabel_solve, random_spd, OwnedQp, Verdict};
 use rand::Rng;

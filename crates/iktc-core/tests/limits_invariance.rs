@@ -1,4 +1,4 @@
-//! Property tests of the viable bounds (the theorem of `iktc::limits::viable`): from a viable
+//! Property tests of the viable bounds (the theorem of `iktc_core::limits::viable`): from a viable
 //! state, every acceleration in the box keeps the joint inside its limits over the step (in-step
 //! peak included), keeps the velocity and acceleration limits, and leads to a viable state whose
 //! box is again non-empty, for any control period and any ratio of the limits.
@@ -15,7 +15,7 @@ mod common;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use common::bounds::proptest_config;
-use iktc::limits::{
+use iktc_core::limits::{
     compute_box, compute_dof, integrate_constant_acceleration, peak_in_step, viable,
     AccelerationBox, BoundMethod, DofBounds, DofLimits, JointLimits, ViableSettings,
 };

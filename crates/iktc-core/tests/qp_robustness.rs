@@ -5,7 +5,7 @@
 //! input errors (non-finite entries, indefinite H) or the overflow error (finite entries near
 //! 1e300).
 
-use iktc::solver::{Hessian, QpProblem, QpSettings, QpStatus, QpWorkspace};
+use iktc_core::solver::{Hessian, QpProblem, QpSettings, QpStatus, QpWorkspace};
 use nalgebra::{DMatrix, DVector};
 use proptest::prelude::*;
 

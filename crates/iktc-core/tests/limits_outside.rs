@@ -2,12 +2,12 @@
 //! range; with `OutsideLimits::Recover` a joint outside its range is brought back at the
 //! acceleration limit, reported as `BoundSource::Recovery`, without crossing any other limit.
 
-use iktc::limits::{
+use iktc_core::limits::{
     compute_box, compute_dof, integrate_constant_acceleration, peak_in_step, viable,
     AccelerationBox, BoundMethod, BoundSource, DofLimits, JointLimits, OutsideLimits,
     ViableSettings,
 };
-use iktc::Error;
+use iktc_core::Error;
 
 /// Relative rounding allowed on the acceleration limit [–].
 const ROUNDING: f64 = 1e-12;

@@ -5,7 +5,7 @@ mod common;
 use common::qp as qp_common;
 use common::rng;
 
-use iktc::solver::{Hessian, QpConstraint, QpProblem, QpSettings, QpStatus, QpWorkspace};
+use iktc_core::solver::{Hessian, QpConstraint, QpProblem, QpSettings, QpStatus, QpWorkspace};
 use nalgebra::{DMatrix, DVector};
 use qp_common::{kkt, random_problem_sized, random_spd, solve, Kind, LARGE, SMALL};
 use rand::Rng;

@@ -5,7 +5,7 @@ use common::rng;
 use common::solver as solver_common;
 use solver_common::*;
 
-use iktc::solver::*;
+use iktc_core::solver::*;
 use nalgebra::DVector;
 
 use common::alloc as counting_alloc;
@@ -51,7 +51,7 @@ fn solvers_allocate_nothing() {
 /// IKTC with the continuity term, and a box with jerk limits, allocate nothing either.
 #[test]
 fn continuity_and_jerk_limits_allocate_nothing() {
-    use iktc::limits::{limit_jerk, AccelerationBox, DofLimits, JointLimits};
+    use iktc_core::limits::{limit_jerk, AccelerationBox, DofLimits, JointLimits};
     let dims = [12, 2, 3, 1, 20];
     let mut r = rng(42);
     let levels = random_levels(&mut r, 38, &dims);

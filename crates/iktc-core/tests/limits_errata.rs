@@ -12,7 +12,7 @@
 
 use std::f64::consts::PI;
 
-use iktc::limits::{
+use iktc_core::limits::{
     compute_box, integrate_constant_acceleration, peak_in_step, AccelerationBox, BoundMethod,
     BoundSource, DofLimits, JointLimits, ViableSettings,
 };

@@ -2,7 +2,7 @@
 
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{DefaultSettings, DefaultSolver, IPSolver, SolverStatus, SupportedConeT};
-use iktc::solver::{Hessian, QpProblem, QpReport, QpSettings, QpStatus, QpWorkspace};
+use iktc_core::solver::{Hessian, QpProblem, QpReport, QpSettings, QpStatus, QpWorkspace};
 use nalgebra::{DMatrix, DVector};
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;

@@ -5,7 +5,7 @@ use common::rng;
 use common::solver as solver_common;
 use solver_common::*;
 
-use iktc::solver::*;
+use iktc_core::solver::*;
 use nalgebra::DVector;
 
 const TABLE1: [usize; 5] = [12, 2, 3, 1, 20];
@@ -140,10 +140,10 @@ fn levels_with_no_coordinate_left_change_nothing() {
 /// G Δh, and that the report's corrections are Δh, level by level.
 #[allow(clippy::too_many_arguments)]
 fn assert_the_least_correction(
-    levels: &[iktc::task::TaskEquation],
+    levels: &[iktc_core::task::TaskEquation],
     dims: &[usize],
     settings: &SolverSettings,
-    bx: &iktc::limits::AccelerationBox,
+    bx: &iktc_core::limits::AccelerationBox,
     q: &DVector<f64>,
     rep: &SolveReport,
     from: usize,
@@ -373,7 +373,7 @@ fn bad_input_is_an_error() {
     let mut q = DVector::zeros(5);
     assert!(matches!(
         s.solve(Method::Iktc, &levels, &wide_box(4), &mut q),
-        Err(iktc::Error::DimensionMismatch { .. })
+        Err(iktc_core::Error::DimensionMismatch { .. })
     ));
     assert!(s
         .solve(Method::Iktc, &levels[..1], &wide_box(5), &mut q)
@@ -381,7 +381,7 @@ fn bad_input_is_an_error() {
     levels[1].jacobian[(0, 0)] = f64::NAN;
     assert!(matches!(
         s.solve(Method::Iktc, &levels, &wide_box(5), &mut q),
-        Err(iktc::Error::NonFinite { .. })
+        Err(iktc_core::Error::NonFinite { .. })
     ));
     let bad = SolverSettings {
         rank_threshold: -1.0,
