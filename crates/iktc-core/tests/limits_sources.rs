@@ -128,7 +128,8 @@ fn viable_position_bound_beyond_the_limit_does_not_let_the_excursion_grow() {
     // q = 1.1 > q_max, q̇ = 1: range widened to q, end-of-step fallback −2q̇/Δt = −20.
     let bound = viable::position_upper(1.1, 1.0, 1.0, 0.1);
     assert_relative_eq!(bound, -20.0, epsilon = 1e-9);
-    let (q_next, qd_next) = iktc_core::limits::integrate_constant_acceleration(1.1, 1.0, bound, 0.1);
+    let (q_next, qd_next) =
+        iktc_core::limits::integrate_constant_acceleration(1.1, 1.0, bound, 0.1);
     assert_relative_eq!(q_next, 1.1, epsilon = 1e-12);
     assert_relative_eq!(qd_next, -1.0, epsilon = 1e-12);
     // Beyond the limit and moving back in: only "not further out".

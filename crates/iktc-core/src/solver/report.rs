@@ -33,7 +33,7 @@ impl Method {
 pub enum Fallback {
     /// No level of IKTC could bring q̈ into the box (rank loss, or Σm_i < n left no freedom):
     /// the prioritized solution was clamped to the box. Also: an IKTC or GF answer that still
-    /// left the box by more than [`INACCURATE_FACTOR`](super::qp::INACCURATE_FACTOR) × the box
+    /// left the box by more than 10³ × the box
     /// tolerance (a QP that lost its accuracy) was clamped into it.
     ClampedToBox,
     /// A level of the cascade had no feasible solution; the solution of the level above was

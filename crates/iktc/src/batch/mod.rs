@@ -29,7 +29,7 @@ pub use npz::{npz_bytes, read_npz, zip_stored, NpyArray, NpyData, MAX_NPZ_ELEMEN
 pub use pool::{longest_first, run_parallel, run_parallel_in, run_parallel_until};
 pub use quality::{
     run_penetration, sole_penetration, trajectory_penetration, ClipQuality, JointFigures,
-    KeypointFigures, Penetration, MARGIN_ROUNDING, PENETRATION_TOLERANCE,
+    KeypointFigures, Penetration,
 };
 pub use record::{
     clip_record, clip_state, is_done, remove_leftovers, write_clip_folder, ClipState,

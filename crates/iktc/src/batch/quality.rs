@@ -9,7 +9,7 @@
 //! frame) is at height `z = (T_foot · c)_z` in the world, the ground being `z = 0`. The depth of
 //! a frame is `max(0, −min z)` over the corners of both soles; the clip's penetration is the
 //! largest depth, and its share the fraction of frames whose depth exceeds
-//! [`PENETRATION_TOLERANCE`].
+//! 0.1 mm.
 
 use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion};
 use serde::Serialize;
@@ -22,14 +22,14 @@ use crate::sim::{ImitateRun, ImitateSummary};
 
 /// A sole corner deeper than this below the ground counts as penetrating in the share of frames
 /// \[m\] (0.1 mm: above the rounding of the kinematics, below anything visible).
-pub const PENETRATION_TOLERANCE: f64 = 1e-4;
+pub(crate) const PENETRATION_TOLERANCE: f64 = 1e-4;
 
 /// How deep the soles went below the ground over a clip.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Penetration {
     /// Deepest sole corner below the ground \[m\] (0 when none went below).
     pub depth: f64,
-    /// Share of the frames with a corner deeper than [`PENETRATION_TOLERANCE`] \[–\].
+    /// Share of the frames with a corner deeper than 0.1 mm \[–\].
     pub share: f64,
 }
 
@@ -107,7 +107,7 @@ pub fn run_penetration(robot: &Robot, run: &ImitateRun, feet: &[&Foot]) -> Resul
 
 /// A limit margin up to this counts as the limit kept \[rad, rad/s, rad/s²\]: the rounding of
 /// the margins' own arithmetic (the in-step peak of a joint resting on its limit).
-pub const MARGIN_ROUNDING: f64 = 1e-9;
+pub(crate) const MARGIN_ROUNDING: f64 = 1e-9;
 
 /// The penetration of `feet`'s soles over recorded configurations `qs` of `robot` (each of
 /// length `nq`), by the forward kinematics of each.
@@ -191,7 +191,7 @@ pub struct KeypointFigures {
     /// Control ticks recorded.
     pub ticks: usize,
     /// Every joint limit kept (position, velocity and acceleration margins at most
-    /// [`MARGIN_ROUNDING`]) and every neutral figure within its limit
+    /// 10⁻⁹) and every neutral figure within its limit
     /// ([`crate::retarget::FidelityLimits`]); `failures` says what failed.
     pub healthy: bool,
     /// What made the clip unhealthy, in words (empty if healthy).
@@ -261,7 +261,7 @@ pub struct KeypointFigures {
     pub foot_float_share: f64,
     /// Deepest sole corner below the ground \[m\] ([`sole_penetration`]).
     pub penetration: f64,
-    /// Share of the ticks with a sole corner deeper than [`PENETRATION_TOLERANCE`] \[–\].
+    /// Share of the ticks with a sole corner deeper than 0.1 mm \[–\].
     pub penetration_share: f64,
     /// Share of the ticks on which IKTC sacrificed the feet's, the COM's or the pelvis and
     /// torso's level (the first five of [`KEYPOINT_LEVELS`]) to keep the joint limits \[–\]:
@@ -277,7 +277,7 @@ pub struct KeypointFigures {
     pub most_on_limit_share: f64,
     /// The static reach where it was asked for ([`crate::retarget::KeypointSettings::reach`]): the least mean
     /// keypoint error of a posture within the joint ranges alone, over the ticks sampled
-    /// every [`crate::retarget::REACH_PERIOD`] \[m\] ([`RetargetQuality::reach_cm`]); `null` otherwise.
+    /// every 0.05 s ([`RetargetQuality::reach_cm`]); `null` otherwise.
     pub reach_keypoint_error: Option<f64>,
     /// The balanced reach beside the static reach: the least mean keypoint error of a posture
     /// that also keeps the clip's feet where the run has them and the COM over their soles
@@ -443,7 +443,7 @@ pub struct JointFigures {
     /// Deepest sole corner below the ground \[m\] ([`sole_penetration`]; 0 until
     /// [`JointFigures::with_penetration`]).
     pub penetration: f64,
-    /// Share of the ticks with a sole corner deeper than [`PENETRATION_TOLERANCE`] \[–\].
+    /// Share of the ticks with a sole corner deeper than 0.1 mm \[–\].
     pub penetration_share: f64,
 }
 

@@ -20,12 +20,12 @@ use crate::sim::ImitateRun;
 
 /// The output rate's tolerance on the last frame \[s·Hz\]: a frame at most this fraction of an
 /// output period past the last tick (rounding of `j / rate`) is still written.
-pub const LAST_FRAME_SLACK: f64 = 1e-9;
+pub(crate) const LAST_FRAME_SLACK: f64 = 1e-9;
 
 /// A frame time within this many control periods of a recorded tick is taken as that tick
 /// \[–\]: `j / rate` and `k Δt` differ by rounding where the output rate divides the control
 /// rate, and the tick is then copied exactly.
-pub const TICK_ROUNDING: f64 = 1e-9;
+pub(crate) const TICK_ROUNDING: f64 = 1e-9;
 
 /// One clip resampled for training.
 #[derive(Debug, Clone, PartialEq)]

@@ -30,7 +30,7 @@ use crate::error::{Error, Result};
 /// section's poles decay as `exp(−ω_c t / √2)` (`ω_c = 2π f_c`), by `e⁻¹³` over three periods:
 /// what is left of the start-up transient of a straight line (its lag, `√2 / ω_c` times its
 /// slope) is below 10⁻⁷ of a slope of 1 unit/s.
-pub const PAD_PERIODS: f64 = 3.0;
+pub(crate) const PAD_PERIODS: f64 = 3.0;
 
 /// The second-order Butterworth sections of [`lowpass`]: `(b₀, b₁, b₂, a₁, a₂)`.
 fn coefficients(cutoff: f64, period: f64) -> (f64, f64, f64, f64, f64) {

@@ -98,7 +98,7 @@ pub use load::{
     detect_format, find_asf, is_amass_archive, is_amass_file, load_motion, motion_from_content,
     scale_clip, strip_bom, Motion, MotionContent, MotionFormat, MotionOptions,
 };
-pub use lowpass::{check_smoothing, lowpass, lowpass_track, PAD_PERIODS};
+pub use lowpass::{check_smoothing, lowpass, lowpass_track};
 pub use markers::{FilledGap, MarkerSet, DEFAULT_MAX_GAP};
 pub use points_csv::read_points_csv;
 pub use recognise::{
@@ -109,7 +109,6 @@ pub use retarget::{retarget, shrunk_range, Retargeted, RobotReferences, Track};
 #[cfg(feature = "toml")]
 pub use retarget_map::{builtin_map, builtin_map_text, BUILTIN_MAP_NAMES};
 pub use retarget_map::{HoldJoint, JointMap, RetargetMap, RootMap, TargetJoint};
-pub use shape::MIN_LIMB_JOINTS;
 pub use skeleton::{JointKind, Skeleton, SkeletonJoint};
 pub use spline::CubicSpline;
 pub use units::{

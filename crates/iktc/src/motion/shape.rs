@@ -28,7 +28,7 @@ use super::body_point::{Limb, Side};
 use super::{BodyPoint, Skeleton};
 
 /// Fewest joints in a subtree for it to count as a limb or spine branch at the pelvis.
-pub const MIN_LIMB_JOINTS: usize = 3;
+pub(crate) const MIN_LIMB_JOINTS: usize = 3;
 
 /// Thigh length over standing height \[–\] (Drillis & Contini 1966).
 const THIGH: f64 = 0.245;

@@ -120,7 +120,7 @@ fn foot_guess(
 /// (`iktc retarget`, 2026-12-06), mean keypoint error over the clips, straight / 3 % / 8 %:
 /// Leju Kuavo S45 16.1 / 14.0 / 14.1 cm (its knees' ranges end at 0), HighTorque Hi 12.5 /
 /// 12.9 / 13.2 cm; the deepest sole 1.8 / 0.63 / 1.2 mm and 0.31 / 0.09 / 0.31 mm.
-pub const CROUCH: f64 = 0.03;
+pub(crate) const CROUCH: f64 = 0.03;
 
 /// The posture's solve starts with every leg joint this share of the way from 0 (clamped
 /// into its range) to the middle of its range \[–\]: a knee whose range is one-sided starts
@@ -304,7 +304,7 @@ const MIN_FOREARM: f64 = 0.05;
 
 /// An arm of at most this many movable joints from the torso ends at a forearm (three at the
 /// shoulder, one at the elbow), not a hand \[–\]: a frame is added at its far end.
-pub const FOREARM_JOINTS: usize = 4;
+pub(crate) const FOREARM_JOINTS: usize = 4;
 
 /// The far end of the forearm link `i` of `t`, in its frame \[m\], and where it came from:
 /// the point of its visual (else collision) geometry (with the links fixed to it) farthest

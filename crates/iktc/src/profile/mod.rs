@@ -93,15 +93,12 @@ mod walk;
 pub use build::{check_map_joints, MISSING};
 pub use glob::glob_match;
 pub use init::{
-    init_profile_toml, init_profile_toml_at, init_profile_toml_with, urdf_key, InitOptions, CROUCH,
-    FOREARM_JOINTS, GUESSED_VELOCITY,
+    init_profile_toml, init_profile_toml_at, init_profile_toml_with, urdf_key, InitOptions,
+    GUESSED_VELOCITY,
 };
 pub use load::{builtin_profile_text, BUILTIN_PROFILES};
 pub use schema::{
     AccelerationProfile, AddedFrame, BodyFrames, Feet, Foot, ImitateProfile, JerkProfile, LockRule,
     ProfileOrigin, PushProfile, RobotProfile, Sole, VelocityProfile, WalkProfile,
-    DEFAULT_ACCELERATION_PER_VELOCITY,
 };
-pub use shape::{MIDLINE, MIN_ARM_JOINTS, MIN_DROP, MIN_LEG_JOINTS};
-pub use sole::{LONG_SOLE, NARROW_SOLE, SOLE_BAND};
 pub use walk::DEFAULT_PUSH_VELOCITY_CHANGE;

@@ -194,7 +194,7 @@ impl VelocityProfile {
 
 /// The default acceleration limit as a multiple of the velocity limit \[1/s\] (the ratio of the
 /// paper's 3R arm, 180°/s and 1800°/s²), as in [`crate::model::ModelOptions`].
-pub const DEFAULT_ACCELERATION_PER_VELOCITY: f64 = 10.0;
+pub(crate) const DEFAULT_ACCELERATION_PER_VELOCITY: f64 = 10.0;
 
 fn default_per_velocity() -> f64 {
     DEFAULT_ACCELERATION_PER_VELOCITY

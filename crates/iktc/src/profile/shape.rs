@@ -20,17 +20,17 @@ use nalgebra::{Isometry3, Vector3};
 
 /// Feet lie at least this far below the base's origin at q = 0 \[m\]: a fixed-base arm's ends
 /// rise above its base.
-pub const MIN_DROP: f64 = 0.1;
+pub(crate) const MIN_DROP: f64 = 0.1;
 
 /// A leg has at least this many movable joints below the link where the two legs part \[–\].
-pub const MIN_LEG_JOINTS: usize = 3;
+pub(crate) const MIN_LEG_JOINTS: usize = 3;
 
 /// An arm's end lies farther than this from the base's x–z plane at q = 0 \[m\]; ends nearer
 /// to it (a head, a neck) are on the midline.
-pub const MIDLINE: f64 = 0.02;
+pub(crate) const MIDLINE: f64 = 0.02;
 
 /// An arm has at least this many movable joints between the torso and its hand link \[–\].
-pub const MIN_ARM_JOINTS: usize = 2;
+pub(crate) const MIN_ARM_JOINTS: usize = 2;
 
 /// The URDF tree laid out at q = 0: links breadth-first from the root.
 pub(super) struct Tree {

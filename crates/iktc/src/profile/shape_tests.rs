@@ -4,8 +4,9 @@
 use crate::model::RobotFiles;
 use nalgebra::Vector3;
 
-use super::{init_profile_toml, init_profile_toml_with, InitOptions, Sole, CROUCH};
+use super::{init_profile_toml, init_profile_toml_with, InitOptions, Sole};
 use crate::model::{BaseKind, Kinematics, ModelOptions, Robot, State};
+use crate::profile::init::CROUCH;
 
 /// A joint of the synthetic humanoid: parent, child, kind, origin `xyz` \[m\], axis.
 struct J<'a>(&'a str, &'a str, &'a str, [f64; 3], [f64; 3]);

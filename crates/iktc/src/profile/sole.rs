@@ -16,15 +16,15 @@ pub(super) type SoleGuess = (f64, f64, f64, f64);
 
 /// Points of the geometry up to this height above its lowest one make the sole \[m\]: the flat
 /// underside of a foot, not the toe's upward curve or the ankle's housing above it.
-pub const SOLE_BAND: f64 = 0.01;
+pub(crate) const SOLE_BAND: f64 = 0.01;
 
 /// A sole narrower than this is questioned in the written profile \[m\] (a foot's geometry
 /// that is a rod or a contact line rather than a sole).
-pub const NARROW_SOLE: f64 = 0.06;
+pub(crate) const NARROW_SOLE: f64 = 0.06;
 
 /// A sole longer than this is questioned in the written profile \[m\] (geometry that takes in
 /// more than the foot).
-pub const LONG_SOLE: f64 = 0.40;
+pub(crate) const LONG_SOLE: f64 = 0.40;
 
 /// Points taken around each rim of a cylinder \[–\].
 const RIM_POINTS: usize = 32;

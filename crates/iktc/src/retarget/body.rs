@@ -17,7 +17,7 @@ use crate::motion::{BodyPoint, Side};
 /// A head frame closer than this to the pelvis frame \[m\] is not taken for the head (some
 /// URDFs put a head link's origin at the waist and its geometry higher up). A human head is
 /// 0.5–0.7 m above the pelvis; a robot's scaled head several decimetres.
-pub const MIN_HEAD_HEIGHT: f64 = 0.1;
+pub(crate) const MIN_HEAD_HEIGHT: f64 = 0.1;
 
 /// The frames of the robot that stand for body points (see the module documentation).
 #[derive(Debug, Clone, PartialEq)]

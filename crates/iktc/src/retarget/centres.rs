@@ -10,7 +10,7 @@
 //!   ones (ankle, wrist) those after `m` nearer `e` than `oₘ`;
 //! * a group's centre is the point nearest all its joints' axes in the least-squares sense,
 //!   `x = argmin Σᵢ |(I − aᵢaᵢᵀ)(x − oᵢ)|² + ε|x − ō|²` (`aᵢ` the unit axes, `ō` the mean
-//!   origin, `ε` = [`AXIS_REGULARISATION`]), which is the axes' intersection where they meet
+//!   origin, `ε` = 10⁻³), which is the axes' intersection where they meet
 //!   and the mean origin of a lone joint's axis otherwise; a limb with no distal joint ends at
 //!   `e`.
 //!
@@ -30,7 +30,7 @@ use crate::motion::BodyPoint;
 /// (relative to one axis' weight 1): it fixes the point along parallel axes and leaves
 /// intersecting ones at their intersection to within about this fraction of the origins'
 /// spread.
-pub const AXIS_REGULARISATION: f64 = 1e-3;
+pub(crate) const AXIS_REGULARISATION: f64 = 1e-3;
 
 /// A point fixed in a link.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -244,7 +244,7 @@ fn limb(
 }
 
 /// The point nearest the lines through `origin` along `axis` in the least-squares sense, pulled
-/// toward the mean origin with weight [`AXIS_REGULARISATION`] (module documentation); a
+/// toward the mean origin with weight 10⁻³ (module documentation); a
 /// joint without an axis counts as a point.
 pub fn axes_point(
     lines: impl Iterator<Item = (Vector3<f64>, Option<Vector3<f64>>)>,

@@ -176,7 +176,7 @@ pub const PIVOT_TURN: f64 = 0.35;
 
 /// Window of the moving average of a pivoting foot's yaw \[s\]: the captured toe's direction
 /// jitters by a few degrees from frame to frame.
-pub const PIVOT_SMOOTHING: f64 = 0.1;
+pub(crate) const PIVOT_SMOOTHING: f64 = 0.1;
 
 /// Fastest a pivoting foot's reference turns \[rad/s\]: the captured turn is followed at this
 /// rate at most and caught up with when it slows. Turning a held foot as fast as a dancer
@@ -187,7 +187,7 @@ pub const PIVOT_SMOOTHING: f64 = 0.1;
 /// dragged 29 mm into the ground. Deepest sole over the shared clips that pivot (131_01,
 /// `scaled_131_02`, `humanoid3d_dance_a`, `humanoid3d_punch`; G1 and JVRC-1) at 2.5 / 3 /
 /// 3.5 / 4 / 4.5 / 5 / 6 rad/s: 29.4 / 0.075 / 0.053 / 0.070 / 0.067 / 0.111 / 0.13 mm.
-pub const PIVOT_RATE: f64 = 4.0;
+pub(crate) const PIVOT_RATE: f64 = 4.0;
 
 /// Holds a foot's yaw `track` \[rad\] in the stance runs of `contact` as [`hold`] does, except
 /// that a stance over which the track spans more than `min_turn` \[rad\] follows it (the foot

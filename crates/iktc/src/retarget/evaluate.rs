@@ -11,7 +11,7 @@
 //! * **Times** are the clip's: the person is read at each tick's time.
 //! * **Evaluation ticks** are `t_k = t_0 + k Δt` from the first frame's time `t_0` up to
 //!   the last frame, `Δt` the evaluation period (by default the control period of a
-//!   retargeting run). A trajectory whose frames are those ticks (within [`TICK_ROUNDING`]
+//!   retargeting run). A trajectory whose frames are those ticks (within 10⁻⁶ s
 //!   periods) is used as it is; any other is **resampled**: every joint and base coordinate
 //!   by a natural cubic spline through its frames ([`crate::motion::CubicSpline`], C²: q̈
 //!   continuous and linear between frames), the base quaternion component-wise after taking
@@ -38,14 +38,14 @@ use crate::profile::RobotProfile;
 /// A frame time within this many evaluation periods of a tick is that tick \[–\]: a file
 /// written at the evaluation rate differs from `t_0 + k Δt` by rounding only, and is then used
 /// without resampling.
-pub const TICK_ROUNDING: f64 = 1e-6;
+pub(crate) const TICK_ROUNDING: f64 = 1e-6;
 
 /// A base quaternion whose norm is within this of 1 is used as written, not normalised \[–\]
 /// (rounding of a unit quaternion written in full precision).
-pub const UNIT_ROUNDING: f64 = 1e-12;
+pub(crate) const UNIT_ROUNDING: f64 = 1e-12;
 
 /// Fewest frames of a trajectory \[–\]: q̈ needs three.
-pub const MIN_TRAJECTORY_FRAMES: usize = 3;
+pub(crate) const MIN_TRAJECTORY_FRAMES: usize = 3;
 
 /// Time column names, first preferred.
 const TIME_COLUMNS: [&str; 2] = ["time", "t"];
@@ -105,7 +105,7 @@ fn parse_error(source: &str, line: usize, message: String) -> Error {
 ///
 /// Errors: [`Error::Parse`] naming the line for a missing time column, a partial set of base
 /// columns, a repeated column, a row of another length, a number that does not parse or is not
-/// finite, fewer than [`MIN_TRAJECTORY_FRAMES`] frames or times that do not increase.
+/// finite, fewer than 3 frames or times that do not increase.
 pub fn read_trajectory_csv(text: &str, source: &str) -> Result<RobotTrajectory> {
     let mut lines = text
         .lines()

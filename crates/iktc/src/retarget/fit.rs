@@ -27,15 +27,15 @@
 //! moved by `δ` (the floating base by its body twist, [`State::integrate`]) and each joint put
 //! back into its range; a joint on a bound that the gradient pushes out of it keeps its place
 //! (its row and column leave the system), and so does a held base. A step is kept if it lowers the sum (μ ÷ 3), else
-//! μ × 4 and it is tried again; at most [`MAX_ITERATIONS`] steps per sample, until a step
-//! gains less than [`MIN_GAIN`]. Each sample starts at the previous one's result (the robot's
+//! μ × 4 and it is tried again; at most 30 steps per sample, until a step
+//! gains less than 10⁻⁸. Each sample starts at the previous one's result (the robot's
 //! start posture for the first). A step has no component in the null space of the
 //! directions' Jacobian (`H`, `g` lie in its row space), so the coordinates the directions do
 //! not fix (a hand's roll, the base's position) keep the start posture's values.
 //!
-//! At every `n`-th tick (`n = round(`[`FIT_PERIOD`]` / Δt)`) the directions come from the
+//! At every `n`-th tick (`n = round(0.02 s / Δt)`) the directions come from the
 //! scaled person's points the plan places relative to the hips (`Plan::neutral`). Each joint's samples are then
-//! low-passed at [`FIT_CUTOFF`] (zero phase, [`crate::motion::lowpass`]) and interpolated by a
+//! low-passed at 6 Hz (zero phase, [`crate::motion::lowpass`]) and interpolated by a
 //! natural cubic spline; the reference at tick `k` is the spline's value, rate and
 //! acceleration at `k Δt`, kept `margin` inside the joint's range (rate and acceleration 0
 //! where it is clamped).
@@ -49,19 +49,19 @@ use crate::model::{FrameId, Kinematics, Robot, State};
 use crate::motion::{lowpass_track, BodyPoint, CubicSpline};
 
 /// Period of the fit's samples \[s\]: 50 Hz, above twice [`FIT_CUTOFF`].
-pub const FIT_PERIOD: f64 = 0.02;
+pub(crate) const FIT_PERIOD: f64 = 0.02;
 
 /// Cut-off of the low-pass on each joint's fitted angles \[Hz\]: the person's limbs move
 /// below it; what is above is the fit's and the capture's noise, which the posture rows would
 /// pass on to the joints' jerk.
-pub const FIT_CUTOFF: f64 = 6.0;
+pub(crate) const FIT_CUTOFF: f64 = 6.0;
 
 /// Most Levenberg–Marquardt steps per sample.
-pub const MAX_ITERATIONS: usize = 30;
+pub(crate) const MAX_ITERATIONS: usize = 30;
 
 /// A sample's descent stops when a step lowers the sum of squared direction errors by less
 /// than this \[–\] (squared unit vectors: 1e-8 is a direction 1e-4 rad off on one segment).
-pub const MIN_GAIN: f64 = 1e-8;
+pub(crate) const MIN_GAIN: f64 = 1e-8;
 
 /// Initial and largest Levenberg–Marquardt damping μ \[1/rad²\] (the units of `JᵀJ`, J in
 /// 1/rad).

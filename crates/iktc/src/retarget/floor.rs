@@ -30,7 +30,7 @@ use crate::task::Gains;
 /// The floor joins the stack once it bounds the lowest corner's downward acceleration to less
 /// than this \[m/s²\] (see the module documentation): larger values engage it earlier (higher
 /// above the ground), smaller ones later, with harder braking.
-pub const FLOOR_ENGAGE: f64 = 2.0;
+pub(crate) const FLOOR_ENGAGE: f64 = 2.0;
 
 /// The corners of a sole in the foot frame \[m\]: `sole_offset_x ± l/2`, `± w/2`, `−ankle_height`.
 pub(crate) fn sole_corners(support: &crate::sim::imitate::SupportSettings) -> [Vector3<f64>; 4] {

@@ -49,23 +49,22 @@ mod scale;
 mod tracker;
 mod viewer;
 
-pub use body::{BodyFrameNames, RobotBody, MIN_HEAD_HEIGHT};
+pub use body::{BodyFrameNames, RobotBody};
 pub use centres::RobotJointCentres;
-pub use contacts::{PIVOT_RATE, PIVOT_SMOOTHING, PIVOT_TURN};
+pub use contacts::PIVOT_TURN;
 #[cfg(all(feature = "json", feature = "npz"))]
 pub use evaluate::{
     evaluate_trajectory, read_trajectory_csv, read_trajectory_npz, RobotTrajectory,
     TrajectoryEvaluation,
 };
 pub use fidelity::{Fidelity, FidelityLimits};
-pub use floor::FLOOR_ENGAGE;
 pub use quality::{
     JointOnLimit, OrientationError, PointError, QualityRecorder, RetargetQuality, FLOAT_HEIGHT,
     LIMIT_BAND,
 };
 pub use scale::Scaling;
-pub use tracker::{KeypointController, Sacrifices, KEYPOINT_LEVELS, LAND_TILT};
-pub use viewer::{keypoint_viewer, ON_LIMIT};
+pub use tracker::{KeypointController, Sacrifices, KEYPOINT_LEVELS};
+pub use viewer::keypoint_viewer;
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -87,10 +86,10 @@ use crate::task::Gains;
 /// keypoint stack uses every dof of the robot, its levels come close to singular (stretched
 /// legs and arms), and undamped inverses there ask for accelerations of 10⁶ rad/s² that IKTC
 /// must then correct away. Larger values track less exactly near singularities.
-pub const DEFAULT_DAMPING: f64 = 0.05;
+pub(crate) const DEFAULT_DAMPING: f64 = 0.05;
 
 /// Size of the singular region of the default damping \[unit of a singular value of J\].
-pub const DEFAULT_DAMPING_REGION: f64 = 0.1;
+pub(crate) const DEFAULT_DAMPING_REGION: f64 = 0.1;
 
 /// Which support polygon the COM reference is kept over.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -137,8 +136,8 @@ pub struct KeypointSettings {
     /// against the viable ones (by 15–46 % on seven robots from `profile init`), at a mean
     /// keypoint error of 11.29 against 11.11 cm on G1 and 12.09 against 12.33 cm on JVRC-1.
     pub bounds: BoundMethod,
-    /// Solver settings (default: adaptive damping, [`DEFAULT_DAMPING`] within
-    /// [`DEFAULT_DAMPING_REGION`] of a singularity).
+    /// Solver settings (default: adaptive damping, 0.05 within
+    /// 0.1 of a singularity).
     pub solver: SolverSettings,
     /// Longest time at rest on the first frame's references before the clip starts \[s\]
     /// (default 1.5 s, about 15 time constants of the default gains): the robot moves from its
@@ -184,7 +183,7 @@ pub struct KeypointSettings {
     pub land_height: f64,
     /// ... every corner of its sole slower than this \[m/s\] (default 0.06 m/s; the corners,
     /// not the ankle: a foot pivoting about a slow ankle turns its sole, and the held foot's
-    /// yaw then overshoots about the ankle), and its sole tilted less than [`LAND_TILT`]. A
+    /// yaw then overshoots about the ankle), and its sole tilted less than 0.03 rad. A
     /// held foot decelerates under the first level's gains: a foot
     /// landing at speed `v` slides about `v / (e ω)` (`ω` = 20 rad/s, the held feet's
     /// gains), about 1.1 mm at the default; faster landings slide more, slower ones land later
@@ -192,7 +191,7 @@ pub struct KeypointSettings {
     /// compensation: at 0.03 m/s slip at most 2.3 mm instead of 3.5 mm over the shared clips,
     /// but mean keypoint errors up to 5.3 cm larger).
     /// Until it lands the foot is brought down in the second level, above the ground
-    /// ([`FLOOR_ENGAGE`]).
+    /// (once the floor bounds its lowest corner's downward acceleration to less than 2 m/s²).
     pub land_speed: f64,
     /// Standing imitation (default false): the feet and the pelvis are held at the robot's
     /// start pose for the whole clip, the COM over the middle of the soles, and only the clip's
@@ -222,7 +221,7 @@ pub struct KeypointSettings {
     /// still compare the robot with the captured points.
     pub smoothing: Option<f64>,
     /// Weight of the posture rows in the `hands` level \[–\] (default
-    /// [`POSTURE_WEIGHT`]; 0 puts them in a level of their own, `posture`, below all tracking):
+    /// 0.1; 0 puts them in a level of their own, `posture`, below all tracking):
     /// a joint's acceleration 1 rad/s² off its posture reference costs as much there as a
     /// hand's `weight` m/s² off its reference. The levels above the posture level can take
     /// every coordinate (on G1 all 35), and each is then solved exactly in what the levels
@@ -234,13 +233,13 @@ pub struct KeypointSettings {
     /// level takes every coordinate, so the `elbows_head` level below it moves nothing).
     pub posture_weight: f64,
     /// Weight of the elbows' and head's positions and the swing feet's orientations in the
-    /// `hands` level \[–\] (default [`BODY_WEIGHT`];
+    /// `hands` level \[–\] (default 0;
     /// 0 puts them in a level of their own, `elbows_head`, where below the
     /// posture rows they have no coordinate left to move). A unit of their error costs
     /// `weight²` as much as a hand's.
     pub body_weight: f64,
     /// Share of the person's trunk lean given to the pelvis' reference \[–\] (default
-    /// [`PELVIS_LEAN`]): its frame's vertical axis is `(1 − a) ẑ + a t̂` made orthogonal to
+    /// 0): its frame's vertical axis is `(1 − a) ẑ + a t̂` made orthogonal to
     /// the hip axis, `t̂` the direction from the hips' middle to the shoulders'. 0 keeps the
     /// pelvis upright and leaves the lean to the waist's joints alone.
     pub pelvis_lean: f64,
@@ -283,14 +282,14 @@ pub struct KeypointSettings {
     /// feet slid 1.5 mm instead of 3.7 mm.
     pub hands: LimbScaling,
     /// Measure the static reach of the body points after the run (default off): per tick
-    /// sampled every [`REACH_PERIOD`], the least mean body point error of a posture within the
+    /// sampled every 0.05 s, the least mean body point error of a posture within the
     /// joint ranges alone, in [`RetargetQuality::reach_cm`] ([`mod@reach`]). It separates what the
     /// robot's body cannot do from what the retargeting gives up for its feet, balance and
     /// smoothness. Costs about as much again as the run (G1, `131_01`: 0.11 s for 1 656
     /// ticks).
     pub reach: bool,
     /// Smallest turn of a foot over one of the clip's stances for the foot to pivot there
-    /// \[rad\] (default `Some(`[`PIVOT_TURN`]`)`; see [`PIVOT_RATE`]): the foot's yaw then follows
+    /// \[rad\] (default `Some(`[`PIVOT_TURN`]`)`): the foot's yaw then follows
     /// the captured one about its sole's centre instead of being held at the stance's mean.
     /// `None` holds every stance's yaw (both feet planted, as `hold_feet` in Python asks).
     pub pivot_turn: Option<f64>,
@@ -320,13 +319,13 @@ pub const MAX_SLIDE: f64 = 0.05;
 /// G1's arms then do not come to rest (its fastest joint at 0.44 rad/s on
 /// `humanoid3d_dance_b` between 2 s and 6 s, against 1e-11 rad/s), and 0.5 loses on the feet
 /// (G1's slip over the person's contacts, mean over clips, 63 → 78 mm).
-pub const BODY_WEIGHT: f64 = 0.0;
+pub(crate) const BODY_WEIGHT: f64 = 0.0;
 
 /// Default [`KeypointSettings::pelvis_lean`] \[–\]: 0, the pelvis upright. On the
 /// development set 1 takes the trunk lean's gap to the person's from 6.8° to 4.3° on G1 and
 /// its mean keypoint error from 11.3 to 10.8 cm, but puts a sole 5.3 mm below the floor
 /// (1.7 mm upright) and widens JVRC-1's knee gap (29° → 33°).
-pub const PELVIS_LEAN: f64 = 0.0;
+pub(crate) const PELVIS_LEAN: f64 = 0.0;
 
 /// Default [`KeypointSettings::max_leg_extension`] \[–\]: 0.95, a knee bent at least 36°
 /// (equal thigh and shank, `2 acos 0.95`) under a foot right below its hip. Straighter legs
@@ -343,7 +342,7 @@ pub const PELVIS_LEAN: f64 = 0.0;
 pub const MAX_LEG_EXTENSION: f64 = 0.95;
 
 /// Sample period of the static reach ([`KeypointSettings::reach`]) \[s\].
-pub const REACH_PERIOD: f64 = 0.05;
+pub(crate) const REACH_PERIOD: f64 = 0.05;
 
 /// Default [`KeypointSettings::posture_weight`] \[–\]: 0.1 rad/s² of a joint against 1 m/s² of
 /// a hand. Against the same rows weighted 0.3 in the level below (`elbows_head`, before
@@ -357,7 +356,7 @@ pub const REACH_PERIOD: f64 = 0.05;
 /// 8.0 and 9.0 cm. In MuJoCo's standing imitation (`mujoco_g1.py standing --plan upper-body`)
 /// 0.3 keeps the plan's ZMP inside the soles on every tick, 0.1 lets it out by up to 18 mm on
 /// 3 of 508 (G1 stays up, the measured ZMP at least 44 mm inside).
-pub const POSTURE_WEIGHT: f64 = 0.1;
+pub(crate) const POSTURE_WEIGHT: f64 = 0.1;
 
 impl Default for KeypointSettings {
     fn default() -> Self {
@@ -547,10 +546,10 @@ pub struct KeypointRun {
 
 /// Fewest frames of a clip the keypoint route retargets \[frames\]: two, one interval to
 /// follow (as `iktc retarget` asks of every clip).
-pub const MIN_FRAMES: usize = 2;
+pub(crate) const MIN_FRAMES: usize = 2;
 
 /// Default [`KeypointSettings::settle_speed`] \[rad/s or m/s\].
-pub const SETTLE_SPEED: f64 = 0.01;
+pub(crate) const SETTLE_SPEED: f64 = 0.01;
 
 /// Runs the settling of `controller` on the first frame's references: `settle_time / dt`
 /// ticks, or fewer once every velocity coordinate is below `settle_speed` and every

@@ -134,7 +134,7 @@ pub struct RetargetQuality {
     pub on_limit: Vec<JointOnLimit>,
     /// The static reach, where asked for ([`super::KeypointSettings::reach`]): the least mean
     /// body point error found per tick by a posture within the joint ranges alone, averaged
-    /// over the ticks sampled every [`super::REACH_PERIOD`] \[cm\] ([`super::reach`]). The robot's
+    /// over the ticks sampled every 0.05 s \[cm\] ([`super::reach`]). The robot's
     /// body cannot do better than about this; the rest of [`RetargetQuality::mean_cm`] is what
     /// the retargeting gives up for its feet, balance and smoothness.
     pub reach_cm: Option<f64>,

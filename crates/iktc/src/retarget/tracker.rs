@@ -294,7 +294,7 @@ const LANDING_AXES: Axes = Axes([true, true, false, false, false, true]);
 /// 1.7°): the first level holds it flat, about the sole's centre where it landed (flattened
 /// about the ankle, its sole's centre would slide by `ankle_height · sin θ`: 3 mm on JVRC-1
 /// at this angle).
-pub const LAND_TILT: f64 = 0.03;
+pub(crate) const LAND_TILT: f64 = 0.03;
 
 /// Gains of the held feet's level (k_p \[1/s²\], k_v \[1/s\]; critically damped, ω = 20 rad/s),
 /// stiffer than the other tasks': the held foot's level is solved exactly, yet the foot

@@ -17,7 +17,7 @@ use super::KeypointRun;
 /// A joint closer than this to an end of its position range counts as on the limit in the
 /// viewer \[rad\] or \[m\] (far above the rounding of the integration, far below a visible
 /// distance).
-pub const ON_LIMIT: f64 = 1e-6;
+pub(crate) const ON_LIMIT: f64 = 1e-6;
 
 /// The body-point segments drawn for the captured person (those whose two ends exist).
 const SEGMENTS: [(BodyPoint, BodyPoint); 17] = {
@@ -44,7 +44,7 @@ const SEGMENTS: [(BodyPoint, BodyPoint); 17] = {
 };
 
 /// The viewer data of `run` (a keypoint retargeting of `kp` onto `robot` at the control period
-/// `dt` \[s\]), decimated to [`FRAME_PERIOD`](crate::sim::viewer::FRAME_PERIOD).
+/// `dt` \[s\]), decimated to 0.02 s.
 ///
 /// # Errors
 /// The kinematics' errors for a configuration of the wrong size or with a non-finite entry.

@@ -37,7 +37,7 @@ pub use switches::LevelSwitches;
 #[cfg(all(feature = "urdf", feature = "json", feature = "toml"))]
 pub use walk_imitate::{
     run_walk_imitate, Push, PushAxisMetrics, WalkImitateConfig, WalkPushSummary, WalkRun, WalkStep,
-    WalkSummary, WalkTick, WalkingController, ZMP_CORRECTION_MARGIN,
+    WalkSummary, WalkTick, WalkingController,
 };
 #[cfg(all(feature = "urdf", feature = "json", feature = "toml"))]
 pub use walk_plants::WalkPlants;

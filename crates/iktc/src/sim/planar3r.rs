@@ -162,13 +162,13 @@ pub struct Planar3rSummary {
     pub tick_median_us: f64,
     /// Smoothness of the commanded q̈ of q1, q2, q3 over the whole run.
     pub smoothness: Vec<JointSmoothness>,
-    /// The same from [`SETTLED_FROM`] on, once q1 rests on its limit.
+    /// The same from 0.7 s on, once q1 rests on its limit.
     pub smoothness_settled: Vec<JointSmoothness>,
 }
 
 /// Start of the window of [`Planar3rSummary::smoothness_settled`] \[s\]: q1 reaches its 60°
 /// limit at about 0.5 s (P_x ≈ 1.48 m); from 0.7 s on it should rest there.
-pub const SETTLED_FROM: f64 = 0.7;
+pub(crate) const SETTLED_FROM: f64 = 0.7;
 
 /// A whole run.
 #[derive(Debug, Clone, Serialize)]

@@ -10,7 +10,7 @@
 //! and a command that alternates tick by tick (a square wave at half the control rate) shows up
 //! as a change whose sign reverses at every tick: tick k is a *reversal* when
 //! `(q̈ₖ − q̈ₖ₋₁)(q̈ₖ₋₁ − q̈ₖ₋₂) < 0`, both changes larger than
-//! [`REVERSAL_CHANGE_TOLERANCE`] in magnitude (changes of rounding size are not a motion). Per
+//! 10⁻⁶ in magnitude (changes of rounding size are not a motion). Per
 //! joint this module gives the RMS and largest |jₖ|, the share of the N−2 ticks that are
 //! reversals, and the standard deviation of q̈ itself (a joint at rest on a limit should have
 //! none).
@@ -22,7 +22,7 @@ use serde::Serialize;
 /// accelerations of order 10 rad/s²; 1e-6 rad/s² stays far above it and far below any change a
 /// drive could feel (it moves a joint by 1e-11 rad in a 5 ms tick). Larger values hide small
 /// oscillations; smaller ones count rounding as chatter.
-pub const REVERSAL_CHANGE_TOLERANCE: f64 = 1e-6;
+pub(crate) const REVERSAL_CHANGE_TOLERANCE: f64 = 1e-6;
 
 /// Smoothness of one dof's commanded acceleration over a run (or a window of it).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]

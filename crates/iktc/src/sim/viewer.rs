@@ -17,7 +17,7 @@ use crate::walk::{sole_corners, Phase, Pose2, Side};
 pub const SKELETON_OFFSET: f64 = 1.2;
 
 /// Time between two viewer frames \[s\] (the run's ticks are decimated to it).
-pub const FRAME_PERIOD: f64 = 0.02;
+pub(crate) const FRAME_PERIOD: f64 = 0.02;
 
 /// A stick figure: segments between points, and the points of every frame.
 #[derive(Debug, Clone, Serialize)]

@@ -14,7 +14,7 @@ use crate::mesh::{base64, pack, MeshSet};
 use crate::model::Robot;
 
 /// Scale of a quaternion component in its 16-bit integer (1 ↦ 32767).
-pub const QUAT_SCALE: f32 = 32767.0;
+pub(crate) const QUAT_SCALE: f32 = 32767.0;
 
 /// The meshes and link orientations of a viewer page.
 #[derive(Debug, Clone, Serialize)]

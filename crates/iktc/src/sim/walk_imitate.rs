@@ -51,7 +51,7 @@ use crate::walk::{
 /// How far inside the support polygon the ZMP correction brings the plan's ZMP \[m\]
 /// ([`WalkingController::correct_zmp`]): a quarter of G1's 5 cm sole width, above the
 /// measured ZMP's lag of a few millimetres behind the plan's in MuJoCo.
-pub const ZMP_CORRECTION_MARGIN: f64 = 0.005;
+pub(crate) const ZMP_CORRECTION_MARGIN: f64 = 0.005;
 
 /// A push on the COM during the walk.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -503,7 +503,7 @@ impl WalkingController {
     /// where the plan is infeasible. A copy of this controller runs the whole walk without the
     /// damping controller; the ZMP of its links' motion `p_mb` ([`multibody_zmp`]) is taken,
     /// tick by tick, against the pattern's support polygon: where it is less than
-    /// [`ZMP_CORRECTION_MARGIN`] inside (or outside), `Δp` is the shortest move along the
+    /// 5 mm inside (or outside), `Δp` is the shortest move along the
     /// segment to the pattern's ZMP reference `p_target` that brings it that far inside,
     /// elsewhere 0. The COM that the preview controller makes the cart-table follow for `Δp`
     /// is added to the COM reference (with its rate and acceleration): moving the cart-table's

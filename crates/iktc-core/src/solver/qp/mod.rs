@@ -117,4 +117,5 @@ mod workspace;
 pub use problem::{Hessian, QpProblem};
 pub use report::{ActiveConstraint, QpConstraint, QpReport, QpStatus};
 pub use settings::QpSettings;
-pub use workspace::{QpWorkspace, INACCURATE_FACTOR};
+pub use workspace::QpWorkspace;
+pub(crate) use workspace::INACCURATE_FACTOR;

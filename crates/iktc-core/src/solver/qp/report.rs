@@ -40,7 +40,7 @@ pub enum QpStatus {
     /// constraints, which may violate others.
     MaxIterations,
     /// Nothing was left to add, but the last iterate violates a row by `max_violation`, more
-    /// than [`INACCURATE_FACTOR`](super::INACCURATE_FACTOR) times the feasibility tolerance:
+    /// than 10³ times the feasibility tolerance:
     /// near-dependent constraint normals made the iterate grow until rounding dominates the
     /// active rows (seen with rank-deficient task levels, ‖x‖ ≈ 1e18). Not a solution; callers
     /// treat it as a failed solve.

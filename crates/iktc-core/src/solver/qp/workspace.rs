@@ -16,7 +16,7 @@ use crate::{Error, Result};
 /// far below the tolerance for a sane iterate, and hundreds of units for the blown-up iterates
 /// (‖x‖ ≈ 1e18) of near-dependent normals. Large enough never to reject a sane solve, small
 /// enough to catch every blow-up seen.
-pub const INACCURATE_FACTOR: f64 = 1e3;
+pub(crate) const INACCURATE_FACTOR: f64 = 1e3;
 
 /// A constraint row as the solver sees it (before choosing a side).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
