@@ -261,11 +261,11 @@ impl PyImitation {
             }
         });
         self.ctl.set_com_override(com);
-        let (ctl, robot, k) = (&mut self.ctl, &self.robot, self.k);
+        let (ctl, k) = (&mut self.ctl, self.k);
         let report = py
             .detach(|| -> iktc::Result<PySolveReport> {
-                let report = PySolveReport::from(ctl.tick(robot, k)?);
-                ctl.integrate(robot)?;
+                let report = PySolveReport::from(ctl.tick(k)?);
+                ctl.integrate()?;
                 Ok(report)
             })
             .map_err(to_py)?;

@@ -40,7 +40,6 @@ type PatternZmp = (Vector2<f64>, f64);
 #[pyclass(name = "Walking", module = "iktc")]
 pub struct PyWalking {
     ctl: WalkingController,
-    robot: std::sync::Arc<iktc::model::Robot>,
     k: usize,
     dt: f64,
     polygon: SupportPolygon,
@@ -120,7 +119,6 @@ impl PyWalking {
         ctl.set_offset_feedforward(offset_feedforward);
         Ok(Self {
             ctl,
-            robot: robot.robot.clone(),
             k: 0,
             dt: cfg.imitate.dt,
             polygon: SupportPolygon::default(),
@@ -159,13 +157,13 @@ impl PyWalking {
             }
             _ => [0.0, 0.0],
         };
-        let (ctl, robot, k) = (&mut self.ctl, &self.robot, self.k);
+        let (ctl, k) = (&mut self.ctl, self.k);
         let out = py
             .detach(
                 || -> iktc::Result<(PySolveReport, &'static str, PatternZmp)> {
-                    let wt = ctl.tick(robot, k, dev)?;
+                    let wt = ctl.tick(k, dev)?;
                     let report = PySolveReport::from(ctl.imitation().report());
-                    ctl.integrate(robot)?;
+                    ctl.integrate()?;
                     let phase = match wt.phase {
                         iktc::balance::SupportPhase::Double => "double",
                         iktc::balance::SupportPhase::Single => "single",

@@ -55,8 +55,8 @@ fn bench(c: &mut Criterion) {
                         k = 0;
                     }
                     let start = Instant::now();
-                    let _ = std::hint::black_box(ctl.tick(&robot, k).map(|r| r.qp_solves));
-                    let _ = ctl.integrate(&robot);
+                    let _ = std::hint::black_box(ctl.tick(k).map(|r| r.qp_solves));
+                    let _ = ctl.integrate();
                     total += start.elapsed();
                     k += 1;
                 }
@@ -69,8 +69,8 @@ fn bench(c: &mut Criterion) {
             let mut ctl = initial.clone();
             for k in 0..n {
                 let start = Instant::now();
-                let _ = std::hint::black_box(ctl.tick(&robot, k).map(|r| r.qp_solves));
-                let _ = ctl.integrate(&robot);
+                let _ = std::hint::black_box(ctl.tick(k).map(|r| r.qp_solves));
+                let _ = ctl.integrate();
                 ticks.push(start.elapsed().as_secs_f64() * 1e6);
             }
         }
@@ -99,8 +99,8 @@ fn bench_walk(c: &mut Criterion) {
      -> Duration {
         let dev = plants.measure();
         let start = Instant::now();
-        let wt = std::hint::black_box(wc.tick(&robot, k, dev)).expect("tick");
-        wc.integrate(&robot).expect("integrate");
+        let wt = std::hint::black_box(wc.tick(k, dev)).expect("tick");
+        wc.integrate().expect("integrate");
         let el = start.elapsed();
         ticks.push(el.as_secs_f64() * 1e6);
         plants.step(k, wc, &wt).expect("plant step");

@@ -51,8 +51,8 @@ fn bench(c: &mut Criterion) {
         let _ = ctl.integrate();
     };
     let imitation_tick = |ctl: &mut ImitationController, k: usize| {
-        let _ = std::hint::black_box(ctl.tick(&robot, k).map(|r| r.qp_solves));
-        let _ = ctl.integrate(&robot);
+        let _ = std::hint::black_box(ctl.tick(k).map(|r| r.qp_solves));
+        let _ = ctl.integrate();
     };
     group.bench_function("keypoints_g1", |b| {
         b.iter_custom(|iters| {

@@ -23,11 +23,11 @@ fn record() -> Vec<(Vec<TaskEquation>, AccelerationBox)> {
     let mut out = Vec::with_capacity(wc.ticks());
     for k in 0..wc.ticks() {
         let dev = plants.measure();
-        let wt = wc.tick(&robot, k, dev).expect("tick");
+        let wt = wc.tick(k, dev).expect("tick");
         let im = wc.imitation();
         out.push((im.equations().to_vec(), im.acceleration_box().clone()));
         plants.step(k, &wc, &wt).expect("plant step");
-        wc.integrate(&robot).expect("integrate");
+        wc.integrate().expect("integrate");
     }
     out
 }

@@ -38,8 +38,8 @@ fn the_humanoid_tick_allocates_nothing() {
         let mut qps = 0;
         let before = allocations();
         for k in 0..refs.len() {
-            qps += ctl.tick(&robot, k).unwrap().qp_solves;
-            ctl.integrate(&robot).unwrap();
+            qps += ctl.tick(k).unwrap().qp_solves;
+            ctl.integrate().unwrap();
         }
         let after = allocations();
         // The run must have exercised the QPs, not only the unconstrained solution.
@@ -69,11 +69,11 @@ fn the_walking_tick_allocates_nothing() {
             1e-3 * (0.01 * k as f64).sin(),
             -1e-3 * (0.013 * k as f64).cos(),
         ];
-        let t = wc.tick(&robot, k, zmp).unwrap();
+        let t = wc.tick(k, zmp).unwrap();
         if t.phase == iktc::balance::SupportPhase::Single {
             single += 1;
         }
-        wc.integrate(&robot).unwrap();
+        wc.integrate().unwrap();
     }
     let after = allocations();
     assert!(
@@ -99,14 +99,14 @@ fn a_cloned_controller_allocates_nothing_and_matches_the_original() {
     let (mut screened, mut qps) = (0, 0);
     let before = allocations();
     for k in 0..refs.len() {
-        let a = original.tick(&robot, k).unwrap().clone_counts();
-        let b = clone.tick(&robot, k).unwrap().clone_counts();
+        let a = original.tick(k).unwrap().clone_counts();
+        let b = clone.tick(k).unwrap().clone_counts();
         assert_eq!(a, b, "tick {k}: the clone solved differently");
         assert_eq!(original.qdd(), clone.qdd(), "tick {k}");
         screened += b.1;
         qps += b.0;
-        original.integrate(&robot).unwrap();
-        clone.integrate(&robot).unwrap();
+        original.integrate().unwrap();
+        clone.integrate().unwrap();
     }
     let after = allocations();
     assert!(qps > 100, "{qps} QPs");

@@ -43,7 +43,7 @@ fn a_command_after_a_large_correction_is_inside_the_box_exactly() {
     let mut largest_before = 0.0_f64;
     for k in 0..wc.ticks() {
         let zmp = plants.measure();
-        let wt = wc.tick(&robot, k, zmp).unwrap();
+        let wt = wc.tick(k, zmp).unwrap();
         let ic = wc.imitation();
         let r = ic.report();
         largest_before = largest_before.max(r.violation_before);
@@ -66,7 +66,7 @@ fn a_command_after_a_large_correction_is_inside_the_box_exactly() {
                 "tick {k} dof {d}: {a}"
             );
         }
-        wc.integrate(&robot).unwrap();
+        wc.integrate().unwrap();
         plants.step(k, &wc, &wt).unwrap();
     }
     assert!(

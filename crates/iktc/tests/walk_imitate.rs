@@ -119,15 +119,15 @@ fn without_the_offset_feedforward_the_com_follows_the_damping_offset_more_slowly
     // A constant measured ZMP deviation of 1 cm forward: the same offsets, followed within a
     // tick with the feedforward, through the COM task's second-order response without.
     for k in 0..40 {
-        let a = on.tick(&robot, k, [0.01, 0.0]).unwrap();
-        let b = off.tick(&robot, k, [0.01, 0.0]).unwrap();
+        let a = on.tick(k, [0.01, 0.0]).unwrap();
+        let b = off.tick(k, [0.01, 0.0]).unwrap();
         assert_eq!(a.com_offset, b.com_offset);
         let com = |c: &WalkingController| c.imitation().kinematics().com();
         let (ca, cb) = (com(&on), com(&off));
         lag_on = lag_on.max((ca.xy() - a.com_reference).norm());
         lag_off = lag_off.max((cb.xy() - b.com_reference).norm());
-        on.integrate(&robot).unwrap();
-        off.integrate(&robot).unwrap();
+        on.integrate().unwrap();
+        off.integrate().unwrap();
     }
     assert!(lag_on < lag_off, "{lag_on} vs {lag_off}");
 }

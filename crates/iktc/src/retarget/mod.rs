@@ -1049,7 +1049,7 @@ pub fn joint_route_quality(
     let (mut times, mut trajectory, mut accelerations) = (Vec::new(), Vec::new(), Vec::new());
     for k in 0..plan.ticks.min(refs.len()) {
         let state = ctl.state().clone();
-        let corrected = shaped_by_box(ctl.tick(robot, k)?);
+        let corrected = shaped_by_box(ctl.tick(k)?);
         times.push(t0 + k as f64 * s.dt);
         trajectory.push(state.q.as_slice().to_vec());
         accelerations.push(ctl.qdd().as_slice().to_vec());
@@ -1064,7 +1064,7 @@ pub fn joint_route_quality(
             &state,
             ctl.qdd().as_slice(),
         )?;
-        ctl.integrate(robot)?;
+        ctl.integrate()?;
     }
     let mut quality = rec.finish(robot);
     quality.fidelity = Some(measure_fidelity(

@@ -462,8 +462,7 @@ impl ImitationController {
     /// task linearisation, acceleration box, solve; q̈ is then available in
     /// [`ImitationController::qdd`] and not yet applied (see [`ImitationController::integrate`]).
     /// Allocates nothing.
-    pub fn tick(&mut self, robot: &Robot, k: usize) -> Result<&SolveReport> {
-        self.check_robot(robot)?;
+    pub fn tick(&mut self, k: usize) -> Result<&SolveReport> {
         let k = k.min(self.refs.len().saturating_sub(1));
         self.tick = k;
         let r = &self.refs;
@@ -533,20 +532,9 @@ impl ImitationController {
 
     /// Applies the last q̈ over Δt (constant acceleration).
     ///
-    /// Errors: no tick solved since the last integration, or another robot.
-    pub fn integrate(&mut self, robot: &Robot) -> Result<()> {
-        self.check_robot(robot)?;
+    /// Errors: no tick solved since the last integration.
+    pub fn integrate(&mut self) -> Result<()> {
         self.ctl.integrate(&mut self.state)
-    }
-
-    /// The controller owns a copy of the robot it was built for; `robot` must have its sizes.
-    fn check_robot(&self, robot: &Robot) -> Result<()> {
-        let own = self.ctl.robot();
-        if robot.nv() != own.nv() || robot.nq() != own.nq() {
-            check_dim("velocity dofs of the robot", own.nv(), robot.nv())?;
-            check_dim("position coordinates of the robot", own.nq(), robot.nq())?;
-        }
-        Ok(())
     }
 
     /// The controller (stack, equations, box, solver) with the tasks of Table 1.

@@ -495,7 +495,7 @@ impl WalkingController {
             com_correction: Vec::new(),
             zmp_corrections: Vec::new(),
         };
-        wc.correct_zmp_passes(robot, cfg.zmp_passes)?;
+        wc.correct_zmp_passes(cfg.zmp_passes)?;
         Ok(wc)
     }
 
@@ -513,7 +513,7 @@ impl WalkingController {
     /// offset, `b − (z_c/g) b̈`. A plan already inside by the margin is left as it is. Returns
     /// the largest `|Δp|` \[m\] of this pass (also in
     /// [`WalkingController::zmp_corrections`]). Allocates (once per pass, not per tick).
-    pub fn correct_zmp(&mut self, robot: &Robot) -> Result<f64> {
+    pub fn correct_zmp(&mut self) -> Result<f64> {
         let n = self.ticks();
         let mut sim = self.clone();
         sim.damping = false;
@@ -524,16 +524,22 @@ impl WalkingController {
             self.pattern.controller().settings().gravity,
         );
         for k in 0..n {
-            let wt = sim.tick(robot, k, [0.0, 0.0])?;
+            let wt = sim.tick(k, [0.0, 0.0])?;
             poses.push(sim.ctl.kinematics().link_poses().to_vec());
             let t = k as f64 * self.dt;
             let (s, _, sdd) = smoothstep(0.0, self.com_blend_time, t);
             let blend = self.blend0 * (1.0 - s) + self.blend0 * (zc / g) * sdd;
             let m = wt.sample.zmp_model;
             target.push([m.0 + self.origin.x + blend.x, m.1 + self.origin.y + blend.y]);
-            sim.integrate(robot)?;
+            sim.integrate()?;
         }
-        let zmp = multibody_zmp(&link_masses(robot), &poses, self.dt, self.ground, g)?;
+        let zmp = multibody_zmp(
+            &link_masses(self.ctl.controller().robot()),
+            &poses,
+            self.dt,
+            self.ground,
+            g,
+        )?;
         let mut polygon = SupportPolygon::default();
         let mut dx = vec![0.0; n];
         let mut dy = vec![0.0; n];
@@ -578,12 +584,12 @@ impl WalkingController {
     /// `|Δp|` went 0.446, 0.339, then 0.470 m: the second pass's correction was undone and
     /// the passes ended there. The kept correction is the
     /// one whose plan had the smallest `|Δp|` measured. Returns the passes run.
-    pub fn correct_zmp_passes(&mut self, robot: &Robot, passes: usize) -> Result<usize> {
+    pub fn correct_zmp_passes(&mut self, passes: usize) -> Result<usize> {
         // (|Δp| of the plan before a pass, the COM correction before that pass).
         let mut last: Option<(f64, Vec<[[f64; 3]; 2]>)> = None;
         for pass in 0..passes {
             let before = self.com_correction.clone();
-            let measured = self.correct_zmp(robot);
+            let measured = self.correct_zmp();
             if let Some((previous, undo)) = last.take() {
                 // A plan whose simulation fails (q̈ not finite) is worse too.
                 if measured.as_ref().map_or(true, |r| *r >= previous) {
@@ -658,7 +664,7 @@ impl WalkingController {
     /// frame of Figure 11) \[m\]: pattern sample, damping controller, COM and feet references,
     /// IK solve. q̈ is then in the imitation controller, applied by
     /// [`WalkingController::integrate`]. Allocates nothing.
-    pub fn tick(&mut self, robot: &Robot, k: usize, zmp: [f64; 2]) -> Result<WalkTick> {
+    pub fn tick(&mut self, k: usize, zmp: [f64; 2]) -> Result<WalkTick> {
         let dt = self.dt;
         let t = k as f64 * dt;
         let s = self.pattern.sample(t)?;
@@ -716,7 +722,7 @@ impl WalkingController {
         for (h, r) in self.feet.iter().zip(&self.feet_refs) {
             self.ctl.controller_mut().set_frame_reference(*h, *r)?;
         }
-        let rep = self.ctl.tick(robot, k)?;
+        let rep = self.ctl.tick(k)?;
         Ok(WalkTick {
             sample: s,
             phase,
@@ -730,8 +736,8 @@ impl WalkingController {
     }
 
     /// Applies the last q̈ over Δt.
-    pub fn integrate(&mut self, robot: &Robot) -> Result<()> {
-        self.ctl.integrate(robot)
+    pub fn integrate(&mut self) -> Result<()> {
+        self.ctl.integrate()
     }
 }
 
@@ -768,7 +774,7 @@ pub fn run_walk_imitate(
         // Measured ZMP deviation of the simulated robot, local frame.
         let dev = plants.measure();
         let start = Instant::now();
-        let wt = wc.tick(robot, k, dev)?;
+        let wt = wc.tick(k, dev)?;
         let tick_us = start.elapsed().as_secs_f64() * 1e6;
         let s = wt.sample;
         let rot = Rotation2::new(wt.local_yaw);
@@ -865,7 +871,7 @@ pub fn run_walk_imitate(
             qd: state.qd.as_slice().to_vec(),
             qdd: ctl.qdd().as_slice().to_vec(),
         });
-        wc.integrate(robot)?;
+        wc.integrate()?;
     }
     let plan = wc.plan();
     let pattern = wc.pattern();

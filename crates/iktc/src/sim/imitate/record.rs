@@ -277,7 +277,7 @@ pub fn run_imitate(
     for k in 0..n {
         let t = k as f64 * cfg.dt;
         let start = Instant::now();
-        ctl.tick(robot, k).map_err(|e| {
+        ctl.tick(k).map_err(|e| {
             e.at(|| {
                 format!(
                     "imitation, tick {k} (t = {} s)",
@@ -399,7 +399,7 @@ pub fn run_imitate(
             fallback_kind: rep.fallback,
             tick_us,
         });
-        ctl.integrate(robot)?;
+        ctl.integrate()?;
     }
     let summary = summarize(
         robot,
