@@ -130,11 +130,11 @@ pub struct KeypointSettings {
     pub gains: Gains,
     /// Solver (IKTC by default).
     pub method: Method,
-    /// Joint bounds (default: quiet, as in the rest of the crate). On the development set
-    /// (`devset/`, ten clips of six rigs) the quiet bounds lower the share of the ticks whose
-    /// change of q̈ reverses from 0.244 to 0.203 on G1 and from 0.315 to 0.178 on JVRC-1
-    /// against the viable ones (by 15–46 % on seven robots from `profile init`), at a mean
-    /// keypoint error of 11.29 against 11.11 cm on G1 and 12.09 against 12.33 cm on JVRC-1.
+    /// Joint bounds (default [`BoundMethod::quiet`], as in the rest of the crate): the quiet
+    /// bounds reverse the joints' change of q̈ on fewer ticks than the viable ones
+    /// ([`BoundMethod::Viable`]). On the development set (`devset/`, ten clips of six rigs)
+    /// the default's share of such ticks is 0.203 on G1 and 0.178 on JVRC-1;
+    /// `book/src/retarget-defaults.md` has the viable bounds' figures.
     pub bounds: BoundMethod,
     /// Solver settings (default: adaptive damping, 0.05 within
     /// 0.1 of a singularity).
@@ -148,10 +148,11 @@ pub struct KeypointSettings {
     /// every velocity coordinate below this \[rad/s or m/s\] and every acceleration below this
     /// times the gains' `k_v` \[rad/s² or m/s²\] (with the default gains, |q̇| < 0.01 rad/s and
     /// |q̈| < 0.2 rad/s²: the tasks' errors are a few milliradians from their rest and decay
-    /// within a time constant). Default 0.01; 0 settles for the whole `settle_time`. On 57
-    /// clips (the shared ones and 51 Bandai Namco ones) on G1 the settling then ends after a
-    /// median of 0.89 s instead of 1.5 s; a clip whose first frame keeps moving the robot (a
-    /// swing foot at the floor's threshold) settles for the whole time.
+    /// within a time constant). Default 0.01; 0 settles for the whole `settle_time`. Larger
+    /// values end the settling sooner and leave more of its transient in the clip. On 57
+    /// clips (the shared ones and 51 Bandai Namco ones) on G1 the default ends the settling
+    /// after a median of 0.89 s; a clip whose first frame keeps moving the robot (a swing
+    /// foot at the floor's threshold) settles for the whole `settle_time`.
     pub settle_speed: f64,
     /// A foot (ankle or toe) within this height of the clip's lowest ankle (toe) height is low
     /// enough to be on the ground \[m\] (human scale, default 0.05 m). Larger values hold the
@@ -186,10 +187,9 @@ pub struct KeypointSettings {
     /// yaw then overshoots about the ankle), and its sole tilted less than 0.03 rad. A
     /// held foot decelerates under the first level's gains: a foot
     /// landing at speed `v` slides about `v / (e ω)` (`ω` = 20 rad/s, the held feet's
-    /// gains), about 1.1 mm at the default; faster landings slide more, slower ones land later
-    /// and hold the feet for less of the clip's stance (measured before the held feet's drift
-    /// compensation: at 0.03 m/s slip at most 2.3 mm instead of 3.5 mm over the shared clips,
-    /// but mean keypoint errors up to 5.3 cm larger).
+    /// gains), about 1.1 mm at the default; a larger value lands faster feet, which slide more,
+    /// a smaller one lands them later and holds the feet for less of the clip's stance, at a
+    /// larger keypoint error (`book/src/retarget-defaults.md` has 0.03 m/s measured).
     /// Until it lands the foot is brought down in the second level, above the ground
     /// (once the floor bounds its lowest corner's downward acceleration to less than 2 m/s²).
     pub land_speed: f64,
@@ -206,19 +206,20 @@ pub struct KeypointSettings {
     /// over the stance foot. With it the torso's orientation leaves the pelvis' level for the
     /// elbows' (above a pelvis and a torso that follow the person's the level could move the
     /// COM only with the arms, which it swings to their limits: G1's wrists 24 cm off the
-    /// person's), and the waist moves the COM, leaning the trunk off the person's. On the
-    /// development set (2026-12-07, `devset/run.sh OUT g1 [--balance]`, ten clips of six rigs)
-    /// G1's mean keypoint error is 9.14 cm without it and 11.24 cm with it, the trunk lean's
-    /// gap to the person's 3.6° and 7.9°. The robot's COM then goes where the person's body
-    /// puts it; a physical robot tracking the result balances by its own controller.
+    /// person's), and the waist moves the COM, leaning the trunk off the person's. Off, the
+    /// robot's COM goes where the person's body puts it; a physical robot tracking the result
+    /// balances by its own controller. On the development set (`devset/run.sh OUT g1`, ten
+    /// clips of six rigs) the default gives G1 a mean keypoint error of 9.14 cm and a trunk
+    /// lean 3.6° from the person's; `book/src/retarget-defaults.md` has the figures with it on.
     pub balance: bool,
     /// Cut-off \[Hz\] of the zero-phase low-pass ([`crate::motion::lowpass`]) applied to the
     /// scaled body points before they are interpolated and differentiated into the tasks'
     /// references (default `None`: as captured; a cut-off at or above the clip's Nyquist
     /// frequency leaves them as captured too). Noise at the capture's frame rate otherwise
-    /// reaches the references' accelerations: on JVRC-1 `humanoid3d_dance_b`, 8 Hz lowers the
-    /// joints' RMS jerk from 5 940 to 5 070 rad/s³ and 6 Hz to 4 610. The quality figures
-    /// still compare the robot with the captured points.
+    /// reaches the references' accelerations; a lower cut-off removes more of it (lower joint
+    /// jerk) and more of the clip's quick motion, and can put the soles below the ground
+    /// (`book/src/retarget-defaults.md` has the jerk at 6 and 8 Hz and the soles' depth at
+    /// 6 Hz). The quality figures still compare the robot with the captured points.
     pub smoothing: Option<f64>,
     /// Weight of the posture rows in the `hands` level \[–\] (default
     /// 0.1; 0 puts them in a level of their own, `posture`, below all tracking):
@@ -246,10 +247,8 @@ pub struct KeypointSettings {
     /// Track the robot's joint centres ([`centres`]: frames `centre:<point>` added at the
     /// hips, knees, shoulders, elbows and wrists) instead of the links and frames
     /// [`RobotBody::find`] names (the hip-pitch links, the hands' frames; default false).
-    /// The neutral figures are measured at the centres either way. On the development set,
-    /// with the trunk lean and a body weight of 0.2, tracking them changes G1's mean keypoint
-    /// error against the person by less than 0.1 cm and puts a sole 2.8 mm below the floor
-    /// instead of 1.7 mm.
+    /// The neutral figures are measured at the centres either way
+    /// (`book/src/retarget-defaults.md` has what tracking the centres measured).
     pub track_joint_centres: bool,
     /// Where no joint-angle reference is given, the posture level follows the person's
     /// posture fitted to the directions of their segments ([`fit`]: per tick, the joint angles
@@ -258,28 +257,24 @@ pub struct KeypointSettings {
     /// levels above leave free then takes the person's shape: the waist's lean and twist, the
     /// arms' swivel. The legs keep the start posture's references: the feet and the pelvis
     /// set a stance leg, and posture rows pulling its knee toward the person's straighter one
-    /// bring it to its singularity (G1 then does not come to rest on a held frame). On the
-    /// development set (2026-12-07, ten clips of six rigs, `iktc retarget`, the neutral
-    /// figures of [`fidelity`]) it lowers G1's mean keypoint error from 11.3 to 10.8 cm and
-    /// JVRC-1's from 12.0 to 10.7 cm, JVRC-1's trunk lean's gap to the person's from 5.4° to
-    /// 4.2° (G1's unchanged, 6.8°), but G1's feet land worse: slip over the person's contacts
-    /// 58 → 69 mm (mean over clips), the lowest sole −2.5 → −4.1 mm, 0.4 mm below the ground
-    /// on CMU 131_01. Off by default until the feet hold.
+    /// bring it to its singularity (G1 then does not come to rest on a held frame). Off by
+    /// default: on the development set (ten clips of six rigs, the neutral figures of
+    /// [`fidelity`]) the fit lowers the mean keypoint error, but G1's feet slip further over
+    /// the person's contacts and its soles go deeper (`book/src/retarget-defaults.md` has the
+    /// figures).
     pub posture_fit: bool,
     /// Where the feet's references are placed (default [`LimbScaling::Leg`]): the person's
     /// ankles relative to the middle of their hips, scaled by the leg ratio; the toes keep
-    /// their offset from the ankle along the robot's foot. On the development set (2026-12-07,
-    /// `devset/run.sh OUT g1`, ten clips of six rigs, the neutral figures of [`fidelity`],
-    /// with [`KeypointSettings::balance`] off) against [`LimbScaling::Segments`]: G1's mean
-    /// keypoint error 9.64 → 9.13 cm, its slip over the person's contacts 41 → 23 mm (mean over
-    /// clips; worst clip 273 → 90 mm).
+    /// their offset from the ankle along the robot's foot. On the development set
+    /// (`devset/run.sh OUT g1`, ten clips of six rigs, the neutral figures of [`fidelity`],
+    /// with [`KeypointSettings::balance`] off) the default gives G1 a mean keypoint error of
+    /// 9.13 cm and a slip over the person's contacts of 23 mm (mean over clips; worst clip
+    /// 90 mm); `book/src/retarget-defaults.md` has [`LimbScaling::Segments`]' figures.
     pub feet: LimbScaling,
     /// Where the hands' references are placed (default [`LimbScaling::Leg`]). On the shared
-    /// clips (`tests/retarget_keypoints.rs`) it brings G1's wrists within a mean 2.7–4.8 cm of
-    /// the captured ones instead of 5.2–6.8 cm with [`LimbScaling::Segments`] on three
-    /// DeepMimic clips and lowers the mean keypoint error on all twelve runs; in MuJoCo
-    /// (Python `iktc.mujoco`, standing imitation of `humanoid3d_dance_b`) G1's
-    /// feet slid 1.5 mm instead of 3.7 mm.
+    /// clips (`tests/retarget_keypoints.rs`) the default brings G1's wrists within a mean
+    /// 2.7–4.8 cm of the captured ones on three DeepMimic clips;
+    /// `book/src/retarget-defaults.md` has [`LimbScaling::Segments`]' figures.
     pub hands: LimbScaling,
     /// Measure the static reach of the body points after the run (default off): per tick
     /// sampled every 0.05 s, the least mean body point error of a posture within the
@@ -301,61 +296,50 @@ pub struct KeypointSettings {
     pub max_slide: Option<f64>,
 }
 
-/// Default [`KeypointSettings::max_slide`] \[m\]: a few centimetres, well below a step's
-/// length. Against every stance held (2026-12-06, `iktc retarget
-/// <clips> --robot R --jobs 2 --no-viewer --out DIR`): on CMU 131_01 G1's mean keypoint error
-/// 9.81 → 8.82 cm and JVRC-1's 11.39 → 11.16 cm (`scaled_131_02` 6.25 → 5.83 and 9.74 → 9.41);
-/// on 45 turning clips of Bandai Namco's dataset G1 7.13 → 7.10 cm with the largest held
-/// foot's slip 19.9 → 4.1 mm and the deepest sole 4.9 → 1.7 mm, JVRC-1 10.53 → 10.45 cm,
-/// 4.1 → 0.95 mm and 1.65 → 0.17 mm; the share of foot ticks held 0.30 → 0.27. The DeepMimic
-/// clips (shuffles of short stances) and 51 other Bandai Namco clips are unchanged.
+/// Default [`KeypointSettings::max_slide`] \[m\]: 0.05 m, a few centimetres, well below a
+/// step's length. A larger value holds more of the captured feet's slides in place (the held
+/// foot lags the captured one); a smaller one splits more stances into steps, and the feet
+/// are held for fewer ticks. On CMU 131_01 the default gives G1 a mean keypoint error of
+/// 8.82 cm and JVRC-1 11.16 cm (`iktc retarget <clips> --robot R --jobs 2 --no-viewer --out
+/// DIR`); `book/src/retarget-defaults.md` has every stance held measured.
 pub const MAX_SLIDE: f64 = 0.05;
 
 /// Default [`KeypointSettings::body_weight`] \[–\]: 0, the elbows, head, torso and swing
-/// feet's orientations in a level of their own. Measured on the development set (ten clips of
-/// six rigs onto G1 and JVRC-1, the neutral figures of [`fidelity`]; with the joint centres
-/// tracked and the pelvis leaned with the trunk), 0.2 takes G1's mean keypoint error against
-/// the person from 11.1 to 10.9 cm and JVRC-1's from 12.0 to 11.7 cm, but on a held frame
-/// G1's arms then do not come to rest (its fastest joint at 0.44 rad/s on
-/// `humanoid3d_dance_b` between 2 s and 6 s, against 1e-11 rad/s), and 0.5 loses on the feet
-/// (G1's slip over the person's contacts, mean over clips, 63 → 78 mm).
+/// feet's orientations in a level of their own. A larger weight follows the elbows and the
+/// head more closely in the hands' level, at the price of arms that do not come to rest on a
+/// held frame and, larger still, of the feet's hold (`book/src/retarget-defaults.md` has 0.2
+/// and 0.5 measured).
 pub(crate) const BODY_WEIGHT: f64 = 0.0;
 
-/// Default [`KeypointSettings::pelvis_lean`] \[–\]: 0, the pelvis upright. On the
-/// development set 1 takes the trunk lean's gap to the person's from 6.8° to 4.3° on G1 and
-/// its mean keypoint error from 11.3 to 10.8 cm, but puts a sole 5.3 mm below the floor
-/// (1.7 mm upright) and widens JVRC-1's knee gap (29° → 33°).
+/// Default [`KeypointSettings::pelvis_lean`] \[–\]: 0, the pelvis upright. A larger share
+/// follows the person's trunk lean more closely, with the pelvis as well as the waist, but
+/// puts the soles deeper and the knees further from the person's
+/// (`book/src/retarget-defaults.md` has a share of 1 measured).
 pub(crate) const PELVIS_LEAN: f64 = 0.0;
 
 /// Default [`KeypointSettings::max_leg_extension`] \[–\]: 0.95, a knee bent at least 36°
 /// (equal thigh and shank, `2 acos 0.95`) under a foot right below its hip. Straighter legs
 /// follow the person's knees closer but land the feet worse. On the development set
-/// (2026-12-07, `devset/run.sh OUT ROBOT --max-leg-extension E`, ten clips of six rigs, the
-/// neutral figures of [`fidelity`]), G1 at 0.92 / 0.94 / 0.95 / 0.96 / 0.97: knee flexion's
-/// gap to the person's 17.9 / 15.0 / 14.2 / 11.5 / 10.2° (mean over clips of the medians'
-/// gap), mean keypoint error 9.14 / 9.11 / 9.01 / 9.25 / 9.22 cm, slip over the person's
-/// contacts 23 / 30 / 27 / 32 / 44 mm (mean over clips; the worst clip 90 / 107 / 112 / 175 /
-/// 297 mm). At 0.95 against 0.92 the knee gap is lower on all 14 robots measured (built-in,
-/// GMR's and unitree_mujoco's MJCF models), the keypoint error on 9 (JVRC-1 10.54 → 10.24 cm,
-/// PM01 10.08 → 9.56, G1-23 10.93 → 10.34) and higher on 5 (N1 9.66 → 10.05, H1-2 13.77 →
-/// 14.30, the G1 MJCF models 9.04 → 9.73 and 9.30 → 9.49 cm).
+/// (`devset/run.sh OUT ROBOT --max-leg-extension E`, ten clips of six rigs, the neutral
+/// figures of [`fidelity`]) the default gives G1 a knee flexion 14.2° from the person's (mean
+/// over clips of the medians' gap), a mean keypoint error of 9.01 cm and a slip over the
+/// person's contacts of 27 mm (mean over clips); `book/src/retarget-defaults.md` has 0.92 to
+/// 0.97 measured, and other robots.
 pub const MAX_LEG_EXTENSION: f64 = 0.95;
 
 /// Sample period of the static reach ([`KeypointSettings::reach`]) \[s\].
 pub(crate) const REACH_PERIOD: f64 = 0.05;
 
 /// Default [`KeypointSettings::posture_weight`] \[–\]: 0.1 rad/s² of a joint against 1 m/s² of
-/// a hand. Against the same rows weighted 0.3 in the level below (`elbows_head`, before
-/// 0.2.0), on 51 Bandai Namco clips (`iktc retarget`, the joint route's posture references):
-/// G1 comes to rest on the held first frame (fastest joint at the end of the settling, median
-/// over clips, 1.1 → 0.0002 rad/s; JVRC-1 1.0 → 0.00003 rad/s), its joints' RMS jerk falls
-/// (median 3 570 → 1 080 rad/s³; JVRC-1 2 850 → 2 080), the worst clip's mean keypoint error
-/// falls (12.1 → 9.9 cm; JVRC-1 15.7 → 14.2) and the median clip's rises (6.22 → 6.87 cm;
-/// JVRC-1 9.91 → 10.26). Weights 0.05 and 0.07 kept more of the median (6.60 cm) but put a
-/// sole 0.46–0.59 mm below the ground on G1 CMU 131_01; 0.15, 0.2 and 0.3 raised it to 7.4,
-/// 8.0 and 9.0 cm. In MuJoCo's standing imitation (`mujoco_g1.py standing --plan upper-body`)
-/// 0.3 keeps the plan's ZMP inside the soles on every tick, 0.1 lets it out by up to 18 mm on
-/// 3 of 508 (G1 stays up, the measured ZMP at least 44 mm inside).
+/// a hand. A larger weight holds the joints closer to their posture references and follows
+/// the hands less closely (a larger median keypoint error); a smaller one follows the hands more
+/// closely but lets the soles dip below the ground. On 51 Bandai Namco clips (`iktc
+/// retarget`, the joint route's posture references) the default gives G1 a fastest joint of
+/// 0.0002 rad/s at the end of the settling and an RMS jerk of 1 080 rad/s³ (medians over
+/// clips), a mean keypoint error of 6.87 cm on the median clip and 9.9 cm on the worst. In
+/// MuJoCo's standing imitation (`mujoco_g1.py standing --plan upper-body`) the plan's ZMP
+/// leaves the soles by up to 18 mm on 3 of 508 ticks; G1 stays up, the measured ZMP at
+/// least 44 mm inside. `book/src/retarget-defaults.md` has the other weights measured.
 pub(crate) const POSTURE_WEIGHT: f64 = 0.1;
 
 impl Default for KeypointSettings {
