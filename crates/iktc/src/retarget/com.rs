@@ -16,13 +16,9 @@
 //! posture's offset turned with the pelvis (G1's COM 4.1 cm ahead of its pelvis frame); where
 //! the captured person bends (a bow, a reach, a crouch), the robot's own masses move its COM
 //! from its pelvis as the posture moves them, and the legs are not asked to hold a COM where
-//! the robot, so posed, does not have it. Before, `d_k` was the start posture's offset turned
-//! with the clip's heading throughout. Mean keypoint error on the shared clips (131_01,
-//! dance_a, dance_b, punch, walk, scaled_131_02), G1: 9.49 / 14.72 / 6.73 / 5.49 / 5.61 / 6.35
-//! → 9.81 / 13.53 / 6.22 / 5.06 / 5.38 / 6.25 cm; JVRC-1: 11.12 / 21.32 / 8.62 / 10.13 / 6.81 /
-//! 9.76 → 11.39 / 21.88 / 8.40 / 7.41 / 6.92 / 9.74 cm. On 51 Bandai Namco clips the mean over
-//! clips is unchanged (G1 6.98 → 7.01, JVRC-1 10.51 → 10.51 cm): their postures' offsets stay
-//! near the standing one.
+//! the robot, so posed, does not have it. `book/src/retarget-defaults.md` compares this
+//! offset with the start posture's offset turned with the clip's heading throughout, and
+//! with none.
 
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 

@@ -181,12 +181,11 @@ pub(crate) const PIVOT_SMOOTHING: f64 = 0.1;
 /// Fastest a pivoting foot's reference turns \[rad/s\]: the captured turn is followed at this
 /// rate at most and caught up with when it slows. Turning a held foot as fast as a dancer
 /// does (CMU 131_01: 4.6–4.9 rad/s) takes more of the legs' joint box than balance leaves:
-/// the held foot's level is corrected and its sole dips below the ground (unlimited: 0.19 mm,
-/// JVRC-1 on `scaled_131_02`). Turning it much slower than the dancer twists the legs under
-/// the spinning body: at 2.5 rad/s JVRC-1's other foot, landing on `humanoid3d_dance_a`, is
-/// dragged 29 mm into the ground. Deepest sole over the shared clips that pivot (131_01,
-/// `scaled_131_02`, `humanoid3d_dance_a`, `humanoid3d_punch`; G1 and JVRC-1) at 2.5 / 3 /
-/// 3.5 / 4 / 4.5 / 5 / 6 rad/s: 29.4 / 0.075 / 0.053 / 0.070 / 0.067 / 0.111 / 0.13 mm.
+/// the held foot's level is corrected and its sole dips below the ground. Turning it much
+/// slower than the dancer twists the legs under the spinning body and drags the other,
+/// landing foot into the ground. At the default the deepest sole over the shared clips that
+/// pivot (131_01, `scaled_131_02`, `humanoid3d_dance_a`, `humanoid3d_punch`; G1 and JVRC-1)
+/// is 0.070 mm; `book/src/retarget-defaults.md` has the other rates measured.
 pub(crate) const PIVOT_RATE: f64 = 4.0;
 
 /// Holds a foot's yaw `track` \[rad\] in the stance runs of `contact` as [`hold`] does, except

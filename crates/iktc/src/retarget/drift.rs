@@ -7,11 +7,9 @@
 //! `v_{k+1} − v_k = a_k Δt + δ_k`,  `δ_k = ½ (2 J̇ q̈ + J̈ q̇) Δt² + O(Δt³)`,
 //!
 //! a disturbance that grows with the cube of the joints' speeds (a whirling floating base
-//! above a held foot). The feedback pulls it back only in proportion to `1/k_p`. On the
-//! shared clips (`tests/retarget_keypoints.rs`) the compensation lowers the held feet's
-//! largest slip from 3.8 to 2.4 mm (JVRC-1, CMU 131_01), 2.1 to 1.6 mm and 2.1 to 1.1 mm
-//! (G1, 131_01 and dance_a); the rest of the 3.8 mm was the landing foot flattened about its
-//! ankle ([`super::tracker`] latches its sole's centre instead).
+//! above a held foot). The feedback pulls it back only in proportion to `1/k_p`; the
+//! compensation below lowers the held feet's slip (`book/src/retarget-defaults.md` has the
+//! largest slip on the shared clips with and without it).
 //!
 //! The disturbance varies slowly from tick to tick, so the last one measured is the best
 //! estimate of the next: each held foot's acceleration reference gets `c_{k+1} = −δ_k / Δt`
@@ -24,9 +22,9 @@
 //! A swing foot under its floor ([`super::floor`]) is measured the same way, and the floor's
 //! height row gets the vertical part of its compensation: the floor bounds the sole's
 //! acceleration at the start of the tick, and a foot turning on the ground drifts below it
-//! within the tick (G1 on CMU 131_01, a foot turning at up to 3 rad/s: 0.46 mm below the
-//! ground without it, 0.04 mm with it). Its other rows get none: on all six the landing foot
-//! went 2.4 mm into the ground on the same clip.
+//! within the tick (G1 on CMU 131_01, a foot turning at up to 3 rad/s, goes 0.04 mm below
+//! the ground with it). Its other rows get none (`book/src/retarget-defaults.md` has the
+//! height row without it, and all six rows with it, measured).
 
 use nalgebra::{DMatrix, DVector, Vector6};
 

@@ -798,12 +798,11 @@ impl KeypointController {
     /// its own (seen with rank-deficient levels below the corrected one), and when IKTC had to
     /// correct the feet's levels while a foot is held (the stance feet's level, or the floor's
     /// below it): GF's answer is then taken if it keeps those levels more exactly (the sum of
-    /// their error norms). On CMU 131_01 on G1 IKTC's corrections of a double stance made the
-    /// held feet slide by 0.9 m, GF's by 0.1 m; on a clip of Bandai Namco's dataset
+    /// their error norms). On a clip of Bandai Namco's dataset
     /// (`dataset-1_walk-left_feminine_001`) JVRC-1's landing foot, its hold beyond the legs'
-    /// reach, went 56 mm into the ground under IKTC's corrections of its floor and 0.15 mm
-    /// under GF's. Taking GF's answer also without a held foot was tried: G1's slip rose to 3.9
-    /// mm on another clip of that dataset. Nothing is clipped. Allocates nothing.
+    /// reach, goes 0.15 mm into the ground with GF's answer taken;
+    /// `book/src/retarget-defaults.md` has IKTC's answer kept, and GF's taken also without a
+    /// held foot, measured. Nothing is clipped. Allocates nothing.
     pub fn tick(&mut self, k: usize, hold: bool) -> Result<&SolveReport> {
         let k = k.min(self.plan.ticks.saturating_sub(1));
         let on = self.contacts(k);
