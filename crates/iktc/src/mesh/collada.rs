@@ -234,85 +234,16 @@ fn read_geometry(
         ));
         return Ok(None);
     };
-    let sources: Vec<&Element> = mesh.all("source").collect();
-    let vertices = mesh.child("vertices").ok_or_else(|| {
-        bad(
-            name,
-            mesh.line,
-            format!("{gid}: <mesh> has no <vertices>, expected one naming the positions"),
-        )
-    })?;
-    let url = vertices
-        .all("input")
-        .find(|i| i.attr("semantic") == Some("POSITION"))
-        .and_then(|i| i.attr("source"))
-        .ok_or_else(|| {
-            bad(
-                name,
-                vertices.line,
-                format!("{gid}: <vertices> has no <input semantic=\"POSITION\" source=…>"),
-            )
-        })?;
-    let source = by_url(&sources, url).ok_or_else(|| {
-        bad(
-            name,
-            vertices.line,
-            format!("{gid}: <vertices> names the positions {url}, expected the id of a <source> of the mesh"),
-        )
-    })?;
     let mut g = Geometry {
-        positions: positions(source, name)?,
+        positions: positions(mesh_positions(mesh, &gid, name)?, name)?,
         triangles: Vec::new(),
     };
     let n = g.positions.len();
     for prim in &mesh.children {
         let what = format!("{gid}, <{}>", prim.tag);
         match prim.tag.as_str() {
-            "triangles" => {
-                let lay = layout(prim, &what, name)?;
-                let Some(p) = prim.child("p") else { continue };
-                let c = corners(p, lay, n, &what, name)?;
-                let count = count_attr(prim, "count", Some(c.len() / 3), name)?;
-                if c.len() != 3 * count {
-                    return Err(bad(
-                        name,
-                        p.line,
-                        format!(
-                            "{what}: <p> holds {} corners, expected 3 × count = {}",
-                            c.len(),
-                            count.saturating_mul(3)
-                        ),
-                    ));
-                }
-                c.chunks_exact(3)
-                    .for_each(|t| g.triangles.push([t[0], t[1], t[2]]));
-            }
-            "polylist" => {
-                let lay = layout(prim, &what, name)?;
-                let Some(p) = prim.child("p") else { continue };
-                let c = corners(p, lay, n, &what, name)?;
-                let vcount = match prim.child("vcount") {
-                    Some(v) => indices(v, name)?,
-                    None => Vec::new(),
-                };
-                let total = vcount.iter().try_fold(0usize, |s, &k| s.checked_add(k));
-                if total != Some(c.len()) {
-                    return Err(bad(
-                        name,
-                        p.line,
-                        format!(
-                            "{what}: <p> holds {} corners, expected the sum of <vcount> ({})",
-                            c.len(),
-                            total.map_or("overflowing".into(), |t| t.to_string())
-                        ),
-                    ));
-                }
-                let mut at = 0;
-                for k in vcount {
-                    triangulate(&c[at..at + k], Shape::Fan, &mut g.triangles);
-                    at += k;
-                }
-            }
+            "triangles" => read_triangles(prim, n, &what, name, &mut g.triangles)?,
+            "polylist" => read_polylist(prim, n, &what, name, &mut g.triangles)?,
             "polygons" | "trifans" | "tristrips" => {
                 let lay = layout(prim, &what, name)?;
                 let shape = if prim.tag == "tristrips" {
@@ -333,6 +264,106 @@ fn read_geometry(
         }
     }
     Ok(Some(g))
+}
+
+/// The `<source>` of `mesh` that its `<vertices>` names as the positions (`gid` describes the
+/// geometry in errors).
+fn mesh_positions<'a>(mesh: &'a Element, gid: &str, name: &str) -> Result<&'a Element> {
+    let sources: Vec<&Element> = mesh.all("source").collect();
+    let vertices = mesh.child("vertices").ok_or_else(|| {
+        bad(
+            name,
+            mesh.line,
+            format!("{gid}: <mesh> has no <vertices>, expected one naming the positions"),
+        )
+    })?;
+    let url = vertices
+        .all("input")
+        .find(|i| i.attr("semantic") == Some("POSITION"))
+        .and_then(|i| i.attr("source"))
+        .ok_or_else(|| {
+            bad(
+                name,
+                vertices.line,
+                format!("{gid}: <vertices> has no <input semantic=\"POSITION\" source=…>"),
+            )
+        })?;
+    by_url(&sources, url).ok_or_else(|| {
+        bad(
+            name,
+            vertices.line,
+            format!("{gid}: <vertices> names the positions {url}, expected the id of a <source> of the mesh"),
+        )
+    })
+}
+
+/// Appends the triangles of a `<triangles>` primitive over `n` positions; its `<p>` must hold
+/// `3 × count` corners.
+fn read_triangles(
+    prim: &Element,
+    n: usize,
+    what: &str,
+    name: &str,
+    triangles: &mut Vec<[usize; 3]>,
+) -> Result<()> {
+    let lay = layout(prim, what, name)?;
+    let Some(p) = prim.child("p") else {
+        return Ok(());
+    };
+    let c = corners(p, lay, n, what, name)?;
+    let count = count_attr(prim, "count", Some(c.len() / 3), name)?;
+    if c.len() != 3 * count {
+        return Err(bad(
+            name,
+            p.line,
+            format!(
+                "{what}: <p> holds {} corners, expected 3 × count = {}",
+                c.len(),
+                count.saturating_mul(3)
+            ),
+        ));
+    }
+    c.chunks_exact(3)
+        .for_each(|t| triangles.push([t[0], t[1], t[2]]));
+    Ok(())
+}
+
+/// Appends the triangles (fans) of a `<polylist>` primitive over `n` positions; its `<p>` must
+/// hold the sum of `<vcount>` corners.
+fn read_polylist(
+    prim: &Element,
+    n: usize,
+    what: &str,
+    name: &str,
+    triangles: &mut Vec<[usize; 3]>,
+) -> Result<()> {
+    let lay = layout(prim, what, name)?;
+    let Some(p) = prim.child("p") else {
+        return Ok(());
+    };
+    let c = corners(p, lay, n, what, name)?;
+    let vcount = match prim.child("vcount") {
+        Some(v) => indices(v, name)?,
+        None => Vec::new(),
+    };
+    let total = vcount.iter().try_fold(0usize, |s, &k| s.checked_add(k));
+    if total != Some(c.len()) {
+        return Err(bad(
+            name,
+            p.line,
+            format!(
+                "{what}: <p> holds {} corners, expected the sum of <vcount> ({})",
+                c.len(),
+                total.map_or("overflowing".into(), |t| t.to_string())
+            ),
+        ));
+    }
+    let mut at = 0;
+    for k in vcount {
+        triangulate(&c[at..at + k], Shape::Fan, triangles);
+        at += k;
+    }
+    Ok(())
 }
 
 /// The transform of `node`'s own transform elements, in document order.
@@ -532,25 +563,7 @@ fn asset_transform(root: &Element, name: &str) -> Result<Matrix4<f64>> {
 /// `<node>` transform with the wrong number of values, and a nesting deeper than
 /// [`MAX_DEPTH`].
 pub fn read_collada(bytes: &[u8], name: &str) -> Result<ColladaMesh> {
-    let text = std::str::from_utf8(bytes).map_err(|e| {
-        bad(
-            name,
-            0,
-            format!("not a Collada file: the bytes are not UTF-8 text ({e}); a binary mesh?"),
-        )
-    })?;
-    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-    let root = parse_tree(text, name)?;
-    if root.tag != "COLLADA" {
-        return Err(bad(
-            name,
-            root.line,
-            format!(
-                "not a Collada file: the root element is <{}>, expected <COLLADA>",
-                root.tag
-            ),
-        ));
-    }
+    let root = collada_root(bytes, name)?;
     let asset = asset_transform(&root, name)?;
     let geometries: Vec<&Element> = root
         .all("library_geometries")
@@ -563,26 +576,7 @@ pub fn read_collada(bytes: &[u8], name: &str) -> Result<ColladaMesh> {
             "no <library_geometries>/<geometry>: nothing to draw",
         ));
     }
-    let scenes: Vec<&Element> = root
-        .all("library_visual_scenes")
-        .flat_map(|l| l.all("visual_scene"))
-        .collect();
-    let chosen = root
-        .child("scene")
-        .and_then(|s| s.child("instance_visual_scene"));
-    let scene = match chosen {
-        Some(inst) => {
-            let url = inst.attr("url").unwrap_or("");
-            Some(by_url(&scenes, url).ok_or_else(|| {
-                bad(
-                    name,
-                    inst.line,
-                    format!("<instance_visual_scene url=\"{url}\">: expected the id of a <visual_scene> of this file"),
-                )
-            })?)
-        }
-        None => scenes.first().copied(),
-    };
+    let scene = chosen_scene(&root, name)?;
     let mut walk = Walk::new(&root, name, &geometries);
     match scene {
         Some(s) => {
@@ -608,43 +602,8 @@ pub fn read_collada(bytes: &[u8], name: &str) -> Result<ColladaMesh> {
             Entry::Occupied(e) => e.into_mut(),
             Entry::Vacant(e) => e.insert(read_geometry(g, name, &mut warnings)?),
         };
-        let Some(geometry) = geometry else {
-            continue;
-        };
-        let f = asset * world;
-        let mirror = f.fixed_view::<3, 3>(0, 0).determinant() < 0.0;
-        let placed: Vec<[f32; 3]> = geometry
-            .positions
-            .iter()
-            .map(|p| {
-                let q = f * Vector4::new(p[0], p[1], p[2], 1.0);
-                [q.x as f32, q.y as f32, q.z as f32]
-            })
-            .collect();
-        if let Some(q) = placed.iter().find(|q| q.iter().any(|x| !x.is_finite())) {
-            return Err(bad(
-                name,
-                g.line,
-                format!(
-                    "{} placed by its node reaches {q:?}, expected finite coordinates in metres",
-                    g.describe()
-                ),
-            ));
-        }
-        if soup.len() + geometry.triangles.len() > MAX_TRIANGLES {
-            return Err(bad(
-                name,
-                g.line,
-                format!(
-                    "the scene places more than {MAX_TRIANGLES} triangles (at {}); expected at \
-                     most that",
-                    g.describe()
-                ),
-            ));
-        }
-        for t in &geometry.triangles {
-            let (a, b, c) = (placed[t[0]], placed[t[1]], placed[t[2]]);
-            soup.push(if mirror { [a, c, b] } else { [a, b, c] });
+        if let Some(geometry) = geometry {
+            place_geometry(g, geometry, &(asset * world), name, &mut soup)?;
         }
     }
     if soup.is_empty() {
@@ -659,6 +618,102 @@ pub fn read_collada(bytes: &[u8], name: &str) -> Result<ColladaMesh> {
         mesh: TriMesh::weld(&soup),
         warnings,
     })
+}
+
+/// The element tree of the Collada file `bytes`: UTF-8 text (a leading byte-order mark
+/// skipped) whose root element is `<COLLADA>`.
+fn collada_root(bytes: &[u8], name: &str) -> Result<Element> {
+    let text = std::str::from_utf8(bytes).map_err(|e| {
+        bad(
+            name,
+            0,
+            format!("not a Collada file: the bytes are not UTF-8 text ({e}); a binary mesh?"),
+        )
+    })?;
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let root = parse_tree(text, name)?;
+    if root.tag != "COLLADA" {
+        return Err(bad(
+            name,
+            root.line,
+            format!(
+                "not a Collada file: the root element is <{}>, expected <COLLADA>",
+                root.tag
+            ),
+        ));
+    }
+    Ok(root)
+}
+
+/// The visual scene to draw: the one `<scene>/<instance_visual_scene>` names, else the first.
+fn chosen_scene<'a>(root: &'a Element, name: &str) -> Result<Option<&'a Element>> {
+    let scenes: Vec<&Element> = root
+        .all("library_visual_scenes")
+        .flat_map(|l| l.all("visual_scene"))
+        .collect();
+    let chosen = root
+        .child("scene")
+        .and_then(|s| s.child("instance_visual_scene"));
+    Ok(match chosen {
+        Some(inst) => {
+            let url = inst.attr("url").unwrap_or("");
+            Some(by_url(&scenes, url).ok_or_else(|| {
+                bad(
+                    name,
+                    inst.line,
+                    format!("<instance_visual_scene url=\"{url}\">: expected the id of a <visual_scene> of this file"),
+                )
+            })?)
+        }
+        None => scenes.first().copied(),
+    })
+}
+
+/// Appends to `soup` the triangles of `geometry` (read from the element `g`) placed by `f`
+/// (file units to metres, Z up), kept counter-clockwise under a mirror; non-finite
+/// coordinates and more than [`MAX_TRIANGLES`] in all are errors.
+fn place_geometry(
+    g: &Element,
+    geometry: &Geometry,
+    f: &Matrix4<f64>,
+    name: &str,
+    soup: &mut Vec<[[f32; 3]; 3]>,
+) -> Result<()> {
+    let mirror = f.fixed_view::<3, 3>(0, 0).determinant() < 0.0;
+    let placed: Vec<[f32; 3]> = geometry
+        .positions
+        .iter()
+        .map(|p| {
+            let q = f * Vector4::new(p[0], p[1], p[2], 1.0);
+            [q.x as f32, q.y as f32, q.z as f32]
+        })
+        .collect();
+    if let Some(q) = placed.iter().find(|q| q.iter().any(|x| !x.is_finite())) {
+        return Err(bad(
+            name,
+            g.line,
+            format!(
+                "{} placed by its node reaches {q:?}, expected finite coordinates in metres",
+                g.describe()
+            ),
+        ));
+    }
+    if soup.len() + geometry.triangles.len() > MAX_TRIANGLES {
+        return Err(bad(
+            name,
+            g.line,
+            format!(
+                "the scene places more than {MAX_TRIANGLES} triangles (at {}); expected at \
+                 most that",
+                g.describe()
+            ),
+        ));
+    }
+    for t in &geometry.triangles {
+        let (a, b, c) = (placed[t[0]], placed[t[1]], placed[t[2]]);
+        soup.push(if mirror { [a, c, b] } else { [a, b, c] });
+    }
+    Ok(())
 }
 
 #[cfg(test)]

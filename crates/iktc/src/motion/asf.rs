@@ -159,195 +159,261 @@ struct RawBone {
     dofs: Vec<AsfDof>,
 }
 
+/// What the sections of an ASF file say, gathered line by line before the bones are ordered.
+struct AsfScan<'a> {
+    p: Parser<'a>,
+    degrees: bool,
+    root_order: Vec<AsfDof>,
+    root_axis_order: Vec<usize>,
+    /// The root's `orientation` in the file's angle unit.
+    root_orientation: [f64; 3],
+    root_position: Vector3<f64>,
+    bones: Vec<RawBone>,
+    /// `:hierarchy` links: (1-based line, parent name, child name).
+    links: Vec<(usize, String, String)>,
+    section: String,
+    current: Option<RawBone>,
+    hierarchy_seen: bool,
+    in_limits: bool,
+}
+
+impl<'a> AsfScan<'a> {
+    /// An empty scan: degrees, root axis order XYZ, root at the origin.
+    fn new(source: &'a str) -> Self {
+        AsfScan {
+            p: Parser { source },
+            degrees: true,
+            root_order: Vec::new(),
+            root_axis_order: vec![0, 1, 2],
+            root_orientation: [0.0; 3],
+            root_position: Vector3::zeros(),
+            bones: Vec::new(),
+            links: Vec::new(),
+            section: String::new(),
+            current: None,
+            hierarchy_seen: false,
+            in_limits: false,
+        }
+    }
+
+    /// Takes one non-blank line: a section header or a line of the current section.
+    fn line(&mut self, line: usize, l: &str) -> Result<()> {
+        let tokens: Vec<&str> = l.split_whitespace().collect();
+        let key = tokens[0].to_ascii_lowercase();
+        if key.starts_with(':') {
+            return self.section_header(line, key);
+        }
+        let args = &tokens[1..];
+        match self.section.as_str() {
+            ":units" if key == "angle" => {
+                self.degrees = match args.first().map(|a| a.to_ascii_lowercase()) {
+                    Some(a) if a.starts_with("deg") => true,
+                    Some(a) if a.starts_with("rad") => false,
+                    _ => return Err(self.p.error(line, "`angle` must be deg or rad")),
+                };
+            }
+            ":root" => self.root_field(line, &key, args)?,
+            ":bonedata" => self.bonedata_line(line, &key, args)?,
+            ":hierarchy" => match key.as_str() {
+                "begin" | "end" => {}
+                _ => {
+                    for child in args {
+                        self.links
+                            .push((line, tokens[0].to_string(), child.to_string()));
+                    }
+                }
+            },
+            _ => {}
+        }
+        Ok(())
+    }
+
+    /// Starts the section `key` (lowercase, with its `:`); an unknown one is an error.
+    fn section_header(&mut self, line: usize, key: String) -> Result<()> {
+        self.in_limits = false;
+        match key.as_str() {
+            ":version" | ":name" | ":units" | ":documentation" | ":root" | ":bonedata" => {}
+            ":hierarchy" => self.hierarchy_seen = true,
+            other => return Err(self.p.error(line, format!("unknown section `{other}`"))),
+        }
+        self.section = key;
+        Ok(())
+    }
+
+    /// One field of `:root`: `order`, `axis`, `position` or `orientation`.
+    fn root_field(&mut self, line: usize, key: &str, args: &[&str]) -> Result<()> {
+        let p = &self.p;
+        match key {
+            "order" => {
+                self.root_order = args
+                    .iter()
+                    .map(|t| p.dof(line, t))
+                    .collect::<Result<Vec<_>>>()?
+            }
+            "axis" => {
+                self.root_axis_order = p.axis_order(line, args.first().copied().unwrap_or(""))?
+            }
+            "position" => {
+                self.root_position = Vector3::from(p.numbers::<3>(line, "position", args)?)
+            }
+            "orientation" => self.root_orientation = p.numbers::<3>(line, "orientation", args)?,
+            _ => return Err(p.error(line, format!("unknown root field `{key}`"))),
+        }
+        Ok(())
+    }
+
+    /// One line of `:bonedata`: `begin`/`end` of a bone block or a field of the open bone.
+    fn bonedata_line(&mut self, line: usize, key: &str, args: &[&str]) -> Result<()> {
+        if self.in_limits && key.starts_with('(') {
+            return Ok(());
+        }
+        self.in_limits = false;
+        let p = &self.p;
+        match (key, self.current.as_mut()) {
+            ("begin", None) => {
+                self.current = Some(RawBone {
+                    line,
+                    order: vec![0, 1, 2],
+                    ..RawBone::default()
+                })
+            }
+            ("end", Some(_)) => {
+                if let Some(b) = self.current.take() {
+                    if b.name.is_empty() {
+                        return Err(p.error(b.line, "a bone without `name`"));
+                    }
+                    self.bones.push(b);
+                }
+            }
+            ("id", Some(_)) => {}
+            ("name", Some(b)) => b.name = args.first().map(|s| s.to_string()).unwrap_or_default(),
+            ("direction", Some(b)) => {
+                b.direction = Vector3::from(p.numbers::<3>(line, "direction", args)?)
+            }
+            ("length", Some(b)) => b.length = p.numbers::<1>(line, "length", args)?[0],
+            ("axis", Some(b)) => {
+                b.axis = p.numbers::<3>(line, "axis", args)?;
+                b.order = p.axis_order(line, args.get(3).copied().unwrap_or("XYZ"))?;
+            }
+            ("dof", Some(b)) => {
+                b.dofs = args
+                    .iter()
+                    .map(|t| p.dof(line, t))
+                    .collect::<Result<Vec<_>>>()?
+            }
+            ("limits", Some(_)) => self.in_limits = true,
+            (k, Some(_)) if k.starts_with("bodymass") || k.starts_with("cofmass") => {}
+            (other, _) => return Err(p.error(line, format!("unexpected `{other}` in :bonedata"))),
+        }
+        Ok(())
+    }
+
+    /// Checks the end of the file: no open bone block, a non-empty `:hierarchy` whose parents
+    /// are all `root` or bones; `last_line` is the file's line count.
+    fn check_complete(&self, last_line: usize) -> Result<()> {
+        let p = &self.p;
+        if let Some(b) = &self.current {
+            return Err(p.error(b.line, "bone block without `end` (truncated file)"));
+        }
+        if !self.hierarchy_seen || self.links.is_empty() {
+            return Err(p.error(
+                last_line,
+                "no `:hierarchy` section (or an empty one): the bones' parents are unknown",
+            ));
+        }
+        // Every parent is the root or a bone, as every child must be a bone.
+        if let Some((line, parent, child)) = self.links.iter().find(|(_, parent, _)| {
+            parent != "root" && !self.bones.iter().any(|b| &b.name == parent)
+        }) {
+            return Err(p.error(
+                *line,
+                format!("`:hierarchy` names unknown bone `{parent}` (parent of `{child}`)"),
+            ));
+        }
+        Ok(())
+    }
+
+    /// The bones parents first, following the hierarchy from the root: (raw bone index, parent
+    /// in the returned order); a bone with two parents or out of reach of `root` is an error.
+    fn bone_order(&self) -> Result<Vec<(usize, Option<usize>)>> {
+        let (p, bones, links) = (&self.p, &self.bones, &self.links);
+        let mut order: Vec<(usize, Option<usize>)> = Vec::new();
+        let mut frontier: Vec<(String, Option<usize>)> = vec![("root".to_string(), None)];
+        while let Some((parent_name, parent_slot)) = frontier.pop() {
+            for (line, parent, child) in links.iter().filter(|(_, p, _)| *p == parent_name) {
+                let b = bones.iter().position(|b| &b.name == child).ok_or_else(|| {
+                    p.error(
+                        *line,
+                        format!("`:hierarchy` names unknown bone `{child}` (child of `{parent}`)"),
+                    )
+                })?;
+                if order.iter().any(|(o, _)| *o == b) {
+                    return Err(p.error(*line, format!("bone `{child}` has two parents")));
+                }
+                order.push((b, parent_slot));
+                frontier.push((child.clone(), Some(order.len() - 1)));
+            }
+        }
+        if let Some(b) = bones
+            .iter()
+            .find(|b| !order.iter().any(|(o, _)| bones[*o].name == b.name))
+        {
+            return Err(p.error(
+                b.line,
+                format!(
+                    "bone `{}` is not reachable from `root` in `:hierarchy`",
+                    b.name
+                ),
+            ));
+        }
+        Ok(order)
+    }
+
+    /// The skeleton, bones in `order` (from [`Self::bone_order`]), angles converted to radians.
+    fn into_asf(self, order: &[(usize, Option<usize>)]) -> Asf {
+        let degrees = self.degrees;
+        let angle = |v: f64| if degrees { v.to_radians() } else { v };
+        let axis_rotation = |values: [f64; 3], axes: &[usize]| {
+            let angles: Vec<f64> = axes.iter().map(|a| angle(values[*a])).collect();
+            fixed_axes_rotation(axes, &angles)
+        };
+        let bones = order
+            .iter()
+            .map(|(b, parent)| {
+                let raw = &self.bones[*b];
+                AsfBone {
+                    name: raw.name.clone(),
+                    vector: raw.direction * raw.length,
+                    axis: axis_rotation(raw.axis, &raw.order),
+                    dofs: raw.dofs.clone(),
+                    parent: *parent,
+                }
+            })
+            .collect();
+        Asf {
+            source: self.p.source.to_string(),
+            degrees,
+            root_order: self.root_order,
+            root_axis: axis_rotation(self.root_orientation, &self.root_axis_order),
+            root_position: self.root_position,
+            bones,
+        }
+    }
+}
+
 /// Reads an ASF file; `source` names it in errors ([`Error::Parse`] with the line): an unknown
 /// section, a malformed number, a bone without name, a missing `:hierarchy`, a hierarchy naming
 /// an unknown bone (as parent or as child) or leaving a bone out. A leading UTF-8 byte-order
 /// mark is skipped.
 pub fn read_asf(text: &str, source: &str) -> Result<Asf> {
     let text = super::strip_bom(text);
-    let p = Parser { source };
-    let mut degrees = true;
-    let mut root_order: Vec<AsfDof> = Vec::new();
-    let mut root_axis_order = vec![0, 1, 2];
-    let mut root_orientation = [0.0; 3];
-    let mut root_position = Vector3::zeros();
-    let mut bones: Vec<RawBone> = Vec::new();
-    let mut links: Vec<(usize, String, String)> = Vec::new();
-    let mut section = String::new();
-    let mut current: Option<RawBone> = None;
-    let mut hierarchy_seen = false;
-    let mut in_limits = false;
-    let last_line = text.lines().count();
+    let mut scan = AsfScan::new(source);
     for (line, l) in acclaim_lines(text) {
-        let tokens: Vec<&str> = l.split_whitespace().collect();
-        let key = tokens[0].to_ascii_lowercase();
-        if key.starts_with(':') {
-            section = key.clone();
-            in_limits = false;
-            match key.as_str() {
-                ":version" | ":name" | ":units" | ":documentation" | ":root" | ":bonedata" => {}
-                ":hierarchy" => hierarchy_seen = true,
-                other => return Err(p.error(line, format!("unknown section `{other}`"))),
-            }
-            continue;
-        }
-        let args = &tokens[1..];
-        match section.as_str() {
-            ":units" if key == "angle" => {
-                degrees = match args.first().map(|a| a.to_ascii_lowercase()) {
-                    Some(a) if a.starts_with("deg") => true,
-                    Some(a) if a.starts_with("rad") => false,
-                    _ => return Err(p.error(line, "`angle` must be deg or rad")),
-                };
-            }
-            ":root" => match key.as_str() {
-                "order" => {
-                    root_order = args
-                        .iter()
-                        .map(|t| p.dof(line, t))
-                        .collect::<Result<Vec<_>>>()?
-                }
-                "axis" => {
-                    root_axis_order = p.axis_order(line, args.first().copied().unwrap_or(""))?
-                }
-                "position" => {
-                    root_position = Vector3::from(p.numbers::<3>(line, "position", args)?)
-                }
-                "orientation" => root_orientation = p.numbers::<3>(line, "orientation", args)?,
-                _ => return Err(p.error(line, format!("unknown root field `{key}`"))),
-            },
-            ":bonedata" => {
-                if in_limits && key.starts_with('(') {
-                    continue;
-                }
-                in_limits = false;
-                match (key.as_str(), current.as_mut()) {
-                    ("begin", None) => {
-                        current = Some(RawBone {
-                            line,
-                            order: vec![0, 1, 2],
-                            ..RawBone::default()
-                        })
-                    }
-                    ("end", Some(_)) => {
-                        if let Some(b) = current.take() {
-                            if b.name.is_empty() {
-                                return Err(p.error(b.line, "a bone without `name`"));
-                            }
-                            bones.push(b);
-                        }
-                    }
-                    ("id", Some(_)) => {}
-                    ("name", Some(b)) => {
-                        b.name = args.first().map(|s| s.to_string()).unwrap_or_default()
-                    }
-                    ("direction", Some(b)) => {
-                        b.direction = Vector3::from(p.numbers::<3>(line, "direction", args)?)
-                    }
-                    ("length", Some(b)) => b.length = p.numbers::<1>(line, "length", args)?[0],
-                    ("axis", Some(b)) => {
-                        b.axis = p.numbers::<3>(line, "axis", args)?;
-                        b.order = p.axis_order(line, args.get(3).copied().unwrap_or("XYZ"))?;
-                    }
-                    ("dof", Some(b)) => {
-                        b.dofs = args
-                            .iter()
-                            .map(|t| p.dof(line, t))
-                            .collect::<Result<Vec<_>>>()?
-                    }
-                    ("limits", Some(_)) => in_limits = true,
-                    (k, Some(_)) if k.starts_with("bodymass") || k.starts_with("cofmass") => {}
-                    (other, _) => {
-                        return Err(p.error(line, format!("unexpected `{other}` in :bonedata")))
-                    }
-                }
-            }
-            ":hierarchy" => match key.as_str() {
-                "begin" | "end" => {}
-                _ => {
-                    for child in args {
-                        links.push((line, tokens[0].to_string(), child.to_string()));
-                    }
-                }
-            },
-            _ => {}
-        }
+        scan.line(line, l)?;
     }
-    if let Some(b) = current {
-        return Err(p.error(b.line, "bone block without `end` (truncated file)"));
-    }
-    if !hierarchy_seen || links.is_empty() {
-        return Err(p.error(
-            last_line,
-            "no `:hierarchy` section (or an empty one): the bones' parents are unknown",
-        ));
-    }
-    // Every parent is the root or a bone, as every child must be a bone.
-    if let Some((line, parent, child)) = links
-        .iter()
-        .find(|(_, parent, _)| parent != "root" && !bones.iter().any(|b| &b.name == parent))
-    {
-        return Err(p.error(
-            *line,
-            format!("`:hierarchy` names unknown bone `{parent}` (parent of `{child}`)"),
-        ));
-    }
-    let angle = |v: f64| if degrees { v.to_radians() } else { v };
-    // Order bones parents first, following the hierarchy from the root.
-    let mut order: Vec<(usize, Option<usize>)> = Vec::new(); // (raw bone index, parent in `order`)
-    let mut frontier: Vec<(String, Option<usize>)> = vec![("root".to_string(), None)];
-    while let Some((parent_name, parent_slot)) = frontier.pop() {
-        for (line, parent, child) in links.iter().filter(|(_, p, _)| *p == parent_name) {
-            let b = bones.iter().position(|b| &b.name == child).ok_or_else(|| {
-                p.error(
-                    *line,
-                    format!("`:hierarchy` names unknown bone `{child}` (child of `{parent}`)"),
-                )
-            })?;
-            if order.iter().any(|(o, _)| *o == b) {
-                return Err(p.error(*line, format!("bone `{child}` has two parents")));
-            }
-            order.push((b, parent_slot));
-            frontier.push((child.clone(), Some(order.len() - 1)));
-        }
-    }
-    if let Some(b) = bones
-        .iter()
-        .find(|b| !order.iter().any(|(o, _)| bones[*o].name == b.name))
-    {
-        return Err(p.error(
-            b.line,
-            format!(
-                "bone `{}` is not reachable from `root` in `:hierarchy`",
-                b.name
-            ),
-        ));
-    }
-    let axis_rotation = |values: [f64; 3], axes: &[usize]| {
-        let angles: Vec<f64> = axes.iter().map(|a| angle(values[*a])).collect();
-        fixed_axes_rotation(axes, &angles)
-    };
-    let out_bones = order
-        .iter()
-        .map(|(b, parent)| {
-            let raw = &bones[*b];
-            AsfBone {
-                name: raw.name.clone(),
-                vector: raw.direction * raw.length,
-                axis: axis_rotation(raw.axis, &raw.order),
-                dofs: raw.dofs.clone(),
-                parent: *parent,
-            }
-        })
-        .collect();
-    Ok(Asf {
-        source: source.to_string(),
-        degrees,
-        root_order,
-        root_axis: axis_rotation(root_orientation, &root_axis_order),
-        root_position,
-        bones: out_bones,
-    })
+    scan.check_complete(text.lines().count())?;
+    let order = scan.bone_order()?;
+    Ok(scan.into_asf(&order))
 }
 
 impl Asf {

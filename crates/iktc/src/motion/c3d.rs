@@ -110,14 +110,28 @@ struct Parameter {
     data_at: usize,
 }
 
-/// Reads a C3D file's points (see the module documentation); `source` names it in errors
-/// ([`Error::Parse`] with the byte offset).
-pub fn read_c3d(bytes: &[u8], source: &str) -> Result<MarkerSet> {
-    let mut r = Reader {
-        bytes,
-        endian: Endian::Little,
-        source,
-    };
+/// The header fields read for points (their byte offsets in the header in brackets).
+struct Header {
+    /// Points per frame (2).
+    points: usize,
+    /// Analog samples per frame (4).
+    analog_per_frame: usize,
+    /// First frame number, from 1 (6).
+    first: usize,
+    /// Last frame number (8).
+    last: usize,
+    /// Scale of integer data; negative for floating-point data (12).
+    scale: f64,
+    /// First block of the data, from 1 (16).
+    data_block: usize,
+    /// Frame rate \[Hz\] (20).
+    rate: f64,
+}
+
+/// Checks the file's start and sets `r`'s number format from the processor type; returns the
+/// byte offset of the parameter section.
+fn read_processor(r: &mut Reader) -> Result<usize> {
+    let bytes = r.bytes;
     if bytes.len() < BLOCK || bytes[1] != 0x50 {
         return Err(r.error(
             1,
@@ -145,13 +159,28 @@ pub fn read_c3d(bytes: &[u8], source: &str) -> Result<MarkerSet> {
             ))
         }
     };
-    let points = r.u16(2)? as usize;
-    let analog_per_frame = r.u16(4)? as usize;
-    let first = r.u16(6)? as usize;
-    let last = r.u16(8)? as usize;
-    let scale = r.f32(12)? as f64;
-    let data_block = r.u16(16)? as usize;
-    let header_rate = r.f32(20)? as f64;
+    Ok(param_at)
+}
+
+/// Reads and checks the header: frames `1 ≤ first ≤ last`, a finite non-zero scale, a data
+/// block ≥ 2.
+fn read_header(r: &Reader) -> Result<Header> {
+    let header = Header {
+        points: r.u16(2)? as usize,
+        analog_per_frame: r.u16(4)? as usize,
+        first: r.u16(6)? as usize,
+        last: r.u16(8)? as usize,
+        scale: r.f32(12)? as f64,
+        data_block: r.u16(16)? as usize,
+        rate: r.f32(20)? as f64,
+    };
+    let Header {
+        first,
+        last,
+        scale,
+        data_block,
+        ..
+    } = header;
     if last < first || first == 0 {
         return Err(r.error(
             6,
@@ -167,14 +196,19 @@ pub fn read_c3d(bytes: &[u8], source: &str) -> Result<MarkerSet> {
     if data_block < 2 {
         return Err(r.error(16, format!("data start block {data_block}; expected ≥ 2")));
     }
-    let params = parameters(&r, param_at)?;
-    let find = |g: &str, n: &str| {
-        params
-            .iter()
-            .find(|p| p.group.eq_ignore_ascii_case(g) && p.name.eq_ignore_ascii_case(n))
-    };
-    // POINT:LABELS holds at most 255 names (a dimension is one byte); LABELS2, LABELS3, …
-    // continue the list.
+    Ok(header)
+}
+
+/// The parameter `group:name` (case-insensitive), if any.
+fn find_parameter<'p>(params: &'p [Parameter], group: &str, name: &str) -> Option<&'p Parameter> {
+    params
+        .iter()
+        .find(|p| p.group.eq_ignore_ascii_case(group) && p.name.eq_ignore_ascii_case(name))
+}
+
+/// The names of the `points` points: `POINT:LABELS` (at most 255 names, as a dimension is one
+/// byte), continued by `LABELS2`, `LABELS3`, …; a missing or empty name is `P<k>` (from 1).
+fn point_names(params: &[Parameter], bytes: &[u8], points: usize) -> Vec<String> {
     let mut names: Vec<String> = Vec::new();
     for k in 1.. {
         let key = if k == 1 {
@@ -182,7 +216,7 @@ pub fn read_c3d(bytes: &[u8], source: &str) -> Result<MarkerSet> {
         } else {
             format!("LABELS{k}")
         };
-        match find("POINT", &key) {
+        match find_parameter(params, "POINT", &key) {
             Some(p) if p.kind == -1 && p.dims.len() == 2 => {
                 let (len, count) = (p.dims[0], p.dims[1]);
                 names.extend((0..count).map(|j| {
@@ -206,18 +240,19 @@ pub fn read_c3d(bytes: &[u8], source: &str) -> Result<MarkerSet> {
             *n = format!("P{}", k + 1);
         }
     }
-    let rate = match find("POINT", "RATE") {
-        Some(p) if p.kind == 4 => r.f32(p.data_at)? as f64,
-        _ => header_rate,
-    };
-    if !(rate.is_finite() && rate > 0.0) {
-        return Err(r.error(20, format!("frame rate {rate} Hz; expected > 0")));
-    }
+    names
+}
+
+/// The point positions, frame after frame (`None` for a point with a negative residual), from
+/// the data section; a file too short or a non-finite coordinate is an error.
+fn read_positions(r: &Reader, h: &Header, names: &[String]) -> Result<Vec<Option<Vector3<f64>>>> {
+    let bytes = r.bytes;
+    let (points, scale) = (h.points, h.scale);
     let float = scale < 0.0;
     let word = if float { 4 } else { 2 };
-    let frame_bytes = (points * 4 + analog_per_frame) * word;
-    let frames = last - first + 1;
-    let data_at = (data_block - 1) * BLOCK;
+    let frame_bytes = (points * 4 + h.analog_per_frame) * word;
+    let frames = h.last - h.first + 1;
+    let data_at = (h.data_block - 1) * BLOCK;
     let needed = data_at + frames * frame_bytes;
     if bytes.len() < needed {
         return Err(r.error(
@@ -250,12 +285,36 @@ pub fn read_c3d(bytes: &[u8], source: &str) -> Result<MarkerSet> {
                     at,
                     format!(
                         "frame {}, point `{name}`: a non-finite coordinate",
-                        first + f
+                        h.first + f
                     ),
                 ));
             }
         }
     }
+    Ok(positions)
+}
+
+/// Reads a C3D file's points (see the module documentation); `source` names it in errors
+/// ([`Error::Parse`] with the byte offset).
+pub fn read_c3d(bytes: &[u8], source: &str) -> Result<MarkerSet> {
+    let mut r = Reader {
+        bytes,
+        endian: Endian::Little,
+        source,
+    };
+    let param_at = read_processor(&mut r)?;
+    let header = read_header(&r)?;
+    let params = parameters(&r, param_at)?;
+    let names = point_names(&params, bytes, header.points);
+    let rate = match find_parameter(&params, "POINT", "RATE") {
+        Some(p) if p.kind == 4 => r.f32(p.data_at)? as f64,
+        _ => header.rate,
+    };
+    if !(rate.is_finite() && rate > 0.0) {
+        return Err(r.error(20, format!("frame rate {rate} Hz; expected > 0")));
+    }
+    let positions = read_positions(&r, &header, &names)?;
+    let frames = header.last - header.first + 1;
     Ok(MarkerSet {
         source: source.to_string(),
         names,

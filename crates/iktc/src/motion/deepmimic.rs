@@ -262,20 +262,57 @@ pub fn read_deepmimic_with(
     settings.validate()?;
     let text = super::strip_bom(text);
     let skeleton = deepmimic_skeleton()?;
-    let parse_error = |line: usize, message: String| Error::Parse {
-        source_name: source_name.to_string(),
-        line,
-        message,
-    };
-    let file: MotionFile =
-        serde_json::from_str(text).map_err(|e| parse_error(e.line(), e.to_string()))?;
+    let file: MotionFile = serde_json::from_str(text)
+        .map_err(|e| frame_error(source_name, e.line(), e.to_string()))?;
     if file.frames.is_empty() {
-        return Err(parse_error(
+        return Err(frame_error(
+            source_name,
             frame_lines(text).first().copied().unwrap_or(0),
             "the motion has zero frames".to_string(),
         ));
     }
-    // Map the file's fields to skeleton joints and check their kinds against the URDF.
+    let reader = FrameReader {
+        text,
+        source_name,
+        settings,
+        targets: joint_targets(&skeleton)?,
+        skeleton: &skeleton,
+    };
+    crate::resources::check_count(
+        &format!("frames in {source_name}"),
+        file.frames.len(),
+        settings.limits.max_clip_frames,
+        "ReadLimits::max_clip_frames",
+    )?;
+    let mut times = Vec::with_capacity(file.frames.len());
+    let mut poses = Vec::with_capacity(file.frames.len());
+    let mut t = 0.0;
+    let last = file.frames.len() - 1;
+    for (i, frame) in file.frames.iter().enumerate() {
+        let (duration, pose) = reader.frame(i, frame, i < last)?;
+        times.push(t);
+        poses.push(pose);
+        t += duration;
+    }
+    let duration = times.last().copied().unwrap_or(0.0);
+    settings
+        .limits
+        .check_clip(source_name, times.len(), duration)?;
+    Clip::new(source_name, skeleton, times, poses, UpAxis::Y)
+}
+
+/// An [`Error::Parse`] in `source_name` at `line`.
+fn frame_error(source_name: &str, line: usize, message: String) -> Error {
+    Error::Parse {
+        source_name: source_name.to_string(),
+        line,
+        message,
+    }
+}
+
+/// Maps the file's joint fields to skeleton joints (index, kind), checking their kinds against
+/// the URDF.
+fn joint_targets(skeleton: &Skeleton) -> Result<[(usize, FieldKind); JOINT_FIELDS.len()]> {
     let mut targets = [(0usize, FieldKind::Angle); JOINT_FIELDS.len()];
     for (slot, (name, _, kind)) in targets.iter_mut().zip(JOINT_FIELDS.iter()) {
         let index = skeleton.index_of(name)?;
@@ -291,22 +328,32 @@ pub fn read_deepmimic_with(
         }
         *slot = (index, *kind);
     }
-    let line_of = |frame: usize| frame_lines(text).get(frame).copied().unwrap_or(0);
-    crate::resources::check_count(
-        &format!("frames in {source_name}"),
-        file.frames.len(),
-        settings.limits.max_clip_frames,
-        "ReadLimits::max_clip_frames",
-    )?;
-    let n = skeleton.len();
-    let mut times = Vec::with_capacity(file.frames.len());
-    let mut poses = Vec::with_capacity(file.frames.len());
-    let mut t = 0.0;
-    let last = file.frames.len() - 1;
-    for (i, frame) in file.frames.iter().enumerate() {
-        let Some(values) = <&[f64; DEEPMIMIC_FRAME_LEN]>::try_from(frame.as_slice()).ok() else {
-            return Err(parse_error(
-                line_of(i),
+    Ok(targets)
+}
+
+/// Turns the frames of a motion file into poses on the DeepMimic skeleton.
+struct FrameReader<'a> {
+    /// The file's text, to find a frame's line for an error.
+    text: &'a str,
+    source_name: &'a str,
+    settings: &'a DeepMimicSettings,
+    /// Skeleton joint and kind per entry of [`JOINT_FIELDS`].
+    targets: [(usize, FieldKind); JOINT_FIELDS.len()],
+    skeleton: &'a Skeleton,
+}
+
+impl FrameReader<'_> {
+    /// An [`Error::Parse`] at the line of frame `i`.
+    fn error(&self, i: usize, message: String) -> Error {
+        let line = frame_lines(self.text).get(i).copied().unwrap_or(0);
+        frame_error(self.source_name, line, message)
+    }
+
+    /// Frame `i`: its duration \[s\] (checked > 0 when `needs_duration`) and its pose.
+    fn frame(&self, i: usize, frame: &[f64], needs_duration: bool) -> Result<(f64, Pose)> {
+        let Some(values) = <&[f64; DEEPMIMIC_FRAME_LEN]>::try_from(frame).ok() else {
+            return Err(self.error(
+                i,
                 format!(
                     "frame {i} has {} numbers; expected {DEEPMIMIC_FRAME_LEN}",
                     frame.len()
@@ -314,41 +361,23 @@ pub fn read_deepmimic_with(
             ));
         };
         let duration = values[0];
-        if i < last && !(duration.is_finite() && duration > 0.0) {
-            return Err(parse_error(
-                line_of(i),
+        if needs_duration && !(duration.is_finite() && duration > 0.0) {
+            return Err(self.error(
+                i,
                 format!("frame {i}, field `duration`: {duration} s; expected a duration > 0"),
             ));
         }
-        let quaternion = |start: usize, field: &str| -> Result<UnitQuaternion<f64>> {
-            let q = Quaternion::new(
-                values[start],
-                values[start + 1],
-                values[start + 2],
-                values[start + 3],
-            );
-            let norm = q.norm();
-            if norm == 0.0 || (norm - 1.0).abs() > settings.max_quaternion_norm_error {
-                return Err(parse_error(
-                    line_of(i),
-                    format!(
-                        "frame {i}, field `{field}`: quaternion norm {norm}; expected 1 within {}",
-                        settings.max_quaternion_norm_error
-                    ),
-                ));
-            }
-            Ok(UnitQuaternion::from_quaternion(q))
-        };
+        let n = self.skeleton.len();
         let mut pose = Pose {
             root_position: Vector3::new(values[1], values[2], values[3]),
-            root_orientation: quaternion(4, "root orientation")?,
+            root_orientation: self.quaternion(i, values, 4, "root orientation")?,
             rotations: vec![UnitQuaternion::identity(); n],
             translations: vec![Vector3::zeros(); n],
         };
-        for ((index, kind), (name, start, _)) in targets.iter().zip(JOINT_FIELDS.iter()) {
+        for ((index, kind), (name, start, _)) in self.targets.iter().zip(JOINT_FIELDS.iter()) {
             let rotation = match kind {
-                FieldKind::Quaternion => quaternion(*start, name)?,
-                FieldKind::Angle => match skeleton.joints().get(*index).map(|j| j.kind) {
+                FieldKind::Quaternion => self.quaternion(i, values, *start, name)?,
+                FieldKind::Angle => match self.skeleton.joints().get(*index).map(|j| j.kind) {
                     Some(JointKind::Hinge { axis }) => {
                         UnitQuaternion::from_axis_angle(&axis, values[*start])
                     }
@@ -359,15 +388,36 @@ pub fn read_deepmimic_with(
                 *slot = rotation;
             }
         }
-        times.push(t);
-        poses.push(pose);
-        t += duration;
+        Ok((duration, pose))
     }
-    let duration = times.last().copied().unwrap_or(0.0);
-    settings
-        .limits
-        .check_clip(source_name, times.len(), duration)?;
-    Clip::new(source_name, skeleton, times, poses, UpAxis::Y)
+
+    /// The unit quaternion `w x y z` at `values[start..]` of frame `i` (field `field`); a norm
+    /// of zero or farther from 1 than the settings allow is an error.
+    fn quaternion(
+        &self,
+        i: usize,
+        values: &[f64; DEEPMIMIC_FRAME_LEN],
+        start: usize,
+        field: &str,
+    ) -> Result<UnitQuaternion<f64>> {
+        let q = Quaternion::new(
+            values[start],
+            values[start + 1],
+            values[start + 2],
+            values[start + 3],
+        );
+        let norm = q.norm();
+        let tolerance = self.settings.max_quaternion_norm_error;
+        if norm == 0.0 || (norm - 1.0).abs() > tolerance {
+            return Err(self.error(
+                i,
+                format!(
+                    "frame {i}, field `{field}`: quaternion norm {norm}; expected 1 within {tolerance}"
+                ),
+            ));
+        }
+        Ok(UnitQuaternion::from_quaternion(q))
+    }
 }
 
 /// The 1-based line on which each frame (each array inside `"Frames"`) starts.

@@ -183,12 +183,12 @@ pub(crate) fn first_towards(skeleton: &Skeleton, from: usize, to: usize) -> Opti
     }
 }
 
-fn by_names(skeleton: &Skeleton) -> Vec<MappedPoint> {
-    let normal: Vec<NormalName> = skeleton
-        .joints()
-        .iter()
-        .map(|j| normalise(&j.name))
-        .collect();
+/// The limb joints found by name (`normal`: the joints' normalised names), leg then arm on
+/// each side, each joint below the one found before it on its chain: (point, joint, how).
+fn limb_joints_by_name(
+    skeleton: &Skeleton,
+    normal: &[NormalName],
+) -> Vec<(BodyPoint, usize, FoundBy)> {
     let mut found: Vec<(BodyPoint, usize, FoundBy)> = Vec::new();
     let used = |found: &[(BodyPoint, usize, FoundBy)], j: usize| found.iter().any(|f| f.1 == j);
     for side in [Side::Left, Side::Right] {
@@ -213,6 +213,16 @@ fn by_names(skeleton: &Skeleton) -> Vec<MappedPoint> {
             }
         }
     }
+    found
+}
+
+fn by_names(skeleton: &Skeleton) -> Vec<MappedPoint> {
+    let normal: Vec<NormalName> = skeleton
+        .joints()
+        .iter()
+        .map(|j| normalise(&j.name))
+        .collect();
+    let mut found = limb_joints_by_name(skeleton, &normal);
     let index = |found: &[(BodyPoint, usize, FoundBy)], p: BodyPoint| {
         found.iter().find(|f| f.0 == p).map(|f| f.1)
     };
@@ -361,11 +371,8 @@ fn family_point(markers: &[String], point: BodyPoint) -> Option<Vec<String>> {
     Some(hit)
 }
 
-/// The body points found on a marker set, possibly not all required ones: the Plug-in-Gait
-/// table, then marker families (a joint's markers in pairs or groups, front/back, inner/outer,
-/// medial/lateral: their centroid), then single markers named like a joint;
-/// the pelvis falls back to the hips' markers.
-pub fn marker_points(markers: &[String]) -> Vec<MappedPoint> {
+/// The body points the Plug-in-Gait table finds on `markers`.
+fn table_points(markers: &[String]) -> Vec<MappedPoint> {
     let plain: Vec<String> = markers
         .iter()
         .map(|m| {
@@ -376,7 +383,6 @@ pub fn marker_points(markers: &[String]) -> Vec<MappedPoint> {
                 .to_ascii_uppercase()
         })
         .collect();
-    let normal: Vec<NormalName> = markers.iter().map(|m| normalise(m)).collect();
     let mut found: Vec<MappedPoint> = Vec::new();
     for (point, groups) in MARKER_TABLE {
         let group = groups.iter().find_map(|g| {
@@ -392,6 +398,58 @@ pub fn marker_points(markers: &[String]) -> Vec<MappedPoint> {
             });
         }
     }
+    found
+}
+
+/// The single marker named like `point`'s joint, if any.
+fn named_marker(markers: &[String], normal: &[NormalName], point: BodyPoint) -> Option<String> {
+    let named = |side: Option<Side>, words: &[&str]| {
+        words.iter().find_map(|w| {
+            normal
+                .iter()
+                .position(|n| n.side == side && n.base == *w)
+                .map(|i| markers[i].clone())
+        })
+    };
+    match point.limb() {
+        Some((side, limb)) => named(Some(side), names::limb_words(limb)),
+        None => named(
+            None,
+            match point {
+                BodyPoint::Pelvis => &names::PELVIS_WORDS[..],
+                BodyPoint::Chest => &names::CHEST_WORDS[..],
+                BodyPoint::Neck => &names::NECK_WORDS[..],
+                _ => &names::HEAD_WORDS[..],
+            },
+        ),
+    }
+}
+
+/// The pelvis from the hips' markers, when both hips are found on markers.
+fn pelvis_from_hips(found: &[MappedPoint]) -> Option<MappedPoint> {
+    let hips: Vec<String> = [BodyPoint::LeftHip, BodyPoint::RightHip]
+        .iter()
+        .filter_map(|h| found.iter().find(|p| p.point == *h))
+        .filter_map(|p| match &p.source {
+            PointSource::Markers(m) => Some(m.clone()),
+            PointSource::Joint(_) => None,
+        })
+        .flatten()
+        .collect();
+    (hips.len() >= 2).then_some(MappedPoint {
+        point: BodyPoint::Pelvis,
+        source: PointSource::Markers(hips),
+        found_by: FoundBy::Structure,
+    })
+}
+
+/// The body points found on a marker set, possibly not all required ones: the Plug-in-Gait
+/// table, then marker families (a joint's markers in pairs or groups, front/back, inner/outer,
+/// medial/lateral: their centroid), then single markers named like a joint;
+/// the pelvis falls back to the hips' markers.
+pub fn marker_points(markers: &[String]) -> Vec<MappedPoint> {
+    let normal: Vec<NormalName> = markers.iter().map(|m| normalise(m)).collect();
+    let mut found = table_points(markers);
     for point in BodyPoint::ALL {
         if found.iter().all(|p| p.point != point) {
             if let Some(m) = family_point(markers, point) {
@@ -403,31 +461,11 @@ pub fn marker_points(markers: &[String]) -> Vec<MappedPoint> {
             }
         }
     }
-    let named = |side: Option<Side>, words: &[&str]| {
-        words.iter().find_map(|w| {
-            normal
-                .iter()
-                .position(|n| n.side == side && n.base == *w)
-                .map(|i| markers[i].clone())
-        })
-    };
     for point in BodyPoint::ALL {
         if found.iter().any(|p| p.point == point) {
             continue;
         }
-        let hit = match point.limb() {
-            Some((side, limb)) => named(Some(side), names::limb_words(limb)),
-            None => named(
-                None,
-                match point {
-                    BodyPoint::Pelvis => &names::PELVIS_WORDS[..],
-                    BodyPoint::Chest => &names::CHEST_WORDS[..],
-                    BodyPoint::Neck => &names::NECK_WORDS[..],
-                    _ => &names::HEAD_WORDS[..],
-                },
-            ),
-        };
-        if let Some(m) = hit {
+        if let Some(m) = named_marker(markers, &normal, point) {
             found.push(MappedPoint {
                 point,
                 source: PointSource::Markers(vec![m]),
@@ -436,22 +474,7 @@ pub fn marker_points(markers: &[String]) -> Vec<MappedPoint> {
         }
     }
     if !found.iter().any(|p| p.point == BodyPoint::Pelvis) {
-        let hips: Vec<String> = [BodyPoint::LeftHip, BodyPoint::RightHip]
-            .iter()
-            .filter_map(|h| found.iter().find(|p| p.point == *h))
-            .filter_map(|p| match &p.source {
-                PointSource::Markers(m) => Some(m.clone()),
-                PointSource::Joint(_) => None,
-            })
-            .flatten()
-            .collect();
-        if hips.len() >= 2 {
-            found.push(MappedPoint {
-                point: BodyPoint::Pelvis,
-                source: PointSource::Markers(hips),
-                found_by: FoundBy::Structure,
-            });
-        }
+        found.extend(pelvis_from_hips(&found));
     }
     found.sort_by_key(|p| p.point);
     found

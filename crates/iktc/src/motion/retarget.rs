@@ -6,9 +6,9 @@ use nalgebra::{Isometry3, Rotation3, UnitQuaternion, Vector3};
 
 use super::angles::unwrap_track;
 use super::decompose::decompose_rotation;
-use super::retarget_map::RetargetMap;
+use super::retarget_map::{JointMap, RetargetMap, RootMap};
 use super::spline::CubicSpline;
-use super::Clip;
+use super::{Clip, Pose, Skeleton};
 use crate::error::{check_finite, Error, Result};
 use crate::model::{JointKind, Kinematics, Robot, State};
 use crate::resources::RunLimits;
@@ -184,64 +184,11 @@ pub fn retarget(clip: &Clip, robot: &Robot, map: &RetargetMap) -> Result<Retarge
     let skeleton = clip.skeleton();
     let state = State::neutral(robot);
     let kin = Kinematics::new(robot, &state)?;
-    let b = map.basis;
-    let mut resolved = Vec::with_capacity(map.joints.len());
-    for jm in &map.joints {
-        let source = skeleton.index_of(&jm.source)?;
-        let mut joints = Vec::with_capacity(jm.targets.len());
-        for t in &jm.targets {
-            robot.active_joint_index(&t.joint)?;
-            let joint = robot
-                .joints()
-                .iter()
-                .find(|j| j.name == t.joint)
-                .ok_or_else(|| Error::UnknownName {
-                    kind: "joint",
-                    name: t.joint.clone(),
-                    valid: robot.active_joints().map(|j| j.name.clone()).collect(),
-                })?;
-            joints.push(joint);
-        }
-        for w in joints.windows(2) {
-            if w[1].parent != w[0].child {
-                return Err(Error::InvalidSetting {
-                    name: format!("targets of `{}`", jm.source),
-                    value: format!("{} then {}", w[0].name, w[1].name),
-                    expected: "robot joints forming a serial chain, parent first".into(),
-                });
-            }
-        }
-        let first_parent = joints.first().map_or(0, |j| j.parent);
-        let parent = kin
-            .link_pose(first_parent)
-            .map_or(Rotation3::identity(), |p| p.rotation.to_rotation_matrix());
-        let mut axes = Vec::with_capacity(joints.len());
-        for j in &joints {
-            let JointKind::Revolute { axis } = j.kind else {
-                return Err(Error::InvalidSetting {
-                    name: format!("robot joint `{}`", j.name),
-                    value: j.kind.name().into(),
-                    expected: "a revolute joint (a captured rotation drives revolute joints)"
-                        .into(),
-                });
-            };
-            let link = kin
-                .link_pose(j.parent)
-                .map_or(Rotation3::identity(), |p| p.rotation.to_rotation_matrix());
-            let world = link * j.origin.rotation.to_rotation_matrix() * axis.into_inner();
-            axes.push(parent.transpose() * world);
-        }
-        let (parent_rest, rest) = RetargetMap::rest(jm);
-        resolved.push(ResolvedJoint {
-            source,
-            parent,
-            parent_rest,
-            rest,
-            axes,
-            sign_scale: jm.targets.iter().map(|t| t.sign * t.scale).collect(),
-            offset: jm.targets.iter().map(|t| t.offset).collect(),
-        });
-    }
+    let resolved = map
+        .joints
+        .iter()
+        .map(|jm| resolve_joint(jm, skeleton, robot, &kin))
+        .collect::<Result<Vec<_>>>()?;
     for h in &map.holds {
         robot.active_joint_index(&h.joint)?;
     }
@@ -252,15 +199,122 @@ pub fn retarget(clip: &Clip, robot: &Robot, map: &RetargetMap) -> Result<Retarge
 
     let n = clip.frame_count();
     let joint_names = map.robot_joints();
-    let mut joint_angles: Vec<Vec<f64>> = vec![Vec::with_capacity(n); joint_names.len()];
-    let mut residuals = vec![0.0f64; resolved.len()];
-    let mut previous: Vec<Option<[f64; 3]>> = vec![None; resolved.len()];
-    let mut transforms = vec![Isometry3::identity(); skeleton.len()];
-    let mut heights = Vec::with_capacity(n);
-    let mut angles: [Vec<f64>; 3] = [Vec::new(), Vec::new(), Vec::new()];
-    let zyx = [Vector3::z(), Vector3::y(), Vector3::x()];
-    let mut prev_zyx: Option<[f64; 3]> = None;
+    let mut joints = JointTracks::new(joint_names.len(), resolved.len(), n);
+    let mut pelvis = PelvisTracks::new(skeleton.len(), n);
     for pose in clip.frames() {
+        joints.push_frame(&resolved, pose, map)?;
+        pelvis.push_frame(skeleton, pose, root, &map.basis)?;
+    }
+    let JointTracks {
+        mut joint_angles,
+        residuals,
+        ..
+    } = joints;
+    for track in joint_angles.iter_mut() {
+        unwrap_track(track, std::f64::consts::TAU);
+    }
+    let (pelvis_height, pelvis_angles) = pelvis.finish(&map.root);
+    Ok(Retargeted {
+        times: clip.times().to_vec(),
+        joint_names,
+        joint_angles,
+        pelvis_height,
+        pelvis_angles,
+        residuals,
+    })
+}
+
+/// Resolves the joint map `jm`: its source joint, its targets (checked to be a serial chain of
+/// revolute joints) and their axes in the frame of the first target's parent link.
+fn resolve_joint(
+    jm: &JointMap,
+    skeleton: &Skeleton,
+    robot: &Robot,
+    kin: &Kinematics,
+) -> Result<ResolvedJoint> {
+    let source = skeleton.index_of(&jm.source)?;
+    let mut joints = Vec::with_capacity(jm.targets.len());
+    for t in &jm.targets {
+        robot.active_joint_index(&t.joint)?;
+        let joint = robot
+            .joints()
+            .iter()
+            .find(|j| j.name == t.joint)
+            .ok_or_else(|| Error::UnknownName {
+                kind: "joint",
+                name: t.joint.clone(),
+                valid: robot.active_joints().map(|j| j.name.clone()).collect(),
+            })?;
+        joints.push(joint);
+    }
+    for w in joints.windows(2) {
+        if w[1].parent != w[0].child {
+            return Err(Error::InvalidSetting {
+                name: format!("targets of `{}`", jm.source),
+                value: format!("{} then {}", w[0].name, w[1].name),
+                expected: "robot joints forming a serial chain, parent first".into(),
+            });
+        }
+    }
+    let first_parent = joints.first().map_or(0, |j| j.parent);
+    let parent = kin
+        .link_pose(first_parent)
+        .map_or(Rotation3::identity(), |p| p.rotation.to_rotation_matrix());
+    let mut axes = Vec::with_capacity(joints.len());
+    for j in &joints {
+        let JointKind::Revolute { axis } = j.kind else {
+            return Err(Error::InvalidSetting {
+                name: format!("robot joint `{}`", j.name),
+                value: j.kind.name().into(),
+                expected: "a revolute joint (a captured rotation drives revolute joints)".into(),
+            });
+        };
+        let link = kin
+            .link_pose(j.parent)
+            .map_or(Rotation3::identity(), |p| p.rotation.to_rotation_matrix());
+        let world = link * j.origin.rotation.to_rotation_matrix() * axis.into_inner();
+        axes.push(parent.transpose() * world);
+    }
+    let (parent_rest, rest) = RetargetMap::rest(jm);
+    Ok(ResolvedJoint {
+        source,
+        parent,
+        parent_rest,
+        rest,
+        axes,
+        sign_scale: jm.targets.iter().map(|t| t.sign * t.scale).collect(),
+        offset: jm.targets.iter().map(|t| t.offset).collect(),
+    })
+}
+
+/// The robot joints' angle tracks being built frame by frame.
+struct JointTracks {
+    /// One track per robot joint of the map (targets, then holds) \[rad\].
+    joint_angles: Vec<Vec<f64>>,
+    /// Largest decomposition residual per joint map.
+    residuals: Vec<f64>,
+    /// Previous frame's angles per joint map \[rad\].
+    previous: Vec<Option<[f64; 3]>>,
+}
+
+impl JointTracks {
+    /// Empty tracks for `joints` robot joints, `maps` joint maps and `frames` frames.
+    fn new(joints: usize, maps: usize, frames: usize) -> Self {
+        JointTracks {
+            joint_angles: vec![Vec::with_capacity(frames); joints],
+            residuals: vec![0.0f64; maps],
+            previous: vec![None; maps],
+        }
+    }
+
+    /// Appends the angles of `pose`: every resolved joint map decomposed, then the held values.
+    fn push_frame(
+        &mut self,
+        resolved: &[ResolvedJoint],
+        pose: &Pose,
+        map: &RetargetMap,
+    ) -> Result<()> {
+        let b = map.basis;
         let mut column = 0;
         for (k, r) in resolved.iter().enumerate() {
             let q_src = pose.rotations[r.source].to_rotation_matrix();
@@ -276,63 +330,97 @@ pub fn retarget(clip: &Clip, robot: &Robot, map: &RetargetMap) -> Result<Retarge
             let report = decompose_rotation(
                 &UnitQuaternion::from_rotation_matrix(&rot),
                 &r.axes,
-                previous[k].as_ref().map(|p| &p[..m]),
+                self.previous[k].as_ref().map(|p| &p[..m]),
                 &mut out[..m],
             )?;
-            residuals[k] = residuals[k].max(report.residual);
-            previous[k] = Some(out);
-            for i in 0..m {
-                joint_angles[column + i].push(r.offset[i] + r.sign_scale[i] * out[i]);
+            self.residuals[k] = self.residuals[k].max(report.residual);
+            self.previous[k] = Some(out);
+            let tracks = &mut self.joint_angles[column..column + m];
+            for (i, track) in tracks.iter_mut().enumerate() {
+                track.push(r.offset[i] + r.sign_scale[i] * out[i]);
             }
             column += m;
         }
-        for (h, track) in map.holds.iter().zip(joint_angles[column..].iter_mut()) {
+        for (h, track) in map.holds.iter().zip(self.joint_angles[column..].iter_mut()) {
             track.push(h.value);
         }
-        skeleton.world_transforms(pose, &mut transforms)?;
-        let root_pose = transforms[root];
+        Ok(())
+    }
+}
+
+/// The pelvis tracks being built frame by frame, in the robot's Z-up world.
+struct PelvisTracks {
+    /// World transforms of the skeleton's joints (scratch).
+    transforms: Vec<Isometry3<f64>>,
+    /// Root height per frame \[skeleton units\].
+    heights: Vec<f64>,
+    /// Z-Y-X angles of the root per frame \[rad\].
+    angles: [Vec<f64>; 3],
+    /// Previous frame's Z-Y-X angles \[rad\].
+    prev_zyx: Option<[f64; 3]>,
+}
+
+impl PelvisTracks {
+    /// Empty tracks for a skeleton of `joints` joints and `frames` frames.
+    fn new(joints: usize, frames: usize) -> Self {
+        PelvisTracks {
+            transforms: vec![Isometry3::identity(); joints],
+            heights: Vec::with_capacity(frames),
+            angles: [Vec::new(), Vec::new(), Vec::new()],
+            prev_zyx: None,
+        }
+    }
+
+    /// Appends the height and Z-Y-X angles of joint `root` of `pose`, through the basis `b`.
+    fn push_frame(
+        &mut self,
+        skeleton: &Skeleton,
+        pose: &Pose,
+        root: usize,
+        b: &Rotation3<f64>,
+    ) -> Result<()> {
+        let zyx = [Vector3::z(), Vector3::y(), Vector3::x()];
+        skeleton.world_transforms(pose, &mut self.transforms)?;
+        let root_pose = self.transforms[root];
         let p = b * root_pose.translation.vector;
-        heights.push(p.z);
+        self.heights.push(p.z);
         let r_body = b * root_pose.rotation.to_rotation_matrix() * b.transpose();
         let mut a = [0.0; 3];
         decompose_rotation(
             &UnitQuaternion::from_rotation_matrix(&r_body),
             &zyx,
-            prev_zyx.as_ref().map(|p| &p[..]),
+            self.prev_zyx.as_ref().map(|p| &p[..]),
             &mut a,
         )?;
-        prev_zyx = Some(a);
-        for (track, v) in angles.iter_mut().zip(a) {
+        self.prev_zyx = Some(a);
+        for (track, v) in self.angles.iter_mut().zip(a) {
             track.push(v);
         }
+        Ok(())
     }
-    for track in joint_angles.iter_mut().chain(angles.iter_mut()) {
-        unwrap_track(track, std::f64::consts::TAU);
-    }
-    let h0 = heights.first().copied().unwrap_or(0.0);
-    let pelvis_height = heights
-        .iter()
-        .map(|h| map.root.height_scale * (h - h0))
-        .collect();
-    let scales = [
-        map.root.yaw_scale,
-        map.root.pitch_scale,
-        map.root.roll_scale,
-    ];
-    for (track, s) in angles.iter_mut().zip(scales) {
-        let a0 = track.first().copied().unwrap_or(0.0);
-        for v in track.iter_mut() {
-            *v = s * (*v - a0);
+
+    /// The height change \[m\] and the unwrapped attitude change \[rad\] from the first frame,
+    /// scaled by the root map.
+    fn finish(self, root: &RootMap) -> (Vec<f64>, [Vec<f64>; 3]) {
+        let mut angles = self.angles;
+        for track in angles.iter_mut() {
+            unwrap_track(track, std::f64::consts::TAU);
         }
+        let h0 = self.heights.first().copied().unwrap_or(0.0);
+        let pelvis_height = self
+            .heights
+            .iter()
+            .map(|h| root.height_scale * (h - h0))
+            .collect();
+        let scales = [root.yaw_scale, root.pitch_scale, root.roll_scale];
+        for (track, s) in angles.iter_mut().zip(scales) {
+            let a0 = track.first().copied().unwrap_or(0.0);
+            for v in track.iter_mut() {
+                *v = s * (*v - a0);
+            }
+        }
+        (pelvis_height, angles)
     }
-    Ok(Retargeted {
-        times: clip.times().to_vec(),
-        joint_names,
-        joint_angles,
-        pelvis_height,
-        pelvis_angles: angles,
-        residuals,
-    })
 }
 
 /// The range `[lower, upper]` \[rad\] shrunk by `margin` \[rad\] on each side,

@@ -196,6 +196,95 @@ pub struct RetargetMap {
 #[cfg(feature = "toml")]
 const BASIS_TOLERANCE: f64 = 1e-6;
 
+/// An [`Error::InvalidSetting`] for the setting `name` of the map `source_name`.
+#[cfg(feature = "toml")]
+fn invalid(source_name: &str, name: String, value: String, expected: &str) -> Error {
+    Error::InvalidSetting {
+        name: format!("{source_name}: {name}"),
+        value,
+        expected: expected.into(),
+    }
+}
+
+/// Checks one joint map: 1 to 3 targets, finite rest rotations \[rad\], signs ±1, finite
+/// scales and offsets.
+#[cfg(feature = "toml")]
+fn check_joint_map(jm: &JointMap, source_name: &str) -> Result<()> {
+    if jm.targets.is_empty() || jm.targets.len() > super::MAX_DECOMPOSITION_AXES {
+        return Err(invalid(
+            source_name,
+            format!("targets of `{}`", jm.source),
+            format!("{} joints", jm.targets.len()),
+            "1 to 3 robot joints",
+        ));
+    }
+    if jm
+        .rest_rotation
+        .iter()
+        .chain(&jm.parent_rest_rotation)
+        .any(|v| !v.is_finite())
+    {
+        return Err(invalid(
+            source_name,
+            format!("rest_rotation of `{}`", jm.source),
+            format!("{:?}", jm.rest_rotation),
+            "a finite rotation vector [rad]",
+        ));
+    }
+    for t in &jm.targets {
+        if t.sign != 1.0 && t.sign != -1.0 {
+            return Err(invalid(
+                source_name,
+                format!("sign of `{}`", t.joint),
+                t.sign.to_string(),
+                "+1 or -1",
+            ));
+        }
+        if !(t.scale.is_finite() && t.offset.is_finite()) {
+            return Err(invalid(
+                source_name,
+                format!("scale / offset of `{}`", t.joint),
+                format!("{} / {}", t.scale, t.offset),
+                "finite numbers",
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Checks that no robot joint is named twice among the targets and holds, and that every held
+/// value \[rad\] is finite.
+#[cfg(feature = "toml")]
+fn check_holds(joints: &[JointMap], holds: &[HoldJoint], source_name: &str) -> Result<()> {
+    let mut seen: Vec<&str> = Vec::new();
+    for name in joints
+        .iter()
+        .flat_map(|j| j.targets.iter().map(|t| t.joint.as_str()))
+        .chain(holds.iter().map(|h| h.joint.as_str()))
+    {
+        if seen.contains(&name) {
+            return Err(invalid(
+                source_name,
+                "robot joints".into(),
+                name.into(),
+                "each robot joint driven by one map entry or hold only",
+            ));
+        }
+        seen.push(name);
+    }
+    for h in holds {
+        if !h.value.is_finite() {
+            return Err(invalid(
+                source_name,
+                format!("hold value of `{}`", h.joint),
+                h.value.to_string(),
+                "a finite angle [rad]",
+            ));
+        }
+    }
+    Ok(())
+}
+
 impl RetargetMap {
     /// Parses and checks a map. `source_name` names the text in errors.
     ///
@@ -207,16 +296,12 @@ impl RetargetMap {
         let file: MapFile =
             toml::from_str(text).map_err(|e| super::body_map::toml_error(text, source_name, &e))?;
         let b = Matrix3::from_fn(|r, c| file.basis[r][c]);
-        let invalid = |name: String, value: String, expected: &str| Error::InvalidSetting {
-            name: format!("{source_name}: {name}"),
-            value,
-            expected: expected.into(),
-        };
         if b.iter().any(|v| !v.is_finite())
             || (b.transpose() * b - Matrix3::identity()).norm() > BASIS_TOLERANCE
             || b.determinant() < 0.0
         {
             return Err(invalid(
+                source_name,
                 "basis".into(),
                 format!("{:?}", file.basis),
                 "a proper rotation matrix (orthonormal rows, determinant +1)",
@@ -230,71 +315,18 @@ impl RetargetMap {
             ("root.roll_scale", root.roll_scale),
         ] {
             if !v.is_finite() {
-                return Err(invalid(n.into(), v.to_string(), "a finite number"));
+                return Err(invalid(
+                    source_name,
+                    n.into(),
+                    v.to_string(),
+                    "a finite number",
+                ));
             }
         }
-        let mut seen: Vec<&str> = Vec::new();
         for jm in &file.joint {
-            if jm.targets.is_empty() || jm.targets.len() > super::MAX_DECOMPOSITION_AXES {
-                return Err(invalid(
-                    format!("targets of `{}`", jm.source),
-                    format!("{} joints", jm.targets.len()),
-                    "1 to 3 robot joints",
-                ));
-            }
-            if jm
-                .rest_rotation
-                .iter()
-                .chain(&jm.parent_rest_rotation)
-                .any(|v| !v.is_finite())
-            {
-                return Err(invalid(
-                    format!("rest_rotation of `{}`", jm.source),
-                    format!("{:?}", jm.rest_rotation),
-                    "a finite rotation vector [rad]",
-                ));
-            }
-            for t in &jm.targets {
-                if t.sign != 1.0 && t.sign != -1.0 {
-                    return Err(invalid(
-                        format!("sign of `{}`", t.joint),
-                        t.sign.to_string(),
-                        "+1 or -1",
-                    ));
-                }
-                if !(t.scale.is_finite() && t.offset.is_finite()) {
-                    return Err(invalid(
-                        format!("scale / offset of `{}`", t.joint),
-                        format!("{} / {}", t.scale, t.offset),
-                        "finite numbers",
-                    ));
-                }
-            }
+            check_joint_map(jm, source_name)?;
         }
-        for name in file
-            .joint
-            .iter()
-            .flat_map(|j| j.targets.iter().map(|t| t.joint.as_str()))
-            .chain(file.hold.iter().map(|h| h.joint.as_str()))
-        {
-            if seen.contains(&name) {
-                return Err(invalid(
-                    "robot joints".into(),
-                    name.into(),
-                    "each robot joint driven by one map entry or hold only",
-                ));
-            }
-            seen.push(name);
-        }
-        for h in &file.hold {
-            if !h.value.is_finite() {
-                return Err(invalid(
-                    format!("hold value of `{}`", h.joint),
-                    h.value.to_string(),
-                    "a finite angle [rad]",
-                ));
-            }
-        }
+        check_holds(&file.joint, &file.hold, source_name)?;
         Ok(Self {
             name: file.name.unwrap_or_else(|| source_name.to_string()),
             basis: Rotation3::from_matrix_unchecked(b),

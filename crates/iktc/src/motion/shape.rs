@@ -173,30 +173,38 @@ struct Limbs {
     toe: Option<usize>,
 }
 
-/// Finds the body points by shape (see the module documentation); `Err` says why not.
-pub(crate) fn by_shape(skeleton: &Skeleton) -> std::result::Result<Vec<MappedPoint>, String> {
-    let tree = Tree::new(skeleton);
+/// The skeleton's vertical at rest: its up direction and standing height.
+struct Upright {
+    /// Unit vector from the legs to the pelvis.
+    up: Vector3<f64>,
+    /// Extent of the rest pose along `up` \[skeleton units\].
+    h: f64,
+}
+
+/// Step 1: the first joint from the root with at least three branches.
+fn find_pelvis(tree: &Tree) -> std::result::Result<usize, String> {
     let mut pelvis = 0usize;
     loop {
         let b = tree.branches(pelvis, MIN_LIMB_JOINTS);
         if b.len() >= 3 {
-            break;
+            return Ok(pelvis);
         }
         match b.first() {
             Some(c) if b.len() == 1 => pelvis = *c,
             _ => return Err("no joint with two legs and a spine branching from it".to_string()),
         }
     }
-    let branches = tree.branches(pelvis, MIN_LIMB_JOINTS);
-    let (spine, legs) = (branches[0], [branches[1], branches[2]]);
-    let p0 = tree.rest[pelvis];
+}
+
+/// Step 2: up from the mean of the `legs`' joints to the pelvis, and the height along it.
+fn upright(tree: &Tree, pelvis: usize, legs: [usize; 2]) -> std::result::Result<Upright, String> {
     let leg_joints: Vec<usize> = legs.iter().flat_map(|l| tree.subtree(*l)).collect();
     let below: Vector3<f64> = leg_joints
         .iter()
         .map(|j| tree.rest[*j])
         .sum::<Vector3<f64>>()
         / leg_joints.len() as f64;
-    let up = (p0 - below)
+    let up = (tree.rest[pelvis] - below)
         .try_normalize(0.0)
         .ok_or("the legs do not hang from the pelvis at rest")?;
     let heights: Vec<f64> = tree.rest.iter().map(|p| p.dot(&up)).collect();
@@ -205,25 +213,37 @@ pub(crate) fn by_shape(skeleton: &Skeleton) -> std::result::Result<Vec<MappedPoi
     if !(h.is_finite() && h > 0.0) {
         return Err("the rest pose has no height".to_string());
     }
-    // Chest: down the spine along the largest child.
+    Ok(Upright { up, h })
+}
+
+/// Step 3, the chest: down the spine along the largest child to three branches of two joints.
+fn find_chest(tree: &Tree, spine: usize) -> std::result::Result<usize, String> {
     let mut chest = spine;
     loop {
         if tree.branches(chest, 2).len() >= 3 {
-            break;
+            return Ok(chest);
         }
         match tree.children[chest].iter().max_by_key(|c| tree.size[**c]) {
             Some(c) => chest = *c,
             None => return Err("no upper-spine joint with two arms and a head".to_string()),
         }
     }
+}
+
+/// Step 3, at the chest: the head branch (reaching highest along `up`) and up to two arms.
+fn head_and_arms(
+    tree: &Tree,
+    chest: usize,
+    up: &Vector3<f64>,
+) -> std::result::Result<(usize, Vec<usize>), String> {
     let pc = tree.rest[chest];
     let upper = tree.branches(chest, 2);
     let head_branch = upper
         .iter()
         .copied()
         .max_by(|a, b| {
-            let ha = tree.rest[tree.farthest(*a, &pc)].dot(&up);
-            let hb = tree.rest[tree.farthest(*b, &pc)].dot(&up);
+            let ha = tree.rest[tree.farthest(*a, &pc)].dot(up);
+            let hb = tree.rest[tree.farthest(*b, &pc)].dot(up);
             ha.total_cmp(&hb)
         })
         .ok_or("no head branch")?;
@@ -233,54 +253,99 @@ pub(crate) fn by_shape(skeleton: &Skeleton) -> std::result::Result<Vec<MappedPoi
         .filter(|b| *b != head_branch)
         .take(2)
         .collect();
-    let leg = |l: usize| -> std::result::Result<Limbs, String> {
-        let chain = tree.chain(l, tree.farthest(l, &p0), &p0);
-        let (i, j, k) =
-            fit_three(&tree, &chain, h, THIGH, SHANK).ok_or("a leg has fewer than three joints")?;
-        let toe = chain.get(k + 1).copied().filter(|t| {
-            let s = tree.rest[*t] - tree.rest[chain[k]];
-            let vertical = s.dot(&up).abs();
-            (s - up * s.dot(&up)).norm() > vertical
-        });
-        Ok(Limbs {
-            top: chain[i],
-            mid: chain[j],
-            end: chain[k],
-            toe,
-        })
-    };
-    let arm = |a: usize| -> std::result::Result<Limbs, String> {
-        let chain = tree.chain(a, tree.farthest(a, &pc), &pc);
-        let (i, j, k) = fit_three(&tree, &chain, h, UPPER_ARM, FOREARM)
-            .ok_or("an arm has fewer than three joints")?;
-        Ok(Limbs {
-            top: chain[i],
-            mid: chain[j],
-            end: chain[k],
-            toe: None,
-        })
-    };
-    let legs = [leg(legs[0])?, leg(legs[1])?];
-    let arms = match arms.as_slice() {
-        [a, b] => [arm(*a)?, arm(*b)?],
-        _ => return Err("fewer than two arms at the upper spine".to_string()),
-    };
+    Ok((head_branch, arms))
+}
+
+/// Step 4 for the leg branch `l` at the pelvis (at `p0`): hip, knee, ankle and toe.
+fn fit_leg(
+    tree: &Tree,
+    l: usize,
+    p0: &Vector3<f64>,
+    body: &Upright,
+) -> std::result::Result<Limbs, String> {
+    let up = body.up;
+    let chain = tree.chain(l, tree.farthest(l, p0), p0);
+    let (i, j, k) =
+        fit_three(tree, &chain, body.h, THIGH, SHANK).ok_or("a leg has fewer than three joints")?;
+    let toe = chain.get(k + 1).copied().filter(|t| {
+        let s = tree.rest[*t] - tree.rest[chain[k]];
+        let vertical = s.dot(&up).abs();
+        (s - up * s.dot(&up)).norm() > vertical
+    });
+    Ok(Limbs {
+        top: chain[i],
+        mid: chain[j],
+        end: chain[k],
+        toe,
+    })
+}
+
+/// Step 4 for the arm branch `a` at the chest (at `pc`): shoulder, elbow and wrist.
+fn fit_arm(tree: &Tree, a: usize, pc: &Vector3<f64>, h: f64) -> std::result::Result<Limbs, String> {
+    let chain = tree.chain(a, tree.farthest(a, pc), pc);
+    let (i, j, k) = fit_three(tree, &chain, h, UPPER_ARM, FOREARM)
+        .ok_or("an arm has fewer than three joints")?;
+    Ok(Limbs {
+        top: chain[i],
+        mid: chain[j],
+        end: chain[k],
+        toe: None,
+    })
+}
+
+/// Step 6: the unit left direction, `up × forward` with forward the mean horizontal toe segment.
+fn left_direction(
+    tree: &Tree,
+    legs: &[Limbs; 2],
+    up: &Vector3<f64>,
+) -> std::result::Result<Vector3<f64>, String> {
     let forward: Vector3<f64> = legs
         .iter()
         .filter_map(|l| l.toe.map(|t| tree.rest[t] - tree.rest[l.end]))
-        .map(|s| s - up * s.dot(&up))
+        .map(|s| s - up * s.dot(up))
         .sum();
     let forward = forward
         .try_normalize(0.0)
         .ok_or("no toe segment to tell the facing direction, so left and right are unknown")?;
-    let left = up.cross(&forward);
-    let order = |a: usize, b: usize| -> std::result::Result<bool, String> {
-        let s = (tree.rest[a] - tree.rest[b]).dot(&left) / h;
-        if s.abs() < MIN_SIDE_SEPARATION {
-            return Err("two limbs are not apart sideways at rest".to_string());
-        }
-        Ok(s > 0.0)
+    Ok(up.cross(&forward))
+}
+
+/// Whether joint `a` lies further along `left` than joint `b`; too close sideways is an error.
+fn is_left_of(
+    tree: &Tree,
+    left: &Vector3<f64>,
+    h: f64,
+    a: usize,
+    b: usize,
+) -> std::result::Result<bool, String> {
+    let s = (tree.rest[a] - tree.rest[b]).dot(left) / h;
+    if s.abs() < MIN_SIDE_SEPARATION {
+        return Err("two limbs are not apart sideways at rest".to_string());
+    }
+    Ok(s > 0.0)
+}
+
+/// Finds the body points by shape (see the module documentation); `Err` says why not.
+pub(crate) fn by_shape(skeleton: &Skeleton) -> std::result::Result<Vec<MappedPoint>, String> {
+    let tree = Tree::new(skeleton);
+    let pelvis = find_pelvis(&tree)?;
+    let branches = tree.branches(pelvis, MIN_LIMB_JOINTS);
+    let (spine, legs) = (branches[0], [branches[1], branches[2]]);
+    let p0 = tree.rest[pelvis];
+    let body = upright(&tree, pelvis, legs)?;
+    let (up, h) = (body.up, body.h);
+    let chest = find_chest(&tree, spine)?;
+    let pc = tree.rest[chest];
+    let (head_branch, arms) = head_and_arms(&tree, chest, &up)?;
+    let legs = [
+        fit_leg(&tree, legs[0], &p0, &body)?,
+        fit_leg(&tree, legs[1], &p0, &body)?,
+    ];
+    let arms = match arms.as_slice() {
+        [a, b] => [fit_arm(&tree, *a, &pc, h)?, fit_arm(&tree, *b, &pc, h)?],
+        _ => return Err("fewer than two arms at the upper spine".to_string()),
     };
+    let left = left_direction(&tree, &legs, &up)?;
     let mut out = Vec::new();
     let mut push = |point: BodyPoint, j: usize| {
         if let Some(joint) = skeleton.joints().get(j) {
@@ -306,8 +371,8 @@ pub(crate) fn by_shape(skeleton: &Skeleton) -> std::result::Result<Vec<MappedPoi
             push(BodyPoint::Head, *before_leaf);
         }
     }
-    let first_leg_left = order(legs[0].top, legs[1].top)?;
-    let first_arm_left = order(arms[0].top, arms[1].top)?;
+    let first_leg_left = is_left_of(&tree, &left, h, legs[0].top, legs[1].top)?;
+    let first_arm_left = is_left_of(&tree, &left, h, arms[0].top, arms[1].top)?;
     for (limbs, first_left, names) in [
         (&legs, first_leg_left, [Limb::Hip, Limb::Knee, Limb::Ankle]),
         (

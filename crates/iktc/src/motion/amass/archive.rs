@@ -58,29 +58,8 @@ impl AmassArchive {
         limits: &ReadLimits,
     ) -> Result<Self> {
         let mut npz = Npz::new(reader, source)?;
-        let bad = |message: String| Error::Parse {
-            source_name: source.to_string(),
-            line: 0,
-            message,
-        };
-        let key = FRAME_RATE_KEYS.iter().find(|k| npz.has(k)).ok_or_else(|| {
-            bad(format!(
-                "no frame rate: an AMASS archive holds `{}` or `{}`; it holds: {}",
-                FRAME_RATE_KEYS[0],
-                FRAME_RATE_KEYS[1],
-                npz.names().join(", ")
-            ))
-        })?;
-        let rate = npz.array(key, 1)?;
-        let frame_rate = match rate.values[..] {
-            [r] if r.is_finite() && r > 0.0 => r,
-            _ => {
-                return Err(bad(format!(
-                    "`{key}` is {:?}, expected one finite frame rate > 0 [Hz]",
-                    rate.values
-                )))
-            }
-        };
+        let bad = |message: String| archive_error(source, message);
+        let frame_rate = read_frame_rate(&mut npz, source)?;
         let shape = npz.shape("poses")?;
         let (frames, width) = match shape[..] {
             [t, w] if t >= 1 && w >= 3 && w % 3 == 0 && w <= MAX_POSE_WIDTH => (t, w),
@@ -115,17 +94,7 @@ impl AmassArchive {
                 });
             }
         }
-        let betas = if npz.has("betas") {
-            npz.array("betas", MAX_BETAS)?.values
-        } else {
-            Vec::new()
-        };
-        if let Some(k) = betas.iter().position(|x| !x.is_finite()) {
-            return Err(Error::NonFinite {
-                what: format!("{source}: `betas` at element {k}"),
-                value: betas[k],
-            });
-        }
+        let betas = read_betas(&mut npz, source)?;
         Ok(Self {
             frame_rate,
             joint_count: width / 3,
@@ -159,4 +128,56 @@ impl AmassArchive {
         let k = (frame * self.joint_count + joint) * 3;
         self.poses.get(k..k + 3).map(Vector3::from_column_slice)
     }
+}
+
+/// An [`Error::Parse`] about the archive `source`.
+fn archive_error(source: &str, message: String) -> Error {
+    Error::Parse {
+        source_name: source.to_string(),
+        line: 0,
+        message,
+    }
+}
+
+/// The frame rate \[Hz\] under the first of [`FRAME_RATE_KEYS`] the archive holds: one
+/// finite number > 0.
+fn read_frame_rate<R: Read + Seek>(npz: &mut Npz<R>, source: &str) -> Result<f64> {
+    let key = FRAME_RATE_KEYS.iter().find(|k| npz.has(k)).ok_or_else(|| {
+        archive_error(
+            source,
+            format!(
+                "no frame rate: an AMASS archive holds `{}` or `{}`; it holds: {}",
+                FRAME_RATE_KEYS[0],
+                FRAME_RATE_KEYS[1],
+                npz.names().join(", ")
+            ),
+        )
+    })?;
+    let rate = npz.array(key, 1)?;
+    match rate.values[..] {
+        [r] if r.is_finite() && r > 0.0 => Ok(r),
+        _ => Err(archive_error(
+            source,
+            format!(
+                "`{key}` is {:?}, expected one finite frame rate > 0 [Hz]",
+                rate.values
+            ),
+        )),
+    }
+}
+
+/// The shape coefficients `betas` (empty when absent), every one finite.
+fn read_betas<R: Read + Seek>(npz: &mut Npz<R>, source: &str) -> Result<Vec<f64>> {
+    let betas = if npz.has("betas") {
+        npz.array("betas", MAX_BETAS)?.values
+    } else {
+        Vec::new()
+    };
+    if let Some(k) = betas.iter().position(|x| !x.is_finite()) {
+        return Err(Error::NonFinite {
+            what: format!("{source}: `betas` at element {k}"),
+            value: betas[k],
+        });
+    }
+    Ok(betas)
 }

@@ -66,11 +66,7 @@ impl BodyModel {
     /// [`MAX_SHAPE_COMPONENTS`]); every value is finite.
     pub fn from_reader<R: Read + Seek>(reader: R, source: &str) -> Result<Self> {
         let mut npz = Npz::new(reader, source)?;
-        let bad = |message: String| Error::Parse {
-            source_name: source.to_string(),
-            line: 0,
-            message: format!("body model: {message}"),
-        };
+        let bad = |message: String| model_error(source, message);
         let template = npz.array("v_template", 3 * MAX_MODEL_VERTICES)?;
         let v = match template.shape[..] {
             [v, 3] => v,
@@ -111,13 +107,7 @@ impl BodyModel {
                 )));
             }
         }
-        // The regressor's non-zero weights, by vertex: (joint, weight).
-        let mut by_vertex: Vec<Vec<(usize, f64)>> = vec![Vec::new(); v];
-        for (k, w) in regressor.values.iter().enumerate() {
-            if *w != 0.0 {
-                by_vertex[k % v].push((k / v, *w));
-            }
-        }
+        let by_vertex = weights_by_vertex(&regressor.values, v);
         let mut template_joints = vec![Vector3::zeros(); j];
         for (vertex, weights) in by_vertex.iter().enumerate() {
             let t = Vector3::from_column_slice(&template.values[3 * vertex..3 * vertex + 3]);
@@ -125,33 +115,7 @@ impl BodyModel {
                 template_joints[*joint] += t * *w;
             }
         }
-        let dirs_shape = npz.shape("shapedirs")?;
-        let b = match dirs_shape[..] {
-            [dv, 3, b] if dv == v && b <= MAX_SHAPE_COMPONENTS => b,
-            _ => {
-                return Err(bad(format!(
-                    "`shapedirs` has shape {dirs_shape:?}, expected ({v}, 3, components ≤ \
-                     {MAX_SHAPE_COMPONENTS})"
-                )))
-            }
-        };
-        let mut joint_shape_dirs = vec![0.0; j * 3 * b];
-        let mut non_finite = None;
-        npz.visit("shapedirs", v * 3 * b, |k, s| {
-            if !s.is_finite() {
-                non_finite.get_or_insert(k);
-                return;
-            }
-            let (vertex, axis, component) = (k / (3 * b), (k / b) % 3, k % b);
-            for (joint, w) in &by_vertex[vertex] {
-                joint_shape_dirs[(joint * 3 + axis) * b + component] += w * s;
-            }
-        })?;
-        if let Some(k) = non_finite {
-            return Err(bad(format!(
-                "`shapedirs` has a non-finite value at element {k}"
-            )));
-        }
+        let (joint_shape_dirs, b) = joint_shape_dirs(&mut npz, &by_vertex, j, source)?;
         Ok(Self {
             source: source.to_string(),
             parents,
@@ -231,6 +195,69 @@ impl BodyModel {
             })
             .collect())
     }
+}
+
+/// An [`Error::Parse`] about the body model `source`.
+fn model_error(source: &str, message: String) -> Error {
+    Error::Parse {
+        source_name: source.to_string(),
+        line: 0,
+        message: format!("body model: {message}"),
+    }
+}
+
+/// The joint regressor's (J×V, row-major) non-zero weights, by vertex: (joint, weight).
+fn weights_by_vertex(regressor: &[f64], v: usize) -> Vec<Vec<(usize, f64)>> {
+    let mut by_vertex: Vec<Vec<(usize, f64)>> = vec![Vec::new(); v];
+    for (k, w) in regressor.iter().enumerate() {
+        if *w != 0.0 {
+            by_vertex[k % v].push((k / v, *w));
+        }
+    }
+    by_vertex
+}
+
+/// Reads `shapedirs` (V×3×B) regressed to the `j` joints: (J×3×B row-major, B); a wrong shape
+/// or a non-finite value is an error.
+fn joint_shape_dirs<R: Read + Seek>(
+    npz: &mut Npz<R>,
+    by_vertex: &[Vec<(usize, f64)>],
+    j: usize,
+    source: &str,
+) -> Result<(Vec<f64>, usize)> {
+    let v = by_vertex.len();
+    let dirs_shape = npz.shape("shapedirs")?;
+    let b = match dirs_shape[..] {
+        [dv, 3, b] if dv == v && b <= MAX_SHAPE_COMPONENTS => b,
+        _ => {
+            return Err(model_error(
+                source,
+                format!(
+                    "`shapedirs` has shape {dirs_shape:?}, expected ({v}, 3, components ≤ \
+                     {MAX_SHAPE_COMPONENTS})"
+                ),
+            ))
+        }
+    };
+    let mut joint_shape_dirs = vec![0.0; j * 3 * b];
+    let mut non_finite = None;
+    npz.visit("shapedirs", v * 3 * b, |k, s| {
+        if !s.is_finite() {
+            non_finite.get_or_insert(k);
+            return;
+        }
+        let (vertex, axis, component) = (k / (3 * b), (k / b) % 3, k % b);
+        for (joint, w) in &by_vertex[vertex] {
+            joint_shape_dirs[(joint * 3 + axis) * b + component] += w * s;
+        }
+    })?;
+    if let Some(k) = non_finite {
+        return Err(model_error(
+            source,
+            format!("`shapedirs` has a non-finite value at element {k}"),
+        ));
+    }
+    Ok((joint_shape_dirs, b))
 }
 
 /// The parents of a `kintree_table`'s first row: the root's a negative number or one at least

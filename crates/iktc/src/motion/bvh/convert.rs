@@ -164,99 +164,16 @@ impl BvhClip {
         let order = depth_first_order(skeleton);
         let frame_time = uniform_frame_time(clip, options)?;
         // Channel layout.
-        let mut joints: Vec<BvhJoint> = Vec::with_capacity(order.len());
         let mut new_index = vec![0usize; skeleton.len()];
         for (k, &old) in order.iter().enumerate() {
             new_index[old] = k;
         }
-        // Per BVH joint: (old index, number of position channels, rotation axes).
-        let mut plan: Vec<(usize, usize, Vec<Vector3<f64>>)> = Vec::with_capacity(order.len());
-        for &old in &order {
-            let sj = &skeleton.joints()[old];
-            let is_root = sj.parent.is_none();
-            let translates = !is_root
-                && clip.frames().iter().any(|p| {
-                    p.translations
-                        .get(old)
-                        .is_some_and(|t| *t != Vector3::zeros())
-                });
-            let has_children = skeleton.children(old).next().is_some();
-            let mut channels = Vec::new();
-            if is_root || translates {
-                channels.extend([
-                    BvhChannel::Xposition,
-                    BvhChannel::Yposition,
-                    BvhChannel::Zposition,
-                ]);
-            }
-            let rotation_channels: Vec<BvhChannel> = match sj.kind {
-                JointKind::Root | JointKind::Spherical => {
-                    options.rotation_order.channels().to_vec()
-                }
-                JointKind::Hinge { axis } => {
-                    let aligned = [
-                        BvhChannel::Xrotation,
-                        BvhChannel::Yrotation,
-                        BvhChannel::Zrotation,
-                    ]
-                    .into_iter()
-                    .find(|c| c.axis().dot(&axis).abs() >= 1.0 - options.axis_alignment_tolerance);
-                    match aligned {
-                        Some(c) => vec![c],
-                        None => options.rotation_order.channels().to_vec(),
-                    }
-                }
-                JointKind::Fixed => Vec::new(),
-            };
-            let axes: Vec<Vector3<f64>> = rotation_channels.iter().map(|c| c.axis()).collect();
-            channels.extend(rotation_channels);
-            let end_site = !is_root && !has_children && channels.is_empty();
-            joints.push(BvhJoint {
-                name: sj.name.clone(),
-                parent: sj.parent.and_then(|p| new_index.get(p).copied()),
-                offset: sj.offset,
-                channels,
-                end_site,
-            });
-            plan.push((old, if is_root || translates { 3 } else { 0 }, axes));
-        }
+        let (joints, plan): (Vec<BvhJoint>, Vec<JointPlan>) = order
+            .iter()
+            .map(|&old| plan_joint(clip, old, &new_index, options))
+            .unzip();
         let channel_count: usize = joints.iter().map(|j| j.channels.len()).sum();
-        let mut values: Vec<f64> = Vec::with_capacity(channel_count * clip.frame_count());
-        let mut angles = [0.0; 3];
-        for (f, pose) in clip.frames().iter().enumerate() {
-            let frame_start = values.len();
-            for (old, positions, axes) in &plan {
-                let is_root = skeleton.joints()[*old].parent.is_none();
-                if *positions > 0 {
-                    let t = if is_root {
-                        pose.root_position - skeleton.joints()[*old].offset
-                    } else {
-                        pose.translations.get(*old).copied().unwrap_or_default()
-                    };
-                    values.extend(t.iter());
-                }
-                if axes.is_empty() {
-                    continue;
-                }
-                let q = if is_root {
-                    pose.root_orientation
-                } else {
-                    pose.rotations.get(*old).copied().unwrap_or_default()
-                };
-                let k = axes.len();
-                let here = values.len() - frame_start;
-                let previous: Option<Vec<f64>> = (f > 0).then(|| {
-                    let start = frame_start - channel_count + here;
-                    values
-                        .get(start..start + k)
-                        .map(|s| s.to_vec())
-                        .unwrap_or_default()
-                });
-                let out = angles.get_mut(..k).unwrap_or(&mut []);
-                decompose_rotation_with(&q, axes, previous.as_deref(), &options.decompose, out)?;
-                values.extend(out.iter());
-            }
-        }
+        let values = channel_values(clip, &plan, channel_count, options)?;
         BvhClip::new(
             clip.name(),
             joints,
@@ -266,6 +183,139 @@ impl BvhClip {
             clip.up_axis(),
         )
     }
+}
+
+/// What one BVH joint writes per frame.
+struct JointPlan {
+    /// The joint's index in the clip's skeleton.
+    old: usize,
+    /// Number of position channels (0 or 3).
+    positions: usize,
+    /// The axes of its rotation channels, in channel order.
+    axes: Vec<Vector3<f64>>,
+}
+
+/// The BVH joint for skeleton joint `old` (parent renumbered by `new_index`) with its channels,
+/// and what it writes per frame.
+fn plan_joint(
+    clip: &Clip,
+    old: usize,
+    new_index: &[usize],
+    options: &BvhExportOptions,
+) -> (BvhJoint, JointPlan) {
+    let skeleton = clip.skeleton();
+    let sj = &skeleton.joints()[old];
+    let is_root = sj.parent.is_none();
+    let translates = !is_root
+        && clip.frames().iter().any(|p| {
+            p.translations
+                .get(old)
+                .is_some_and(|t| *t != Vector3::zeros())
+        });
+    let has_children = skeleton.children(old).next().is_some();
+    let mut channels = Vec::new();
+    if is_root || translates {
+        channels.extend([
+            BvhChannel::Xposition,
+            BvhChannel::Yposition,
+            BvhChannel::Zposition,
+        ]);
+    }
+    let rotation_channels = rotation_channels(sj.kind, options);
+    let axes: Vec<Vector3<f64>> = rotation_channels.iter().map(|c| c.axis()).collect();
+    channels.extend(rotation_channels);
+    let end_site = !is_root && !has_children && channels.is_empty();
+    let joint = BvhJoint {
+        name: sj.name.clone(),
+        parent: sj.parent.and_then(|p| new_index.get(p).copied()),
+        offset: sj.offset,
+        channels,
+        end_site,
+    };
+    let positions = if is_root || translates { 3 } else { 0 };
+    (
+        joint,
+        JointPlan {
+            old,
+            positions,
+            axes,
+        },
+    )
+}
+
+/// The rotation channels of a joint of kind `kind`: three in `options.rotation_order`, one for
+/// a hinge about a coordinate axis, none for a fixed joint.
+fn rotation_channels(kind: JointKind, options: &BvhExportOptions) -> Vec<BvhChannel> {
+    match kind {
+        JointKind::Root | JointKind::Spherical => options.rotation_order.channels().to_vec(),
+        JointKind::Hinge { axis } => {
+            let aligned = [
+                BvhChannel::Xrotation,
+                BvhChannel::Yrotation,
+                BvhChannel::Zrotation,
+            ]
+            .into_iter()
+            .find(|c| c.axis().dot(&axis).abs() >= 1.0 - options.axis_alignment_tolerance);
+            match aligned {
+                Some(c) => vec![c],
+                None => options.rotation_order.channels().to_vec(),
+            }
+        }
+        JointKind::Fixed => Vec::new(),
+    }
+}
+
+/// The channel values of every frame (positions in the clip's units, angles \[rad\]), each
+/// frame's angles decomposed nearest to the previous frame's.
+fn channel_values(
+    clip: &Clip,
+    plan: &[JointPlan],
+    channel_count: usize,
+    options: &BvhExportOptions,
+) -> Result<Vec<f64>> {
+    let skeleton = clip.skeleton();
+    let mut values: Vec<f64> = Vec::with_capacity(channel_count * clip.frame_count());
+    let mut angles = [0.0; 3];
+    for (f, pose) in clip.frames().iter().enumerate() {
+        let frame_start = values.len();
+        for JointPlan {
+            old,
+            positions,
+            axes,
+        } in plan
+        {
+            let is_root = skeleton.joints()[*old].parent.is_none();
+            if *positions > 0 {
+                let t = if is_root {
+                    pose.root_position - skeleton.joints()[*old].offset
+                } else {
+                    pose.translations.get(*old).copied().unwrap_or_default()
+                };
+                values.extend(t.iter());
+            }
+            if axes.is_empty() {
+                continue;
+            }
+            let q = if is_root {
+                pose.root_orientation
+            } else {
+                pose.rotations.get(*old).copied().unwrap_or_default()
+            };
+            let k = axes.len();
+            let here = values.len() - frame_start;
+            let previous: Option<Vec<f64>> = (f > 0).then(|| {
+                let start = frame_start - channel_count + here;
+                values
+                    .get(start..start + k)
+                    .map(|s| s.to_vec())
+                    .unwrap_or_default()
+            });
+            let out = angles.get_mut(..k).unwrap_or(&mut []);
+            decompose_rotation_with(&q, axes, previous.as_deref(), &options.decompose, out)?;
+            values.extend(out.iter());
+        }
+    }
+    Ok(values)
 }
 
 /// Joint indices in depth-first order from the root, children in index order.

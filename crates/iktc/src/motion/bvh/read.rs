@@ -39,6 +39,17 @@ struct Reader<'a> {
     line: usize,
 }
 
+/// The numbers after `MOTION`.
+#[derive(Clone, Copy)]
+struct MotionHeader {
+    /// Line of `Frames:`.
+    frames_line: usize,
+    /// Frames declared.
+    frame_count: usize,
+    /// Time between frames \[s\].
+    frame_time: f64,
+}
+
 /// A joint whose `{ … }` block is open.
 struct Open {
     index: usize,
@@ -122,7 +133,22 @@ impl<'a> Reader<'a> {
         }
         let joints = self.read_hierarchy(scale)?;
         let channel_count: usize = joints.iter().map(|j| j.channels.len()).sum();
-        // After the root's closing brace: MOTION.
+        self.read_motion_keyword(channel_count)?;
+        let header = self.read_motion_header(options)?;
+        let mut values = self.read_frames(&joints, channel_count, &header)?;
+        convert_units(&joints, &mut values, channel_count, scale);
+        BvhClip::new(
+            self.source_name,
+            joints,
+            header.frame_time,
+            header.frame_count,
+            values,
+            options.up_axis,
+        )
+    }
+
+    /// Reads `MOTION` after the root's closing brace; the hierarchy must declare a channel.
+    fn read_motion_keyword(&mut self, channel_count: usize) -> Result<()> {
         match self.next_token() {
             Some(("MOTION", l)) => {
                 if let Some(t) = self.rest_of_line().first() {
@@ -131,18 +157,19 @@ impl<'a> Reader<'a> {
                 if channel_count == 0 {
                     return Err(self.error(l, "the hierarchy declares no channel"));
                 }
+                Ok(())
             }
-            Some(("ROOT", l)) => {
-                return Err(self.error(
-                    l,
-                    "a second `ROOT` is not supported (one skeleton per file)",
-                ))
-            }
-            Some((t, l)) => return Err(self.error(l, format!("expected `MOTION`, found `{t}`"))),
-            None => {
-                return Err(self.error(self.line, "the file ends before `MOTION` (truncated file)"))
-            }
+            Some(("ROOT", l)) => Err(self.error(
+                l,
+                "a second `ROOT` is not supported (one skeleton per file)",
+            )),
+            Some((t, l)) => Err(self.error(l, format!("expected `MOTION`, found `{t}`"))),
+            None => Err(self.error(self.line, "the file ends before `MOTION` (truncated file)")),
         }
+    }
+
+    /// Reads `Frames:` and `Frame Time:`, checking the count, the capture rate and the limits.
+    fn read_motion_header(&mut self, options: &BvhReadOptions) -> Result<MotionHeader> {
         let (frames_line, frame_count) = self.read_header_number("Frames")?;
         let frame_count = frame_count.parse::<usize>().map_err(|_| {
             self.error(
@@ -179,6 +206,26 @@ impl<'a> Reader<'a> {
                 frame_time * (frame_count - 1) as f64,
             )
             .map_err(|e| self.error(time_line, e.to_string()))?;
+        Ok(MotionHeader {
+            frames_line,
+            frame_count,
+            frame_time,
+        })
+    }
+
+    /// Reads the frame lines: exactly `frame_count` lines of `channel_count` plausible values
+    /// each (in the file's units), frame after frame.
+    fn read_frames(
+        &mut self,
+        joints: &[BvhJoint],
+        channel_count: usize,
+        header: &MotionHeader,
+    ) -> Result<Vec<f64>> {
+        let MotionHeader {
+            frames_line,
+            frame_count,
+            ..
+        } = *header;
         // Reserve no more than the text can hold (at least two bytes per value).
         let capacity = frame_count
             .saturating_mul(channel_count)
@@ -232,15 +279,7 @@ impl<'a> Reader<'a> {
                 ),
             ));
         }
-        convert_units(&joints, &mut values, channel_count, scale);
-        BvhClip::new(
-            self.source_name,
-            joints,
-            frame_time,
-            frame_count,
-            values,
-            options.up_axis,
-        )
+        Ok(values)
     }
 
     /// Reads `<key>: value` (or `<key> : value`) on the next non-blank line.
@@ -267,26 +306,10 @@ impl<'a> Reader<'a> {
     }
 
     fn read_hierarchy(&mut self, scale: f64) -> Result<Vec<BvhJoint>> {
-        let mut joints: Vec<BvhJoint> = Vec::new();
         let mut stack: Vec<Open> = Vec::new();
         // A joint header waiting for its `{`: (index, line of the header).
         let mut pending: Option<(usize, usize)> = None;
-        match self.next_token() {
-            Some(("ROOT", l)) => {
-                let name = self.header_name(l, "ROOT", &mut pending, 0)?;
-                joints.push(BvhJoint {
-                    name,
-                    parent: None,
-                    offset: Vector3::zeros(),
-                    channels: Vec::new(),
-                    end_site: false,
-                });
-            }
-            Some((t, l)) => return Err(self.error(l, format!("expected `ROOT`, found `{t}`"))),
-            None => {
-                return Err(self.error(self.line, "the file ends before `ROOT` (truncated file)"))
-            }
-        }
+        let mut joints = vec![self.read_root(&mut pending)?];
         loop {
             let Some((token, line)) = self.next_token() else {
                 let name = stack
@@ -321,12 +344,11 @@ impl<'a> Reader<'a> {
                 return Err(self.error(line, format!("unexpected `{token}`")));
             };
             let current = open.index;
-            let in_end_site = joints.get(current).is_some_and(|j| j.end_site);
+            let name = || joints.get(current).map_or("", |j| j.name.as_str());
             match token {
                 "}" => {
                     if !open.has_offset {
-                        let name = joints.get(current).map_or("", |j| j.name.as_str());
-                        return Err(self.error(line, format!("joint `{name}` has no OFFSET")));
+                        return Err(self.error(line, format!("joint `{}` has no OFFSET", name())));
                     }
                     stack.pop();
                     if stack.is_empty() {
@@ -336,70 +358,16 @@ impl<'a> Reader<'a> {
                         return Ok(joints);
                     }
                 }
-                "OFFSET" => {
-                    if open.has_offset {
-                        return Err(self.error(line, "a second OFFSET in the same joint"));
-                    }
-                    open.has_offset = true;
-                    let rest = self.rest_of_line();
-                    if rest.len() != 3 {
-                        return Err(self.error(
-                            line,
-                            format!("OFFSET needs 3 numbers, found {}", rest.len()),
-                        ));
-                    }
-                    let mut offset = Vector3::zeros();
-                    for (o, t) in offset.iter_mut().zip(&rest) {
-                        *o = self.number(t, line, "OFFSET")? * scale;
-                    }
-                    if let Some(j) = joints.get_mut(current) {
-                        j.offset = offset;
-                    }
-                }
-                "CHANNELS" => {
-                    if in_end_site {
-                        return Err(self.error(line, "an End Site cannot have CHANNELS"));
-                    }
-                    if open.has_children {
-                        return Err(
-                            self.error(line, "CHANNELS must come before the joint's children")
-                        );
-                    }
-                    let channels = self.channels(line)?;
-                    if let Some(j) = joints.get_mut(current) {
-                        if !j.channels.is_empty() {
-                            return Err(self.error(line, "a second CHANNELS in the same joint"));
-                        }
-                        j.channels = channels;
-                    }
-                }
-                "JOINT" | "End" => {
-                    if in_end_site {
-                        return Err(self.error(line, "an End Site cannot have children"));
-                    }
-                    open.has_children = true;
-                    let end_site = token == "End";
-                    let name = if end_site {
-                        self.end_site_name(line, &joints, current, &mut pending)?
-                    } else {
-                        self.header_name(line, "JOINT", &mut pending, joints.len())?
-                    };
-                    if joints.iter().any(|j| j.name == name) {
-                        return Err(self.error(line, format!("joint name `{name}` is used twice")));
-                    }
-                    joints.push(BvhJoint {
-                        name,
-                        parent: Some(current),
-                        offset: Vector3::zeros(),
-                        channels: Vec::new(),
-                        end_site,
-                    });
-                }
+                "OFFSET" => self.read_offset(line, open, &mut joints, scale)?,
+                "CHANNELS" => self.read_joint_channels(line, open, &mut joints)?,
+                "JOINT" | "End" => self.read_child(token, line, open, &mut joints, &mut pending)?,
                 "MOTION" | "ROOT" => {
-                    let name = joints.get(current).map_or("", |j| j.name.as_str());
                     return Err(self.error(
                         line,
-                        format!("missing `}}`: joint `{name}` is not closed before `{token}`"),
+                        format!(
+                            "missing `}}`: joint `{}` is not closed before `{token}`",
+                            name()
+                        ),
                     ));
                 }
                 "{" => return Err(self.error(line, "unexpected `{`")),
@@ -413,6 +381,110 @@ impl<'a> Reader<'a> {
                 }
             }
         }
+    }
+
+    /// Reads `ROOT <name>`, the first token of the hierarchy, leaving its block to open.
+    fn read_root(&mut self, pending: &mut Option<(usize, usize)>) -> Result<BvhJoint> {
+        match self.next_token() {
+            Some(("ROOT", l)) => {
+                let name = self.header_name(l, "ROOT", pending, 0)?;
+                Ok(BvhJoint {
+                    name,
+                    parent: None,
+                    offset: Vector3::zeros(),
+                    channels: Vec::new(),
+                    end_site: false,
+                })
+            }
+            Some((t, l)) => Err(self.error(l, format!("expected `ROOT`, found `{t}`"))),
+            None => Err(self.error(self.line, "the file ends before `ROOT` (truncated file)")),
+        }
+    }
+
+    /// Reads the open joint's `OFFSET x y z` (file units), stored scaled by `scale` \[m/unit\].
+    fn read_offset(
+        &mut self,
+        line: usize,
+        open: &mut Open,
+        joints: &mut [BvhJoint],
+        scale: f64,
+    ) -> Result<()> {
+        if open.has_offset {
+            return Err(self.error(line, "a second OFFSET in the same joint"));
+        }
+        open.has_offset = true;
+        let rest = self.rest_of_line();
+        if rest.len() != 3 {
+            return Err(self.error(
+                line,
+                format!("OFFSET needs 3 numbers, found {}", rest.len()),
+            ));
+        }
+        let mut offset = Vector3::zeros();
+        for (o, t) in offset.iter_mut().zip(&rest) {
+            *o = self.number(t, line, "OFFSET")? * scale;
+        }
+        if let Some(j) = joints.get_mut(open.index) {
+            j.offset = offset;
+        }
+        Ok(())
+    }
+
+    /// Reads the open joint's `CHANNELS`: once, not in an End Site, before the children.
+    fn read_joint_channels(
+        &mut self,
+        line: usize,
+        open: &Open,
+        joints: &mut [BvhJoint],
+    ) -> Result<()> {
+        if joints.get(open.index).is_some_and(|j| j.end_site) {
+            return Err(self.error(line, "an End Site cannot have CHANNELS"));
+        }
+        if open.has_children {
+            return Err(self.error(line, "CHANNELS must come before the joint's children"));
+        }
+        let channels = self.channels(line)?;
+        if let Some(j) = joints.get_mut(open.index) {
+            if !j.channels.is_empty() {
+                return Err(self.error(line, "a second CHANNELS in the same joint"));
+            }
+            j.channels = channels;
+        }
+        Ok(())
+    }
+
+    /// Reads a child of the open joint, `JOINT <name>` or `End Site` (after `token`), leaving
+    /// its block to open; a name used twice is an error.
+    fn read_child(
+        &mut self,
+        token: &str,
+        line: usize,
+        open: &mut Open,
+        joints: &mut Vec<BvhJoint>,
+        pending: &mut Option<(usize, usize)>,
+    ) -> Result<()> {
+        let current = open.index;
+        if joints.get(current).is_some_and(|j| j.end_site) {
+            return Err(self.error(line, "an End Site cannot have children"));
+        }
+        open.has_children = true;
+        let end_site = token == "End";
+        let name = if end_site {
+            self.end_site_name(line, joints, current, pending)?
+        } else {
+            self.header_name(line, "JOINT", pending, joints.len())?
+        };
+        if joints.iter().any(|j| j.name == name) {
+            return Err(self.error(line, format!("joint name `{name}` is used twice")));
+        }
+        joints.push(BvhJoint {
+            name,
+            parent: Some(current),
+            offset: Vector3::zeros(),
+            channels: Vec::new(),
+            end_site,
+        });
+        Ok(())
     }
 
     /// The name after `ROOT`/`JOINT` (the rest of the line, a trailing `{` opening the block).

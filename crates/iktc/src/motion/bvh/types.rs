@@ -164,6 +164,71 @@ fn hierarchy_error(message: String) -> Error {
     }
 }
 
+/// Checks the joints' names and every joint ([`check_joint`]); returns each joint's first
+/// channel index and the channel count.
+fn channel_layout(joints: &[BvhJoint]) -> Result<(Vec<usize>, usize)> {
+    let mut names = HashSet::new();
+    let mut channel_starts = Vec::with_capacity(joints.len());
+    let mut channel_count = 0usize;
+    for (i, joint) in joints.iter().enumerate() {
+        if joint.name.is_empty() || !names.insert(joint.name.as_str()) {
+            return Err(hierarchy_error(format!(
+                "joint {i} has an empty or repeated name `{}`",
+                joint.name
+            )));
+        }
+        check_joint(joints, i)?;
+        channel_starts.push(channel_count);
+        channel_count += joint.channels.len();
+    }
+    Ok((channel_starts, channel_count))
+}
+
+/// Checks joint `i`: the root first, a parent among the previous joint and its ancestors that
+/// is not an end site, no channels on an end site, no channel twice, a finite offset.
+fn check_joint(joints: &[BvhJoint], i: usize) -> Result<()> {
+    let joint = &joints[i];
+    match (i, joint.parent) {
+        (0, None) if !joint.end_site => {}
+        (0, _) => return Err(hierarchy_error("joint 0 must be the root".to_string())),
+        (_, Some(p)) if p < i && is_on_path(joints, i - 1, p) => {
+            if joints.get(p).is_some_and(|j| j.end_site) {
+                return Err(hierarchy_error(format!(
+                    "joint `{}` has an end site as parent",
+                    joint.name
+                )));
+            }
+        }
+        _ => {
+            return Err(hierarchy_error(format!(
+                "joint {i} (`{}`): its parent must be the previous joint or one of its ancestors",
+                joint.name
+            )))
+        }
+    }
+    if joint.end_site && !joint.channels.is_empty() {
+        return Err(hierarchy_error(format!(
+            "end site `{}` has channels",
+            joint.name
+        )));
+    }
+    let mut seen = HashSet::new();
+    if let Some(c) = joint.channels.iter().find(|c| !seen.insert(**c)) {
+        return Err(hierarchy_error(format!(
+            "joint `{}` lists channel {} twice",
+            joint.name,
+            c.name()
+        )));
+    }
+    if joint.offset.iter().any(|v| !v.is_finite()) {
+        return Err(Error::NonFinite {
+            what: format!("offset of BVH joint `{}`", joint.name),
+            value: f64::NAN,
+        });
+    }
+    Ok(())
+}
+
 impl BvhClip {
     /// Checks and assembles a clip (see the invariants in the type's documentation).
     pub fn new(
@@ -177,57 +242,7 @@ impl BvhClip {
         if joints.is_empty() {
             return Err(hierarchy_error("no joint".to_string()));
         }
-        let mut names = HashSet::new();
-        let mut channel_starts = Vec::with_capacity(joints.len());
-        let mut channel_count = 0usize;
-        for (i, joint) in joints.iter().enumerate() {
-            if joint.name.is_empty() || !names.insert(joint.name.as_str()) {
-                return Err(hierarchy_error(format!(
-                    "joint {i} has an empty or repeated name `{}`",
-                    joint.name
-                )));
-            }
-            match (i, joint.parent) {
-                (0, None) if !joint.end_site => {}
-                (0, _) => return Err(hierarchy_error("joint 0 must be the root".to_string())),
-                (_, Some(p)) if p < i && is_on_path(&joints, i - 1, p) => {
-                    if joints.get(p).is_some_and(|j| j.end_site) {
-                        return Err(hierarchy_error(format!(
-                            "joint `{}` has an end site as parent",
-                            joint.name
-                        )));
-                    }
-                }
-                _ => {
-                    return Err(hierarchy_error(format!(
-                        "joint {i} (`{}`): its parent must be the previous joint or one of its ancestors",
-                        joint.name
-                    )))
-                }
-            }
-            if joint.end_site && !joint.channels.is_empty() {
-                return Err(hierarchy_error(format!(
-                    "end site `{}` has channels",
-                    joint.name
-                )));
-            }
-            let mut seen = HashSet::new();
-            if let Some(c) = joint.channels.iter().find(|c| !seen.insert(**c)) {
-                return Err(hierarchy_error(format!(
-                    "joint `{}` lists channel {} twice",
-                    joint.name,
-                    c.name()
-                )));
-            }
-            if joint.offset.iter().any(|v| !v.is_finite()) {
-                return Err(Error::NonFinite {
-                    what: format!("offset of BVH joint `{}`", joint.name),
-                    value: f64::NAN,
-                });
-            }
-            channel_starts.push(channel_count);
-            channel_count += joint.channels.len();
-        }
+        let (channel_starts, channel_count) = channel_layout(&joints)?;
         if channel_count == 0 || frame_count == 0 {
             return Err(Error::InsufficientData {
                 what: "BVH clip".to_string(),
