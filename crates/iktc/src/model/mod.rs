@@ -31,8 +31,10 @@ pub(crate) use description::read_description;
 pub use description::{declared_base, description_format, DescriptionFormat};
 #[cfg(feature = "urdf")]
 pub use files::RobotFiles;
+#[cfg(all(feature = "urdf", feature = "toml"))]
+pub(crate) use urdf::pose as urdf_pose;
 #[cfg(feature = "urdf")]
-pub(crate) use urdf::{pose as urdf_pose, read_urdf};
+pub(crate) use urdf::read_urdf;
 
 #[cfg(feature = "mjcf")]
 pub use builtin::G1_MJCF;
