@@ -5,9 +5,9 @@
 use std::path::{Path, PathBuf};
 
 use iktc::motion::{
-    builtin_clip, builtin_map, load_motion, motion_from_content, retarget, Clip, Motion,
-    MotionContent, MotionFormat, MotionOptions, RetargetMap, Retargeted, RobotReferences, Track,
-    BUILTIN_CLIP_NAMES, BUILTIN_MAP_NAMES,
+    builtin_clip, builtin_map, load_motion, motion_from_content, retarget_joint_angles, Clip,
+    Motion, MotionContent, MotionFormat, MotionOptions, RetargetMap, Retargeted, RobotReferences,
+    Track, BUILTIN_CLIP_NAMES, BUILTIN_MAP_NAMES,
 };
 use numpy::{PyArray1, PyArray2, PyArray3};
 use pyo3::prelude::*;
@@ -190,8 +190,8 @@ pub struct PyRetargeted {
 /// change and attitude follow the source root. `map`: a built-in map name or a TOML file;
 /// without it the robot profile's map for the motion's format.
 #[pyfunction]
-#[pyo3(name = "retarget", signature = (motion, robot, map=None))]
-pub fn py_retarget(
+#[pyo3(name = "retarget_joint_angles", signature = (motion, robot, map=None))]
+pub fn py_retarget_joint_angles(
     py: Python<'_>,
     motion: &PyMotion,
     robot: &PyRobot,
@@ -200,7 +200,7 @@ pub fn py_retarget(
     let map = resolve_map(robot, motion, map)?;
     let clip = motion.clip()?;
     let inner = py
-        .detach(|| retarget(clip, &robot.robot, &map))
+        .detach(|| retarget_joint_angles(clip, &robot.robot, &map))
         .map_err(to_py)?;
     Ok(PyRetargeted { inner })
 }
@@ -356,7 +356,7 @@ impl PyReferences {
 
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(py_load_motion, m)?)?;
-    m.add_function(wrap_pyfunction!(py_retarget, m)?)?;
+    m.add_function(wrap_pyfunction!(py_retarget_joint_angles, m)?)?;
     m.add_class::<PyMotion>()?;
     m.add_class::<PyRetargeted>()?;
     m.add_class::<PyReferences>()?;

@@ -52,7 +52,7 @@ def test_a_builtin_clip_and_its_file_load_to_the_same_keypoints():
 
 def test_retargeting_returns_arrays_and_the_resampled_splines_pass_through_the_frames():
     robot = iktc.Robot("g1")
-    rt = iktc.retarget(iktc.load_motion("humanoid3d_dance_b"), robot)
+    rt = iktc.retarget_joint_angles(iktc.load_motion("humanoid3d_dance_b"), robot)
     f, j = rt.joint_angles.shape
     assert f == rt.times.shape[0] and j == len(rt.joint_names) and rt.pelvis_angles.shape == (f, 3)
     assert all(n in robot.joint_names for n in rt.joint_names)
@@ -85,9 +85,9 @@ def test_a_map_is_needed_without_a_profile_and_the_profile_map_is_the_builtin_on
     motion = iktc.load_motion("humanoid3d_dance_b")
     bare = iktc.Robot(str(DATA / "robots" / "jvrc1" / "jvrc1.urdf"), floating=True)
     with pytest.raises(iktc.IktcError, match="has no profile: pass map="):
-        iktc.retarget(motion, bare)
-    by_profile = iktc.retarget(motion, iktc.Robot("jvrc1"))
-    by_name = iktc.retarget(motion, bare, map="deepmimic_jvrc1")
+        iktc.retarget_joint_angles(motion, bare)
+    by_profile = iktc.retarget_joint_angles(motion, iktc.Robot("jvrc1"))
+    by_name = iktc.retarget_joint_angles(motion, bare, map="deepmimic_jvrc1")
     assert by_name.joint_names == by_profile.joint_names
     assert np.array_equal(by_name.joint_angles, by_profile.joint_angles)
 

@@ -2,7 +2,7 @@
 //! `bvh_jvrc1` map: read, retarget, resample, imitate, without exceeding a limit.
 
 use iktc::model::{jvrc1, ModelOptions};
-use iktc::motion::{builtin_map, read_bvh, retarget, BvhReadOptions};
+use iktc::motion::{builtin_map, read_bvh, retarget_joint_angles, BvhReadOptions};
 use iktc::sim::{run_imitate, ImitateConfig};
 
 fn bvh_text(frames: usize) -> String {
@@ -41,7 +41,7 @@ fn bvh_clip_is_imitated_within_limits() {
         .to_clip()
         .unwrap();
     let map = builtin_map("bvh_jvrc1").unwrap();
-    let out = retarget(&clip, &robot, &map).unwrap();
+    let out = retarget_joint_angles(&clip, &robot, &map).unwrap();
     for r in &out.residuals {
         assert!(r.is_finite());
     }

@@ -5,7 +5,7 @@
 use iktc::model::RobotFiles;
 use iktc::model::*;
 use iktc::motion::{
-    builtin_clip, builtin_map, read_bvh, read_deepmimic, retarget, BvhReadOptions,
+    builtin_clip, builtin_map, read_bvh, read_deepmimic, retarget_joint_angles, BvhReadOptions,
     DEEPMIMIC_FRAME_LEN,
 };
 use iktc::resources::{ReadLimits, RunLimits};
@@ -416,7 +416,7 @@ fn imitation_and_walking_bounds() {
     let robot = jvrc1(&ModelOptions::default()).unwrap();
     let clip = builtin_clip("humanoid3d_walk").unwrap().to_z_up();
     let map = builtin_map("deepmimic_jvrc1").unwrap();
-    let r = retarget(&clip, &robot, &map).unwrap();
+    let r = retarget_joint_angles(&clip, &robot, &map).unwrap();
     let tight = RunLimits {
         max_ticks: 100,
         ..RunLimits::default()

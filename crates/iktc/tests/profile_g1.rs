@@ -160,7 +160,7 @@ fn g1_walks_while_imitating_within_its_limits() {
     cfg.steps = 2;
     cfg.push = None;
     let clip = builtin_clip("humanoid3d_dance_b").unwrap();
-    let refs = iktc::motion::retarget(&clip, &robot, &map)
+    let refs = iktc::motion::retarget_joint_angles(&clip, &robot, &map)
         .unwrap()
         .resample(cfg.imitate.dt)
         .unwrap();

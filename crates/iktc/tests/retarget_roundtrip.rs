@@ -73,7 +73,7 @@ fn roundtrip(map: &RetargetMap, skeleton: Skeleton, frames: usize, seed: u64) {
         times.push(f as f64 / 30.0);
     }
     let clip = Clip::new("generated", skeleton, times, poses, UpAxis::Y).unwrap();
-    let out = retarget(&clip, &robot, map).unwrap();
+    let out = retarget_joint_angles(&clip, &robot, map).unwrap();
     assert_eq!(out.joint_names, map.robot_joints());
     for (j, name) in out.joint_names.iter().enumerate() {
         for (f, (&got, &want)) in out.joint_angles[j].iter().zip(&expected[j]).enumerate() {
@@ -163,7 +163,7 @@ fn bvh_t_pose_rest_maps_to_raised_arms() {
         UpAxis::Y,
     )
     .unwrap();
-    let out = retarget(&clip, &robot, &map).unwrap();
+    let out = retarget_joint_angles(&clip, &robot, &map).unwrap();
     for (name, track) in out.joint_names.iter().zip(&out.joint_angles) {
         let want = match name.as_str() {
             "R_SHOULDER_R" => -std::f64::consts::FRAC_PI_2,
@@ -179,7 +179,7 @@ fn builtin_clip_retargets_and_resamples() {
     let robot = jvrc1(&ModelOptions::default()).unwrap();
     let clip = builtin_clip("humanoid3d_dance_b").unwrap();
     let map = builtin_map("deepmimic_jvrc1").unwrap();
-    let out = retarget(&clip, &robot, &map).unwrap();
+    let out = retarget_joint_angles(&clip, &robot, &map).unwrap();
     let refs = out.resample(0.005).unwrap();
     assert!(refs.len() > 100);
     assert_eq!(refs.joints.len(), 20);
@@ -228,11 +228,13 @@ fn malformed_maps_are_errors() {
     let clip = builtin_clip("humanoid3d_walk").unwrap();
     let unknown = "basis = [[1,0,0],[0,1,0],[0,0,1]]\n[[joint]]\nsource = \"chest\"\ntargets = [{ joint = \"NOPE\" }]\n";
     let map = RetargetMap::from_toml_str(unknown, "m.toml").unwrap();
-    let e = retarget(&clip, &robot, &map).unwrap_err().to_string();
+    let e = retarget_joint_angles(&clip, &robot, &map)
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("NOPE"), "{e}");
     let not_chain = "basis = [[1,0,0],[0,1,0],[0,0,1]]\n[[joint]]\nsource = \"chest\"\ntargets = [{ joint = \"WAIST_Y\" }, { joint = \"NECK_Y\" }]\n";
     let map = RetargetMap::from_toml_str(not_chain, "m.toml").unwrap();
-    assert!(retarget(&clip, &robot, &map).is_err());
+    assert!(retarget_joint_angles(&clip, &robot, &map).is_err());
 }
 
 #[test]

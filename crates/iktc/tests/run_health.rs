@@ -6,7 +6,7 @@
 use iktc::balance::{run_push, PushScenario, SupportPhase};
 use iktc::model::RobotFiles;
 use iktc::model::{jvrc1, BaseKind, ModelOptions, Robot, JVRC1_URDF};
-use iktc::motion::{builtin_clip, builtin_map, retarget, RobotReferences};
+use iktc::motion::{builtin_clip, builtin_map, retarget_joint_angles, RobotReferences};
 use iktc::sim::{
     imitation_references, run_imitate, run_walk_imitate, HealthCheck, HealthMonitor,
     HealthSettings, ImitateConfig, Push, Verdict, WalkImitateConfig,
@@ -173,7 +173,7 @@ fn walk(push: Push, keep_going: bool) -> iktc::Result<iktc::sim::WalkRun> {
     let robot = jvrc1(&ModelOptions::default()).unwrap();
     let clip = builtin_clip("humanoid3d_dance_b").unwrap();
     let map = builtin_map("deepmimic_jvrc1").unwrap();
-    let refs = retarget(&clip, &robot, &map)
+    let refs = retarget_joint_angles(&clip, &robot, &map)
         .unwrap()
         .resample(0.005)
         .unwrap();

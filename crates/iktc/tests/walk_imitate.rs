@@ -4,7 +4,7 @@
 //! is exceeded at any tick; the feet do not slide in stance.
 
 use iktc::model::{jvrc1, ModelOptions, Robot};
-use iktc::motion::{builtin_clip, builtin_map, retarget, RobotReferences};
+use iktc::motion::{builtin_clip, builtin_map, retarget_joint_angles, RobotReferences};
 use iktc::sim::{run_walk_imitate, WalkImitateConfig, WalkRun};
 use iktc::walk::{Phase, Side};
 
@@ -19,7 +19,7 @@ fn setup() -> (Robot, RobotReferences) {
     let robot = jvrc1(&ModelOptions::default()).unwrap();
     let clip = builtin_clip("humanoid3d_dance_b").unwrap();
     let map = builtin_map("deepmimic_jvrc1").unwrap();
-    let refs = retarget(&clip, &robot, &map)
+    let refs = retarget_joint_angles(&clip, &robot, &map)
         .unwrap()
         .resample(0.005)
         .unwrap();

@@ -14,7 +14,7 @@ Quick start::
 
 Motions (``load_motion``: a built-in DeepMimic clip or a BVH, ASF/AMC, DeepMimic, C3D,
 points-CSV file, or an AMASS ``.npz`` archive with ``body_model=`` the SMPL-H / SMPL-X model
-file) retarget to a robot with ``retarget`` (joint angles) or ``retarget_keypoints`` (body points,
+file) retarget to a robot with ``retarget_joint_angles`` or ``retarget_keypoints`` (body points,
 the robot's q, v, q̈ per tick), numpy arrays; ``Imitation`` steps the
 imitation of Section 5.3 tick by tick.
 
@@ -45,7 +45,7 @@ from ._iktc import (
     Imitation,
     Walking,
     load_motion,
-    retarget,
+    retarget_joint_angles,
     retarget_keypoints,
     KeypointTrajectory,
     profile_init,
@@ -73,7 +73,7 @@ __all__ = [
     "Imitation",
     "Walking",
     "load_motion",
-    "retarget",
+    "retarget_joint_angles",
     "retarget_keypoints",
     "KeypointTrajectory",
     "profile_init",

@@ -17,7 +17,7 @@
 //!   `amass`) — the readers behind it.
 //! * [`decompose_rotation`] — a rotation as a product of rotations about 1–3 given joint axes
 //!   (generalised Euler / Davenport angles in closed form, least squares otherwise).
-//! * [`retarget`], [`RetargetMap`], [`builtin_map`] — a clip to robot joint, pelvis height and
+//! * [`retarget_joint_angles`], [`RetargetMap`], [`builtin_map`] — a clip to robot joint, pelvis height and
 //!   pelvis attitude references (a TOML map names which source joint drives which robot joints),
 //!   resampled to the control rate by C² splines ([`Retargeted::resample`], [`CubicSpline`]).
 //!
@@ -105,7 +105,7 @@ pub use recognise::{
     builtin_body_map, draft_body_map_toml, marker_points, recognise_markers, recognise_skeleton,
     skeleton_points, BUILTIN_BODY_MAP_NAMES,
 };
-pub use retarget::{retarget, shrunk_range, Retargeted, RobotReferences, Track};
+pub use retarget::{retarget_joint_angles, shrunk_range, Retargeted, RobotReferences, Track};
 #[cfg(feature = "toml")]
 pub use retarget_map::{builtin_map, builtin_map_text, BUILTIN_MAP_NAMES};
 pub use retarget_map::{HoldJoint, JointMap, RetargetMap, RootMap, TargetJoint};

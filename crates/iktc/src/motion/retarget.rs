@@ -180,7 +180,7 @@ struct ResolvedJoint {
 /// Errors: a source joint or robot joint that does not exist, a robot joint that is not an
 /// active revolute joint, targets of one map entry that do not form a serial chain (each the
 /// child of the previous one's link), and the errors of [`decompose_rotation`].
-pub fn retarget(clip: &Clip, robot: &Robot, map: &RetargetMap) -> Result<Retargeted> {
+pub fn retarget_joint_angles(clip: &Clip, robot: &Robot, map: &RetargetMap) -> Result<Retargeted> {
     let skeleton = clip.skeleton();
     let state = State::neutral(robot);
     let kin = Kinematics::new(robot, &state)?;

@@ -244,12 +244,12 @@ impl Default for ImitateConfig {
     }
 }
 
-/// The references of a run: `clip` retargeted with `map` ([`retarget`]), the joint samples
+/// The references of a run: `clip` retargeted with `map` ([`retarget_joint_angles`]), the joint samples
 /// clamped into their (narrowed) ranges shrunk by `cfg.reference_margin` *before* the
 /// interpolation (so the tracked references stay C²; the controller's own clamp then only trims
 /// the splines' small overshoots), and resampled at `cfg.dt` ([`Retargeted::resample`]).
 ///
-/// [`retarget`]: crate::motion::retarget
+/// [`retarget_joint_angles`]: crate::motion::retarget_joint_angles
 /// [`Retargeted::resample`]: crate::motion::Retargeted::resample
 pub fn imitation_references(
     robot: &Robot,
@@ -258,7 +258,7 @@ pub fn imitation_references(
     cfg: &ImitateConfig,
 ) -> Result<RobotReferences> {
     cfg.validate()?;
-    let mut r = crate::motion::retarget(clip, robot, map)?;
+    let mut r = crate::motion::retarget_joint_angles(clip, robot, map)?;
     if let Some(fc) = cfg.smoothing {
         let low = |x: &[f64]| crate::motion::lowpass_track(x, &r.times, fc);
         let joints = r
