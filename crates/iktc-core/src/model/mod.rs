@@ -7,6 +7,7 @@
 //! * [`Kinematics`]: link poses, frame Jacobians and drifts, centre of mass, computed once per
 //!   state without allocation.
 
+mod build;
 mod builtin;
 mod joint;
 mod kinematics;

@@ -1,10 +1,8 @@
 //! The immutable robot model: links, joints, frames and the layout of q and q̇.
 
-use std::collections::HashMap;
-
 use nalgebra::{Isometry3, Matrix3, Vector3};
 
-use super::joint::{Joint, JointKind, JointLimit, JointRole};
+use super::joint::{Joint, JointKind, JointLimit};
 use crate::error::{Error, Result};
 
 /// A rigid link.
@@ -139,11 +137,11 @@ pub struct JointSpec {
 /// Collects links, joints and frames, then validates them into a [`Robot`].
 #[derive(Debug, Clone, Default)]
 pub struct RobotBuilder {
-    name: String,
-    links: Vec<Link>,
-    joints: Vec<JointSpec>,
-    frames: Vec<(String, String, Isometry3<f64>)>,
-    warnings: Vec<String>,
+    pub(super) name: String,
+    pub(super) links: Vec<Link>,
+    pub(super) joints: Vec<JointSpec>,
+    pub(super) frames: Vec<(String, String, Isometry3<f64>)>,
+    pub(super) warnings: Vec<String>,
 }
 
 impl RobotBuilder {
@@ -192,7 +190,7 @@ impl RobotBuilder {
     /// beyond the plausibility bounds of [`plausible`](super::plausible) (a mass, length,
     /// inertia, speed or acceleration no robot has).
     pub fn build(self, options: &ModelOptions) -> Result<Robot> {
-        Robot::from_builder(self, options)
+        super::build::robot(self, options)
     }
 }
 
@@ -219,374 +217,7 @@ pub struct Robot {
     pub(crate) warnings: Vec<String>,
 }
 
-fn finite_vec(what: &str, v: &Vector3<f64>) -> Result<()> {
-    crate::error::check_all_finite(what, v.as_slice())
-}
-
-fn finite_iso(what: &str, t: &Isometry3<f64>) -> Result<()> {
-    finite_vec(what, &t.translation.vector)?;
-    crate::error::check_all_finite(what, t.rotation.coords.as_slice())
-}
-
 impl Robot {
-    fn from_builder(b: RobotBuilder, options: &ModelOptions) -> Result<Robot> {
-        crate::error::check_finite(
-            || "ModelOptions::acceleration_per_velocity".into(),
-            options.acceleration_per_velocity,
-        )?;
-        if options.acceleration_per_velocity <= 0.0 {
-            return Err(Error::InvalidSetting {
-                name: "acceleration_per_velocity".into(),
-                value: options.acceleration_per_velocity.to_string(),
-                expected: "a positive number [1/s]".into(),
-            });
-        }
-        if options.fallback_velocity.is_nan() || options.fallback_velocity <= 0.0 {
-            return Err(Error::InvalidSetting {
-                name: "fallback_velocity".into(),
-                value: options.fallback_velocity.to_string(),
-                expected: "a positive velocity limit [rad/s or m/s], or +inf for none".into(),
-            });
-        }
-        if options.jerk_per_acceleration.is_nan() || options.jerk_per_acceleration <= 0.0 {
-            return Err(Error::InvalidSetting {
-                name: "jerk_per_acceleration".into(),
-                value: options.jerk_per_acceleration.to_string(),
-                expected: "a positive number [1/s], or +inf for no default jerk limit".into(),
-            });
-        }
-        if b.links.is_empty() {
-            return Err(Error::Urdf {
-                message: "the robot has no link".into(),
-            });
-        }
-        // Links.
-        let mut link_index: HashMap<&str, usize> = HashMap::new();
-        for (i, l) in b.links.iter().enumerate() {
-            if link_index.insert(l.name.as_str(), i).is_some() {
-                return Err(Error::Urdf {
-                    message: format!("duplicate link name `{}`", l.name),
-                });
-            }
-            crate::error::check_finite(|| format!("mass of link `{}`", l.name), l.mass)?;
-            if l.mass < 0.0 {
-                return Err(Error::Urdf {
-                    message: format!("link `{}` has negative mass {}", l.name, l.mass),
-                });
-            }
-            finite_vec(&format!("centre of mass of link `{}`", l.name), &l.com)?;
-            crate::error::check_all_finite(
-                &format!("inertia of link `{}`", l.name),
-                l.inertia.as_slice(),
-            )?;
-            super::plausible::check_link(l)?;
-        }
-        let link_names = || b.links.iter().map(|l| l.name.clone()).collect::<Vec<_>>();
-        let find_link = |name: &str| -> Result<usize> {
-            link_index
-                .get(name)
-                .copied()
-                .ok_or_else(|| Error::UnknownName {
-                    kind: "link",
-                    name: name.to_string(),
-                    valid: link_names(),
-                })
-        };
-        // Joints: parent/child indices, one parent per link.
-        let mut joint_names: HashMap<&str, usize> = HashMap::new();
-        let mut parent_of: Vec<Option<usize>> = vec![None; b.links.len()];
-        let mut children: Vec<Vec<usize>> = vec![Vec::new(); b.links.len()];
-        for (j, s) in b.joints.iter().enumerate() {
-            if joint_names.insert(s.name.as_str(), j).is_some() {
-                return Err(Error::Urdf {
-                    message: format!("duplicate joint name `{}`", s.name),
-                });
-            }
-            let p = find_link(&s.parent)?;
-            let c = find_link(&s.child)?;
-            if let Some(other) = parent_of[c] {
-                return Err(Error::Urdf {
-                    message: format!(
-                        "link `{}` is the child of two joints, `{}` and `{}`",
-                        s.child, b.joints[other].name, s.name
-                    ),
-                });
-            }
-            parent_of[c] = Some(j);
-            children[p].push(j);
-            finite_iso(&format!("origin of joint `{}`", s.name), &s.origin)?;
-            super::plausible::check_joint(s)?;
-            let l = &s.limit;
-            for (what, v) in [("lower", l.lower), ("upper", l.upper)] {
-                if v.is_nan() {
-                    return Err(Error::NonFinite {
-                        what: format!("{what} limit of joint `{}`", s.name),
-                        value: v,
-                    });
-                }
-            }
-            if l.lower > l.upper {
-                return Err(Error::InvalidLimit {
-                    what: format!("joint `{}`", s.name),
-                    lower: l.lower,
-                    upper: l.upper,
-                });
-            }
-            for (what, v) in [
-                ("velocity", l.velocity),
-                ("acceleration", l.acceleration),
-                ("effort", l.effort),
-            ] {
-                if v.is_nan() || v < 0.0 || (what != "effort" && v == 0.0) {
-                    return Err(Error::InvalidSetting {
-                        name: format!("{what} limit of joint `{}`", s.name),
-                        value: v.to_string(),
-                        expected: "a positive number or +inf".into(),
-                    });
-                }
-            }
-        }
-        let roots: Vec<usize> = (0..b.links.len())
-            .filter(|&i| parent_of[i].is_none())
-            .collect();
-        if roots.len() != 1 {
-            return Err(Error::Urdf {
-                message: format!(
-                    "expected exactly one root link (a link that is no joint's child), found {}: {}",
-                    roots.len(),
-                    crate::error::name_list(
-                        &roots
-                            .iter()
-                            .map(|&i| b.links[i].name.as_str())
-                            .collect::<Vec<_>>()
-                    )
-                ),
-            });
-        }
-        let root = roots[0];
-        // Depth-first order from the root.
-        let mut order: Vec<usize> = Vec::with_capacity(b.joints.len());
-        let mut stack: Vec<usize> = children[root].iter().rev().copied().collect();
-        while let Some(j) = stack.pop() {
-            order.push(j);
-            let c = find_link(&b.joints[j].child)?;
-            stack.extend(children[c].iter().rev().copied());
-        }
-        if order.len() != b.joints.len() {
-            return Err(Error::Urdf {
-                message: "the joints do not form a tree: some links are not reachable from the root (a cycle?)".into(),
-            });
-        }
-        // Locked values and acceleration limits by name.
-        let all_joint_names = || b.joints.iter().map(|j| j.name.clone()).collect::<Vec<_>>();
-        let find_joint = |kind: &'static str, name: &str| -> Result<usize> {
-            joint_names
-                .get(name)
-                .copied()
-                .ok_or_else(|| Error::UnknownName {
-                    kind,
-                    name: name.to_string(),
-                    valid: all_joint_names(),
-                })
-        };
-        let mut locked: HashMap<usize, f64> = HashMap::new();
-        for (name, value) in &options.locked {
-            let j = find_joint("joint", name)?;
-            crate::error::check_finite(|| format!("locked value of joint `{name}`"), *value)?;
-            if matches!(b.joints[j].kind, JointKind::Fixed) {
-                return Err(Error::InvalidSetting {
-                    name: format!("locked joint `{name}`"),
-                    value: value.to_string(),
-                    expected: "a revolute, continuous or prismatic joint (this one is fixed)"
-                        .into(),
-                });
-            }
-            let range = b.joints[j].limit;
-            if *value < range.lower || *value > range.upper {
-                return Err(Error::StateOutsideLimits {
-                    joint: name.clone(),
-                    quantity: "locked position [rad or m]".into(),
-                    value: *value,
-                    lower: range.lower,
-                    upper: range.upper,
-                });
-            }
-            locked.insert(j, *value);
-        }
-        // Per-joint limits by name: positive or +inf, named in the error.
-        let by_joint = |list: &[(String, f64)], what: &str, unit: &str| {
-            let mut out: HashMap<usize, f64> = HashMap::new();
-            for (name, value) in list {
-                let j = find_joint("joint", name)?;
-                if value.is_nan() || *value <= 0.0 {
-                    return Err(Error::InvalidSetting {
-                        name: format!("{what} limit of joint `{name}`"),
-                        value: value.to_string(),
-                        expected: format!("a positive number [{unit}] or +inf"),
-                    });
-                }
-                out.insert(j, *value);
-            }
-            Ok(out)
-        };
-        let velocity = by_joint(&options.velocity_limits, "velocity", "rad/s")?;
-        let accel = by_joint(&options.acceleration_limits, "acceleration", "rad/s²")?;
-        let jerk = by_joint(&options.jerk_limits, "jerk", "rad/s³")?;
-        // Roles. First pass: active / locked / fixed; mimics resolved after.
-        let nbase_v = if options.base == BaseKind::Floating {
-            6
-        } else {
-            0
-        };
-        let mut joints: Vec<Joint> = Vec::with_capacity(order.len());
-        let mut new_index: Vec<usize> = vec![0; b.joints.len()];
-        for (k, &j) in order.iter().enumerate() {
-            new_index[j] = k;
-        }
-        let mut active: Vec<usize> = Vec::new();
-        for &j in &order {
-            let s = &b.joints[j];
-            let role = if matches!(s.kind, JointKind::Fixed) {
-                JointRole::Fixed
-            } else if let Some(v) = locked.get(&j) {
-                JointRole::Locked { value: *v }
-            } else if s.mimic.is_some() {
-                JointRole::Fixed // placeholder, resolved below
-            } else {
-                active.push(new_index[j]);
-                JointRole::Active {
-                    index: active.len() - 1,
-                }
-            };
-            let mut limit = s.limit;
-            if let Some(v) = velocity.get(&j) {
-                limit.velocity = *v;
-            } else if !limit.velocity.is_finite() && !matches!(s.kind, JointKind::Fixed) {
-                limit.velocity = options.fallback_velocity;
-            }
-            if let Some(a) = accel.get(&j) {
-                limit.acceleration = *a;
-            } else if !limit.acceleration.is_finite() && !matches!(s.kind, JointKind::Fixed) {
-                limit.acceleration = if limit.velocity.is_finite() {
-                    options.acceleration_per_velocity * limit.velocity
-                } else {
-                    options.fallback_acceleration
-                };
-            }
-            if let Some(value) = jerk.get(&j) {
-                limit.jerk = *value;
-            } else if !matches!(s.kind, JointKind::Fixed) {
-                // inf · a: +inf unless both are finite (0 · inf cannot occur: a > 0).
-                limit.jerk = options.jerk_per_acceleration * limit.acceleration;
-            }
-            joints.push(Joint {
-                name: s.name.clone(),
-                parent: find_link(&s.parent)?,
-                child: find_link(&s.child)?,
-                origin: s.origin,
-                kind: s.kind,
-                limit,
-                role,
-            });
-        }
-        for &j in &order {
-            let s = &b.joints[j];
-            let Some((master, mult, off)) = &s.mimic else {
-                continue;
-            };
-            if locked.contains_key(&j) || matches!(s.kind, JointKind::Fixed) {
-                continue;
-            }
-            let m = find_joint("joint (mimic master)", master)?;
-            crate::error::check_all_finite(
-                &format!("mimic of joint `{}`", s.name),
-                &[*mult, *off],
-            )?;
-            let role = match joints[new_index[m]].role {
-                JointRole::Locked { value } => JointRole::Locked {
-                    value: mult * value + off,
-                },
-                JointRole::Active { index } => match options.mimic {
-                    MimicPolicy::Follow => JointRole::Mimic {
-                        master: index,
-                        multiplier: *mult,
-                        offset: *off,
-                    },
-                    MimicPolicy::Reject => {
-                        return Err(Error::Urdf {
-                            message: format!(
-                                "joint `{}` mimics `{master}`, which is not locked, and the mimic policy is Reject; lock `{master}` or use MimicPolicy::Follow",
-                                s.name
-                            ),
-                        })
-                    }
-                },
-                _ => {
-                    return Err(Error::Urdf {
-                        message: format!(
-                            "joint `{}` mimics `{master}`, which is fixed or itself a mimic; chains of mimics are not supported",
-                            s.name
-                        ),
-                    })
-                }
-            };
-            joints[new_index[j]].role = role;
-        }
-        let drive = joints
-            .iter()
-            .map(|j| match j.role {
-                JointRole::Active { index } => Some((nbase_v + index, 1.0)),
-                JointRole::Mimic {
-                    master, multiplier, ..
-                } => Some((nbase_v + master, multiplier)),
-                _ => None,
-            })
-            .collect();
-        let mut parent_joint = vec![None; b.links.len()];
-        for (k, j) in joints.iter().enumerate() {
-            parent_joint[j.child] = Some(k);
-        }
-        // Frames: every link, then the extra frames.
-        let mut frames: Vec<Frame> = b
-            .links
-            .iter()
-            .enumerate()
-            .map(|(i, l)| Frame {
-                name: l.name.clone(),
-                link: i,
-                offset: Isometry3::identity(),
-            })
-            .collect();
-        for (name, link, offset) in &b.frames {
-            if frames.iter().any(|f| &f.name == name) {
-                return Err(Error::Urdf {
-                    message: format!("duplicate frame name `{name}`"),
-                });
-            }
-            finite_iso(&format!("offset of frame `{name}`"), offset)?;
-            super::plausible::check_frame(name, offset)?;
-            frames.push(Frame {
-                name: name.clone(),
-                link: find_link(link)?,
-                offset: *offset,
-            });
-        }
-        let total_mass = b.links.iter().map(|l| l.mass).sum();
-        Ok(Robot {
-            name: b.name,
-            base: options.base,
-            links: b.links,
-            joints,
-            root,
-            frames,
-            active,
-            drive,
-            parent_joint,
-            total_mass,
-            warnings: b.warnings,
-        })
-    }
-
     /// The robot's name.
     pub fn name(&self) -> &str {
         &self.name
@@ -672,7 +303,7 @@ impl Robot {
     /// error lists the frames), a name a link or frame already has, a non-finite offset.
     pub fn with_frame(mut self, name: &str, parent: &str, offset: Isometry3<f64>) -> Result<Robot> {
         let p = self.frame_id(parent)?;
-        finite_iso(&format!("offset of the frame `{name}`"), &offset)?;
+        super::build::finite_iso(&format!("offset of the frame `{name}`"), &offset)?;
         if self.frames.iter().any(|f| f.name == name) {
             return Err(Error::InvalidSetting {
                 name: "frame name".into(),
