@@ -3,12 +3,13 @@
 //! base `x y z qw qx qy qz`, then one column per joint) against the captured motion it
 //! retargets ([`iktc::retarget::evaluate_trajectory`]).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use iktc::motion::{load_motion, DEFAULT_MAX_GAP};
 use iktc::retarget::{
-    evaluate_trajectory, read_trajectory_csv, read_trajectory_npz, TrajectoryEvaluation,
+    evaluate_trajectory, read_trajectory_csv, read_trajectory_npz, RobotTrajectory,
+    TrajectoryEvaluation,
 };
 use serde::Serialize;
 
@@ -70,21 +71,42 @@ pub fn run(a: &Args) -> Result<()> {
         .with_context(|| format!("reading the motion {}", a.motion.display()))?;
     let kp = motion.keypoints(DEFAULT_MAX_GAP)?;
     let source = a.trajectory.display().to_string();
-    let bytes =
-        std::fs::read(&a.trajectory).with_context(|| format!("reading the trajectory {source}"))?;
-    let is_npz = a
-        .trajectory
+    let trajectory = read_trajectory(&a.trajectory, &source)?;
+    let e = evaluate_trajectory(profile, &resolved.robot, &kp, &trajectory, 1.0 / rate)?;
+    print_evaluation(&e)?;
+    if let Some(out) = &a.out {
+        let o = Output {
+            motion: a.motion.display().to_string(),
+            trajectory: source,
+            robot: &a.robot,
+            evaluation: &e,
+        };
+        let json = crate::finite::to_json("evaluation", &o)?;
+        std::fs::write(out, json).with_context(|| format!("writing {}", out.display()))?;
+    }
+    Ok(())
+}
+
+/// Reads the robot trajectory at `path` (named `source` in errors): NPZ by extension or
+/// content, CSV otherwise.
+fn read_trajectory(path: &Path, source: &str) -> Result<RobotTrajectory> {
+    let bytes = std::fs::read(path).with_context(|| format!("reading the trajectory {source}"))?;
+    let is_npz = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("npz"))
         || bytes.starts_with(b"PK\x03\x04");
-    let trajectory = if is_npz {
-        read_trajectory_npz(&bytes, &source)?
+    Ok(if is_npz {
+        read_trajectory_npz(&bytes, source)?
     } else {
         let text = String::from_utf8(bytes)
             .map_err(|_| anyhow::anyhow!("{source}: not UTF-8 text (a CSV was expected)"))?;
-        read_trajectory_csv(&text, &source)?
-    };
-    let e = evaluate_trajectory(profile, &resolved.robot, &kp, &trajectory, 1.0 / rate)?;
+        read_trajectory_csv(&text, source)?
+    })
+}
+
+/// Prints the evaluation: rates [Hz], keypoint error [cm], posture, contacts [mm], smoothness
+/// and the verdict.
+fn print_evaluation(e: &TrajectoryEvaluation) -> Result<()> {
     let f = &e.fidelity;
     crate::outln!(
         "{} frames at {:.3} Hz evaluated at {:.3} Hz{}; {}",
@@ -132,16 +154,6 @@ pub fn run(a: &Args) -> Result<()> {
         crate::outln!("verdict: healthy")?;
     } else {
         crate::outln!("verdict: {}", f.failures.join("; "))?;
-    }
-    if let Some(out) = &a.out {
-        let o = Output {
-            motion: a.motion.display().to_string(),
-            trajectory: source,
-            robot: &a.robot,
-            evaluation: &e,
-        };
-        let json = crate::finite::to_json("evaluation", &o)?;
-        std::fs::write(out, json).with_context(|| format!("writing {}", out.display()))?;
     }
     Ok(())
 }

@@ -303,7 +303,17 @@ pub fn run(
 /// The summary lists this many joints on a position limit, the most often first.
 const ON_LIMIT_LISTED: usize = 3;
 
+/// Prints the keypoint run's quality beside the joint route's (`joints`, when it ran).
 fn print(run: &KeypointRun, joints: Option<&RetargetQuality>) -> std::io::Result<()> {
+    let k = &run.quality;
+    print_header(run, joints)?;
+    print_points(k, joints)?;
+    print_contacts_and_limits(k, joints)?;
+    crate::outln!("(mean / max; jerk in rad/s³, and its square's share on the ticks the solver corrected into the joint limits' box and the ticks after them; margins position [rad], velocity [rad/s], acceleration [rad/s²], positive = a limit exceeded)")
+}
+
+/// Prints the run's ticks, solvers and sacrificed levels, and the table's column titles.
+fn print_header(run: &KeypointRun, joints: Option<&RetargetQuality>) -> std::io::Result<()> {
     let k = &run.quality;
     crate::outln!(
         "keypoint retargeting: {} ticks, leg ratio {:.3}, {} ticks solved by GF (+{} for the feet), tick median {:.1} µs",
@@ -329,10 +339,17 @@ fn print(run: &KeypointRun, joints: Option<&RetargetQuality>) -> std::io::Result
         } else {
             "joints (not run)"
         }
-    )?;
-    let row = |name: &str, a: String, b: Option<String>| {
-        crate::outln!("{name:<16} {a:>22} {:>22}", b.unwrap_or_default())
-    };
+    )
+}
+
+/// Prints one row of the table: its name, the keypoint route's value `a`, the joint route's `b`.
+fn row(name: &str, a: String, b: Option<String>) -> std::io::Result<()> {
+    crate::outln!("{name:<16} {a:>22} {:>22}", b.unwrap_or_default())
+}
+
+/// Prints the position errors of the points [cm], the reaches [cm] and the orientation errors
+/// of the frames [deg].
+fn print_points(k: &RetargetQuality, joints: Option<&RetargetQuality>) -> std::io::Result<()> {
     for (i, p) in k.points.iter().enumerate() {
         let other = joints
             .and_then(|j| j.points.get(i))
@@ -372,6 +389,28 @@ fn print(run: &KeypointRun, joints: Option<&RetargetQuality>) -> std::io::Result
             other,
         )?;
     }
+    Ok(())
+}
+
+/// The joints most often on a position limit with their share of the ticks, or "none".
+fn on_limit_text(q: &RetargetQuality) -> String {
+    if q.on_limit.is_empty() {
+        return "none".into();
+    }
+    q.on_limit
+        .iter()
+        .take(ON_LIMIT_LISTED)
+        .map(|j| format!("{} {:.0} %", j.joint, 100.0 * j.share))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// Prints the feet's contact (slip, depth, floating [mm]), the joints on a limit, the jerk
+/// [rad/s³] and the worst margins.
+fn print_contacts_and_limits(
+    k: &RetargetQuality,
+    joints: Option<&RetargetQuality>,
+) -> std::io::Result<()> {
     row(
         "stance slip",
         format!("{:.2} mm", k.slip_mm),
@@ -387,21 +426,10 @@ fn print(run: &KeypointRun, joints: Option<&RetargetQuality>) -> std::io::Result
         format!("{:.1} mm, {:.1} %", k.float_mm, 100.0 * k.float_share),
         joints.map(|j| format!("{:.1} mm, {:.1} %", j.float_mm, 100.0 * j.float_share)),
     )?;
-    let on_limit = |q: &RetargetQuality| -> String {
-        if q.on_limit.is_empty() {
-            return "none".into();
-        }
-        q.on_limit
-            .iter()
-            .take(ON_LIMIT_LISTED)
-            .map(|j| format!("{} {:.0} %", j.joint, 100.0 * j.share))
-            .collect::<Vec<_>>()
-            .join(", ")
-    };
     row(
         "on a position limit (ticks)",
-        on_limit(k),
-        joints.map(on_limit),
+        on_limit_text(k),
+        joints.map(on_limit_text),
     )?;
     row(
         "jerk RMS / max",
@@ -425,6 +453,5 @@ fn print(run: &KeypointRun, joints: Option<&RetargetQuality>) -> std::io::Result
                 j.position_margin, j.velocity_margin, j.acceleration_margin
             )
         }),
-    )?;
-    crate::outln!("(mean / max; jerk in rad/s³, and its square's share on the ticks the solver corrected into the joint limits' box and the ticks after them; margins position [rad], velocity [rad/s], acceleration [rad/s²], positive = a limit exceeded)")
+    )
 }

@@ -108,97 +108,108 @@ pub enum MapCommand {
 /// Runs `iktc map`.
 pub fn run(a: &Args) -> Result<()> {
     match &a.command {
-        MapCommand::Show { name } => {
-            if BUILTIN_MAP_NAMES.contains(&name.as_str()) {
-                crate::out::write_out(format_args!("{}", builtin_map_text(name)?))?;
-            } else if BUILTIN_BODY_MAP_NAMES.contains(&name.as_str()) {
-                crate::out::write_out(format_args!(
-                    "{}",
-                    builtin_body_map(name)?.to_toml_string()
-                ))?;
-            } else {
-                anyhow::bail!(
-                    "no built-in map `{name}`; retargeting maps: {}; body maps: {}",
-                    BUILTIN_MAP_NAMES.join(", "),
-                    BUILTIN_BODY_MAP_NAMES.join(", ")
-                );
-            }
-            Ok(())
-        }
+        MapCommand::Show { name } => show(name),
         MapCommand::Init {
             motion,
             options,
             map,
             out,
-        } => {
-            let given = match map {
-                Some(p) => {
-                    let text = std::fs::read_to_string(p)
-                        .with_context(|| format!("reading the body map `{}`", p.display()))?;
-                    Some(BodyMap::from_toml_str(&text, &p.display().to_string())?)
-                }
-                None => None,
-            };
-            let out = out.clone().unwrap_or_else(|| {
-                let stem = motion
-                    .file_stem()
-                    .map(|s| s.to_string_lossy().to_string())
-                    .unwrap_or_else(|| "motion".to_string());
-                PathBuf::from(format!("{stem}.map.toml"))
-            });
-            let name = motion
-                .file_stem()
-                .map(|s| s.to_string_lossy().to_string())
-                .unwrap_or_else(|| "motion".to_string());
-            let m = match load(motion, options, given.clone()) {
-                Ok(m) => m,
-                // Without a body map the up axis cannot be decided: read the file with one
-                // assumed, only for its names, and write what was found.
-                Err(first) if given.is_none() => {
-                    let assumed = MotionArgs {
-                        up: "z".into(),
-                        units: "m".into(),
-                        ..options.clone()
-                    };
-                    load(motion, &assumed, None).map_err(|_| first)?
-                }
-                Err(e) => return Err(e),
-            };
-            let text = match &m.body_map {
-                Ok(body_map) => {
-                    let mut body_map = body_map.clone();
-                    body_map.name = name.clone();
-                    body_map.to_toml_string()
-                }
-                Err(e) => {
-                    let (found, what, available) = match &m.content {
-                        MotionContent::Markers(set) => {
-                            (marker_points(&set.names), "markers", set.names.clone())
-                        }
-                        MotionContent::Skeleton(clip) => (
-                            skeleton_points(clip.skeleton()),
-                            "joints",
-                            clip.skeleton()
-                                .joints()
-                                .iter()
-                                .map(|j| j.name.clone())
-                                .collect(),
-                        ),
-                    };
-                    crate::outln!(
-                        "not every required body point was recognised ({e}); the map holds what was found and a commented entry for each point to fill in"
-                    )?;
-                    draft_body_map_toml(&name, &found, what, &available)
-                }
-            };
-            crate::out::write_out(format_args!("{text}"))?;
-            std::fs::write(&out, &text).with_context(|| format!("writing `{}`", out.display()))?;
-            crate::outln!("wrote {}", out.display())?;
-            if m.body_map.is_ok() {
-                let keypoints = m.keypoints(iktc::motion::DEFAULT_MAX_GAP)?;
-                crate::outln!("{}", keypoints.summary())?;
-            }
-            Ok(())
-        }
+        } => init(motion, options, map.as_deref(), out.as_deref()),
     }
+}
+
+/// Prints the built-in retargeting or body map `name`.
+fn show(name: &str) -> Result<()> {
+    if BUILTIN_MAP_NAMES.contains(&name) {
+        crate::out::write_out(format_args!("{}", builtin_map_text(name)?))?;
+    } else if BUILTIN_BODY_MAP_NAMES.contains(&name) {
+        crate::out::write_out(format_args!("{}", builtin_body_map(name)?.to_toml_string()))?;
+    } else {
+        anyhow::bail!(
+            "no built-in map `{name}`; retargeting maps: {}; body maps: {}",
+            BUILTIN_MAP_NAMES.join(", "),
+            BUILTIN_BODY_MAP_NAMES.join(", ")
+        );
+    }
+    Ok(())
+}
+
+/// The motion file's stem, or "motion".
+fn motion_stem(motion: &Path) -> String {
+    motion
+        .file_stem()
+        .map(|s| s.to_string_lossy().to_string())
+        .unwrap_or_else(|| "motion".to_string())
+}
+
+/// Finds the body points of `motion` (with the body map `map`, if given) and prints and writes
+/// the body map to `out` (default `<motion stem>.map.toml`).
+fn init(motion: &Path, options: &MotionArgs, map: Option<&Path>, out: Option<&Path>) -> Result<()> {
+    let given = match map {
+        Some(p) => {
+            let text = std::fs::read_to_string(p)
+                .with_context(|| format!("reading the body map `{}`", p.display()))?;
+            Some(BodyMap::from_toml_str(&text, &p.display().to_string())?)
+        }
+        None => None,
+    };
+    let out = out
+        .map(Path::to_path_buf)
+        .unwrap_or_else(|| PathBuf::from(format!("{}.map.toml", motion_stem(motion))));
+    let name = motion_stem(motion);
+    let m = match load(motion, options, given.clone()) {
+        Ok(m) => m,
+        // Without a body map the up axis cannot be decided: read the file with one
+        // assumed, only for its names, and write what was found.
+        Err(first) if given.is_none() => {
+            let assumed = MotionArgs {
+                up: "z".into(),
+                units: "m".into(),
+                ..options.clone()
+            };
+            load(motion, &assumed, None).map_err(|_| first)?
+        }
+        Err(e) => return Err(e),
+    };
+    let text = body_map_text(&m, &name)?;
+    crate::out::write_out(format_args!("{text}"))?;
+    std::fs::write(&out, &text).with_context(|| format!("writing `{}`", out.display()))?;
+    crate::outln!("wrote {}", out.display())?;
+    if m.body_map.is_ok() {
+        let keypoints = m.keypoints(iktc::motion::DEFAULT_MAX_GAP)?;
+        crate::outln!("{}", keypoints.summary())?;
+    }
+    Ok(())
+}
+
+/// The body map of `m` named `name` as TOML; when not every required body point was
+/// recognised, a draft with what was found and a commented entry for each point to fill in.
+fn body_map_text(m: &Motion, name: &str) -> Result<String> {
+    Ok(match &m.body_map {
+        Ok(body_map) => {
+            let mut body_map = body_map.clone();
+            body_map.name = name.to_string();
+            body_map.to_toml_string()
+        }
+        Err(e) => {
+            let (found, what, available) = match &m.content {
+                MotionContent::Markers(set) => {
+                    (marker_points(&set.names), "markers", set.names.clone())
+                }
+                MotionContent::Skeleton(clip) => (
+                    skeleton_points(clip.skeleton()),
+                    "joints",
+                    clip.skeleton()
+                        .joints()
+                        .iter()
+                        .map(|j| j.name.clone())
+                        .collect(),
+                ),
+            };
+            crate::outln!(
+                "not every required body point was recognised ({e}); the map holds what was found and a commented entry for each point to fill in"
+            )?;
+            draft_body_map_toml(name, &found, what, &available)
+        }
+    })
 }

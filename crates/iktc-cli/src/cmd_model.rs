@@ -151,9 +151,34 @@ pub fn run(a: &Args) -> Result<()> {
     }
     let neutral = State::neutral(&robot);
     let kin0 = Kinematics::new(&robot, &neutral)?;
-    let names: Vec<String> = robot.joints().iter().map(|j| j.name.clone()).collect();
-    let active_names: Vec<String> = robot.active_joints().map(|j| j.name.clone()).collect();
-    let summary_joints = robot
+    let mut summary = Summary {
+        name: robot.name().into(),
+        base: robot.base(),
+        nq: robot.nq(),
+        nv: robot.nv(),
+        total_mass: robot.total_mass(),
+        com_neutral: kin0.com().into(),
+        joints: joints_out(&robot),
+        warnings: robot.warnings().to_vec(),
+        locked: locked_out(&robot),
+        mimic: mimic_out(&robot),
+        frames: robot.frames().iter().map(|f| f.name.clone()).collect(),
+        state: None,
+    };
+    if let Some(path) = &a.config {
+        summary.state = Some(state_out(&robot, a, path)?);
+    }
+    if a.json {
+        crate::outln!("{}", crate::finite::to_json("model summary", &summary)?)?;
+    } else {
+        print_text(&summary)?;
+    }
+    Ok(())
+}
+
+/// The active joints with their indices and limits.
+fn joints_out(robot: &Robot) -> Vec<JointOut> {
+    robot
         .active_joints()
         .enumerate()
         .map(|(i, j)| JointOut {
@@ -171,95 +196,88 @@ pub fn run(a: &Args) -> Result<()> {
             acceleration: j.limit.acceleration,
             effort: j.limit.effort,
         })
-        .collect();
-    let _ = names;
-    let mut summary = Summary {
-        name: robot.name().into(),
-        base: robot.base(),
-        nq: robot.nq(),
-        nv: robot.nv(),
-        total_mass: robot.total_mass(),
-        com_neutral: kin0.com().into(),
-        joints: summary_joints,
-        warnings: robot.warnings().to_vec(),
-        locked: robot
-            .joints()
-            .iter()
-            .filter_map(|j| match j.role {
-                JointRole::Locked { value } => Some((j.name.clone(), value)),
-                _ => None,
-            })
-            .collect(),
-        mimic: robot
-            .joints()
-            .iter()
-            .filter_map(|j| match j.role {
-                JointRole::Mimic {
-                    master,
-                    multiplier,
-                    offset,
-                } => Some(Mimic {
-                    name: j.name.clone(),
-                    master: active_names[master].clone(),
-                    multiplier,
-                    offset,
-                }),
-                _ => None,
-            })
-            .collect(),
-        frames: robot.frames().iter().map(|f| f.name.clone()).collect(),
-        state: None,
-    };
-    if let Some(path) = &a.config {
-        let s = state_from_file(&robot, path)?;
-        let kin = Kinematics::new(&robot, &s)?;
-        let mut jacobians = Vec::new();
-        let mut j6 = DMatrix::zeros(6, robot.nv());
-        for f in &a.jacobians {
-            let id = robot.frame_id(f)?;
-            kin.frame_jacobian(&robot, id, &mut j6)?;
-            jacobians.push(JacobianOut {
-                frame: f.clone(),
-                jacobian: rows(&j6),
-                drift: kin.frame_drift(&robot, id)?.iter().copied().collect(),
-                velocity: kin.frame_velocity(&robot, id)?.iter().copied().collect(),
-            });
-        }
-        let com_jacobian = if a.com_jacobian {
-            let mut j3 = DMatrix::zeros(3, robot.nv());
-            kin.com_jacobian(&robot, &mut j3)?;
-            Some(JacobianOut {
-                frame: "com".into(),
-                jacobian: rows(&j3),
-                drift: kin.com_drift().iter().copied().collect(),
-                velocity: kin.com_velocity().iter().copied().collect(),
-            })
-        } else {
-            None
-        };
-        summary.state = Some(StateOut {
-            q: s.q.iter().copied().collect(),
-            qd: s.qd.iter().copied().collect(),
-            links: robot
-                .links()
-                .iter()
-                .zip(kin.link_poses())
-                .map(|(l, t)| pose_out(&l.name, t))
-                .collect(),
-            com: kin.com().into(),
-            com_velocity: kin.com_velocity().into(),
-            jacobians,
-            com_jacobian,
-        });
-    }
-    if a.json {
-        crate::outln!("{}", crate::finite::to_json("model summary", &summary)?)?;
-    } else {
-        print_text(&summary)?;
-    }
-    Ok(())
+        .collect()
 }
 
+/// The locked joints and the values they are locked at.
+fn locked_out(robot: &Robot) -> Vec<(String, f64)> {
+    robot
+        .joints()
+        .iter()
+        .filter_map(|j| match j.role {
+            JointRole::Locked { value } => Some((j.name.clone(), value)),
+            _ => None,
+        })
+        .collect()
+}
+
+/// The mimic joints and the active joints they follow.
+fn mimic_out(robot: &Robot) -> Vec<Mimic> {
+    let active_names: Vec<String> = robot.active_joints().map(|j| j.name.clone()).collect();
+    robot
+        .joints()
+        .iter()
+        .filter_map(|j| match j.role {
+            JointRole::Mimic {
+                master,
+                multiplier,
+                offset,
+            } => Some(Mimic {
+                name: j.name.clone(),
+                master: active_names[master].clone(),
+                multiplier,
+                offset,
+            }),
+            _ => None,
+        })
+        .collect()
+}
+
+/// The kinematics at the configuration in the file `path`, with the Jacobians `a` asks for.
+fn state_out(robot: &Robot, a: &Args, path: &std::path::Path) -> Result<StateOut> {
+    let s = state_from_file(robot, path)?;
+    let kin = Kinematics::new(robot, &s)?;
+    let mut jacobians = Vec::new();
+    let mut j6 = DMatrix::zeros(6, robot.nv());
+    for f in &a.jacobians {
+        let id = robot.frame_id(f)?;
+        kin.frame_jacobian(robot, id, &mut j6)?;
+        jacobians.push(JacobianOut {
+            frame: f.clone(),
+            jacobian: rows(&j6),
+            drift: kin.frame_drift(robot, id)?.iter().copied().collect(),
+            velocity: kin.frame_velocity(robot, id)?.iter().copied().collect(),
+        });
+    }
+    let com_jacobian = if a.com_jacobian {
+        let mut j3 = DMatrix::zeros(3, robot.nv());
+        kin.com_jacobian(robot, &mut j3)?;
+        Some(JacobianOut {
+            frame: "com".into(),
+            jacobian: rows(&j3),
+            drift: kin.com_drift().iter().copied().collect(),
+            velocity: kin.com_velocity().iter().copied().collect(),
+        })
+    } else {
+        None
+    };
+    Ok(StateOut {
+        q: s.q.iter().copied().collect(),
+        qd: s.qd.iter().copied().collect(),
+        links: robot
+            .links()
+            .iter()
+            .zip(kin.link_poses())
+            .map(|(l, t)| pose_out(&l.name, t))
+            .collect(),
+        com: kin.com().into(),
+        com_velocity: kin.com_velocity().into(),
+        jacobians,
+        com_jacobian,
+    })
+}
+
+/// A limit to four decimals, or "-" when unbounded.
 fn fmt_lim(v: f64) -> String {
     if v.is_infinite() {
         "-".into()
@@ -268,6 +286,7 @@ fn fmt_lim(v: f64) -> String {
     }
 }
 
+/// Prints the summary as text.
 fn print_text(s: &Summary) -> std::io::Result<()> {
     crate::outln!(
         "robot {}: {:?} base, nq = {}, nv = {}",
@@ -287,6 +306,16 @@ fn print_text(s: &Summary) -> std::io::Result<()> {
         s.com_neutral[2]
     )?;
     crate::outln!()?;
+    print_joints(&s.joints)?;
+    print_roles(s)?;
+    if let Some(st) = &s.state {
+        print_state(st)?;
+    }
+    Ok(())
+}
+
+/// Prints the table of the active joints: indices, type and limits (rad or m, per s, per s²).
+fn print_joints(joints: &[JointOut]) -> std::io::Result<()> {
     crate::outln!(
         "{:>4} {:>4}  {:<16} {:<10} {:>9} {:>9} {:>9} {:>10}",
         "q",
@@ -298,7 +327,7 @@ fn print_text(s: &Summary) -> std::io::Result<()> {
         "vel max",
         "acc max"
     )?;
-    for j in &s.joints {
+    for j in joints {
         crate::outln!(
             "{:>4} {:>4}  {:<16} {:<10} {:>9} {:>9} {:>9} {:>10}",
             j.q_index,
@@ -311,7 +340,11 @@ fn print_text(s: &Summary) -> std::io::Result<()> {
             fmt_lim(j.acceleration)
         )?;
     }
-    crate::outln!("(units: rad, rad/s, rad/s² for revolute joints; m, m/s, m/s² for prismatic; - = unbounded)")?;
+    crate::outln!("(units: rad, rad/s, rad/s² for revolute joints; m, m/s, m/s² for prismatic; - = unbounded)")
+}
+
+/// Prints the locked and the mimic joints, if any.
+fn print_roles(s: &Summary) -> std::io::Result<()> {
     if !s.locked.is_empty() {
         crate::outln!()?;
         crate::outln!(
@@ -333,33 +366,36 @@ fn print_text(s: &Summary) -> std::io::Result<()> {
                 .join(", ")
         )?;
     }
-    if let Some(st) = &s.state {
-        crate::outln!()?;
+    Ok(())
+}
+
+/// Prints the kinematics at the configuration given: COM and link poses [m], Jacobians.
+fn print_state(st: &StateOut) -> std::io::Result<()> {
+    crate::outln!()?;
+    crate::outln!(
+        "at the configuration given: COM ({:.4}, {:.4}, {:.4}) m",
+        st.com[0],
+        st.com[1],
+        st.com[2]
+    )?;
+    for l in &st.links {
+        crate::outln!("  {:<20} p = ({:>8.4}, {:>8.4}, {:>8.4})  q(xyzw) = ({:>7.4}, {:>7.4}, {:>7.4}, {:>7.4})", l.name, l.position[0], l.position[1], l.position[2], l.orientation[0], l.orientation[1], l.orientation[2], l.orientation[3])?;
+    }
+    for j in st.jacobians.iter().chain(st.com_jacobian.iter()) {
         crate::outln!(
-            "at the configuration given: COM ({:.4}, {:.4}, {:.4}) m",
-            st.com[0],
-            st.com[1],
-            st.com[2]
+            "Jacobian of {} (rows vx vy vz wx wy wz, world axes):",
+            j.frame
         )?;
-        for l in &st.links {
-            crate::outln!("  {:<20} p = ({:>8.4}, {:>8.4}, {:>8.4})  q(xyzw) = ({:>7.4}, {:>7.4}, {:>7.4}, {:>7.4})", l.name, l.position[0], l.position[1], l.position[2], l.orientation[0], l.orientation[1], l.orientation[2], l.orientation[3])?;
-        }
-        for j in st.jacobians.iter().chain(st.com_jacobian.iter()) {
+        for r in &j.jacobian {
             crate::outln!(
-                "Jacobian of {} (rows vx vy vz wx wy wz, world axes):",
-                j.frame
+                "  {}",
+                r.iter()
+                    .map(|v| format!("{v:>8.4}"))
+                    .collect::<Vec<_>>()
+                    .join(" ")
             )?;
-            for r in &j.jacobian {
-                crate::outln!(
-                    "  {}",
-                    r.iter()
-                        .map(|v| format!("{v:>8.4}"))
-                        .collect::<Vec<_>>()
-                        .join(" ")
-                )?;
-            }
-            crate::outln!("  drift J̇q̇ = {:?}", j.drift)?;
         }
+        crate::outln!("  drift J̇q̇ = {:?}", j.drift)?;
     }
     Ok(())
 }

@@ -199,6 +199,26 @@ fn histogram(label: &str, values: &[f64]) -> String {
     )
 }
 
+/// The page's head: its title and style sheet, up to the body's start.
+const HEAD: &str = "<!DOCTYPE html><html lang=\"en\"><head><meta charset=\"utf-8\"><title>iktc retarget: dataset report</title><style>\
+         body{font:13px sans-serif;margin:16px;color:#222}table{border-collapse:collapse}\
+         td,th{border:1px solid #ccc;padding:3px 6px;text-align:right}td:first-child,th:first-child{text-align:left}\
+         th{cursor:pointer;background:#f0f0f0}tr.bad td{background:#fde8e8}\
+         figure{display:inline-block;margin:6px}figcaption{font-size:11px}pre{white-space:pre-wrap}\
+         </style></head><body>";
+
+/// The script that sorts the clips table by the column clicked, and the page's end.
+const SORT_SCRIPT: &str = "<script>\"use strict\";\
+         const t=document.getElementById('clips');let dir={};\
+         t.querySelectorAll('th').forEach((th,i)=>th.onclick=()=>{\
+         const rows=[...t.tBodies[0].rows];dir[i]=-(dir[i]||1);\
+         const key=r=>{const c=r.cells[i];const v=c.dataset.v;return v===undefined?c.textContent:(v===''?NaN:parseFloat(v));};\
+         rows.sort((a,b)=>{const x=key(a),y=key(b);\
+         if(typeof x==='string')return dir[i]*x.localeCompare(y);\
+         if(isNaN(x))return 1;if(isNaN(y))return -1;return dir[i]*(x-y);});\
+         rows.forEach(r=>t.tBodies[0].appendChild(r));});\
+         </script></body></html>";
+
 /// The page.
 pub fn render(clips: &[ClipStatus], robot: &str) -> String {
     let mut ok: Vec<&ClipStatus> = clips
@@ -216,15 +236,24 @@ pub fn render(clips: &[ClipStatus], robot: &str) -> String {
         .into_iter()
         .filter(|(key, _)| ok.iter().any(|c| figure(c, key).is_some()))
         .collect();
-    let mut s = String::from(
-        "<!DOCTYPE html><html lang=\"en\"><head><meta charset=\"utf-8\"><title>iktc retarget: dataset report</title><style>\
-         body{font:13px sans-serif;margin:16px;color:#222}table{border-collapse:collapse}\
-         td,th{border:1px solid #ccc;padding:3px 6px;text-align:right}td:first-child,th:first-child{text-align:left}\
-         th{cursor:pointer;background:#f0f0f0}tr.bad td{background:#fde8e8}\
-         figure{display:inline-block;margin:6px}figcaption{font-size:11px}pre{white-space:pre-wrap}\
-         </style></head><body>",
-    );
-    s.push_str(&format!(
+    let mut s = String::from(HEAD);
+    s.push_str(&intro(clips, robot, failed.len()));
+    s.push_str(&clips_table(&ok, &columns));
+    s.push_str("<h2>Distributions across the dataset</h2>");
+    for (key, label) in &columns {
+        let v: Vec<f64> = ok.iter().filter_map(|c| figure(c, key)).collect();
+        if !v.is_empty() {
+            s.push_str(&histogram(label, &v));
+        }
+    }
+    s.push_str(&failures_table(&failed));
+    s.push_str(SORT_SCRIPT);
+    s
+}
+
+/// The title and the paragraph counting the clips by status (`failed` of them failed).
+fn intro(clips: &[ClipStatus], robot: &str, failed: usize) -> String {
+    format!(
         "<h1>Dataset report</h1><p>Robot: {}. {} clips: {} retargeted, {} up to date (skipped), {} failed, {} not run (batch interrupted). \
          Rows are sorted worst first (checks failed, then the largest mean keypoint error, or upper-body RMS error on the joint route); click a header to sort by it. \
          Checks: on the keypoint route every joint limit kept, on the joint route the run checks (feet held, finite state, COM over the support). \
@@ -233,65 +262,75 @@ pub fn render(clips: &[ClipStatus], robot: &str) -> String {
         clips.len(),
         clips.iter().filter(|c| c.status == "retargeted").count(),
         clips.iter().filter(|c| c.status == "skipped").count(),
-        failed.len(),
+        failed,
         clips.iter().filter(|c| c.status == "interrupted").count()
-    ));
-    s.push_str("<h2>Clips</h2><table id=\"clips\"><thead><tr><th>clip</th><th>checks</th>");
-    for (_, label) in &columns {
+    )
+}
+
+/// The table of the clips `ok` with the figures of `columns` (key, label), one row per clip.
+fn clips_table(ok: &[&ClipStatus], columns: &[(&str, &str)]) -> String {
+    let mut s =
+        String::from("<h2>Clips</h2><table id=\"clips\"><thead><tr><th>clip</th><th>checks</th>");
+    for (_, label) in columns {
         s.push_str(&format!("<th>{}</th>", escape_html(label)));
     }
     s.push_str("<th>files</th></tr></thead><tbody>");
-    for c in &ok {
-        let h = healthy(c);
-        let why = failures(c).join("; ");
-        s.push_str(&format!(
-            "<tr{}><td>{}</td><td data-v=\"{}\" title=\"{}\">{}</td>",
-            if h { "" } else { " class=\"bad\"" },
-            escape_html(&c.name),
-            u8::from(h),
-            escape_html(&why),
-            if h {
-                "passed".to_string()
-            } else if why.is_empty() {
-                "FAILED".to_string()
-            } else {
-                format!("FAILED: {}", escape_html(&why))
-            }
-        ));
-        for (key, _) in &columns {
-            match figure(c, key) {
-                Some(v) => s.push_str(&format!("<td data-v=\"{v:e}\">{}</td>", cell(v))),
-                None => s.push_str("<td data-v=\"\">–</td>"),
-            }
-        }
-        // Links to the files the clip's folder holds, the viewer first.
-        let dir = escape_html(&c.name);
-        let links: Vec<String> = [
-            ("viewer.html", "viewer"),
-            ("motion.csv", "csv"),
-            ("motion.npz", "npz"),
-            ("quality.json", "quality"),
-        ]
-        .iter()
-        .filter(|(f, _)| c.files.iter().any(|x| x == f))
-        .map(|(f, label)| format!("<a href=\"{dir}/{f}\">{label}</a>"))
-        .collect();
-        let links = links.join(" ");
-        s.push_str(&format!("<td>{links}</td></tr>"));
+    for c in ok {
+        s.push_str(&clip_row(c, columns));
     }
-    s.push_str("</tbody></table><h2>Distributions across the dataset</h2>");
-    for (key, label) in &columns {
-        let v: Vec<f64> = ok.iter().filter_map(|c| figure(c, key)).collect();
-        if !v.is_empty() {
-            s.push_str(&histogram(label, &v));
+    s.push_str("</tbody></table>");
+    s
+}
+
+/// One clip's row: its name, checks, figures and links to its files.
+fn clip_row(c: &ClipStatus, columns: &[(&str, &str)]) -> String {
+    let h = healthy(c);
+    let why = failures(c).join("; ");
+    let mut s = format!(
+        "<tr{}><td>{}</td><td data-v=\"{}\" title=\"{}\">{}</td>",
+        if h { "" } else { " class=\"bad\"" },
+        escape_html(&c.name),
+        u8::from(h),
+        escape_html(&why),
+        if h {
+            "passed".to_string()
+        } else if why.is_empty() {
+            "FAILED".to_string()
+        } else {
+            format!("FAILED: {}", escape_html(&why))
+        }
+    );
+    for (key, _) in columns {
+        match figure(c, key) {
+            Some(v) => s.push_str(&format!("<td data-v=\"{v:e}\">{}</td>", cell(v))),
+            None => s.push_str("<td data-v=\"\">–</td>"),
         }
     }
-    s.push_str(&format!("<h2>Failures ({})</h2>", failed.len()));
+    // Links to the files the clip's folder holds, the viewer first.
+    let dir = escape_html(&c.name);
+    let links: Vec<String> = [
+        ("viewer.html", "viewer"),
+        ("motion.csv", "csv"),
+        ("motion.npz", "npz"),
+        ("quality.json", "quality"),
+    ]
+    .iter()
+    .filter(|(f, _)| c.files.iter().any(|x| x == f))
+    .map(|(f, label)| format!("<a href=\"{dir}/{f}\">{label}</a>"))
+    .collect();
+    let links = links.join(" ");
+    s.push_str(&format!("<td>{links}</td></tr>"));
+    s
+}
+
+/// The failed clips with their input and error, or "None.".
+fn failures_table(failed: &[&ClipStatus]) -> String {
+    let mut s = format!("<h2>Failures ({})</h2>", failed.len());
     if failed.is_empty() {
         s.push_str("<p>None.</p>");
     } else {
         s.push_str("<table id=\"failures\"><thead><tr><th>clip</th><th>input</th><th>error</th></tr></thead><tbody>");
-        for c in &failed {
+        for c in failed {
             s.push_str(&format!(
                 "<tr><td>{}</td><td>{}</td><td><pre>{}</pre></td></tr>",
                 escape_html(&c.name),
@@ -301,17 +340,5 @@ pub fn render(clips: &[ClipStatus], robot: &str) -> String {
         }
         s.push_str("</tbody></table>");
     }
-    s.push_str(
-        "<script>\"use strict\";\
-         const t=document.getElementById('clips');let dir={};\
-         t.querySelectorAll('th').forEach((th,i)=>th.onclick=()=>{\
-         const rows=[...t.tBodies[0].rows];dir[i]=-(dir[i]||1);\
-         const key=r=>{const c=r.cells[i];const v=c.dataset.v;return v===undefined?c.textContent:(v===''?NaN:parseFloat(v));};\
-         rows.sort((a,b)=>{const x=key(a),y=key(b);\
-         if(typeof x==='string')return dir[i]*x.localeCompare(y);\
-         if(isNaN(x))return 1;if(isNaN(y))return -1;return dir[i]*(x-y);});\
-         rows.forEach(r=>t.tBodies[0].appendChild(r));});\
-         </script></body></html>",
-    );
     s
 }

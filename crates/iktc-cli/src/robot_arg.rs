@@ -154,13 +154,32 @@ fn base_profile(spec: &str) -> Result<(RobotProfile, String)> {
     )
 }
 
+/// The profile key prefixes set by flags, each with its flag.
+type FlagKeys = Vec<(String, &'static str)>;
+
 /// Applies the flags to `p`; returns the key prefixes they set.
 fn apply_flags(
     p: &mut RobotProfile,
     o: &RobotOptions,
     f: Option<&ProfileFlags>,
-) -> Result<Vec<(String, &'static str)>> {
-    let mut keys: Vec<(String, &'static str)> = Vec::new();
+) -> Result<FlagKeys> {
+    let mut keys: FlagKeys = Vec::new();
+    apply_robot_options(p, o, &mut keys)?;
+    let Some(f) = f else {
+        return Ok(keys);
+    };
+    apply_feet(p, f, &mut keys)?;
+    apply_sole_and_ankle(p, f, &mut keys)?;
+    if let Some(pelvis) = &f.pelvis {
+        p.frames.pelvis = Some(pelvis.trim().to_string());
+        keys.push(("frames.pelvis".into(), "--pelvis"));
+    }
+    apply_posture_and_narrow(p, f, &mut keys)?;
+    Ok(keys)
+}
+
+/// Applies `--floating`, `--lock`, `--accel` and `--accel-per-velocity` to `p`.
+fn apply_robot_options(p: &mut RobotProfile, o: &RobotOptions, keys: &mut FlagKeys) -> Result<()> {
     if o.floating {
         p.base = BaseKind::Floating;
         keys.push(("base".into(), "--floating"));
@@ -183,43 +202,52 @@ fn apply_flags(
         p.acceleration.per_velocity = r;
         keys.push(("acceleration.per_velocity".into(), "--accel-per-velocity"));
     }
-    let Some(f) = f else {
-        return Ok(keys);
-    };
-    if !f.feet.is_empty() {
-        let [left, right] = &f.feet[..] else {
-            anyhow::bail!(
-                "--feet `{}`: expected two foot frames LEFT,RIGHT (profile keys `feet.left.frame`, `feet.right.frame`)",
-                f.feet.join(",")
-            );
-        };
-        let (right, left) = (right.trim().to_string(), left.trim().to_string());
-        match &mut p.feet {
-            Some(feet) => {
-                feet.right.frame = right;
-                feet.left.frame = left;
-            }
-            None => {
-                let sole = f.sole.as_deref().map(parse_sole).transpose()?.with_context(|| {
-                    "--feet is given but not the sole: pass --sole LENGTH,WIDTH[,OFFSET_X] [m] (profile keys `feet.left.sole`, `feet.right.sole`)"
-                })?;
-                let ankle_height = f.ankle_height.with_context(|| {
-                    "--feet is given but not the ankle height: pass --ankle-height H [m] (profile keys `feet.left.ankle_height`, `feet.right.ankle_height`)"
-                })?;
-                let foot = |frame| Foot {
-                    frame,
-                    ankle_height,
-                    sole,
-                };
-                p.feet = Some(Feet {
-                    left: foot(left),
-                    right: foot(right),
-                });
-            }
-        }
-        keys.push(("feet.right.frame".into(), "--feet"));
-        keys.push(("feet.left.frame".into(), "--feet"));
+    Ok(())
+}
+
+/// Applies `--feet` to `p`: the foot frames, and for a profile without feet the feet themselves
+/// (which then need `--sole` and `--ankle-height`).
+fn apply_feet(p: &mut RobotProfile, f: &ProfileFlags, keys: &mut FlagKeys) -> Result<()> {
+    if f.feet.is_empty() {
+        return Ok(());
     }
+    let [left, right] = &f.feet[..] else {
+        anyhow::bail!(
+            "--feet `{}`: expected two foot frames LEFT,RIGHT (profile keys `feet.left.frame`, `feet.right.frame`)",
+            f.feet.join(",")
+        );
+    };
+    let (right, left) = (right.trim().to_string(), left.trim().to_string());
+    match &mut p.feet {
+        Some(feet) => {
+            feet.right.frame = right;
+            feet.left.frame = left;
+        }
+        None => {
+            let sole = f.sole.as_deref().map(parse_sole).transpose()?.with_context(|| {
+                "--feet is given but not the sole: pass --sole LENGTH,WIDTH[,OFFSET_X] [m] (profile keys `feet.left.sole`, `feet.right.sole`)"
+            })?;
+            let ankle_height = f.ankle_height.with_context(|| {
+                "--feet is given but not the ankle height: pass --ankle-height H [m] (profile keys `feet.left.ankle_height`, `feet.right.ankle_height`)"
+            })?;
+            let foot = |frame| Foot {
+                frame,
+                ankle_height,
+                sole,
+            };
+            p.feet = Some(Feet {
+                left: foot(left),
+                right: foot(right),
+            });
+        }
+    }
+    keys.push(("feet.right.frame".into(), "--feet"));
+    keys.push(("feet.left.frame".into(), "--feet"));
+    Ok(())
+}
+
+/// Applies `--sole` [m] and `--ankle-height` [m] to both feet of `p` (which must have feet).
+fn apply_sole_and_ankle(p: &mut RobotProfile, f: &ProfileFlags, keys: &mut FlagKeys) -> Result<()> {
     if let Some(feet) = &mut p.feet {
         if let Some(s) = &f.sole {
             let sole = parse_sole(s)?;
@@ -237,10 +265,15 @@ fn apply_flags(
     } else if f.sole.is_some() || f.ankle_height.is_some() {
         anyhow::bail!("--sole and --ankle-height need the foot frames: pass --feet LEFT,RIGHT (profile keys `feet.left.frame`, `feet.right.frame`)");
     }
-    if let Some(pelvis) = &f.pelvis {
-        p.frames.pelvis = Some(pelvis.trim().to_string());
-        keys.push(("frames.pelvis".into(), "--pelvis"));
-    }
+    Ok(())
+}
+
+/// Applies `--posture` and `--narrow` [rad] to `p`.
+fn apply_posture_and_narrow(
+    p: &mut RobotProfile,
+    f: &ProfileFlags,
+    keys: &mut FlagKeys,
+) -> Result<()> {
     if let Some(s) = &f.posture {
         p.posture = parse_assignments(
             "--posture",
@@ -268,7 +301,7 @@ fn apply_flags(
         .collect();
         keys.push(("narrow".into(), "--narrow"));
     }
-    Ok(keys)
+    Ok(())
 }
 
 /// The flag that gives each profile key a command needs, for a missing key.
