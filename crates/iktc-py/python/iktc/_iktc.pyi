@@ -8,7 +8,7 @@ import numpy.typing as npt
 __all__ = [
     "__version__", "IktcError", "Robot", "ControllerBuilder", "Controller", "FrameHandle",
     "ComHandle", "JointsHandle", "SolveReport", "Imitation", "Walking", "profile_init",
-    "builtin_text", "load_motion", "retarget", "Motion", "Retargeted", "References",
+    "builtin_text", "load_motion", "retarget_joint_angles", "Motion", "Retargeted", "References",
     "retarget_keypoints", "KeypointTrajectory", "measure_zmp", "identify", "dominant_mode",
     "PlaneModel", "DampingController",
 ]
