@@ -118,6 +118,46 @@ pub fn read_trajectory_csv(text: &str, source: &str) -> Result<RobotTrajectory> 
             "empty file: expected a header line".into(),
         ));
     };
+    let CsvColumns { names, time, base } = csv_columns(header, source)?;
+    let used: Vec<usize> = std::iter::once(time)
+        .chain(base.iter().flatten().copied())
+        .collect();
+    let joint_cols: Vec<usize> = (0..names.len()).filter(|i| !used.contains(i)).collect();
+    let mut t = RobotTrajectory {
+        source: source.into(),
+        times: Vec::new(),
+        base: base.as_ref().map(|_| Vec::new()),
+        joint_names: joint_cols.iter().map(|&i| names[i].clone()).collect(),
+        joints: Vec::new(),
+    };
+    for (ln, line) in lines {
+        let v = csv_row(line, ln, &names, source)?;
+        t.times.push(v[time]);
+        if let (Some(b), Some(cols)) = (t.base.as_mut(), base.as_ref()) {
+            b.push((
+                [v[cols[0]], v[cols[1]], v[cols[2]]],
+                [v[cols[3]], v[cols[4]], v[cols[5]], v[cols[6]]],
+            ));
+        }
+        t.joints.push(joint_cols.iter().map(|&i| v[i]).collect());
+    }
+    check_times(&t)?;
+    Ok(t)
+}
+
+/// The columns of a trajectory CSV's header.
+struct CsvColumns {
+    /// Every column's name, in order.
+    names: Vec<String>,
+    /// The time column.
+    time: usize,
+    /// The base's columns (x y z qw qx qy qz), where the file has them.
+    base: Option<Vec<usize>>,
+}
+
+/// The columns of `header`, the first line of `source`. Errors: a repeated column, no time
+/// column, a partial set of base columns.
+fn csv_columns(header: &str, source: &str) -> Result<CsvColumns> {
     let names: Vec<String> = header.split(',').map(|s| s.trim().to_string()).collect();
     let mut seen = HashMap::new();
     for (i, n) in names.iter().enumerate() {
@@ -162,59 +202,43 @@ pub fn read_trajectory_csv(text: &str, source: &str) -> Result<RobotTrajectory> 
             ),
         ));
     };
-    let used: Vec<usize> = std::iter::once(time)
-        .chain(base.iter().flatten().copied())
-        .collect();
-    let joint_cols: Vec<usize> = (0..names.len()).filter(|i| !used.contains(i)).collect();
-    let mut t = RobotTrajectory {
-        source: source.into(),
-        times: Vec::new(),
-        base: base.as_ref().map(|_| Vec::new()),
-        joint_names: joint_cols.iter().map(|&i| names[i].clone()).collect(),
-        joints: Vec::new(),
-    };
-    for (ln, line) in lines {
-        let row: Vec<&str> = line.split(',').map(str::trim).collect();
-        if row.len() != names.len() {
+    Ok(CsvColumns { names, time, base })
+}
+
+/// The values of `line` (index `ln` in `source`) under the columns `names`. Errors: a row of
+/// another length, a number that does not parse or is not finite.
+fn csv_row(line: &str, ln: usize, names: &[String], source: &str) -> Result<Vec<f64>> {
+    let row: Vec<&str> = line.split(',').map(str::trim).collect();
+    if row.len() != names.len() {
+        return Err(parse_error(
+            source,
+            ln + 1,
+            format!(
+                "{} values, expected {} (the header's columns)",
+                row.len(),
+                names.len()
+            ),
+        ));
+    }
+    let mut v = Vec::with_capacity(row.len());
+    for (c, s) in row.iter().enumerate() {
+        let x: f64 = s.parse().map_err(|_| {
+            parse_error(
+                source,
+                ln + 1,
+                format!("column `{}`: `{s}` is not a number", names[c]),
+            )
+        })?;
+        if !x.is_finite() {
             return Err(parse_error(
                 source,
                 ln + 1,
-                format!(
-                    "{} values, expected {} (the header's columns)",
-                    row.len(),
-                    names.len()
-                ),
+                format!("column `{}`: {s} is not finite", names[c]),
             ));
         }
-        let mut v = Vec::with_capacity(row.len());
-        for (c, s) in row.iter().enumerate() {
-            let x: f64 = s.parse().map_err(|_| {
-                parse_error(
-                    source,
-                    ln + 1,
-                    format!("column `{}`: `{s}` is not a number", names[c]),
-                )
-            })?;
-            if !x.is_finite() {
-                return Err(parse_error(
-                    source,
-                    ln + 1,
-                    format!("column `{}`: {s} is not finite", names[c]),
-                ));
-            }
-            v.push(x);
-        }
-        t.times.push(v[time]);
-        if let (Some(b), Some(cols)) = (t.base.as_mut(), base.as_ref()) {
-            b.push((
-                [v[cols[0]], v[cols[1]], v[cols[2]]],
-                [v[cols[3]], v[cols[4]], v[cols[5]], v[cols[6]]],
-            ));
-        }
-        t.joints.push(joint_cols.iter().map(|&i| v[i]).collect());
+        v.push(x);
     }
-    check_times(&t)?;
-    Ok(t)
+    Ok(v)
 }
 
 /// Reads iktc's `motion.npz` (or any NPZ with its arrays: `time` (n), `joint_names` (m),
@@ -225,44 +249,8 @@ pub fn read_trajectory_csv(text: &str, source: &str) -> Result<RobotTrajectory> 
 pub fn read_trajectory_npz(bytes: &[u8], source: &str) -> Result<RobotTrajectory> {
     use crate::batch::NpyData;
     let arrays = crate::batch::read_npz(bytes, source)?;
-    let get = |name: &str| {
-        arrays.iter().find(|a| a.name == name).ok_or_else(|| {
-            parse_error(
-                source,
-                0,
-                format!(
-                    "no array `{name}`; it has: {}",
-                    arrays
-                        .iter()
-                        .map(|a| a.name.as_str())
-                        .collect::<Vec<_>>()
-                        .join(", ")
-                ),
-            )
-        })
-    };
-    let floats = |name: &str, shape: &[Option<usize>]| -> Result<Vec<f64>> {
-        let a = get(name)?;
-        let ok = a.shape.len() == shape.len()
-            && a.shape
-                .iter()
-                .zip(shape)
-                .all(|(d, s)| s.is_none_or(|s| *d == s));
-        match (&a.data, ok) {
-            (NpyData::F64(v), true) => {
-                crate::error::check_all_finite(name, v)?;
-                Ok(v.clone())
-            }
-            _ => Err(parse_error(
-                source,
-                0,
-                format!(
-                    "array `{name}` has shape {:?}; expected {shape:?} of float64 (None: any)",
-                    a.shape
-                ),
-            )),
-        }
-    };
+    let get = |name: &str| npz_array(&arrays, name, source);
+    let floats = |name: &str, shape: &[Option<usize>]| npz_floats(&arrays, name, shape, source);
     let names = match &get("joint_names")?.data {
         NpyData::Str(v) => v.clone(),
         NpyData::F64(_) => {
@@ -301,6 +289,60 @@ pub fn read_trajectory_npz(bytes: &[u8], source: &str) -> Result<RobotTrajectory
     };
     check_times(&t)?;
     Ok(t)
+}
+
+/// The array `name` of `arrays` (read from `source`). Errors: no such array.
+fn npz_array<'a>(
+    arrays: &'a [crate::batch::NpyArray],
+    name: &str,
+    source: &str,
+) -> Result<&'a crate::batch::NpyArray> {
+    arrays.iter().find(|a| a.name == name).ok_or_else(|| {
+        parse_error(
+            source,
+            0,
+            format!(
+                "no array `{name}`; it has: {}",
+                arrays
+                    .iter()
+                    .map(|a| a.name.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        )
+    })
+}
+
+/// The float64 values of the array `name` of `arrays` (read from `source`), of the `shape`
+/// given (`None`: any length). Errors: no such array, another shape or type, a non-finite
+/// value.
+fn npz_floats(
+    arrays: &[crate::batch::NpyArray],
+    name: &str,
+    shape: &[Option<usize>],
+    source: &str,
+) -> Result<Vec<f64>> {
+    use crate::batch::NpyData;
+    let a = npz_array(arrays, name, source)?;
+    let ok = a.shape.len() == shape.len()
+        && a.shape
+            .iter()
+            .zip(shape)
+            .all(|(d, s)| s.is_none_or(|s| *d == s));
+    match (&a.data, ok) {
+        (NpyData::F64(v), true) => {
+            crate::error::check_all_finite(name, v)?;
+            Ok(v.clone())
+        }
+        _ => Err(parse_error(
+            source,
+            0,
+            format!(
+                "array `{name}` has shape {:?}; expected {shape:?} of float64 (None: any)",
+                a.shape
+            ),
+        )),
+    }
 }
 
 /// At least [`MIN_TRAJECTORY_FRAMES`] frames, times strictly increasing.
@@ -408,24 +450,7 @@ pub fn trajectory_ticks(
             .all(|(a, b)| (a - b).abs() <= TICK_ROUNDING * dt);
     // Base quaternions (w, x, y, z), checked; for resampling each on the previous one's side.
     let quats: Vec<Vector4<f64>> = match base {
-        Some(b) => {
-            let mut out: Vec<Vector4<f64>> = Vec::with_capacity(b.len());
-            for (i, (_, q)) in b.iter().enumerate() {
-                let mut v = Vector4::new(q[0], q[1], q[2], q[3]);
-                if v.norm() == 0.0 {
-                    return Err(Error::InvalidSetting {
-                        name: format!("base quaternion of frame {i} of `{}`", t.source),
-                        value: "0 0 0 0".into(),
-                        expected: "a non-zero quaternion (qw qx qy qz)".into(),
-                    });
-                }
-                if !same && out.last().is_some_and(|p| p.dot(&v) < 0.0) {
-                    v = -v;
-                }
-                out.push(v);
-            }
-            out
-        }
+        Some(b) => base_quaternions(t, b, same)?,
         None => Vec::new(),
     };
     // Channels: joints in the robot's order, then base x y z and quaternion w x y z.
@@ -454,28 +479,63 @@ pub fn trajectory_ticks(
             })
             .collect::<Result<_>>()?
     };
-    let nj = cols.len();
     let qs = (0..ticks)
-        .map(|k| {
-            let mut q = Vec::with_capacity(robot.nq());
-            if floating {
-                let v = |i: usize| values[nj + i][k];
-                let raw = Quaternion::new(v(3), v(4), v(5), v(6));
-                // A unit quaternion within rounding is used as written (a file of iktc's own
-                // then gives its run's configurations bit for bit).
-                let r = if (raw.norm() - 1.0).abs() <= UNIT_ROUNDING {
-                    UnitQuaternion::new_unchecked(raw)
-                } else {
-                    UnitQuaternion::from_quaternion(raw)
-                };
-                q.extend([v(0), v(1), v(2)]);
-                q.extend_from_slice(r.coords.as_slice());
-            }
-            q.extend(values[..nj].iter().map(|c| c[k]));
-            q
-        })
+        .map(|k| tick_configuration(robot, &values, cols.len(), floating, k))
         .collect();
     Ok((times, qs, !same))
+}
+
+/// The base quaternions (w, x, y, z) of `t`'s base poses `b`, checked; unless the frames are
+/// the ticks (`same`), each on the previous one's side, for resampling. Errors: a zero
+/// quaternion.
+fn base_quaternions(
+    t: &RobotTrajectory,
+    b: &[([f64; 3], [f64; 4])],
+    same: bool,
+) -> Result<Vec<Vector4<f64>>> {
+    let mut out: Vec<Vector4<f64>> = Vec::with_capacity(b.len());
+    for (i, (_, q)) in b.iter().enumerate() {
+        let mut v = Vector4::new(q[0], q[1], q[2], q[3]);
+        if v.norm() == 0.0 {
+            return Err(Error::InvalidSetting {
+                name: format!("base quaternion of frame {i} of `{}`", t.source),
+                value: "0 0 0 0".into(),
+                expected: "a non-zero quaternion (qw qx qy qz)".into(),
+            });
+        }
+        if !same && out.last().is_some_and(|p| p.dot(&v) < 0.0) {
+            v = -v;
+        }
+        out.push(v);
+    }
+    Ok(out)
+}
+
+/// The configuration q of tick `k` from the channels `values` (the `nj` joints in the robot's
+/// order, then with a `floating` base its x y z and quaternion w x y z).
+fn tick_configuration(
+    robot: &Robot,
+    values: &[Vec<f64>],
+    nj: usize,
+    floating: bool,
+    k: usize,
+) -> Vec<f64> {
+    let mut q = Vec::with_capacity(robot.nq());
+    if floating {
+        let v = |i: usize| values[nj + i][k];
+        let raw = Quaternion::new(v(3), v(4), v(5), v(6));
+        // A unit quaternion within rounding is used as written (a file of iktc's own
+        // then gives its run's configurations bit for bit).
+        let r = if (raw.norm() - 1.0).abs() <= UNIT_ROUNDING {
+            UnitQuaternion::new_unchecked(raw)
+        } else {
+            UnitQuaternion::from_quaternion(raw)
+        };
+        q.extend([v(0), v(1), v(2)]);
+        q.extend_from_slice(r.coords.as_slice());
+    }
+    q.extend(values[..nj].iter().map(|c| c[k]));
+    q
 }
 
 /// The fidelity figures of `trajectory` (a motion of the robot of `profile`, `robot` built

@@ -378,31 +378,10 @@ pub fn person_contacts(kp: &Keypoints) -> [Vec<(usize, usize)>; 2] {
 /// The fidelity figures of `input` against `limits` (module documentation).
 pub fn fidelity(input: &FidelityInput, limits: &FidelityLimits) -> Fidelity {
     let kp = input.person;
-    let person_leg = {
-        let mut legs: Vec<f64> = (0..kp.frame_count())
-            .filter_map(|f| person_at(kp, kp.times[f]))
-            .map(|x| leg_length(&x))
-            .collect();
-        legs.retain(|l| l.is_finite());
-        percentile(&legs, 0.5)
-    };
-    let scale = if person_leg > 0.0 {
-        input.robot_leg / person_leg
-    } else {
-        1.0
-    };
+    let scale = person_scale(input);
     let persons: Vec<Option<[Vector3<f64>; 12]>> =
         input.times.iter().map(|t| person_at(kp, *t)).collect();
-    // The heading fit over every point and tick.
-    let (mut cross, mut dot) = (0.0, 0.0);
-    for (r, p) in input.robot.iter().zip(&persons) {
-        let Some(p) = p else { continue };
-        for (d, b) in relative(p).iter().zip(relative(&r.centres)) {
-            cross += scale * (d.x * b.y - d.y * b.x);
-            dot += scale * (d.x * b.x + d.y * b.y);
-        }
-    }
-    let heading = cross.atan2(dot);
+    let heading = fit_heading(input, &persons, scale);
     let rot = Rotation3::from_axis_angle(&Vector3::z_axis(), heading);
     let names: Vec<String> = JOINT_CENTRES
         .iter()
@@ -437,33 +416,7 @@ pub fn fidelity(input: &FidelityInput, limits: &FidelityLimits) -> Fidelity {
         })
         .collect();
     let keypoint_mean_cm = points.iter().map(|p| p.mean_cm).sum::<f64>() / points.len() as f64;
-    let posture_names = [
-        "left_knee",
-        "right_knee",
-        "left_elbow",
-        "right_elbow",
-        "trunk_lean",
-        "hip_height",
-    ];
-    let posture: Vec<PostureFigure> = posture_names
-        .iter()
-        .zip(&post)
-        .enumerate()
-        .map(|(i, (name, v))| {
-            let unit = if i == 5 { 100.0 } else { 1.0 };
-            let person: Vec<f64> = v.iter().map(|x| unit * x.0).collect();
-            let robot: Vec<f64> = v.iter().map(|x| unit * x.1).collect();
-            let diff: Vec<f64> = v.iter().map(|x| unit * (x.1 - x.0)).collect();
-            let abs: Vec<f64> = diff.iter().map(|d| d.abs()).collect();
-            PostureFigure {
-                name: (*name).into(),
-                person_median: percentile(&person, 0.5),
-                robot_median: percentile(&robot, 0.5),
-                difference_median: percentile(&diff, 0.5),
-                difference_p90: percentile(&abs, 0.9),
-            }
-        })
-        .collect();
+    let posture = posture_figures(&post);
     let contacts = contact_figures(input, scale);
     let smoothness = smoothness(input.qdd, input.dt);
     let mut f = Fidelity {
@@ -481,6 +434,71 @@ pub fn fidelity(input: &FidelityInput, limits: &FidelityLimits) -> Fidelity {
     f.failures = verdict(&f, limits);
     f.healthy = f.failures.is_empty();
     f
+}
+
+/// The scale of the person onto the robot \[–\]: the robot's leg over the median of the
+/// person's (1 without a person's leg).
+fn person_scale(input: &FidelityInput) -> f64 {
+    let kp = input.person;
+    let person_leg = {
+        let mut legs: Vec<f64> = (0..kp.frame_count())
+            .filter_map(|f| person_at(kp, kp.times[f]))
+            .map(|x| leg_length(&x))
+            .collect();
+        legs.retain(|l| l.is_finite());
+        percentile(&legs, 0.5)
+    };
+    if person_leg > 0.0 {
+        input.robot_leg / person_leg
+    } else {
+        1.0
+    }
+}
+
+/// The heading fit \[rad\] over every point and tick of the scaled person `persons` (per
+/// tick) onto the robot's joint centres.
+fn fit_heading(input: &FidelityInput, persons: &[Option<[Vector3<f64>; 12]>], scale: f64) -> f64 {
+    let (mut cross, mut dot) = (0.0, 0.0);
+    for (r, p) in input.robot.iter().zip(persons) {
+        let Some(p) = p else { continue };
+        for (d, b) in relative(p).iter().zip(relative(&r.centres)) {
+            cross += scale * (d.x * b.y - d.y * b.x);
+            dot += scale * (d.x * b.x + d.y * b.y);
+        }
+    }
+    cross.atan2(dot)
+}
+
+/// The posture figures from the (person, robot) values per tick of the knees, elbows \[°\],
+/// trunk lean \[°\] and hip height \[m\] (in cm in the figures).
+fn posture_figures(post: &[Vec<(f64, f64)>; 6]) -> Vec<PostureFigure> {
+    let posture_names = [
+        "left_knee",
+        "right_knee",
+        "left_elbow",
+        "right_elbow",
+        "trunk_lean",
+        "hip_height",
+    ];
+    posture_names
+        .iter()
+        .zip(post)
+        .enumerate()
+        .map(|(i, (name, v))| {
+            let unit = if i == 5 { 100.0 } else { 1.0 };
+            let person: Vec<f64> = v.iter().map(|x| unit * x.0).collect();
+            let robot: Vec<f64> = v.iter().map(|x| unit * x.1).collect();
+            let diff: Vec<f64> = v.iter().map(|x| unit * (x.1 - x.0)).collect();
+            let abs: Vec<f64> = diff.iter().map(|d| d.abs()).collect();
+            PostureFigure {
+                name: (*name).into(),
+                person_median: percentile(&person, 0.5),
+                robot_median: percentile(&robot, 0.5),
+                difference_median: percentile(&diff, 0.5),
+                difference_p90: percentile(&abs, 0.9),
+            }
+        })
+        .collect()
 }
 
 /// The contact figures of `input` (module documentation).
@@ -537,6 +555,26 @@ fn contact_figures(input: &FidelityInput, scale: f64) -> ContactFigures {
             slip_sum += slip;
         }
     }
+    let (lowest, skate, distance) = skating(input);
+    let foot_ticks = (2 * ticks).max(1) as f64;
+    let held = in_window.iter().flatten().filter(|b| **b).count();
+    ContactFigures {
+        windows: count,
+        share: held as f64 / foot_ticks,
+        slip_max_mm: 1000.0 * slip_max,
+        slip_mean_mm: 1000.0 * slip_sum / count.max(1) as f64,
+        height_max_mm: if count > 0 { 1000.0 * height_max } else { 0.0 },
+        lowest_sole_mm: if ticks > 0 { 1000.0 * lowest } else { 0.0 },
+        skate_share: skate as f64 / foot_ticks,
+        skate_distance_m: distance,
+        worst_slip: worst,
+    }
+}
+
+/// The lowest sole over the run \[m\], and the foot ticks that skate (a sole within
+/// `SKATE_HEIGHT` of the ground moving faster than `SKATE_SPEED`) with the distance \[m\] they
+/// cover.
+fn skating(input: &FidelityInput) -> (f64, usize, f64) {
     let mut lowest = f64::INFINITY;
     let (mut skate, mut distance) = (0usize, 0.0);
     for (k, r) in input.robot.iter().enumerate() {
@@ -553,19 +591,7 @@ fn contact_figures(input: &FidelityInput, scale: f64) -> ContactFigures {
             }
         }
     }
-    let foot_ticks = (2 * ticks).max(1) as f64;
-    let held = in_window.iter().flatten().filter(|b| **b).count();
-    ContactFigures {
-        windows: count,
-        share: held as f64 / foot_ticks,
-        slip_max_mm: 1000.0 * slip_max,
-        slip_mean_mm: 1000.0 * slip_sum / count.max(1) as f64,
-        height_max_mm: if count > 0 { 1000.0 * height_max } else { 0.0 },
-        lowest_sole_mm: if ticks > 0 { 1000.0 * lowest } else { 0.0 },
-        skate_share: skate as f64 / foot_ticks,
-        skate_distance_m: distance,
-        worst_slip: worst,
-    }
+    (lowest, skate, distance)
 }
 
 /// The largest horizontal distance between two of `points` \[m\] (0 for fewer than two).
@@ -624,6 +650,14 @@ fn verdict(f: &Fidelity, l: &FidelityLimits) -> Vec<String> {
             f.keypoint_mean_cm, l.keypoint_cm
         ));
     }
+    posture_failures(f, l, &mut out);
+    let checks = contact_and_smoothness_checks(f, l);
+    out.extend(checks.into_iter().filter(|(ok, _)| !ok).map(|(_, m)| m));
+    out
+}
+
+/// The posture figures whose medians are further apart than `l` allows, as messages onto `out`.
+fn posture_failures(f: &Fidelity, l: &FidelityLimits, out: &mut Vec<String>) {
     for p in &f.posture {
         let gap = p.robot_median - p.person_median;
         let (limit, unit) = if p.name == "hip_height" {
@@ -638,8 +672,12 @@ fn verdict(f: &Fidelity, l: &FidelityLimits) -> Vec<String> {
             ));
         }
     }
+}
+
+/// The contact and smoothness checks of `f` against `l`: whether each passes, and its message.
+fn contact_and_smoothness_checks(f: &Fidelity, l: &FidelityLimits) -> [(bool, String); 6] {
     let c = &f.contacts;
-    let checks = [
+    [
         (
             !exceeds(c.slip_max_mm, l.slip_mm),
             format!(
@@ -690,9 +728,7 @@ fn verdict(f: &Fidelity, l: &FidelityLimits) -> Vec<String> {
                 f.smoothness.flip_max, l.flip
             ),
         ),
-    ];
-    out.extend(checks.into_iter().filter(|(ok, _)| !ok).map(|(_, m)| m));
-    out
+    ]
 }
 
 /// Whether `x` is above `limit` or not a number (a figure that cannot be computed fails).

@@ -45,7 +45,7 @@ use nalgebra::{DMatrix, DVector, Matrix3, UnitQuaternion, Vector3};
 use super::body::RobotBody;
 use super::tracker::PostureTracks;
 use crate::error::{Error, Result};
-use crate::model::{FrameId, Kinematics, Robot, State};
+use crate::model::{FrameId, JointLimit, Kinematics, Robot, State};
 use crate::motion::{lowpass_track, BodyPoint, CubicSpline};
 
 /// Period of the fit's samples \[s\]: 50 Hz, above twice [`FIT_CUTOFF`].
@@ -350,28 +350,7 @@ pub(crate) fn fit(
     let mut names = Vec::with_capacity(joints.len());
     let mut tracks = Vec::with_capacity(joints.len());
     for (j, v) in joints.iter().zip(&values) {
-        let smooth = lowpass_track(v, &times, FIT_CUTOFF)?;
-        let spline = CubicSpline::new(&times, &smooth)?;
-        let (lo, hi) = (j.limit.lower + margin, j.limit.upper - margin);
-        let (mut p, mut v, mut a) = (
-            Vec::with_capacity(ticks),
-            Vec::with_capacity(ticks),
-            Vec::with_capacity(ticks),
-        );
-        for k in 0..ticks {
-            let [x, xd, xdd] = spline.eval(k as f64 * dt);
-            let (x, xd, xdd) = if lo > hi {
-                (0.5 * (lo + hi), 0.0, 0.0)
-            } else if x < lo || x > hi {
-                (x.clamp(lo, hi), 0.0, 0.0)
-            } else {
-                (x, xd, xdd)
-            };
-            p.push(x);
-            v.push(xd);
-            a.push(xdd);
-        }
-        let track = [p, v, a];
+        let track = fitted_track(v, &times, &j.limit, margin, ticks, dt)?;
         names.push(j.name.clone());
         tracks.push(track);
     }
@@ -379,6 +358,41 @@ pub(crate) fn fit(
         tracks: (names, tracks),
         rms_error: (sum / count.max(1) as f64).sqrt(),
     })
+}
+
+/// The posture references \[rad\], \[rad/s\], \[rad/s²\] at the `ticks` ticks of period `dt`
+/// \[s\] of a joint fitted to `v` at the sample `times` \[s\]: low-passed, interpolated, and
+/// held still at `margin` \[rad\] inside the joint's `limit` where it would leave it.
+fn fitted_track(
+    v: &[f64],
+    times: &[f64],
+    limit: &JointLimit,
+    margin: f64,
+    ticks: usize,
+    dt: f64,
+) -> Result<[Vec<f64>; 3]> {
+    let smooth = lowpass_track(v, times, FIT_CUTOFF)?;
+    let spline = CubicSpline::new(times, &smooth)?;
+    let (lo, hi) = (limit.lower + margin, limit.upper - margin);
+    let (mut p, mut v, mut a) = (
+        Vec::with_capacity(ticks),
+        Vec::with_capacity(ticks),
+        Vec::with_capacity(ticks),
+    );
+    for k in 0..ticks {
+        let [x, xd, xdd] = spline.eval(k as f64 * dt);
+        let (x, xd, xdd) = if lo > hi {
+            (0.5 * (lo + hi), 0.0, 0.0)
+        } else if x < lo || x > hi {
+            (x.clamp(lo, hi), 0.0, 0.0)
+        } else {
+            (x, xd, xdd)
+        };
+        p.push(x);
+        v.push(xd);
+        a.push(xdd);
+    }
+    Ok([p, v, a])
 }
 
 #[cfg(test)]

@@ -633,6 +633,8 @@ fn check_acceleration_limits(robot: &Robot) -> Result<()> {
     }
 }
 
+/// The robot, body, scaled clip, plan and keypoint controller of a run of `kp` (see the
+/// module documentation), its posture fitted unless given.
 fn setup(
     robot: Arc<Robot>,
     profile: &RobotProfile,
@@ -688,46 +690,8 @@ fn setup(
     if posture.is_none() && s.posture_fit && !s.standing {
         // The person's posture, fitted at the joint centres; the plan again with it (the COM
         // offset depends on the posture asked).
-        let (fit_robot, fit_body) = centres.frames(&robot, body.clone())?;
-        // The base held at the pelvis' references, which the pelvis level holds.
-        let to_base = kin.frame_pose(&robot, body.pelvis)?.rotation.inverse()
-            * state.base_pose(&robot).rotation;
-        let base: Vec<_> = plan.pelvis.iter().map(|p| p.rotation * to_base).collect();
-        let fitted = fit::fit(
-            &fit_robot,
-            &fit_body,
-            &state,
-            &plan.neutral,
-            Some(&base),
-            s.dt,
-            s.posture_margin,
-        )?;
-        // The legs keep the start posture's references: the feet and the pelvis above the
-        // posture set a stance leg, and its rows pulling a knee toward the person's
-        // straighter one bring it to its singularity (G1 then does not come to rest on a held
-        // frame of `humanoid3d_punch`: 0.47 rad/s).
-        fit_error = Some(2.0 * (0.5 * fitted.rms_error).min(1.0).asin());
-        let legs = [
-            body::chain(&robot, body.feet[0])?,
-            body::chain(&robot, body.feet[1])?,
-        ];
-        let below = body::branch(&legs);
-        let leg_links: Vec<usize> = legs.iter().flat_map(|c| c[below..].to_vec()).collect();
-        for ((name, fitted), track) in fitted
-            .tracks
-            .0
-            .iter()
-            .zip(&fitted.tracks.1)
-            .zip(&mut tracks.1)
-        {
-            let in_leg = robot
-                .joints()
-                .iter()
-                .any(|j| j.name == *name && leg_links.contains(&j.child));
-            if !in_leg {
-                track.clone_from(fitted);
-            }
-        }
+        let start = (&robot, &body, &centres, &kin, &state);
+        fit_error = Some(fit_posture(start, &plan, s, &mut tracks)?);
         plan = plan_with(&tracks)?;
     }
     let controller =
@@ -741,6 +705,64 @@ fn setup(
         scaling: clip.scaling,
         fit_error,
     })
+}
+
+/// The person's posture fitted at the joint centres of the robot (its body, centres, start
+/// kinematics and state) to `plan`'s neutral targets, taken into `tracks` for every joint
+/// outside the legs; the fit's RMS direction error \[rad\].
+fn fit_posture(
+    (robot, body, centres, kin, state): (
+        &Arc<Robot>,
+        &RobotBody,
+        &RobotJointCentres,
+        &Kinematics,
+        &State,
+    ),
+    plan: &plan::Plan,
+    s: &KeypointSettings,
+    tracks: &mut tracker::PostureTracks,
+) -> Result<f64> {
+    let (fit_robot, fit_body) = centres.frames(robot, body.clone())?;
+    // The base held at the pelvis' references, which the pelvis level holds.
+    let to_base =
+        kin.frame_pose(robot, body.pelvis)?.rotation.inverse() * state.base_pose(robot).rotation;
+    let base: Vec<_> = plan.pelvis.iter().map(|p| p.rotation * to_base).collect();
+    let fitted = fit::fit(
+        &fit_robot,
+        &fit_body,
+        state,
+        &plan.neutral,
+        Some(&base),
+        s.dt,
+        s.posture_margin,
+    )?;
+    // The legs keep the start posture's references: the feet and the pelvis above the
+    // posture set a stance leg, and its rows pulling a knee toward the person's
+    // straighter one bring it to its singularity (G1 then does not come to rest on a held
+    // frame of `humanoid3d_punch`: 0.47 rad/s).
+    let fit_error = 2.0 * (0.5 * fitted.rms_error).min(1.0).asin();
+    let legs = [
+        body::chain(robot, body.feet[0])?,
+        body::chain(robot, body.feet[1])?,
+    ];
+    let below = body::branch(&legs);
+    let leg_links: Vec<usize> = legs.iter().flat_map(|c| c[below..].to_vec()).collect();
+    for ((name, fitted), track) in fitted
+        .tracks
+        .0
+        .iter()
+        .zip(&fitted.tracks.1)
+        .zip(&mut tracks.1)
+    {
+        let in_leg = robot
+            .joints()
+            .iter()
+            .any(|j| j.name == *name && leg_links.contains(&j.child));
+        if !in_leg {
+            track.clone_from(fitted);
+        }
+    }
+    Ok(fit_error)
 }
 
 /// Posture references of every active joint: the joint route's where given (kept
@@ -857,54 +879,15 @@ pub fn retarget_keypoints_on(
             )
         })
     })?;
-    let ticks = controller.ticks();
-    let mut rec = QualityRecorder::new("keypoints", &body, s.dt);
-    let mut trajectory = Vec::with_capacity(ticks);
-    let mut velocities = Vec::with_capacity(ticks);
-    let mut accelerations = Vec::with_capacity(ticks);
-    let mut times = Vec::with_capacity(ticks);
-    let mut tick_us = Vec::with_capacity(ticks);
-    let mut stance = [Vec::with_capacity(ticks), Vec::with_capacity(ticks)];
-    let t0 = kp.times.first().copied().unwrap_or(0.0);
-    for k in 0..ticks {
-        let at = || {
-            format!(
-                "keypoint retargeting of `{}`, tick {k} (t = {} s)",
-                kp.source,
-                crate::resources::fmt_value(t0 + k as f64 * s.dt)
-            )
-        };
-        let state = controller.state().clone();
-        let start = Instant::now();
-        let report = controller.tick(k, false).map_err(|e| e.at(at))?;
-        let corrected = shaped_by_box(report) || controller.used_fallback();
-        tick_us.push(start.elapsed().as_secs_f64() * 1e6);
-        let plan = controller.plan();
-        let on = controller.stance();
-        stance[0].push(on[0]);
-        stance[1].push(on[1]);
-        // The tick's controller prepared its kinematics at `state`.
-        rec.record(
-            &robot,
-            controller.controller().kinematics(),
-            &body,
-            plan,
-            &support,
-            (k, on, corrected),
-            &state,
-            controller.qdd().as_slice(),
-        )
-        .map_err(|e| e.at(at))?;
-        accelerations.push(controller.qdd().as_slice().to_vec());
-        let start = Instant::now();
-        controller.integrate().map_err(|e| e.at(at))?;
-        if let Some(last) = tick_us.last_mut() {
-            *last += start.elapsed().as_secs_f64() * 1e6;
-        }
-        trajectory.push(state.q.as_slice().to_vec());
-        velocities.push(state.qd.as_slice().to_vec());
-        times.push(t0 + k as f64 * s.dt);
-    }
+    let RunTicks {
+        rec,
+        trajectory,
+        velocities,
+        accelerations,
+        times,
+        tick_us,
+        stance,
+    } = run_ticks(&mut controller, &robot, &body, &support, kp, s)?;
     let contacts = controller.plan().contact.clone();
     let mut quality = rec.finish(&robot);
     quality.fidelity = Some(measure_fidelity(
@@ -946,6 +929,92 @@ pub fn retarget_keypoints_on(
         sacrificed: controller.sacrificed().clone(),
         settle_sacrificed: controller.settle_sacrificed().clone(),
         settle_ticks,
+    })
+}
+
+/// What a run records at its ticks.
+struct RunTicks {
+    rec: QualityRecorder,
+    /// Configuration per tick.
+    trajectory: Vec<Vec<f64>>,
+    /// Velocity per tick.
+    velocities: Vec<Vec<f64>>,
+    /// q̈ per tick.
+    accelerations: Vec<Vec<f64>>,
+    /// Clip time per tick \[s\].
+    times: Vec<f64>,
+    /// The tick's solve and integration per tick \[µs\].
+    tick_us: Vec<f64>,
+    /// Feet held per tick (left, right).
+    stance: [Vec<bool>; 2],
+}
+
+/// Ticks the settled `controller` through the clip, recording the quality figures and the
+/// trajectory; errors name the tick.
+fn run_ticks(
+    controller: &mut KeypointController,
+    robot: &Robot,
+    body: &RobotBody,
+    support: &SupportSettings,
+    kp: &Keypoints,
+    s: &KeypointSettings,
+) -> Result<RunTicks> {
+    let ticks = controller.ticks();
+    let mut rec = QualityRecorder::new("keypoints", body, s.dt);
+    let mut trajectory = Vec::with_capacity(ticks);
+    let mut velocities = Vec::with_capacity(ticks);
+    let mut accelerations = Vec::with_capacity(ticks);
+    let mut times = Vec::with_capacity(ticks);
+    let mut tick_us = Vec::with_capacity(ticks);
+    let mut stance = [Vec::with_capacity(ticks), Vec::with_capacity(ticks)];
+    let t0 = kp.times.first().copied().unwrap_or(0.0);
+    for k in 0..ticks {
+        let at = || {
+            format!(
+                "keypoint retargeting of `{}`, tick {k} (t = {} s)",
+                kp.source,
+                crate::resources::fmt_value(t0 + k as f64 * s.dt)
+            )
+        };
+        let state = controller.state().clone();
+        let start = Instant::now();
+        let report = controller.tick(k, false).map_err(|e| e.at(at))?;
+        let corrected = shaped_by_box(report) || controller.used_fallback();
+        tick_us.push(start.elapsed().as_secs_f64() * 1e6);
+        let plan = controller.plan();
+        let on = controller.stance();
+        stance[0].push(on[0]);
+        stance[1].push(on[1]);
+        // The tick's controller prepared its kinematics at `state`.
+        rec.record(
+            robot,
+            controller.controller().kinematics(),
+            body,
+            plan,
+            support,
+            (k, on, corrected),
+            &state,
+            controller.qdd().as_slice(),
+        )
+        .map_err(|e| e.at(at))?;
+        accelerations.push(controller.qdd().as_slice().to_vec());
+        let start = Instant::now();
+        controller.integrate().map_err(|e| e.at(at))?;
+        if let Some(last) = tick_us.last_mut() {
+            *last += start.elapsed().as_secs_f64() * 1e6;
+        }
+        trajectory.push(state.q.as_slice().to_vec());
+        velocities.push(state.qd.as_slice().to_vec());
+        times.push(t0 + k as f64 * s.dt);
+    }
+    Ok(RunTicks {
+        rec,
+        trajectory,
+        velocities,
+        accelerations,
+        times,
+        tick_us,
+        stance,
     })
 }
 

@@ -274,8 +274,6 @@ pub(crate) fn plan(
     clip: &ScaledClip,
     s: &KeypointSettings,
 ) -> Result<Plan> {
-    let (robot, kin, body, support) = (r.robot, r.kin, r.body, r.support);
-    let n = kp.points.len();
     let frames = kp.frame_count();
     let (t0, t1) = (kp.times[0], kp.times[frames - 1]);
     let ticks = s
@@ -283,76 +281,198 @@ pub(crate) fn plan(
         .ticks(&format!("`{}`", kp.source), t1 - t0, s.dt)?
         + 1;
     let times: Vec<f64> = (0..ticks).map(|k| (t0 + k as f64 * s.dt).min(t1)).collect();
-    let idx = |p: BodyPoint| kp.points.iter().position(|q| *q == p);
-    // Splines through the scaled (low-passed, when asked) and aligned points.
-    let sample = |data: &[Vector3<f64>], k: usize, smooth: bool| -> Result<Vec<Vector3<f64>>> {
-        let mut out = vec![Vector3::zeros(); ticks];
-        let mut column = vec![0.0; ticks];
-        if frames == 1 {
-            out.iter_mut().for_each(|o| *o = data[k]);
-            return Ok(out);
-        }
-        for axis in 0..3 {
-            let mut y: Vec<f64> = (0..frames).map(|f| data[f * n + k][axis]).collect();
-            if let (true, Some(fc)) = (smooth, s.smoothing) {
-                y = lowpass_track(&y, &kp.times, fc)?;
-            }
-            CubicSpline::new(&kp.times, &y)?.values_at(&times, &mut column)?;
-            for (o, v) in out.iter_mut().zip(&column) {
-                o[axis] = *v;
-            }
-        }
-        Ok(out)
+    let tr = Tracks::sample(kp, clip, s, &times)?;
+    let contact = contact_ticks(&tr, clip, s, &times)?;
+    let pelvis_x = tr.get(BodyPoint::Pelvis)?;
+    let (lh, rh) = (tr.get(BodyPoint::LeftHip)?, tr.get(BodyPoint::RightHip)?);
+    let heading: Vec<f64> = unwrap(
+        (0..ticks)
+            .map(|k| {
+                let l = lh[k] - rh[k];
+                l.y.atan2(l.x) - std::f64::consts::FRAC_PI_2
+            })
+            .collect(),
+    );
+    let feet = foot_refs(r, &tr, s, &contact, &heading, ticks)?;
+    let start = StartPoints::of(r, &tr)?;
+    let pelvis_rot = pelvis_rotations(r, &tr, s, &start, lh, rh, ticks)?;
+    let com = com_refs(r, s, &contact, &feet, pelvis_x, &pelvis_rot, ticks)?;
+    let drop = leg_drops(r, &tr, s, &contact, &feet, pelvis_x, &heading, ticks)?;
+    let lowered = lowering(&drop, s, ticks);
+    let pelvis_x: Vec<Vector3<f64>> = pelvis_x.iter().zip(&lowered).map(|(p, d)| p - d).collect();
+    let pelvis = pose_refs(pelvis_x, pelvis_rot, s.dt);
+    let torso = torso_refs(r, &tr, s, &start, lh, rh, ticks)?;
+    let points = point_tracks(r.body, &tr, &lowered, s.dt);
+    let neutral = neutral_points(r.body, &tr, clip, ticks)?;
+    let latch_weight = [
+        latch_weights(&contact[0], s.dt),
+        latch_weights(&contact[1], s.dt),
+    ];
+    let mut plan = Plan {
+        ticks,
+        feet,
+        contact,
+        latch_weight,
+        com,
+        pelvis,
+        torso,
+        points,
+        neutral,
     };
-    let mut scaled: Vec<Option<Vec<Vector3<f64>>>> = vec![None; n];
-    let mut aligned: Vec<Option<Vec<Vector3<f64>>>> = vec![None; n];
-    for k in 0..n {
-        scaled[k] = Some(sample(&clip.scaled, k, true)?);
-        aligned[k] = Some(sample(&clip.aligned, k, false)?);
+    if s.standing {
+        hold_stance(&mut plan, r.robot, r.kin, r.body, r.support, s.dt)?;
     }
-    let track =
-        |p: BodyPoint| -> Option<&Vec<Vector3<f64>>> { idx(p).and_then(|k| scaled[k].as_ref()) };
-    let missing = |p: BodyPoint| Error::UnknownName {
-        kind: "body point (missing from the keypoints)",
-        name: format!("{p}` in `{}", kp.source),
-        valid: kp.points.iter().map(|q| q.name().to_string()).collect(),
-    };
-    let get = |p: BodyPoint| track(p).ok_or_else(|| missing(p));
-    // Contacts at the source rate, on the aligned clip, then per tick (nearest frame).
-    let frame_of_tick = |t: f64| -> usize {
-        let f = kp.times.partition_point(|x| *x < t);
-        if f == 0 {
-            0
-        } else if f >= frames {
-            frames - 1
-        } else if t - kp.times[f - 1] < kp.times[f] - t {
-            f - 1
-        } else {
-            f
+    Ok(plan)
+}
+
+/// The ankle and toe points of the feet (left, right).
+const SIDES: [(BodyPoint, BodyPoint); 2] = [
+    (BodyPoint::LeftAnkle, BodyPoint::LeftToe),
+    (BodyPoint::RightAnkle, BodyPoint::RightToe),
+];
+
+/// The clip's points sampled at the tick times, and the lookups of the plan's steps.
+struct Tracks<'a> {
+    kp: &'a Keypoints,
+    /// Per body point of `kp`, the scaled points (low-passed, when asked) per tick \[m\].
+    scaled: Vec<Option<Vec<Vector3<f64>>>>,
+    /// Per body point of `kp`, the aligned points per tick \[m\].
+    aligned: Vec<Option<Vec<Vector3<f64>>>>,
+}
+
+impl<'a> Tracks<'a> {
+    /// Splines through the scaled (low-passed, when asked) and aligned points, at `times` \[s\].
+    fn sample(
+        kp: &'a Keypoints,
+        clip: &ScaledClip,
+        s: &KeypointSettings,
+        times: &[f64],
+    ) -> Result<Self> {
+        let n = kp.points.len();
+        let mut scaled: Vec<Option<Vec<Vector3<f64>>>> = vec![None; n];
+        let mut aligned: Vec<Option<Vec<Vector3<f64>>>> = vec![None; n];
+        for k in 0..n {
+            scaled[k] = Some(sample_point(kp, times, &clip.scaled, k, s.smoothing)?);
+            aligned[k] = Some(sample_point(kp, times, &clip.aligned, k, None)?);
         }
-    };
+        Ok(Tracks {
+            kp,
+            scaled,
+            aligned,
+        })
+    }
+
+    /// The index of `p` among the keypoints' points.
+    fn idx(&self, p: BodyPoint) -> Option<usize> {
+        self.kp.points.iter().position(|q| *q == p)
+    }
+
+    /// The scaled track of `p`, if the keypoints have it.
+    fn track(&self, p: BodyPoint) -> Option<&Vec<Vector3<f64>>> {
+        self.idx(p).and_then(|k| self.scaled[k].as_ref())
+    }
+
+    /// The error of a body point missing from the keypoints.
+    fn missing(&self, p: BodyPoint) -> Error {
+        Error::UnknownName {
+            kind: "body point (missing from the keypoints)",
+            name: format!("{p}` in `{}", self.kp.source),
+            valid: self
+                .kp
+                .points
+                .iter()
+                .map(|q| q.name().to_string())
+                .collect(),
+        }
+    }
+
+    /// The scaled track of `p`, or the error of its absence.
+    fn get(&self, p: BodyPoint) -> Result<&Vec<Vector3<f64>>> {
+        self.track(p).ok_or_else(|| self.missing(p))
+    }
+
+    /// The position \[m\] of the robot's frame of `p` in its start posture.
+    fn at_start(&self, r: &PlanRobot, p: BodyPoint) -> Result<Vector3<f64>> {
+        let f = r.body.frame_of(p).ok_or_else(|| self.missing(p))?;
+        Ok(r.kin.frame_pose(r.robot, f)?.translation.vector)
+    }
+}
+
+/// Point `k` of `data` (frame-major) at `times` \[s\] by a cubic spline, low-passed at
+/// `smoothing` \[Hz\] when given.
+fn sample_point(
+    kp: &Keypoints,
+    times: &[f64],
+    data: &[Vector3<f64>],
+    k: usize,
+    smoothing: Option<f64>,
+) -> Result<Vec<Vector3<f64>>> {
+    let n = kp.points.len();
+    let frames = kp.frame_count();
+    let ticks = times.len();
+    let mut out = vec![Vector3::zeros(); ticks];
+    let mut column = vec![0.0; ticks];
+    if frames == 1 {
+        out.iter_mut().for_each(|o| *o = data[k]);
+        return Ok(out);
+    }
+    for axis in 0..3 {
+        let mut y: Vec<f64> = (0..frames).map(|f| data[f * n + k][axis]).collect();
+        if let Some(fc) = smoothing {
+            y = lowpass_track(&y, &kp.times, fc)?;
+        }
+        CubicSpline::new(&kp.times, &y)?.values_at(times, &mut column)?;
+        for (o, v) in out.iter_mut().zip(&column) {
+            o[axis] = *v;
+        }
+    }
+    Ok(out)
+}
+
+/// The source frame nearest to time `t` \[s\] (the earlier one on a tie).
+fn nearest_frame(times: &[f64], t: f64) -> usize {
+    let frames = times.len();
+    let f = times.partition_point(|x| *x < t);
+    if f == 0 {
+        0
+    } else if f >= frames {
+        frames - 1
+    } else if t - times[f - 1] < times[f] - t {
+        f - 1
+    } else {
+        f
+    }
+}
+
+/// Contacts at the source rate, on the aligned clip, then per tick (nearest frame).
+fn contact_ticks(
+    tr: &Tracks,
+    clip: &ScaledClip,
+    s: &KeypointSettings,
+    times: &[f64],
+) -> Result<[Vec<bool>; 2]> {
+    let kp = tr.kp;
+    let n = kp.points.len();
+    let frames = kp.frame_count();
+    let (t0, t1) = (kp.times[0], kp.times[frames - 1]);
     let rate_dt = if frames > 1 {
         (t1 - t0) / (frames - 1) as f64
     } else {
         s.dt
     };
     let min_len = (s.min_phase / rate_dt).round() as usize;
-    let sides = [
-        (BodyPoint::LeftAnkle, BodyPoint::LeftToe),
-        (BodyPoint::RightAnkle, BodyPoint::RightToe),
-    ];
     let column =
         |k: usize| -> Vec<Vector3<f64>> { (0..frames).map(|f| clip.aligned[f * n + k]).collect() };
-    let toe_ground = sides
+    let toe_ground = SIDES
         .iter()
-        .filter_map(|(_, t)| idx(*t))
+        .filter_map(|(_, t)| tr.idx(*t))
         .flat_map(|k| (0..frames).map(move |f| (k, f)))
         .map(|(k, f)| clip.aligned[f * n + k].z)
         .fold(f64::INFINITY, f64::min);
     let mut contact: [Vec<bool>; 2] = [Vec::new(), Vec::new()];
-    for (i, (a, t)) in sides.iter().enumerate() {
-        let ankle = column(idx(*a).ok_or_else(|| missing(*a))?);
-        let toe = idx(*t).map(column);
+    for (i, (a, t)) in SIDES.iter().enumerate() {
+        let ankle = column(tr.idx(*a).ok_or_else(|| tr.missing(*a))?);
+        let toe = tr.idx(*t).map(column);
         let mut c = detect(
             &kp.times,
             &ankle,
@@ -366,33 +486,39 @@ pub(crate) fn plan(
         if let Some(d) = s.max_slide {
             split_slides(&mut c, &ankle, d, min_len);
         }
-        contact[i] = times.iter().map(|t| c[frame_of_tick(*t)]).collect();
+        contact[i] = times
+            .iter()
+            .map(|t| c[nearest_frame(&kp.times, *t)])
+            .collect();
     }
-    // Feet: x, y (of the sole's centre) and yaw held in stance (the yaw followed where the foot
-    // pivots), z on the ground in stance.
+    Ok(contact)
+}
+
+/// Feet: x, y (of the sole's centre) and yaw held in stance (the yaw followed where the foot
+/// pivots), z on the ground in stance; `heading` per tick \[rad\].
+fn foot_refs(
+    r: &PlanRobot,
+    tr: &Tracks,
+    s: &KeypointSettings,
+    contact: &[Vec<bool>; 2],
+    heading: &[f64],
+    ticks: usize,
+) -> Result<[Vec<PoseRef>; 2]> {
+    let (robot, kin, body, support) = (r.robot, r.kin, r.body, r.support);
     let h_a = support.ankle_height;
-    let pelvis_x = get(BodyPoint::Pelvis)?;
-    let (lh, rh) = (get(BodyPoint::LeftHip)?, get(BodyPoint::RightHip)?);
-    let heading: Vec<f64> = unwrap(
-        (0..ticks)
-            .map(|k| {
-                let l = lh[k] - rh[k];
-                l.y.atan2(l.x) - std::f64::consts::FRAC_PI_2
-            })
-            .collect(),
-    );
     let mut feet: [Vec<PoseRef>; 2] = [Vec::new(), Vec::new()];
     let pivot_half = (0.5 * PIVOT_SMOOTHING / s.dt).round() as usize;
-    for (i, (a, t)) in sides.iter().enumerate() {
-        let ankle = get(*a)?;
+    for (i, (a, t)) in SIDES.iter().enumerate() {
+        let ankle = tr.get(*a)?;
         let foot0 = kin.frame_pose(robot, body.feet[i])?;
         // The toe's yaw where it gives one, else the heading; relative to the first tick.
-        let raw = track(*t)
+        let raw = tr
+            .track(*t)
             .and_then(|toe| {
                 let dirs: Vec<Vector3<f64>> = (0..ticks).map(|k| toe[k] - ankle[k]).collect();
-                foot_yaw(&dirs, &heading)
+                foot_yaw(&dirs, heading)
             })
-            .unwrap_or_else(|| heading.clone());
+            .unwrap_or_else(|| heading.to_vec());
         let yaw: Vec<f64> = raw.iter().map(|y| y - raw[0]).collect();
         // The sole's centre is held (x, y), and a pivoting foot turns about it: the ankle's
         // track is carried to the sole's centre with the captured yaw and back with the
@@ -422,29 +548,67 @@ pub(crate) fn plan(
             .collect();
         feet[i] = pose_refs(pos, rot, s.dt);
     }
-    // Pelvis and torso orientations, from the same construction on the robot at its start.
-    let at0 = |p: BodyPoint| -> Result<Vector3<f64>> {
-        let f = body.frame_of(p).ok_or_else(|| missing(p))?;
-        Ok(kin.frame_pose(robot, f)?.translation.vector)
-    };
-    let (rlh, rrh) = (at0(BodyPoint::LeftHip)?, at0(BodyPoint::RightHip)?);
-    let (rls, rrs) = (
-        at0(BodyPoint::LeftShoulder)?,
-        at0(BodyPoint::RightShoulder)?,
-    );
+    Ok(feet)
+}
+
+/// The robot's hips and shoulders in its start posture \[m\].
+struct StartPoints {
+    lh: Vector3<f64>,
+    rh: Vector3<f64>,
+    ls: Vector3<f64>,
+    rs: Vector3<f64>,
+}
+
+impl StartPoints {
+    /// The robot's hips and shoulders at its start.
+    fn of(r: &PlanRobot, tr: &Tracks) -> Result<Self> {
+        let (lh, rh) = (
+            tr.at_start(r, BodyPoint::LeftHip)?,
+            tr.at_start(r, BodyPoint::RightHip)?,
+        );
+        let (ls, rs) = (
+            tr.at_start(r, BodyPoint::LeftShoulder)?,
+            tr.at_start(r, BodyPoint::RightShoulder)?,
+        );
+        Ok(StartPoints { lh, rh, ls, rs })
+    }
+}
+
+/// Pelvis orientations per tick, from the same construction on the robot at its start.
+fn pelvis_rotations(
+    r: &PlanRobot,
+    tr: &Tracks,
+    s: &KeypointSettings,
+    start: &StartPoints,
+    lh: &[Vector3<f64>],
+    rh: &[Vector3<f64>],
+    ticks: usize,
+) -> Result<Vec<UnitQuaternion<f64>>> {
     let trunk = s.pelvis_lean;
     let (sl, sr) = (
-        get(BodyPoint::LeftShoulder)?,
-        get(BodyPoint::RightShoulder)?,
+        tr.get(BodyPoint::LeftShoulder)?,
+        tr.get(BodyPoint::RightShoulder)?,
     );
-    let c_pelvis = pelvis_frame(rlh, rrh, rls, rrs, trunk).inverse()
-        * kin.frame_pose(robot, body.pelvis)?.rotation;
-    let pelvis_rot: Vec<UnitQuaternion<f64>> = (0..ticks)
+    let c_pelvis = pelvis_frame(start.lh, start.rh, start.ls, start.rs, trunk).inverse()
+        * r.kin.frame_pose(r.robot, r.body.pelvis)?.rotation;
+    Ok((0..ticks)
         .map(|k| pelvis_frame(lh[k], rh[k], sl[k], sr[k], trunk) * c_pelvis)
-        .collect();
-    // COM over the support polygon of the feet on the ground: the scaled pelvis plus the
-    // robot's own COM offset from its pelvis in the posture asked of it ([`com`]).
-    let com_offset = com::com_offsets(robot, r.start, body.pelvis, &pelvis_rot, r.posture)?;
+        .collect())
+}
+
+/// COM over the support polygon of the feet on the ground: the scaled pelvis plus the
+/// robot's own COM offset from its pelvis in the posture asked of it ([`com`]), smoothed.
+fn com_refs(
+    r: &PlanRobot,
+    s: &KeypointSettings,
+    contact: &[Vec<bool>; 2],
+    feet: &[Vec<PoseRef>; 2],
+    pelvis_x: &[Vector3<f64>],
+    pelvis_rot: &[UnitQuaternion<f64>],
+    ticks: usize,
+) -> Result<Vec<ComReference>> {
+    let support = r.support;
+    let com_offset = com::com_offsets(r.robot, r.start, r.body.pelvis, pelvis_rot, r.posture)?;
     let mut com: Vec<Vector3<f64>> = Vec::with_capacity(ticks);
     for k in 0..ticks {
         let any = contact[0][k] || contact[1][k];
@@ -473,15 +637,31 @@ pub(crate) fn plan(
     let half = (0.5 * s.com_smoothing / s.dt).round() as usize;
     moving_average(&mut com, half);
     moving_average(&mut com, half);
-    let com = point_refs(com, s.dt)
+    Ok(point_refs(com, s.dt)
         .into_iter()
         .map(|r| ComReference {
             position: r.position,
             velocity: r.velocity,
             acceleration: r.acceleration,
         })
-        .collect();
-    // Legs within reach: lower the pelvis (and the points above it) where needed.
+        .collect())
+}
+
+/// Legs within reach: per tick, how far \[m\] the pelvis must be lowered for both legs to
+/// reach their feet's references.
+#[allow(clippy::too_many_arguments)]
+fn leg_drops(
+    r: &PlanRobot,
+    tr: &Tracks,
+    s: &KeypointSettings,
+    contact: &[Vec<bool>; 2],
+    feet: &[Vec<PoseRef>; 2],
+    pelvis_x: &[Vector3<f64>],
+    heading: &[f64],
+    ticks: usize,
+) -> Result<Vec<f64>> {
+    let (robot, kin, body) = (r.robot, r.kin, r.body);
+    let aligned = &tr.aligned;
     let mut drop = vec![0.0; ticks];
     for (i, (hip, knee, ankle)) in [
         (
@@ -498,11 +678,15 @@ pub(crate) fn plan(
     .into_iter()
     .enumerate()
     {
-        let (h0, k0, a0) = (at0(hip)?, at0(knee)?, at0(ankle)?);
+        let (h0, k0, a0) = (
+            tr.at_start(r, hip)?,
+            tr.at_start(r, knee)?,
+            tr.at_start(r, ankle)?,
+        );
         let (thigh, shank) = ((k0 - h0).norm(), (a0 - k0).norm());
         let cap = s.max_leg_extension * (thigh + shank);
         // The person's knee, as the angle between thigh and shank (π straight).
-        let person = [idx(hip), idx(knee), idx(ankle)];
+        let person = [tr.idx(hip), tr.idx(knee), tr.idx(ankle)];
         let offset = h0 - kin.frame_pose(robot, body.pelvis)?.translation.vector;
         for k in 0..ticks {
             let reach = match person {
@@ -523,6 +707,12 @@ pub(crate) fn plan(
             drop[k] = f64::max(drop[k], need);
         }
     }
+    Ok(drop)
+}
+
+/// The lowering \[m\] per tick of the pelvis and the points above it: the drops' running
+/// maximum over `com_smoothing`, smoothed by two moving averages.
+fn lowering(drop: &[f64], s: &KeypointSettings, ticks: usize) -> Vec<Vector3<f64>> {
     let half = (0.5 * s.com_smoothing / s.dt).round() as usize;
     let peak: Vec<f64> = (0..ticks)
         .map(|k| {
@@ -534,38 +724,76 @@ pub(crate) fn plan(
     let mut lowered: Vec<Vector3<f64>> = peak.iter().map(|d| Vector3::new(0.0, 0.0, *d)).collect();
     moving_average(&mut lowered, half);
     moving_average(&mut lowered, half);
-    let pelvis_x: Vec<Vector3<f64>> = pelvis_x.iter().zip(&lowered).map(|(p, d)| p - d).collect();
-    let pelvis = pose_refs(pelvis_x, pelvis_rot, s.dt);
+    lowered
+}
+
+/// Torso orientations per tick, from the same construction on the robot at its start.
+fn torso_refs(
+    r: &PlanRobot,
+    tr: &Tracks,
+    s: &KeypointSettings,
+    start: &StartPoints,
+    lh: &[Vector3<f64>],
+    rh: &[Vector3<f64>],
+    ticks: usize,
+) -> Result<Vec<PoseRef>> {
     let (ls, rs) = (
-        get(BodyPoint::LeftShoulder)?,
-        get(BodyPoint::RightShoulder)?,
+        tr.get(BodyPoint::LeftShoulder)?,
+        tr.get(BodyPoint::RightShoulder)?,
     );
-    let c_torso = match body.torso {
-        Some(f) => torso_frame(rls, rrs, rlh, rrh).inverse() * kin.frame_pose(robot, f)?.rotation,
+    let c_torso = match r.body.torso {
+        Some(f) => {
+            torso_frame(start.ls, start.rs, start.lh, start.rh).inverse()
+                * r.kin.frame_pose(r.robot, f)?.rotation
+        }
         None => UnitQuaternion::identity(),
     };
     let torso_rot: Vec<UnitQuaternion<f64>> = (0..ticks)
         .map(|k| torso_frame(ls[k], rs[k], lh[k], rh[k]) * c_torso)
         .collect();
-    let torso = pose_refs(vec![Vector3::zeros(); ticks], torso_rot, s.dt);
-    // Hands, elbows, head.
+    Ok(pose_refs(vec![Vector3::zeros(); ticks], torso_rot, s.dt))
+}
+
+/// Hands, elbows, head: the scaled points lowered by `lowered` \[m\] per tick.
+fn point_tracks(
+    body: &RobotBody,
+    tr: &Tracks,
+    lowered: &[Vector3<f64>],
+    dt: f64,
+) -> Vec<(BodyPoint, Vec<PointRef>)> {
     let mut points = Vec::new();
     for p in TRACKED {
         if body.frame_of(p).is_some() {
-            if let Some(x) = track(p) {
-                let x = x.iter().zip(&lowered).map(|(p, d)| p - d).collect();
-                points.push((p, point_refs(x, s.dt)));
+            if let Some(x) = tr.track(p) {
+                let x = x.iter().zip(lowered).map(|(p, d)| p - d).collect();
+                points.push((p, point_refs(x, dt)));
             }
         }
     }
-    // Neutral targets: the aligned human points scaled by the leg ratio, placed at the middle
-    // of the hips (the joint centres both bodies have; see `Plan::neutral`).
+    points
+}
+
+/// The neutral targets of one tick: per point of the robot body, relative to the middle of its
+/// hips \[m\] (see `Plan::neutral`).
+type NeutralTargets = Vec<(BodyPoint, Vector3<f64>)>;
+
+/// Neutral targets: the aligned human points scaled by the leg ratio, placed at the middle
+/// of the hips (the joint centres both bodies have; see `Plan::neutral`).
+fn neutral_points(
+    body: &RobotBody,
+    tr: &Tracks,
+    clip: &ScaledClip,
+    ticks: usize,
+) -> Result<Vec<NeutralTargets>> {
+    let aligned = &tr.aligned;
     let hip_k = [
-        idx(BodyPoint::LeftHip).ok_or_else(|| missing(BodyPoint::LeftHip))?,
-        idx(BodyPoint::RightHip).ok_or_else(|| missing(BodyPoint::RightHip))?,
+        tr.idx(BodyPoint::LeftHip)
+            .ok_or_else(|| tr.missing(BodyPoint::LeftHip))?,
+        tr.idx(BodyPoint::RightHip)
+            .ok_or_else(|| tr.missing(BodyPoint::RightHip))?,
     ];
     let leg = clip.scaling.leg;
-    let neutral = (0..ticks)
+    Ok((0..ticks)
         .map(|k| {
             let (Some(l), Some(r)) = (&aligned[hip_k[0]], &aligned[hip_k[1]]) else {
                 return Vec::new();
@@ -574,7 +802,7 @@ pub(crate) fn plan(
             body.points
                 .iter()
                 .filter_map(|(p, _)| {
-                    let a = aligned[idx(*p)?].as_ref()?[k];
+                    let a = aligned[tr.idx(*p)?].as_ref()?[k];
                     // The pelvis is the alignment point itself (see `Plan::neutral`).
                     let rel = match p {
                         BodyPoint::Pelvis => Vector3::zeros(),
@@ -584,26 +812,7 @@ pub(crate) fn plan(
                 })
                 .collect()
         })
-        .collect();
-    let latch_weight = [
-        latch_weights(&contact[0], s.dt),
-        latch_weights(&contact[1], s.dt),
-    ];
-    let mut plan = Plan {
-        ticks,
-        feet,
-        contact,
-        latch_weight,
-        com,
-        pelvis,
-        torso,
-        points,
-        neutral,
-    };
-    if s.standing {
-        hold_stance(&mut plan, robot, kin, body, support, s.dt)?;
-    }
-    Ok(plan)
+        .collect())
 }
 
 /// Standing imitation ([`KeypointSettings::standing`]): the feet and the pelvis held at the
@@ -767,408 +976,5 @@ fn unwrap(mut a: Vec<f64>) -> Vec<f64> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::profile::RobotProfile;
-    use crate::retarget::contacts::PIVOT_TURN;
-    use crate::sim::ImitateConfig;
-
-    /// The plans of `clip` on `robot` as the keypoint route builds them, with and without
-    /// `standing`, and the robot's start kinematics and body.
-    fn plans(
-        robot: &str,
-        clip: &str,
-    ) -> (Robot, Kinematics, RobotBody, SupportSettings, Plan, Plan) {
-        plans_with(robot, clip, &KeypointSettings::default())
-    }
-
-    fn plans_with(
-        robot: &str,
-        clip: &str,
-        s: &KeypointSettings,
-    ) -> (Robot, Kinematics, RobotBody, SupportSettings, Plan, Plan) {
-        let profile = RobotProfile::builtin(robot).unwrap();
-        let robot = profile.robot().unwrap();
-        let cfg = profile.imitate_config(ImitateConfig::default()).unwrap();
-        let names = super::super::frame_names(&profile, &cfg).unwrap();
-        let mut kin = Kinematics::new(&robot, &crate::model::State::neutral(&robot)).unwrap();
-        let body = RobotBody::find(&robot, &kin, &names).unwrap();
-        let state = profile.standing_state(&robot).unwrap();
-        kin.update(&robot, &state).unwrap();
-        let kp = super::super::builtin_motion(clip)
-            .unwrap()
-            .keypoints(crate::motion::DEFAULT_MAX_GAP)
-            .unwrap();
-        let scaled = super::super::scale::scale_clip(
-            &robot,
-            &kin,
-            &body,
-            &kp,
-            cfg.support.ankle_height,
-            s.hands,
-            s.feet,
-        )
-        .unwrap();
-        let posture = super::super::posture_tracks(&robot, &state, None, s.posture_margin).unwrap();
-        let on = PlanRobot {
-            robot: &robot,
-            start: &state,
-            kin: &kin,
-            body: &body,
-            support: &cfg.support,
-            posture: &posture,
-        };
-        let free = plan(&on, &kp, &scaled, s).unwrap();
-        let standing = KeypointSettings {
-            standing: true,
-            ..s.clone()
-        };
-        let held = plan(&on, &kp, &scaled, &standing).unwrap();
-        (robot, kin, body, cfg.support, free, held)
-    }
-
-    /// `humanoid3d_dance_a` spins on its feet: with the default a foot's yaw turns by more
-    /// than [`PIVOT_TURN`] over one of its stances (0.96 rad on G1), about its sole's centre,
-    /// which stays where the
-    /// stance holds it; with `pivot_turn: None` every stance holds the foot's yaw. Either way
-    /// the sole's centre is constant in every stance, and a pivoting foot turns no faster
-    /// than [`PIVOT_RATE`] there.
-    #[test]
-    fn a_spinning_foot_pivots_about_its_sole_centre_unless_asked_to_hold() {
-        let planted = KeypointSettings {
-            pivot_turn: None,
-            ..KeypointSettings::default()
-        };
-        let (.., support, free, _) = plans("g1", "humanoid3d_dance_a");
-        let (.., held, _) = plans_with("g1", "humanoid3d_dance_a", &planted);
-        let s = Vector3::new(support.sole_offset_x, 0.0, -support.ankle_height);
-        let centre = |f: &PoseRef| f.position.position + f.rotation * s;
-        let yaw = |f: &PoseRef| {
-            (f.rotation * Vector3::x())
-                .y
-                .atan2((f.rotation * Vector3::x()).x)
-        };
-        // Rounding of a held value carried through a rotation and back [m], [rad].
-        let tol = 1e-12;
-        let dt = KeypointSettings::default().dt;
-        let mut largest_turn: f64 = 0.0;
-        for (plan, pivots) in [(&free, true), (&held, false)] {
-            for i in 0..2 {
-                for (a, b) in runs(&plan.contact[i]) {
-                    let f = &plan.feet[i];
-                    for k in a + 1..b {
-                        assert!((centre(&f[k]) - centre(&f[a])).norm() < tol, "{i} {k}");
-                        let step = f[k].rotation.angle_to(&f[k - 1].rotation);
-                        if pivots {
-                            assert!(step <= PIVOT_RATE * dt + tol, "{i} {k}: {step}");
-                        } else {
-                            assert!(step < tol, "{i} {k}: {step}");
-                        }
-                    }
-                    if pivots {
-                        let turn = f[a..b]
-                            .iter()
-                            .map(|p| (yaw(p) - yaw(&f[a])).abs())
-                            .fold(0.0, f64::max);
-                        largest_turn = largest_turn.max(turn);
-                    }
-                }
-            }
-        }
-        assert!(largest_turn > PIVOT_TURN, "{largest_turn}");
-    }
-
-    /// Standing: feet, pelvis and COM are constant at the robot's start, both feet on the ground
-    /// throughout; every tracked point is the free plan's point moved by X₀ X_k⁻¹ (recomputed
-    /// here from the free plan's pelvis as a rotation and a translation, not as an isometry
-    /// product) and the torso keeps its orientation relative to the pelvis.
-    #[test]
-    fn standing_holds_feet_and_pelvis_and_carries_the_upper_body_on_the_pelvis() {
-        for (robot_name, clip) in [("g1", "humanoid3d_dance_b"), ("jvrc1", "humanoid3d_punch")] {
-            let (robot, kin, body, support, free, held) = plans(robot_name, clip);
-            assert_eq!(free.ticks, held.ticks);
-            let x0 = kin.frame_pose(&robot, body.pelvis).unwrap();
-            // A pose read back from the kinematics and stored: exact up to rounding.
-            let tol = 1e-12;
-            for k in 0..held.ticks {
-                let p = &held.pelvis[k];
-                assert!((p.position.position - x0.translation.vector).norm() < tol);
-                assert!(p.rotation.angle_to(&x0.rotation) < tol);
-                assert!(p.position.velocity.norm() < tol && p.angular_velocity.norm() < tol);
-                for i in 0..2 {
-                    assert!(held.contact[i][k], "{robot_name}: foot {i} off at tick {k}");
-                    let f0 = kin.frame_pose(&robot, body.feet[i]).unwrap();
-                    assert!(
-                        (held.feet[i][k].position.position - f0.translation.vector).norm() < tol
-                    );
-                }
-                assert!((held.com[k].position - held.com[0].position).norm() < tol);
-                // The pelvis pose the free plan gives at tick k.
-                let (xk, rk) = (free.pelvis[k].position.position, free.pelvis[k].rotation);
-                for ((pf, rf), (ph, rh)) in free.points.iter().zip(&held.points) {
-                    assert_eq!(pf, ph);
-                    let expected = x0.rotation * (rk.inverse() * (rf[k].position - xk))
-                        + x0.translation.vector;
-                    assert!(
-                        (rh[k].position - expected).norm() < 1e-9,
-                        "{robot_name} {pf} tick {k}: {} vs {expected}",
-                        rh[k].position
-                    );
-                }
-                let rel_free = rk.inverse() * free.torso[k].rotation;
-                let rel_held = x0.rotation.inverse() * held.torso[k].rotation;
-                assert!(
-                    rel_free.angle_to(&rel_held) < 1e-9,
-                    "{robot_name} torso tick {k}"
-                );
-            }
-            // The COM over the middle of the soles: inside the support polygon of both feet.
-            let soles: Vec<_> = (0..2)
-                .map(|i| {
-                    let f0 = kin.frame_pose(&robot, body.feet[i]).unwrap();
-                    sole_pose(&f0, &support)
-                })
-                .collect();
-            let mut polygon = SupportPolygon::default();
-            polygon.set_hull_of_soles(
-                &soles[0],
-                &soles[1],
-                support.sole_length,
-                support.sole_width,
-            );
-            let c = held.com[0].position;
-            assert!(
-                polygon.margin((c.x, c.y)) > 0.0,
-                "{robot_name}: COM {c} outside"
-            );
-            // The upper body does move.
-            let (_, hand) = &held.points[0];
-            let travel = hand
-                .iter()
-                .map(|r| (r.position - hand[0].position).norm())
-                .fold(0.0, f64::max);
-            assert!(travel > 0.1, "{robot_name}: the hand moves {travel} m");
-        }
-    }
-
-    /// Share of ticks where the change of a reference acceleration reverses its sign.
-    fn reversals(a: &[f64]) -> f64 {
-        let d: Vec<f64> = a.windows(2).map(|w| w[1] - w[0]).collect();
-        let n = d.windows(2).filter(|w| w[0] * w[1] < 0.0).count();
-        n as f64 / (d.len() - 1) as f64
-    }
-
-    /// The low-pass takes the capture's frame-rate noise out of the references' accelerations:
-    /// as captured (60 Hz, cubic splines), the change of the wrists' and elbows' reference
-    /// acceleration reverses its sign on 21–23 % of the 200 Hz ticks (at the frames); low-passed
-    /// at 6 Hz, on 5–6 %. The references move by at most 2.1 cm (the dance's fastest arm
-    /// motions, at the cut-off).
-    #[test]
-    fn smoothing_takes_the_frame_rate_noise_out_of_the_references() {
-        let raw = plans_with("jvrc1", "humanoid3d_dance_b", &KeypointSettings::default()).4;
-        let s = KeypointSettings {
-            smoothing: Some(6.0),
-            ..KeypointSettings::default()
-        };
-        let smooth = plans_with("jvrc1", "humanoid3d_dance_b", &s).4;
-        for ((p, r), (_, f)) in raw.points.iter().zip(&smooth.points) {
-            let (mut rr, mut rf, mut moved) = (0.0_f64, 0.0_f64, 0.0_f64);
-            for axis in 0..3 {
-                let ar: Vec<f64> = r.iter().map(|x| x.acceleration[axis]).collect();
-                let af: Vec<f64> = f.iter().map(|x| x.acceleration[axis]).collect();
-                rr = rr.max(reversals(&ar));
-                rf = rf.max(reversals(&af));
-            }
-            for (a, b) in r.iter().zip(f) {
-                moved = moved.max((a.position - b.position).norm());
-            }
-            assert!(rr > 0.15, "{p}: as captured {rr}");
-            assert!(rf < 0.1, "{p}: low-passed {rf}");
-            assert!(moved < 0.03, "{p}: moved {moved} m");
-        }
-    }
-
-    /// The COM reference is the pelvis' ground projection plus the robot's own COM offset from
-    /// its pelvis frame in the posture asked of it (here the start posture, every tick) with
-    /// the pelvis frame at its orientation reference, wherever that lies inside the support
-    /// polygon (unsmoothed here, so it is compared tick by tick; elsewhere it is pulled to the
-    /// polygon's margin). The offset is computed here from the robot placed by the plan's
-    /// pelvis reference. On G1 it is about 4 cm: held over the pelvis instead, the reference
-    /// would match on no tick.
-    #[test]
-    fn the_com_reference_carries_the_robots_com_offset_from_its_pelvis() {
-        let s = KeypointSettings {
-            com_smoothing: 0.0,
-            ..KeypointSettings::default()
-        };
-        let (robot, mut kin, body, _, free, _) = plans_with("g1", "humanoid3d_walk", &s);
-        let profile = RobotProfile::builtin("g1").unwrap();
-        let mut state = profile.standing_state(&robot).unwrap();
-        let base_in_pelvis =
-            kin.frame_pose(&robot, body.pelvis).unwrap().inverse() * state.base_pose(&robot);
-        let (mut with, mut without) = (0, 0);
-        for k in 0..free.ticks {
-            let r = &free.pelvis[k];
-            let pelvis = Isometry3::from_parts(Translation3::from(r.position.position), r.rotation);
-            state
-                .set_base_pose(&robot, &(pelvis * base_in_pelvis))
-                .unwrap();
-            kin.update(&robot, &state).unwrap();
-            let placed = kin.frame_pose(&robot, body.pelvis).unwrap();
-            // The robot placed by the reference: its pelvis frame is there.
-            assert!((placed.translation.vector - r.position.position).norm() < 1e-9);
-            let offset = kin.com() - placed.translation.vector;
-            assert!(
-                offset.xy().norm() > 0.03,
-                "G1's offset at tick {k}: {offset}"
-            );
-            let p = r.position.position;
-            let c = free.com[k].position;
-            // A reference built from stored positions: equal up to rounding.
-            if (c.xy() - (p + offset).xy()).norm() < 1e-9 {
-                with += 1;
-            }
-            if (c.xy() - p.xy()).norm() < 1e-9 {
-                without += 1;
-            }
-        }
-        assert!(2 * with > free.ticks, "{with} of {} ticks", free.ticks);
-        assert_eq!(without, 0);
-    }
-
-    /// The neutral targets are aligned at the middle of the hips: the two hips' targets are
-    /// opposite (their middle is the origin), and a robot whose body points sit exactly on
-    /// the targets, placed from the middle of its hips, scores zero error whichever of its
-    /// frames is taken for the pelvis; moved by 1 cm, every point scores 1 cm. The pelvis
-    /// frame's reference turned by 0.1 rad about the vertical scores 0.1 rad, in degrees, on
-    /// each of two ticks.
-    #[test]
-    fn the_keypoint_error_is_aligned_at_the_middle_of_the_hips() {
-        use super::super::quality::QualityRecorder;
-        let (robot, mut kin, body, support, free, _) = plans("g1", "humanoid3d_punch");
-        // The robot turned and tilted, so that no frame is at the identity.
-        let mut state = crate::model::State::neutral(&robot);
-        let pose = Isometry3::new(Vector3::new(0.1, -0.2, 0.7), Vector3::new(0.2, -0.1, 0.6));
-        state.set_base_pose(&robot, &pose).unwrap();
-        kin.update(&robot, &state).unwrap();
-        // Sums of decimetre-sized vectors, and one of 0.01 m \[m\].
-        let tol = 1e-12;
-        let k = free.ticks / 2;
-        let target = |p: BodyPoint| free.neutral[k].iter().find(|(q, _)| *q == p).unwrap().1;
-        let (l, r) = (target(BodyPoint::LeftHip), target(BodyPoint::RightHip));
-        assert!((l + r).norm() < tol, "{l} {r}");
-        assert!(l.norm() > 0.03, "half the hips' width: {l}");
-        // A plan whose tick k is the robot's own points relative to its hip middle.
-        let at = |p: BodyPoint| {
-            let f = body.frame_of(p).unwrap();
-            kin.frame_pose(&robot, f).unwrap().translation.vector
-        };
-        let middle = 0.5 * (at(BodyPoint::LeftHip) + at(BodyPoint::RightHip));
-        let mut plan = free.clone();
-        let shift = Vector3::new(0.0, 0.01, 0.0);
-        for (p, rel) in plan.neutral[k].iter_mut() {
-            if *p == BodyPoint::Pelvis {
-                assert_eq!(*rel, Vector3::zeros(), "the pelvis is the alignment point");
-                continue;
-            }
-            *rel = at(*p) - middle
-                + if *p == BodyPoint::LeftHip || *p == BodyPoint::RightHip {
-                    Vector3::zeros()
-                } else {
-                    shift
-                };
-        }
-        let turn = 0.1;
-        for t in [k, k + 1] {
-            plan.neutral[t] = plan.neutral[k].clone();
-            plan.pelvis[t].rotation = UnitQuaternion::from_euler_angles(0.0, 0.0, turn)
-                * kin.frame_pose(&robot, body.pelvis).unwrap().rotation;
-        }
-        let qdd = vec![0.0; robot.nv()];
-        let pelvis_frame = body.pelvis;
-        for pelvis in [body.pelvis, body.torso.unwrap()] {
-            let body = RobotBody {
-                pelvis,
-                ..body.clone()
-            };
-            let mut rec = QualityRecorder::new("keypoints", &body, 0.005);
-            for t in [k, k + 1] {
-                rec.record(
-                    &robot,
-                    &kin,
-                    &body,
-                    &plan,
-                    &support,
-                    (t, [false; 2], false),
-                    &state,
-                    &qdd,
-                )
-                .unwrap();
-            }
-            let q = rec.finish(&robot);
-            if pelvis == pelvis_frame {
-                let o = &q.orientations[0];
-                assert_eq!(o.frame, "pelvis");
-                assert!((o.mean_deg - turn.to_degrees()).abs() < 1e-9, "{o:?}");
-                assert!((o.max_deg - turn.to_degrees()).abs() < 1e-9, "{o:?}");
-            }
-            for e in &q.points {
-                let want = if e.point.ends_with("_hip") || e.point == "pelvis" {
-                    0.0
-                } else {
-                    1.0
-                };
-                assert!(
-                    (e.mean_cm - want).abs() < 1e-9,
-                    "{}: {} cm",
-                    e.point,
-                    e.mean_cm
-                );
-            }
-        }
-    }
-
-    /// A foot's yaw from its toe: where the toe points down (past [`TOE_LEVEL`]) or backwards
-    /// (past [`TOE_TWIST`] from the heading), the twist from the heading is interpolated between
-    /// the neighbouring ticks that give one, never the `atan2` of that tick; held at the ends.
-    #[test]
-    fn a_foot_pointing_down_or_backwards_gives_no_yaw() {
-        let deg = f64::to_radians;
-        // A heading turning by 5° a tick, the foot twisted 10° out, on the level.
-        let heading: Vec<f64> = (0..8).map(|k| deg(5.0 * k as f64)).collect();
-        let level = |k: usize, twist: f64| {
-            let a = heading[k] + deg(twist);
-            Vector3::new(a.cos(), a.sin(), -0.2)
-        };
-        let mut dirs: Vec<Vector3<f64>> = (0..8).map(|k| level(k, 10.0)).collect();
-        dirs[0] = Vector3::new(0.05, 0.3, -1.0); // pointing down, horizontal part 30% of it
-        dirs[3] = Vector3::new(0.2, -0.1, -1.0); // pointing down
-        dirs[4] = -level(4, 10.0) + Vector3::new(0.0, 0.0, -0.4); // backwards
-        dirs[7] = -level(7, 30.0) + Vector3::new(0.0, 0.0, -0.4); // backwards
-        dirs[5] = level(5, 40.0);
-        // A foot's length: the share of the horizontal part, not its length, decides.
-        let dirs: Vec<Vector3<f64>> = dirs.iter().map(|d| 0.15 * d).collect();
-        let yaw = foot_yaw(&dirs, &heading).unwrap();
-        let twist: Vec<f64> = yaw
-            .iter()
-            .zip(&heading)
-            .map(|(y, h)| (y - h).to_degrees())
-            .collect();
-        let expected = [10.0, 10.0, 10.0, 20.0, 30.0, 40.0, 10.0, 10.0];
-        for (k, (t, e)) in twist.iter().zip(expected).enumerate() {
-            assert!((t - e).abs() < 1e-9, "tick {k}: twist {t}°, expected {e}°");
-        }
-        // Unwrapped: a heading past ±180° carries the yaw with it.
-        let heading: Vec<f64> = (0..4).map(|k| deg(170.0 + 10.0 * k as f64)).collect();
-        let dirs: Vec<Vector3<f64>> = heading
-            .iter()
-            .map(|h| Vector3::new(h.cos(), h.sin(), 0.0))
-            .collect();
-        let yaw = foot_yaw(&dirs, &heading).unwrap();
-        for (y, h) in yaw.iter().zip(&heading) {
-            assert!((y - h).abs() < 1e-9);
-        }
-        // No tick gives a yaw.
-        assert!(foot_yaw(&[Vector3::new(0.0, 0.0, -1.0)], &[0.0]).is_none());
-    }
-}
+#[path = "plan_tests.rs"]
+mod tests;

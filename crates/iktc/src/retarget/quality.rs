@@ -299,6 +299,44 @@ impl QualityRecorder {
             })
             .collect();
         let mean_cm = points.iter().map(|p| p.mean_cm).sum::<f64>() / points.len().max(1) as f64;
+        let orientations = self.orientation_errors(n);
+        let JointFigures {
+            sum_sq,
+            count,
+            jerk_max,
+            pm,
+            vm,
+            am,
+            on_limit,
+        } = self.joint_figures(robot);
+        RetargetQuality {
+            route: self.route.clone(),
+            ticks: self.ticks,
+            points,
+            mean_cm,
+            orientations,
+            slip_mm: 1000.0 * self.slip,
+            below_ground_mm: 1000.0 * self.below.max(0.0),
+            float_mm: 1000.0 * self.float.0,
+            float_share: self.float.2 as f64 / self.float.1.max(1) as f64,
+            stance_ticks: self.stance_ticks,
+            jerk_rms: (sum_sq / count.max(1) as f64).sqrt(),
+            jerk_max,
+            jerk_limit_share: jerk_limit_share(&self.qdd, &self.corrected),
+            position_margin: pm,
+            velocity_margin: vm,
+            acceleration_margin: am,
+            on_limit,
+            reach_cm: None,
+            balanced_reach_cm: None,
+            posture_fit_deg: None,
+            reach_run_cm: None,
+            fidelity: None,
+        }
+    }
+
+    /// The pelvis' orientation error, and the torso's where one was recorded, over `n` ticks.
+    fn orientation_errors(&self, n: f64) -> Vec<OrientationError> {
         let mut orientations = vec![OrientationError {
             frame: "pelvis".into(),
             mean_deg: self.orient[0].0 / n * 180.0 / std::f64::consts::PI,
@@ -311,6 +349,11 @@ impl QualityRecorder {
                 max_deg: self.orient[1].1.to_degrees(),
             });
         }
+        orientations
+    }
+
+    /// The jerk, margin and on-limit figures of every active joint of `robot`.
+    fn joint_figures(&self, robot: &Robot) -> JointFigures {
         let joints = robot.n_active();
         let (mut sum_sq, mut count, mut jerk_max) = (0.0, 0usize, 0.0_f64);
         let (mut pm, mut vm, mut am) = (f64::NEG_INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY);
@@ -345,31 +388,32 @@ impl QualityRecorder {
         }
         // Stable: ties keep the robot's joint order.
         on_limit.sort_by(|a, b| b.share.total_cmp(&a.share));
-        RetargetQuality {
-            route: self.route.clone(),
-            ticks: self.ticks,
-            points,
-            mean_cm,
-            orientations,
-            slip_mm: 1000.0 * self.slip,
-            below_ground_mm: 1000.0 * self.below.max(0.0),
-            float_mm: 1000.0 * self.float.0,
-            float_share: self.float.2 as f64 / self.float.1.max(1) as f64,
-            stance_ticks: self.stance_ticks,
-            jerk_rms: (sum_sq / count.max(1) as f64).sqrt(),
+        JointFigures {
+            sum_sq,
+            count,
             jerk_max,
-            jerk_limit_share: jerk_limit_share(&self.qdd, &self.corrected),
-            position_margin: pm,
-            velocity_margin: vm,
-            acceleration_margin: am,
+            pm,
+            vm,
+            am,
             on_limit,
-            reach_cm: None,
-            balanced_reach_cm: None,
-            posture_fit_deg: None,
-            reach_run_cm: None,
-            fidelity: None,
         }
     }
+}
+
+/// The joints' figures of a run ([`QualityRecorder::finish`]).
+struct JointFigures {
+    /// The sum over the joints of the squared RMS jerk times the joint's steps \[rad²/s⁶\].
+    sum_sq: f64,
+    /// The steps summed over the joints.
+    count: usize,
+    /// The largest jerk \[rad/s³\].
+    jerk_max: f64,
+    /// The largest position, velocity and acceleration margins over the joints.
+    pm: f64,
+    vm: f64,
+    am: f64,
+    /// The joints that were within [`LIMIT_BAND`] of a limit, most of the time first.
+    on_limit: Vec<JointOnLimit>,
 }
 
 /// [`RetargetQuality::jerk_limit_share`] of the joint accelerations `qdd` (one row per tick,

@@ -126,34 +126,77 @@ pub(crate) fn scale_clip(
     let rot = Rotation3::from_axis_angle(&Vector3::z_axis(), -heading);
     let origin = Vector3::new(o.x, o.y, ground);
     let aligned: Vec<Vector3<f64>> = kp.positions.iter().map(|p| rot * (p - origin)).collect();
-    let robot_at = |p: BodyPoint| -> Result<Option<Vector3<f64>>> {
-        match body.frame_of(p) {
-            Some(f) => Ok(Some(kin.frame_pose(robot, f)?.translation.vector)),
+    let rp = RobotPoints { robot, kin, body };
+    let (lk, rk) = (required(kp, B::LeftKnee)?, required(kp, B::RightKnee)?);
+    let leg = leg_ratio(&rp, kp, [(lh, lk, la), (rh, rk, ra)])?;
+    let segments = segment_ratios(&rp, kp, leg)?;
+    let robot_hips = match (rp.at(B::LeftHip)?, rp.at(B::RightHip)?, rp.at(B::Pelvis)?) {
+        (Some(l), Some(r), Some(p)) => p.z - 0.5 * (l.z + r.z),
+        _ => 0.0,
+    };
+    let scaled = ScaleFrames {
+        kp,
+        aligned: &aligned,
+        leg,
+        segments: &segments,
+        ankle_height,
+        robot_hips,
+        ids: [pelvis, lh, rh, la, ra],
+    }
+    .scaled(hands, feet);
+    Ok(ScaledClip {
+        scaling: Scaling {
+            heading,
+            ground,
+            leg,
+            segments,
+        },
+        aligned,
+        scaled,
+    })
+}
+
+/// The robot's body points in its start posture.
+struct RobotPoints<'a> {
+    robot: &'a Robot,
+    kin: &'a Kinematics,
+    body: &'a RobotBody,
+}
+
+impl RobotPoints<'_> {
+    /// The position \[m\] of the robot's frame of `p`, if it has one.
+    fn at(&self, p: BodyPoint) -> Result<Option<Vector3<f64>>> {
+        match self.body.frame_of(p) {
+            Some(f) => Ok(Some(self.kin.frame_pose(self.robot, f)?.translation.vector)),
             None => Ok(None),
         }
-    };
-    let human_len = |a: usize, b: usize| {
-        let mut d: Vec<f64> = (0..frames).map(|f| (at(f, b) - at(f, a)).norm()).collect();
-        d.sort_by(f64::total_cmp);
-        d[d.len() / 2]
-    };
-    let ratio = |pa: BodyPoint, pb: BodyPoint, a: usize, b: usize| -> Result<Option<f64>> {
-        let (Some(ra), Some(rb)) = (robot_at(pa)?, robot_at(pb)?) else {
-            return Ok(None);
-        };
-        let h = human_len(a, b);
-        Ok((h > 0.0).then(|| (rb - ra).norm() / h))
-    };
-    let (lk, rk) = (required(kp, B::LeftKnee)?, required(kp, B::RightKnee)?);
+    }
+}
+
+/// The median over the frames of `kp` of the distance \[m\] between its points `a` and `b`.
+fn human_length(kp: &Keypoints, a: usize, b: usize) -> f64 {
+    let n = kp.points.len();
+    let frames = kp.frame_count();
+    let at = |f: usize, k: usize| kp.positions[f * n + k];
+    let mut d: Vec<f64> = (0..frames).map(|f| (at(f, b) - at(f, a)).norm()).collect();
+    d.sort_by(f64::total_cmp);
+    d[d.len() / 2]
+}
+
+/// The leg ratio: the robot's leg length over the person's (hip–knee plus knee–ankle, the
+/// medians), the mean over the legs both have; `legs` are the (hip, knee, ankle) indices of
+/// the left and right legs in `kp`.
+fn leg_ratio(r: &RobotPoints, kp: &Keypoints, legs: [(usize, usize, usize); 2]) -> Result<f64> {
+    let [(lh, lk, la), (rh, rk, ra)] = legs;
     let mut legs = Vec::new();
     for (h, k, a, ph, pk, pa) in [
         (lh, lk, la, B::LeftHip, B::LeftKnee, B::LeftAnkle),
         (rh, rk, ra, B::RightHip, B::RightKnee, B::RightAnkle),
     ] {
-        let (Some(rh), Some(rk), Some(ra)) = (robot_at(ph)?, robot_at(pk)?, robot_at(pa)?) else {
+        let (Some(rh), Some(rk), Some(ra)) = (r.at(ph)?, r.at(pk)?, r.at(pa)?) else {
             continue;
         };
-        let human = human_len(h, k) + human_len(k, a);
+        let human = human_length(kp, h, k) + human_length(kp, k, a);
         if human > 0.0 {
             legs.push(((rk - rh).norm() + (ra - rk).norm()) / human);
         }
@@ -164,7 +207,24 @@ pub(crate) fn scale_clip(
             message: "the hips, knees and ankles coincide in every frame".into(),
         });
     }
-    let leg = legs.iter().sum::<f64>() / legs.len() as f64;
+    Ok(legs.iter().sum::<f64>() / legs.len() as f64)
+}
+
+/// The ratio of each segment of [`SEGMENTS`] `kp` has: the robot's length over the
+/// person's, or where the robot lacks a point, the knee's (toes), the head's (chest, neck) or
+/// the `leg` ratio.
+fn segment_ratios(
+    r: &RobotPoints,
+    kp: &Keypoints,
+    leg: f64,
+) -> Result<Vec<(BodyPoint, BodyPoint, f64)>> {
+    let ratio = |pa: BodyPoint, pb: BodyPoint, a: usize, b: usize| -> Result<Option<f64>> {
+        let (Some(ra), Some(rb)) = (r.at(pa)?, r.at(pb)?) else {
+            return Ok(None);
+        };
+        let h = human_length(kp, a, b);
+        Ok((h > 0.0).then(|| (rb - ra).norm() / h))
+    };
     let mut segments: Vec<(BodyPoint, BodyPoint, f64)> = Vec::new();
     for (pa, pb) in SEGMENTS {
         let (Some(a), Some(b)) = (index(kp, pa), index(kp, pb)) else {
@@ -188,57 +248,69 @@ pub(crate) fn scale_clip(
         let r = ratio(pa, pb, a, b)?.unwrap_or(fallback);
         segments.push((pa, pb, r));
     }
-    let mut scaled = vec![Vector3::zeros(); aligned.len()];
-    let robot_hips = match (
-        robot_at(B::LeftHip)?,
-        robot_at(B::RightHip)?,
-        robot_at(B::Pelvis)?,
-    ) {
-        (Some(l), Some(r), Some(p)) => p.z - 0.5 * (l.z + r.z),
-        _ => 0.0,
-    };
-    let wrists = [index(kp, B::LeftWrist), index(kp, B::RightWrist)];
-    let ankles = [(la, index(kp, B::LeftToe)), (ra, index(kp, B::RightToe))];
-    // p'_m + s_leg (a(p) − a(m)) with p'_m = (s_leg a(m)_xy, h_a + s_leg a(m)_z), i.e.
-    // s_leg a(p) + h_a ẑ: a point placed from the middle of the hips by the leg ratio.
-    let by_leg = |i: usize| leg * aligned[i] + Vector3::new(0.0, 0.0, ankle_height);
-    for f in 0..frames {
-        let row = f * n;
-        let hips = 0.5 * (aligned[row + lh] + aligned[row + rh]);
-        let p = leg * aligned[row + pelvis];
-        scaled[row + pelvis] = Vector3::new(p.x, p.y, ankle_height + leg * hips.z + robot_hips);
-        for &(pa, pb, r) in &segments {
-            if let (Some(a), Some(b)) = (index(kp, pa), index(kp, pb)) {
-                scaled[row + b] = scaled[row + a] + r * (aligned[row + b] - aligned[row + a]);
+    Ok(segments)
+}
+
+/// What the scaled points of every frame are made from.
+struct ScaleFrames<'a> {
+    kp: &'a Keypoints,
+    /// The aligned points, frame-major \[m\].
+    aligned: &'a [Vector3<f64>],
+    /// The leg ratio \[–\].
+    leg: f64,
+    segments: &'a [(BodyPoint, BodyPoint, f64)],
+    /// The robot's ankle above its sole \[m\].
+    ankle_height: f64,
+    /// The robot's pelvis above the middle of its hips \[m\].
+    robot_hips: f64,
+    /// The indices in `kp` of the pelvis, left and right hips, left and right ankles.
+    ids: [usize; 5],
+}
+
+impl ScaleFrames<'_> {
+    /// The scaled points, frame-major \[m\]: the pelvis, then each segment from its parent,
+    /// then the ankles (with `feet`) and wrists (with `hands`) by the leg ratio.
+    fn scaled(&self, hands: LimbScaling, feet: LimbScaling) -> Vec<Vector3<f64>> {
+        let (kp, aligned, leg) = (self.kp, self.aligned, self.leg);
+        let [pelvis, lh, rh, la, ra] = self.ids;
+        let n = kp.points.len();
+        let frames = kp.frame_count();
+        let mut scaled = vec![Vector3::zeros(); aligned.len()];
+        let wrists = [index(kp, B::LeftWrist), index(kp, B::RightWrist)];
+        let ankles = [(la, index(kp, B::LeftToe)), (ra, index(kp, B::RightToe))];
+        // p'_m + s_leg (a(p) − a(m)) with p'_m = (s_leg a(m)_xy, h_a + s_leg a(m)_z), i.e.
+        // s_leg a(p) + h_a ẑ: a point placed from the middle of the hips by the leg ratio.
+        let by_leg = |i: usize| leg * aligned[i] + Vector3::new(0.0, 0.0, self.ankle_height);
+        for f in 0..frames {
+            let row = f * n;
+            let hips = 0.5 * (aligned[row + lh] + aligned[row + rh]);
+            let p = leg * aligned[row + pelvis];
+            scaled[row + pelvis] =
+                Vector3::new(p.x, p.y, self.ankle_height + leg * hips.z + self.robot_hips);
+            for &(pa, pb, r) in self.segments {
+                if let (Some(a), Some(b)) = (index(kp, pa), index(kp, pb)) {
+                    scaled[row + b] = scaled[row + a] + r * (aligned[row + b] - aligned[row + a]);
+                }
             }
-        }
-        if feet == LimbScaling::Leg {
-            // The ankle by the leg ratio; the toe keeps its offset from the ankle.
-            for (a, toe) in ankles {
-                let moved = by_leg(row + a);
-                let shift = moved - scaled[row + a];
-                scaled[row + a] = moved;
-                if let Some(t) = toe {
-                    scaled[row + t] += shift;
+            if feet == LimbScaling::Leg {
+                // The ankle by the leg ratio; the toe keeps its offset from the ankle.
+                for (a, toe) in ankles {
+                    let moved = by_leg(row + a);
+                    let shift = moved - scaled[row + a];
+                    scaled[row + a] = moved;
+                    if let Some(t) = toe {
+                        scaled[row + t] += shift;
+                    }
+                }
+            }
+            if hands == LimbScaling::Leg {
+                for w in wrists.iter().flatten() {
+                    scaled[row + w] = by_leg(row + w);
                 }
             }
         }
-        if hands == LimbScaling::Leg {
-            for w in wrists.iter().flatten() {
-                scaled[row + w] = by_leg(row + w);
-            }
-        }
+        scaled
     }
-    Ok(ScaledClip {
-        scaling: Scaling {
-            heading,
-            ground,
-            leg,
-            segments,
-        },
-        aligned,
-        scaled,
-    })
 }
 
 #[cfg(test)]

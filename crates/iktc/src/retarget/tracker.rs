@@ -493,7 +493,6 @@ fn add_body_tasks(
     w: f64,
 ) -> Result<()> {
     let name = |f: FrameId| frame_name(robot, f);
-    let hand = |p: &BodyPoint| matches!(p, BodyPoint::LeftWrist | BodyPoint::RightWrist);
     for (i, (p, _)) in plan
         .points
         .iter()
@@ -526,7 +525,6 @@ fn build_stack(
     s: &KeypointSettings,
     modes: [FootMode; 2],
 ) -> Result<Stack> {
-    let stance = modes.map(|m| m == FootMode::Stance);
     let swing = modes.map(|m| matches!(m, FootMode::Swing | FootMode::Floor));
     let mut b = ControllerBuilder::new(robot.clone(), state)?;
     b.gains(s.gains).settings(ControllerSettings {
@@ -535,28 +533,7 @@ fn build_stack(
         solver: s.solver,
     });
     let name = |f: FrameId| frame_name(robot, f);
-    let mut feet = Vec::with_capacity(4);
-    let mut floor = Vec::with_capacity(4);
-    let near = |m: &FootMode| matches!(m, FootMode::Floor | FootMode::Landing);
-    // The held feet, 6D, and the floor rows of every foot near the ground: no level below
-    // can take a sole under the floor.
-    if stance.contains(&true) || modes.iter().any(near) {
-        b.level(KEYPOINT_LEVELS[0]);
-        b.gains(STANCE_GAINS);
-        for i in (0..2).filter(|i| stance[*i]) {
-            feet.push((i, b.frame(&name(body.feet[i]), Axes::ALL)?));
-        }
-        b.gains(s.gains);
-        for i in (0..2).filter(|i| near(&modes[*i])) {
-            floor.push((i, b.frame(&name(body.feet[i]), FLOOR_AXES)?));
-        }
-    }
-    if modes.contains(&FootMode::Landing) {
-        b.level(KEYPOINT_LEVELS[1]);
-        for i in (0..2).filter(|i| modes[*i] == FootMode::Landing) {
-            floor.push((i, b.frame(&name(body.feet[i]), LANDING_AXES)?));
-        }
-    }
+    let (mut feet, floor) = add_feet_levels(&mut b, robot, body, s, modes)?;
     let com = if s.balance || s.standing {
         Some(b.level(KEYPOINT_LEVELS[2]).com([true, true, false])?)
     } else {
@@ -574,34 +551,127 @@ fn build_stack(
     // The torso's orientation beside the pelvis, unless the COM level above would then have
     // only the arms to move the COM with: with it, among the elbows and the head.
     let balanced = com.is_some();
-    let mut torso = match body.torso {
+    let torso = match body.torso {
         Some(f) if !balanced => Some(b.frame(&name(f), Axes::ORIENTATION)?),
         _ => None,
     };
     let torso_with_elbows = body.torso.filter(|_| balanced);
     let mut points = Vec::new();
     b.level(KEYPOINT_LEVELS[5]);
-    let hand = |p: &BodyPoint| matches!(p, BodyPoint::LeftWrist | BodyPoint::RightWrist);
     for (i, (p, _)) in plan.points.iter().enumerate().filter(|(_, (p, _))| hand(p)) {
         if let Some(f) = body.frame_of(*p) {
             points.push((b.frame(&name(f), Axes::POSITION)?, i));
         }
     }
+    let mut lower = LowerTasks {
+        points,
+        torso,
+        torso_with_elbows,
+        feet,
+        swing,
+    };
+    let posture = add_lower_levels(&mut b, robot, body, plan, posture, s, &mut lower)?;
+    let LowerTasks {
+        points,
+        torso,
+        feet,
+        ..
+    } = lower;
+    finish_stack(
+        b,
+        s,
+        Tasks {
+            feet,
+            floor,
+            com,
+            pelvis,
+            torso,
+            points,
+            posture,
+        },
+    )
+}
+
+/// Foot index (left 0, right 1) and handle of the feet's tasks.
+type FootTasks = Vec<(usize, FrameHandle)>;
+
+/// Whether `p` is a hand (tracked in the sixth level; the elbows and head below it).
+fn hand(p: &BodyPoint) -> bool {
+    matches!(p, BodyPoint::LeftWrist | BodyPoint::RightWrist)
+}
+
+/// The first two levels of the stack of `modes`: the held feet, 6D, and the floor rows of
+/// every foot near the ground (no level below can take a sole under the floor), then the
+/// landing feet's horizontal rows; the feet's and the floor's tasks (foot index, handle).
+fn add_feet_levels(
+    b: &mut ControllerBuilder,
+    robot: &Robot,
+    body: &RobotBody,
+    s: &KeypointSettings,
+    modes: [FootMode; 2],
+) -> Result<(FootTasks, FootTasks)> {
+    let stance = modes.map(|m| m == FootMode::Stance);
+    let name = |f: FrameId| frame_name(robot, f);
+    let mut feet = Vec::with_capacity(4);
+    let mut floor = Vec::with_capacity(4);
+    let near = |m: &FootMode| matches!(m, FootMode::Floor | FootMode::Landing);
+    if stance.contains(&true) || modes.iter().any(near) {
+        b.level(KEYPOINT_LEVELS[0]);
+        b.gains(STANCE_GAINS);
+        for i in (0..2).filter(|i| stance[*i]) {
+            feet.push((i, b.frame(&name(body.feet[i]), Axes::ALL)?));
+        }
+        b.gains(s.gains);
+        for i in (0..2).filter(|i| near(&modes[*i])) {
+            floor.push((i, b.frame(&name(body.feet[i]), FLOOR_AXES)?));
+        }
+    }
+    if modes.contains(&FootMode::Landing) {
+        b.level(KEYPOINT_LEVELS[1]);
+        for i in (0..2).filter(|i| modes[*i] == FootMode::Landing) {
+            floor.push((i, b.frame(&name(body.feet[i]), LANDING_AXES)?));
+        }
+    }
+    Ok((feet, floor))
+}
+
+/// The tasks [`add_lower_levels`] adds to: the tracked points, the torso's orientation, the
+/// feet, and what decides them (the torso's frame among the elbows, the swing feet).
+struct LowerTasks {
+    points: Vec<(FrameHandle, usize)>,
+    torso: Option<FrameHandle>,
+    torso_with_elbows: Option<FrameId>,
+    feet: Vec<(usize, FrameHandle)>,
+    swing: [bool; 2],
+}
+
+/// The elbows, head and swing feet's orientations, weighted into the sixth level or (weight
+/// 0) a seventh level of their own, and the posture, weighted into the sixth level or in a
+/// level of its own below: the posture's handle.
+fn add_lower_levels(
+    b: &mut ControllerBuilder,
+    robot: &Robot,
+    body: &RobotBody,
+    plan: &Plan,
+    posture: &[String],
+    s: &KeypointSettings,
+    t: &mut LowerTasks,
+) -> Result<JointsHandle> {
     let names: Vec<&str> = posture.iter().map(String::as_str).collect();
     // The elbows, head and swing feet's orientations: weighted into the sixth level, or
     // (weight 0) a seventh level of their own.
     let w = s.body_weight;
     if w > 0.0 {
         add_body_tasks(
-            &mut b,
+            b,
             robot,
             body,
             plan,
-            &mut points,
-            &mut torso,
-            torso_with_elbows,
-            &mut feet,
-            swing,
+            &mut t.points,
+            &mut t.torso,
+            t.torso_with_elbows,
+            &mut t.feet,
+            t.swing,
             w,
         )?;
     }
@@ -615,8 +685,8 @@ fn build_stack(
     if w == 0.0 {
         // The seventh level only with a task in it (a robot without elbows or head frames
         // standing on both feet has none).
-        let seventh = torso_with_elbows.is_some()
-            || swing.contains(&true)
+        let seventh = t.torso_with_elbows.is_some()
+            || t.swing.contains(&true)
             || plan
                 .points
                 .iter()
@@ -625,22 +695,26 @@ fn build_stack(
             b.level(KEYPOINT_LEVELS[6]);
         }
         add_body_tasks(
-            &mut b,
+            b,
             robot,
             body,
             plan,
-            &mut points,
-            &mut torso,
-            torso_with_elbows,
-            &mut feet,
-            swing,
+            &mut t.points,
+            &mut t.torso,
+            t.torso_with_elbows,
+            &mut t.feet,
+            t.swing,
             1.0,
         )?;
     }
-    let posture = match weighted {
+    Ok(match weighted {
         Some(h) => h,
         None => b.level(KEYPOINT_LEVELS[7]).joints(&names)?,
-    };
+    })
+}
+
+/// The controller of builder `b` with `tasks`, and its GF fallback on the same stack.
+fn finish_stack(b: ControllerBuilder, s: &KeypointSettings, tasks: Tasks) -> Result<Stack> {
     // The clone keeps the builder's identity: the handles address both controllers.
     let mut gf = b.clone();
     gf.settings(ControllerSettings {
@@ -659,15 +733,7 @@ fn build_stack(
         ctl,
         fallback: gf.build()?,
         feet_levels,
-        tasks: Tasks {
-            feet,
-            floor,
-            com,
-            pelvis,
-            torso,
-            points,
-            posture,
-        },
+        tasks,
     })
 }
 
@@ -807,6 +873,37 @@ impl KeypointController {
         let k = k.min(self.plan.ticks.saturating_sub(1));
         let on = self.contacts(k);
         self.used_fallback = false;
+        self.touch_downs(k, hold, on);
+        let mut modes = self.foot_modes(k, hold, on)?;
+        if modes.contains(&FootMode::Floor) {
+            self.floor_ticks += 1;
+        }
+        self.active = modes[0].index() + 4 * modes[1].index();
+        self.refer(false, k, hold)?;
+        let stack = &mut self.stacks[self.active & 15];
+        let tolerance = stack.ctl.settings().solver.box_tolerance;
+        // The kinematics of the state, computed above for the feet: swapped in, not
+        // computed again (the fallback below computes its own).
+        stack
+            .ctl
+            .prepare_with_kinematics(&self.state, self.dt, &mut self.kin)?;
+        let iktc = stack.ctl.settings().method == Method::Iktc;
+        stack.ctl.solve()?;
+        if self.catch_dips(k, hold, on, &mut modes)? {
+            self.dip_ticks += 1;
+            self.active = modes[0].index() + 4 * modes[1].index();
+            self.refer(false, k, hold)?;
+            let ctl = &mut self.stacks[self.active & 15].ctl;
+            ctl.prepare(&self.state, self.dt)?;
+            ctl.solve()?;
+        }
+        self.floored = modes.map(|m| matches!(m, FootMode::Floor | FootMode::Landing));
+        self.checked_answer(k, hold, tolerance, iktc)
+    }
+
+    /// The clip's contacts `on` at tick `k` taken for the feet: held (with `hold`) or lifted as
+    /// the clip has them; a foot the clip puts down goes to the plan's hold, then lands.
+    fn touch_downs(&mut self, k: usize, hold: bool, on: [bool; 2]) {
         let c = &self.plan.contact;
         for i in 0..2 {
             if hold || !on[i] {
@@ -816,6 +913,12 @@ impl KeypointController {
                 self.latch[i] = (Vector3::zeros(), 0.0);
             }
         }
+    }
+
+    /// The mode of each foot at tick `k` from where the robot's feet are now: a foot the clip
+    /// puts on the ground lands once low, slow and flat; the others are in swing, or their
+    /// floor is engaged (then set in `self.floor`).
+    fn foot_modes(&mut self, k: usize, hold: bool, on: [bool; 2]) -> Result<[FootMode; 2]> {
         let mut modes = [FootMode::Stance; 2];
         // The robot's feet where they are now, and the held feet's drift over the last tick.
         self.kin.update(&self.robot, &self.state)?;
@@ -865,23 +968,20 @@ impl KeypointController {
                 self.floor[i] = self.floor_of(&r, &pose, &v, a_min, modes[i]);
             }
         }
-        if modes.contains(&FootMode::Floor) {
-            self.floor_ticks += 1;
-        }
-        self.active = modes[0].index() + 4 * modes[1].index();
-        self.refer(false, k, hold)?;
-        let stack = &mut self.stacks[self.active & 15];
-        let tolerance = stack.ctl.settings().solver.box_tolerance;
-        // The kinematics of the state, computed above for the feet: swapped in, not
-        // computed again (the fallback below computes its own).
-        stack
-            .ctl
-            .prepare_with_kinematics(&self.state, self.dt, &mut self.kin)?;
-        let iktc = stack.ctl.settings().method == Method::Iktc;
-        stack.ctl.solve()?;
-        // A swing foot whose floor is not engaged and which this tick's q̈ would take below
-        // the ground (a correction of the level it shares with the hands can pull it down
-        // at hundreds of m/s²): the tick is solved again with its floor engaged.
+        Ok(modes)
+    }
+
+    /// A swing foot whose floor is not engaged and which this tick's q̈ would take below
+    /// the ground (a correction of the level it shares with the hands can pull it down
+    /// at hundreds of m/s²): its floor engaged in `modes`; true when the tick is to be
+    /// solved again.
+    fn catch_dips(
+        &mut self,
+        k: usize,
+        hold: bool,
+        on: [bool; 2],
+        modes: &mut [FootMode; 2],
+    ) -> Result<bool> {
         let mut again = false;
         for i in 0..2 {
             if modes[i] != FootMode::Swing {
@@ -907,15 +1007,19 @@ impl KeypointController {
                 again = true;
             }
         }
-        if again {
-            self.dip_ticks += 1;
-            self.active = modes[0].index() + 4 * modes[1].index();
-            self.refer(false, k, hold)?;
-            let ctl = &mut self.stacks[self.active & 15].ctl;
-            ctl.prepare(&self.state, self.dt)?;
-            ctl.solve()?;
-        }
-        self.floored = modes.map(|m| matches!(m, FootMode::Floor | FootMode::Landing));
+        Ok(again)
+    }
+
+    /// The answer of the active stack, counted by the level it sacrificed, or GF's on the
+    /// same stack where IKTC's leaves the box by more than `tolerance` or corrected the feet's
+    /// levels while a foot is held and GF keeps them more exactly.
+    fn checked_answer(
+        &mut self,
+        k: usize,
+        hold: bool,
+        tolerance: f64,
+        iktc: bool,
+    ) -> Result<&SolveReport> {
         let stack = &self.stacks[self.active & 15];
         let r = stack.ctl.report();
         let feet_levels = stack.feet_levels;
@@ -1080,303 +1184,5 @@ impl KeypointController {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::profile::RobotProfile;
-
-    /// G1 set up on `humanoid3d_dance_b` with `s`: its robot, start state, body, the
-    /// controller (for its plan) and the posture's joint names.
-    fn g1(
-        s: &KeypointSettings,
-    ) -> (
-        Arc<Robot>,
-        State,
-        RobotBody,
-        KeypointController,
-        Vec<String>,
-    ) {
-        let profile = RobotProfile::builtin("g1").unwrap();
-        let kp = super::super::builtin_motion("humanoid3d_dance_b")
-            .unwrap()
-            .keypoints(crate::motion::DEFAULT_MAX_GAP)
-            .unwrap();
-        let robot = Arc::new(profile.robot().unwrap());
-        let set = super::super::setup(robot, &profile, &kp, None, s).unwrap();
-        // The set-up's robot: the profile's with frames at the joint centres.
-        let robot = set.robot.clone();
-        let names = robot.active_joints().map(|j| j.name.clone()).collect();
-        let state = set.controller.state().clone();
-        (robot, state, set.body, set.controller, names)
-    }
-
-    /// A foot whose plan pivots about its sole's centre `c` (yaw `ψ(t) = sin t`, the ankle
-    /// at `c − R_z(ψ) s`): with the latch at full weight (in stance) the reference keeps the
-    /// sole's centre at `c + d`, turned by the latched yaw, and with any weight (here
-    /// `w(t) = (1 − cos t)/2`, fading as in a swing) its velocity and acceleration are the
-    /// central differences of its pose.
-    #[test]
-    fn a_held_foot_pivots_about_its_sole_centre() {
-        use super::super::plan::{PointRef, PoseRef};
-        let s = KeypointSettings::default();
-        let (_, _, _, c, _) = g1(&s);
-        let mut p = c.plan().clone();
-        // Sample spacing of the synthetic plan [s]: central differences err by O(h²).
-        let h = 1e-4;
-        let n = 3000;
-        let sole = Vector3::new(0.035, 0.01, -0.035);
-        let centre = Vector3::new(0.3, -0.1, 0.035);
-        let pose = |t: f64| {
-            let (psi, om, al) = (t.sin(), t.cos(), -t.sin());
-            let rot = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), psi);
-            let (w, a) = (om * Vector3::z(), al * Vector3::z());
-            let r = rot * sole;
-            PoseRef {
-                position: PointRef {
-                    position: centre - r,
-                    velocity: -w.cross(&r),
-                    acceleration: -(a.cross(&r) + w.cross(&w.cross(&r))),
-                },
-                rotation: rot,
-                angular_velocity: w,
-                angular_acceleration: a,
-            }
-        };
-        let times: Vec<f64> = (0..n).map(|k| k as f64 * h).collect();
-        p.feet[0] = times.iter().map(|t| pose(*t)).collect();
-        let latch = (Vector3::new(0.004, -0.003, 0.0), 0.2);
-        // Held: the sole's centre stays where the latch put it.
-        p.latch_weight[0] = vec![[1.0, 0.0, 0.0]; n];
-        for k in (0..n).step_by(100) {
-            let r = foot_reference(&p, 0, k, false, latch, &sole);
-            let centre_now = r.pose.translation.vector + r.pose.rotation * sole;
-            assert!((centre_now - (centre + latch.0)).norm() < 1e-12, "{k}");
-            let yaw = (r.pose.rotation * p.feet[0][k].rotation.inverse()).angle();
-            assert!((yaw - latch.1).abs() < 1e-12, "{k}: {yaw}");
-        }
-        // Fading: the rates are the pose's.
-        p.latch_weight[0] = times
-            .iter()
-            .map(|t| [0.5 * (1.0 - t.cos()), 0.5 * t.sin(), 0.5 * t.cos()])
-            .collect();
-        let refs: Vec<_> = (0..n)
-            .map(|k| foot_reference(&p, 0, k, false, latch, &sole))
-            .collect();
-        // Largest difference from the central differences [m/s, m/s², rad/s, rad/s²]: O(h²)
-        // times third derivatives of order 1.
-        let tol = 1e-6;
-        for k in 1..n - 1 {
-            let (a, r, b) = (&refs[k - 1], &refs[k], &refs[k + 1]);
-            let v = (b.pose.translation.vector - a.pose.translation.vector) / (2.0 * h);
-            let acc = (b.velocity - a.velocity) / (2.0 * h);
-            let om = (b.pose.rotation * a.pose.rotation.inverse()).scaled_axis() / (2.0 * h);
-            assert!((v - r.velocity.fixed_rows::<3>(0)).norm() < tol, "{k}: v");
-            assert!((om - r.velocity.fixed_rows::<3>(3)).norm() < tol, "{k}: ω");
-            assert!((acc - r.acceleration).norm() < tol, "{k}: a");
-        }
-    }
-
-    /// The feet's levels of a stack (what GF takes over when IKTC corrects them under a held
-    /// foot) are its leading `stance_feet` and `swing_floor` levels, whichever it has.
-    #[test]
-    fn the_feet_levels_are_the_leading_stance_and_floor_levels() {
-        use FootMode::{Floor, Landing, Stance, Swing};
-        let s = KeypointSettings::default();
-        let (robot, state, body, c, names) = g1(&s);
-        for (modes, want) in [
-            ([Stance, Stance], 1),
-            ([Stance, Swing], 1),
-            ([Stance, Landing], 2),
-            ([Swing, Floor], 1),
-            ([Swing, Swing], 0),
-        ] {
-            let stack = build_stack(&robot, &state, &body, c.plan(), &names, &s, modes).unwrap();
-            let lead = levels(&stack)
-                .iter()
-                .take_while(|l| l.0 == KEYPOINT_LEVELS[0] || l.0 == KEYPOINT_LEVELS[1])
-                .count();
-            assert_eq!(lead, want, "{modes:?}");
-            assert_eq!(stack.feet_levels, want, "{modes:?}");
-        }
-    }
-
-    /// A foot near the ground that is not held has its floor rows (height, roll, pitch) in the
-    /// first level, beside the held feet; a landing foot its horizontal position and yaw in
-    /// the second; a foot in the air, its floor engaged or not, its position in `swing_feet`,
-    /// before the pelvis and the torso's orientation; the COM only with `balance` (or
-    /// standing), between the feet's levels and the swing feet, the torso's orientation then
-    /// with the elbows.
-    #[test]
-    fn the_floor_leads_and_the_feet_in_the_air_come_before_the_pelvis() {
-        use FootMode::{Floor, Landing, Stance, Swing};
-        let s = KeypointSettings::default();
-        let (robot, state, body, c, names) = g1(&s);
-        let rows = |modes: [FootMode; 2], s: &KeypointSettings| {
-            let stack = build_stack(&robot, &state, &body, c.plan(), &names, s, modes).unwrap();
-            levels(&stack).into_iter().take(5).collect::<Vec<_>>()
-        };
-        assert_eq!(
-            rows([Stance, Floor], &s),
-            named(&[
-                ("stance_feet", 6 + 3),
-                ("swing_feet", 3),
-                ("pelvis_torso", 6 + 3),
-                ("hands", 6 + 29),
-                ("elbows_head", 6 + 3),
-            ])
-        );
-        assert_eq!(
-            rows([Landing, Swing], &s),
-            named(&[
-                ("stance_feet", 3),
-                ("swing_floor", 3),
-                ("swing_feet", 3),
-                ("pelvis_torso", 6 + 3),
-                ("hands", 6 + 29),
-            ])
-        );
-        let balance = KeypointSettings {
-            balance: true,
-            ..s.clone()
-        };
-        // With the COM level the torso's orientation joins the elbows in the seventh level.
-        let all = |modes: [FootMode; 2], s: &KeypointSettings| {
-            let stack = build_stack(&robot, &state, &body, c.plan(), &names, s, modes).unwrap();
-            levels(&stack)
-        };
-        assert_eq!(
-            all([Swing, Stance], &balance),
-            named(&[
-                ("stance_feet", 6),
-                ("com_xy", 2),
-                ("swing_feet", 3),
-                ("pelvis_torso", 6),
-                ("hands", 6 + 29),
-                ("elbows_head", 6 + 3 + 3),
-            ])
-        );
-        let standing = KeypointSettings {
-            standing: true,
-            ..s
-        };
-        assert_eq!(
-            rows([Stance, Stance], &standing)[..2],
-            named(&[("stance_feet", 12), ("com_xy", 2)])[..]
-        );
-    }
-
-    /// The levels of a stack, as (name, rows).
-    fn levels(stack: &Stack) -> Vec<(String, usize)> {
-        let levels = &stack.ctl.stack().levels;
-        levels.iter().map(|l| (l.name.clone(), l.dim())).collect()
-    }
-
-    fn named(v: &[(&str, usize)]) -> Vec<(String, usize)> {
-        v.iter().map(|(n, m)| (n.to_string(), *m)).collect()
-    }
-
-    /// With a posture weight the posture rows (one per active joint, 29 on G1) follow the
-    /// hands' positions (3 rows each) in the sixth level; the elbows (3 rows each) make the
-    /// seventh, or join the sixth with a body weight; the torso's orientation (3) is in the
-    /// pelvis' level either way. With a posture weight of 0 the posture has a level of its
-    /// own, last.
-    #[test]
-    fn the_posture_rows_share_the_hands_level() {
-        let stance = [FootMode::Stance, FootMode::Stance];
-        let s = KeypointSettings::default();
-        let (robot, state, body, c, names) = g1(&s);
-        assert_eq!(names.len(), 29);
-        let stack = build_stack(&robot, &state, &body, c.plan(), &names, &s, stance).unwrap();
-        let want = [
-            ("stance_feet", 12),
-            ("pelvis_torso", 6 + 3),
-            ("hands", 6 + 29),
-            ("elbows_head", 6),
-        ];
-        assert_eq!(levels(&stack), named(&want));
-        let weighted = KeypointSettings {
-            body_weight: 0.2,
-            ..s.clone()
-        };
-        let stack =
-            build_stack(&robot, &state, &body, c.plan(), &names, &weighted, stance).unwrap();
-        let want = [
-            ("stance_feet", 12),
-            ("pelvis_torso", 6 + 3),
-            ("hands", 6 + 6 + 29),
-        ];
-        assert_eq!(levels(&stack), named(&want));
-        let s0 = KeypointSettings {
-            posture_weight: 0.0,
-            ..s
-        };
-        let stack = build_stack(&robot, &state, &body, c.plan(), &names, &s0, stance).unwrap();
-        let want = [
-            ("stance_feet", 12),
-            ("pelvis_torso", 6 + 3),
-            ("hands", 6),
-            ("elbows_head", 6),
-            ("posture", 29),
-        ];
-        assert_eq!(levels(&stack), named(&want));
-    }
-
-    /// A body without elbows or head frames has no seventh level while both feet are held
-    /// (an empty level is an error), and one with the swing foot's orientation otherwise; a
-    /// body with elbows has it. The torso's orientation is in the pelvis' level when the body
-    /// has a torso frame.
-    #[test]
-    fn the_seventh_level_is_there_only_with_a_task() {
-        let s = KeypointSettings::default();
-        let (robot, state, body, c, names) = g1(&s);
-        let hands_only = RobotBody {
-            torso: None,
-            points: body
-                .points
-                .iter()
-                .filter(|(p, _)| {
-                    !matches!(
-                        p,
-                        BodyPoint::LeftElbow | BodyPoint::RightElbow | BodyPoint::Head
-                    )
-                })
-                .copied()
-                .collect(),
-            ..body.clone()
-        };
-        let stance = [FootMode::Stance, FootMode::Stance];
-        let swing = [FootMode::Swing, FootMode::Stance];
-        let stack = build_stack(&robot, &state, &hands_only, c.plan(), &names, &s, stance).unwrap();
-        let names_of =
-            |st: &Stack| -> Vec<String> { levels(st).into_iter().map(|l| l.0).collect() };
-        assert!(!names_of(&stack).iter().any(|n| n == KEYPOINT_LEVELS[6]));
-        assert!(levels(&stack).contains(&(KEYPOINT_LEVELS[4].to_string(), 6)));
-        let stack = build_stack(&robot, &state, &hands_only, c.plan(), &names, &s, swing).unwrap();
-        assert_eq!(
-            levels(&stack).last().unwrap(),
-            &(KEYPOINT_LEVELS[6].to_string(), 3)
-        );
-        let torso_only = RobotBody {
-            torso: body.torso,
-            ..hands_only.clone()
-        };
-        let stack = build_stack(&robot, &state, &torso_only, c.plan(), &names, &s, stance).unwrap();
-        assert!(!names_of(&stack).iter().any(|n| n == KEYPOINT_LEVELS[6]));
-        assert!(levels(&stack).contains(&(KEYPOINT_LEVELS[4].to_string(), 6 + 3)));
-        let elbows_only = RobotBody {
-            torso: None,
-            points: body
-                .points
-                .iter()
-                .filter(|(p, _)| *p != BodyPoint::Head)
-                .copied()
-                .collect(),
-            ..body.clone()
-        };
-        let stack =
-            build_stack(&robot, &state, &elbows_only, c.plan(), &names, &s, stance).unwrap();
-        assert_eq!(
-            levels(&stack).last().unwrap(),
-            &(KEYPOINT_LEVELS[6].to_string(), 6)
-        );
-    }
-}
+#[path = "tracker_tests.rs"]
+mod tests;
