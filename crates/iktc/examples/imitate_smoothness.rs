@@ -14,7 +14,7 @@
 //! where the change of q̈ reverses its sign; and the largest excursion beyond a limit.
 
 use iktc::limits::BoundMethod;
-use iktc::sim::{Experiment, ImitateConfig};
+use iktc::sim::{Experiment, ImitateConfig, ImitateSummary};
 use iktc::solver::SolverSettings;
 
 fn main() -> iktc::Result<()> {
@@ -86,30 +86,35 @@ fn main() -> iktc::Result<()> {
             ..defaults.clone()
         };
         cfg.health.keep_going = true;
-        let s = e.imitate(&cfg)?.summary;
-        let all = (s
-            .smoothness
-            .iter()
-            .map(|j| j.smoothness.rms_jerk.powi(2))
-            .sum::<f64>()
-            / s.smoothness.len() as f64)
-            .sqrt();
-        print!(
-            "{name}: level changes {} ({} undone), RMS jerk {all:.0} rad/s³",
-            s.level_switches.switches, s.level_switches.flips
-        );
-        for j in &s.narrowed_smoothness {
-            print!(
-                "; {} {:.0} rad/s³, reversals {:.1} %",
-                j.joint,
-                j.smoothness.rms_jerk,
-                100.0 * j.smoothness.reversal_share
-            );
-        }
-        println!(
-            "; worst excursion {:.1e} rad",
-            s.worst_position_margin.max(0.0)
-        );
+        print_variant(name, &e.imitate(&cfg)?.summary);
     }
     Ok(())
+}
+
+/// One line per variant: level changes (and those undone), RMS jerk over all joints
+/// \[rad/s³\], each narrowed joint's RMS jerk and reversal share, the worst excursion \[rad\].
+fn print_variant(name: &str, s: &ImitateSummary) {
+    let all = (s
+        .smoothness
+        .iter()
+        .map(|j| j.smoothness.rms_jerk.powi(2))
+        .sum::<f64>()
+        / s.smoothness.len() as f64)
+        .sqrt();
+    print!(
+        "{name}: level changes {} ({} undone), RMS jerk {all:.0} rad/s³",
+        s.level_switches.switches, s.level_switches.flips
+    );
+    for j in &s.narrowed_smoothness {
+        print!(
+            "; {} {:.0} rad/s³, reversals {:.1} %",
+            j.joint,
+            j.smoothness.rms_jerk,
+            100.0 * j.smoothness.reversal_share
+        );
+    }
+    println!(
+        "; worst excursion {:.1e} rad",
+        s.worst_position_margin.max(0.0)
+    );
 }
