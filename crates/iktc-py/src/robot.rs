@@ -53,24 +53,14 @@ impl PyRobot {
     ) -> PyResult<Self> {
         let is_urdf = spec.ends_with(".urdf") || spec.ends_with(".xml");
         let is_profile = spec.ends_with(".toml") || BUILTIN_PROFILES.contains(&spec);
-        let limits_given = accel.is_some() || velocity.is_some() || default_velocity.is_some();
-        if is_profile && (floating.is_some() || lock.is_some()) {
-            return Err(crate::IktcError::new_err(format!(
-                "`{spec}` is a profile: floating and lock apply to URDF and MJCF files only (a profile sets them with its keys `base` and `lock`)"
-            )));
-        }
-        if !is_urdf && !is_profile && (floating.is_some() || lock.is_some() || limits_given) {
-            return Err(crate::IktcError::new_err(format!(
-                "`{spec}` is a built-in robot without a profile: floating, lock, accel, velocity and default_velocity apply to URDF and MJCF files only (accel, velocity and default_velocity also to profiles)"
-            )));
-        }
-        if let Some(v) = default_velocity {
-            if v.is_nan() || v <= 0.0 {
-                return Err(crate::IktcError::new_err(format!(
-                    "default_velocity = {v}: expected a velocity limit > 0 [rad/s] (or +inf for none)"
-                )));
-            }
-        }
+        let keywords = Keywords {
+            floating,
+            lock,
+            accel,
+            velocity,
+            default_velocity,
+        };
+        keywords.check(spec, is_urdf, is_profile)?;
         let profile = if spec.ends_with(".toml") {
             Some(RobotProfile::load(Path::new(spec)).map_err(to_py)?)
         } else if BUILTIN_PROFILES.contains(&spec) {
@@ -78,56 +68,11 @@ impl PyRobot {
         } else {
             None
         };
-        if let Some(mut p) = profile {
-            if limits_given {
-                // The keywords replace the profile's keys for the joints they name.
-                p.acceleration.limits.extend(accel.unwrap_or_default());
-                p.velocity.limits.extend(velocity.unwrap_or_default());
-                if default_velocity.is_some() {
-                    p.velocity.default = default_velocity;
-                }
-                let keywords = |e: iktc::Error| {
-                    crate::IktcError::new_err(format!(
-                        "accel, velocity or default_velocity given to the profile `{spec}` (they set its keys acceleration.limits, velocity.limits and velocity.default): {e}"
-                    ))
-                };
-                p.check_values().map_err(keywords)?;
-                let robot = p.robot().map_err(keywords)?;
-                return Ok(Self {
-                    robot: Arc::new(robot),
-                    profile: Some(Arc::new(p)),
-                });
-            }
-            let robot = p.robot().map_err(to_py)?;
-            return Ok(Self {
-                robot: Arc::new(robot),
-                profile: Some(Arc::new(p)),
-            });
+        if let Some(p) = profile {
+            return keywords.profile_robot(spec, p);
         }
         let robot = if is_urdf {
-            // Unless told: an MJCF model floats when it has a free joint, a URDF floats.
-            let base = match floating {
-                Some(true) => BaseKind::Floating,
-                Some(false) => BaseKind::Fixed,
-                None => {
-                    let path = Path::new(spec);
-                    let text = std::fs::read_to_string(path).map_err(|e| {
-                        crate::IktcError::new_err(format!("cannot read {spec}: {e}"))
-                    })?;
-                    declared_base(&text, path.parent())
-                        .map_err(to_py)?
-                        .unwrap_or(BaseKind::Floating)
-                }
-            };
-            let options = ModelOptions {
-                base,
-                locked: lock.unwrap_or_default(),
-                acceleration_limits: accel.unwrap_or_default(),
-                velocity_limits: velocity.unwrap_or_default(),
-                fallback_velocity: default_velocity.unwrap_or(f64::INFINITY),
-                ..ModelOptions::default()
-            };
-            Robot::from_description_file(Path::new(spec), &options).map_err(to_py)?
+            keywords.file_robot(spec)?
         } else {
             builtin_robot(spec).map_err(to_py)?
         };
@@ -314,6 +259,104 @@ impl PyRobot {
             self.robot.nv(),
             self.robot.total_mass()
         )
+    }
+}
+
+/// The keyword arguments of `Robot(spec, …)`.
+struct Keywords {
+    floating: Option<bool>,
+    lock: Option<Vec<(String, f64)>>,
+    /// (joint, acceleration limit \[rad/s²\]) pairs.
+    accel: Option<Vec<(String, f64)>>,
+    /// (joint, velocity limit \[rad/s\]) pairs.
+    velocity: Option<Vec<(String, f64)>>,
+    /// Velocity limit \[rad/s\] of the joints given none.
+    default_velocity: Option<f64>,
+}
+
+impl Keywords {
+    /// Whether any of accel, velocity and default_velocity is given.
+    fn limits_given(&self) -> bool {
+        self.accel.is_some() || self.velocity.is_some() || self.default_velocity.is_some()
+    }
+
+    /// Errors for keywords that do not apply to `spec` (a URDF or MJCF file when `is_urdf`, a
+    /// profile when `is_profile`, else a built-in robot) and for a bad default_velocity.
+    fn check(&self, spec: &str, is_urdf: bool, is_profile: bool) -> PyResult<()> {
+        let file_keywords = self.floating.is_some() || self.lock.is_some();
+        if is_profile && file_keywords {
+            return Err(crate::IktcError::new_err(format!(
+                "`{spec}` is a profile: floating and lock apply to URDF and MJCF files only (a profile sets them with its keys `base` and `lock`)"
+            )));
+        }
+        if !is_urdf && !is_profile && (file_keywords || self.limits_given()) {
+            return Err(crate::IktcError::new_err(format!(
+                "`{spec}` is a built-in robot without a profile: floating, lock, accel, velocity and default_velocity apply to URDF and MJCF files only (accel, velocity and default_velocity also to profiles)"
+            )));
+        }
+        if let Some(v) = self.default_velocity {
+            if v.is_nan() || v <= 0.0 {
+                return Err(crate::IktcError::new_err(format!(
+                    "default_velocity = {v}: expected a velocity limit > 0 [rad/s] (or +inf for none)"
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// The robot of the profile `p` read from `spec`, the limit keywords replacing its keys
+    /// for the joints they name.
+    fn profile_robot(self, spec: &str, mut p: RobotProfile) -> PyResult<PyRobot> {
+        if self.limits_given() {
+            // The keywords replace the profile's keys for the joints they name.
+            p.acceleration.limits.extend(self.accel.unwrap_or_default());
+            p.velocity.limits.extend(self.velocity.unwrap_or_default());
+            if self.default_velocity.is_some() {
+                p.velocity.default = self.default_velocity;
+            }
+            let keywords = |e: iktc::Error| {
+                crate::IktcError::new_err(format!(
+                    "accel, velocity or default_velocity given to the profile `{spec}` (they set its keys acceleration.limits, velocity.limits and velocity.default): {e}"
+                ))
+            };
+            p.check_values().map_err(keywords)?;
+            let robot = p.robot().map_err(keywords)?;
+            return Ok(PyRobot {
+                robot: Arc::new(robot),
+                profile: Some(Arc::new(p)),
+            });
+        }
+        let robot = p.robot().map_err(to_py)?;
+        Ok(PyRobot {
+            robot: Arc::new(robot),
+            profile: Some(Arc::new(p)),
+        })
+    }
+
+    /// The robot of the URDF or MJCF file `spec`, with the keywords as its model options.
+    fn file_robot(self, spec: &str) -> PyResult<Robot> {
+        // Unless told: an MJCF model floats when it has a free joint, a URDF floats.
+        let base = match self.floating {
+            Some(true) => BaseKind::Floating,
+            Some(false) => BaseKind::Fixed,
+            None => {
+                let path = Path::new(spec);
+                let text = std::fs::read_to_string(path)
+                    .map_err(|e| crate::IktcError::new_err(format!("cannot read {spec}: {e}")))?;
+                declared_base(&text, path.parent())
+                    .map_err(to_py)?
+                    .unwrap_or(BaseKind::Floating)
+            }
+        };
+        let options = ModelOptions {
+            base,
+            locked: self.lock.unwrap_or_default(),
+            acceleration_limits: self.accel.unwrap_or_default(),
+            velocity_limits: self.velocity.unwrap_or_default(),
+            fallback_velocity: self.default_velocity.unwrap_or(f64::INFINITY),
+            ..ModelOptions::default()
+        };
+        Robot::from_description_file(Path::new(spec), &options).map_err(to_py)
     }
 }
 

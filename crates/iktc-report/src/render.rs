@@ -162,17 +162,37 @@ fn y_label_area<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, y_range: (f64
     (widest + Y_DESC_AREA).max(MIN_Y_LABEL_AREA)
 }
 
+/// The title of `panel` drawn at the top of `area`; the rest of the area, or all of it for a
+/// panel without a title.
+fn titled_area<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    panel: &Panel,
+) -> Result<DrawingArea<DB, Shift>, ReportError> {
+    if panel.title.trim().is_empty() {
+        Ok(area.clone())
+    } else {
+        let style = (FONT_FAMILY, 17).into_font().style(FontStyle::Bold);
+        area.titled(&panel.title, style)
+            .map_err(err("drawing a panel title"))
+    }
+}
+
+/// The error of a panel whose axis ranges cannot be drawn.
+fn unusable(panel: &Panel, x_range: (f64, f64), y_range: (f64, f64)) -> ReportError {
+    ReportError::Plot {
+        what: format!(
+            "panel '{}' has axis ranges x {x_range:?}, y {y_range:?} that cannot be drawn",
+            panel.title
+        ),
+    }
+}
+
+/// Draws one panel: its title, its axes sized to its data and limit lines, its series.
 fn draw_panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     panel: &Panel,
 ) -> Result<(), ReportError> {
-    let area = if panel.title.trim().is_empty() {
-        area.clone()
-    } else {
-        let style = (FONT_FAMILY, 17).into_font().style(FontStyle::Bold);
-        area.titled(&panel.title, style)
-            .map_err(err("drawing a panel title"))?
-    };
+    let area = titled_area(area, panel)?;
     let log_x = panel.log_x;
     let pts = || {
         panel
@@ -196,16 +216,10 @@ fn draw_panel<DB: DrawingBackend>(
         .margin_right(MARGIN_RIGHT)
         .x_label_area_size(X_LABEL_AREA)
         .y_label_area_size(y_label_area);
-    let unusable = |x_range: (f64, f64), y_range: (f64, f64)| ReportError::Plot {
-        what: format!(
-            "panel '{}' has axis ranges x {x_range:?}, y {y_range:?} that cannot be drawn",
-            panel.title
-        ),
-    };
     if log_x {
         let x_range = log_range(xb);
         if !is_usable(x_range) || !is_usable(y_range) {
-            return Err(unusable(x_range, y_range));
+            return Err(unusable(panel, x_range, y_range));
         }
         let mut chart = builder
             .build_cartesian_2d((x_range.0..x_range.1).log_scale(), y_range.0..y_range.1)
@@ -226,7 +240,7 @@ fn draw_panel<DB: DrawingBackend>(
             (x_range, y_range) = equalize(x_range, y_range, plot_w, plot_h);
         }
         if !is_usable(x_range) || !is_usable(y_range) {
-            return Err(unusable(x_range, y_range));
+            return Err(unusable(panel, x_range, y_range));
         }
         let mut chart = builder
             .build_cartesian_2d(x_range.0..x_range.1, y_range.0..y_range.1)
@@ -244,6 +258,17 @@ fn draw_panel<DB: DrawingBackend>(
     }
 }
 
+/// What the drawn lines leave for the legend: the pixels they cover and the legend entries.
+struct Marks {
+    /// Pixel of the plotting area's top-left corner in the backend \[px\].
+    origin: (i32, i32),
+    /// Pixels covered by lines and points, relative to `origin` \[px\].
+    occupied: Vec<(i32, i32)>,
+    /// Legend entries, in drawing order.
+    entries: Vec<LegendEntry>,
+}
+
+/// Fills a built chart: grid and axes, limit lines, series, the no-data note and the legend.
 fn fill_chart<'a, DB, X>(
     chart: &mut ChartContext<'a, DB, Cartesian2d<X, RangedCoordf64>>,
     panel: &Panel,
@@ -254,7 +279,44 @@ where
     DB: DrawingBackend + 'a,
     X: Ranged<ValueType = f64> + ValueFormatter<f64>,
 {
-    let (x_range, y_range) = (view.x_range, view.y_range);
+    draw_mesh(chart, panel, view.y_range, x_fmt)?;
+    let origin = {
+        let (xr, yr) = chart.plotting_area().get_pixel_range();
+        (xr.start, yr.start)
+    };
+    let mut marks = Marks {
+        origin,
+        occupied: Vec::new(),
+        entries: Vec::new(),
+    };
+    draw_limit_lines(chart, panel, view, &mut marks)?;
+    for (i, s) in panel.series.iter().enumerate() {
+        let color = PALETTE[i % PALETTE.len()];
+        draw_series(chart, s, color, panel.log_x, view, &mut marks)?;
+    }
+
+    let plot = chart.plotting_area().strip_coord_spec();
+    if !view.has_data {
+        draw_no_data_note(&plot)?;
+    }
+
+    if marks.entries.len() > 1 {
+        draw_legend(&plot, &marks.entries, &marks.occupied)?;
+    }
+    Ok(())
+}
+
+/// Draws the grid, the axes, their tick labels (tick font \[px\]) and their descriptions.
+fn draw_mesh<'a, DB, X>(
+    chart: &mut ChartContext<'a, DB, Cartesian2d<X, RangedCoordf64>>,
+    panel: &Panel,
+    y_range: (f64, f64),
+    x_fmt: &dyn Fn(&f64) -> String,
+) -> Result<(), ReportError>
+where
+    DB: DrawingBackend + 'a,
+    X: Ranged<ValueType = f64> + ValueFormatter<f64>,
+{
     let y_fmt = linear_formatter(y_range);
     chart
         .configure_mesh()
@@ -272,14 +334,22 @@ where
         .light_line_style(RGBColor(240, 240, 240))
         .axis_style(RGBColor(90, 90, 90))
         .draw()
-        .map_err(err("drawing axes"))?;
+        .map_err(err("drawing axes"))
+}
 
-    let origin = {
-        let (xr, yr) = chart.plotting_area().get_pixel_range();
-        (xr.start, yr.start)
-    };
-    let mut occupied: Vec<(i32, i32)> = Vec::new();
-    let mut entries: Vec<LegendEntry> = Vec::new();
+/// Draws the panel's finite horizontal limit lines (dashed, in the limit colour) across the
+/// chart; one legend entry per distinct label.
+fn draw_limit_lines<'a, DB, X>(
+    chart: &mut ChartContext<'a, DB, Cartesian2d<X, RangedCoordf64>>,
+    panel: &Panel,
+    view: &View<'_>,
+    marks: &mut Marks,
+) -> Result<(), ReportError>
+where
+    DB: DrawingBackend + 'a,
+    X: Ranged<ValueType = f64> + ValueFormatter<f64>,
+{
+    let x_range = view.x_range;
     for h in panel.hlines.iter().filter(|h| h.y.is_finite()) {
         let style = LIMIT_COLOR.stroke_width(LINE_WIDTH);
         let hy = clamp_to_view(&[(x_range.0, h.y)], view, panel.log_x)
@@ -294,98 +364,130 @@ where
             ))
             .map_err(err("drawing a limit line"))?;
         let (_, py) = chart.backend_coord(&(x_range.0, hy));
-        occupied.extend(
+        marks.occupied.extend(
             (0..view.columns as i32)
                 .step_by(4)
-                .map(|px| (px, py - origin.1)),
+                .map(|px| (px, py - marks.origin.1)),
         );
-        if !h.label.is_empty() && !entries.iter().any(|e| e.label == h.label) {
-            entries.push(LegendEntry {
+        if !h.label.is_empty() && !marks.entries.iter().any(|e| e.label == h.label) {
+            marks.entries.push(LegendEntry {
                 label: h.label.clone(),
                 marker: Marker::Dashed(LIMIT_COLOR),
             });
         }
     }
+    Ok(())
+}
 
-    for (i, s) in panel.series.iter().enumerate() {
-        let color = PALETTE[i % PALETTE.len()];
-        let line = color.stroke_width(LINE_WIDTH);
-        let segs: Vec<Vec<(f64, f64)>> = segments(s, panel.log_x)
-            .iter()
-            .map(|seg| {
-                let seg = clamp_to_view(seg, view, panel.log_x);
-                match s.style {
-                    LineStyle::Points => seg,
-                    _ => decimate(&seg, view.columns, view.to_col),
-                }
-            })
-            .collect();
-        let ctx = format!("drawing series '{}'", s.label);
-        for seg in &segs {
-            occupied.extend(seg.iter().map(|p| {
-                let (px, py) = chart.backend_coord(p);
-                (px - origin.0, py - origin.1)
-            }));
-            if seg.len() == 1 && s.style != LineStyle::Points {
-                // An isolated finite sample of a line has no segment to draw: mark it with a dot.
-                chart
-                    .draw_series(
-                        seg.iter()
-                            .map(|&p| Circle::new(p, LINE_WIDTH + 1, color.filled())),
-                    )
-                    .map_err(err(&ctx))?;
-                continue;
-            }
+/// The runs of series `s` to draw: its finite segments pulled into the view, lines decimated
+/// to the chart's pixel columns.
+fn series_segments(s: &Series, log_x: bool, view: &View<'_>) -> Vec<Vec<(f64, f64)>> {
+    segments(s, log_x)
+        .iter()
+        .map(|seg| {
+            let seg = clamp_to_view(seg, view, log_x);
             match s.style {
-                LineStyle::Solid => {
-                    chart
-                        .draw_series(LineSeries::new(seg.iter().copied(), line))
-                        .map_err(err(&ctx))?;
-                }
-                LineStyle::Dashed => {
-                    chart
-                        .draw_series(DashedLineSeries::new(seg.iter().copied(), 9, 5, line))
-                        .map_err(err(&ctx))?;
-                }
-                LineStyle::Points => {
-                    chart
-                        .draw_series(
-                            seg.iter()
-                                .map(|&p| Circle::new(p, POINT_RADIUS, color.filled())),
-                        )
-                        .map_err(err(&ctx))?;
-                }
+                LineStyle::Points => seg,
+                _ => decimate(&seg, view.columns, view.to_col),
             }
-        }
-        if !s.label.is_empty() {
-            let marker = match s.style {
-                LineStyle::Solid => Marker::Line(color),
-                LineStyle::Dashed => Marker::Dashed(color),
-                LineStyle::Points => Marker::Dot(color),
-            };
-            entries.push(LegendEntry {
-                label: s.label.clone(),
-                marker,
-            });
-        }
-    }
+        })
+        .collect()
+}
 
-    let plot = chart.plotting_area().strip_coord_spec();
-    if !view.has_data {
-        let (w, h) = plot.dim_in_pixel();
-        let style = TextStyle::from((FONT_FAMILY, 16).into_font())
-            .color(&RGBColor(120, 120, 120))
-            .pos(Pos::new(HPos::Center, VPos::Center));
-        plot.draw(&Text::new(
-            "no finite data",
-            ((w / 2) as i32, (h / 2) as i32),
-            style,
-        ))
-        .map_err(err("drawing the no-data note"))?;
+/// Draws series `s` in `color` and records its pixels and its legend entry (when labelled).
+fn draw_series<'a, DB, X>(
+    chart: &mut ChartContext<'a, DB, Cartesian2d<X, RangedCoordf64>>,
+    s: &Series,
+    color: RGBColor,
+    log_x: bool,
+    view: &View<'_>,
+    marks: &mut Marks,
+) -> Result<(), ReportError>
+where
+    DB: DrawingBackend + 'a,
+    X: Ranged<ValueType = f64> + ValueFormatter<f64>,
+{
+    let segs = series_segments(s, log_x, view);
+    let ctx = format!("drawing series '{}'", s.label);
+    let origin = marks.origin;
+    for seg in &segs {
+        marks.occupied.extend(seg.iter().map(|p| {
+            let (px, py) = chart.backend_coord(p);
+            (px - origin.0, py - origin.1)
+        }));
+        draw_segment(chart, seg, s.style, color, &ctx)?;
     }
-
-    if entries.len() > 1 {
-        draw_legend(&plot, &entries, &occupied)?;
+    if !s.label.is_empty() {
+        let marker = match s.style {
+            LineStyle::Solid => Marker::Line(color),
+            LineStyle::Dashed => Marker::Dashed(color),
+            LineStyle::Points => Marker::Dot(color),
+        };
+        marks.entries.push(LegendEntry {
+            label: s.label.clone(),
+            marker,
+        });
     }
     Ok(())
+}
+
+/// Draws one run of a series in `style` (line width and marker radius \[px\]); `ctx` names the
+/// series in errors.
+fn draw_segment<'a, DB, X>(
+    chart: &mut ChartContext<'a, DB, Cartesian2d<X, RangedCoordf64>>,
+    seg: &[(f64, f64)],
+    style: LineStyle,
+    color: RGBColor,
+    ctx: &str,
+) -> Result<(), ReportError>
+where
+    DB: DrawingBackend + 'a,
+    X: Ranged<ValueType = f64> + ValueFormatter<f64>,
+{
+    let line = color.stroke_width(LINE_WIDTH);
+    if seg.len() == 1 && style != LineStyle::Points {
+        // An isolated finite sample of a line has no segment to draw: mark it with a dot.
+        chart
+            .draw_series(
+                seg.iter()
+                    .map(|&p| Circle::new(p, LINE_WIDTH + 1, color.filled())),
+            )
+            .map_err(err(ctx))?;
+        return Ok(());
+    }
+    match style {
+        LineStyle::Solid => {
+            chart
+                .draw_series(LineSeries::new(seg.iter().copied(), line))
+                .map_err(err(ctx))?;
+        }
+        LineStyle::Dashed => {
+            chart
+                .draw_series(DashedLineSeries::new(seg.iter().copied(), 9, 5, line))
+                .map_err(err(ctx))?;
+        }
+        LineStyle::Points => {
+            chart
+                .draw_series(
+                    seg.iter()
+                        .map(|&p| Circle::new(p, POINT_RADIUS, color.filled())),
+                )
+                .map_err(err(ctx))?;
+        }
+    }
+    Ok(())
+}
+
+/// Writes "no finite data" (16 px, grey) at the centre of the plotting area `plot`.
+fn draw_no_data_note<DB: DrawingBackend>(plot: &DrawingArea<DB, Shift>) -> Result<(), ReportError> {
+    let (w, h) = plot.dim_in_pixel();
+    let style = TextStyle::from((FONT_FAMILY, 16).into_font())
+        .color(&RGBColor(120, 120, 120))
+        .pos(Pos::new(HPos::Center, VPos::Center));
+    plot.draw(&Text::new(
+        "no finite data",
+        ((w / 2) as i32, (h / 2) as i32),
+        style,
+    ))
+    .map_err(err("drawing the no-data note"))
 }

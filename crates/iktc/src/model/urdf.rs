@@ -107,16 +107,6 @@ fn units(j: &urdf_rs::Joint) -> (&'static str, &'static str) {
 /// The checked limits of a revolute, continuous or prismatic joint (see
 /// [`Robot::from_urdf_str_with`](super::RobotFiles::from_urdf_str_with)); warnings go to the builder.
 fn checked_limit(j: &urdf_rs::Joint, raw: &RawJoint, b: &mut RobotBuilder) -> Result<JointLimit> {
-    let l = &j.limit;
-    let (pos_unit, vel_unit) = units(j);
-    let bad = |attr: &str, value: f64, expected: String| Error::Urdf {
-        message: format!(
-            "joint `{}`: <limit {attr}=\"{}\">: expected {expected}",
-            j.name,
-            raw.limit_attr(attr)
-                .map_or_else(|| value.to_string(), str::to_string)
-        ),
-    };
     let continuous = matches!(j.joint_type, urdf_rs::JointType::Continuous);
     if raw.limit.is_none() && !continuous {
         return Err(Error::Urdf {
@@ -128,76 +118,119 @@ fn checked_limit(j: &urdf_rs::Joint, raw: &RawJoint, b: &mut RobotBuilder) -> Re
     }
     let mut limit = JointLimit::UNBOUNDED;
     if !continuous {
-        for (attr, v) in [("lower", l.lower), ("upper", l.upper)] {
-            if !v.is_finite() {
-                return Err(bad(
-                    attr,
-                    v,
-                    format!("a finite position [{pos_unit}] (an unbounded revolute joint is type=\"continuous\")"),
-                ));
-            }
-        }
-        if l.lower > l.upper {
-            return Err(Error::InvalidLimit {
-                what: format!("joint `{}` (URDF <limit lower upper>)", j.name),
-                lower: l.lower,
-                upper: l.upper,
-            });
-        }
-        if l.lower == l.upper {
-            return Err(Error::Urdf {
-                message: format!(
-                    "joint `{}` ({:?}) has the zero-width range [{}, {}] {pos_unit} (lower and upper default to 0 when missing); a joint that must not move is type=\"fixed\" or locked (ModelOptions::locked, --lock)",
-                    j.name, j.joint_type, l.lower, l.upper
-                ),
-            });
-        }
-        limit.lower = l.lower;
-        limit.upper = l.upper;
+        (limit.lower, limit.upper) = checked_range(j, raw)?;
     }
     if raw.limit.is_some() {
-        match raw.limit_attr("velocity") {
-            Some(_) if !(l.velocity.is_finite() && l.velocity > 0.0) => {
-                return Err(bad(
-                    "velocity",
-                    l.velocity,
-                    format!("a finite velocity limit > 0 [{vel_unit}] (a joint that must not move is type=\"fixed\" or locked with --lock)"),
-                ))
-            }
-            Some(_) => limit.velocity = l.velocity,
-            None => b.warn(format!(
-                "joint `{}`: <limit> has no velocity; read as unbounded (URDF 1.2) unless ModelOptions::fallback_velocity or a robot profile's `velocity.default` sets one",
-                j.name
-            )),
-        }
-        if raw.limit_attr("effort").is_some() {
-            if !(l.effort.is_finite() && l.effort >= 0.0) {
-                return Err(bad(
-                    "effort",
-                    l.effort,
-                    "a finite effort limit >= 0 [N·m or N]".into(),
-                ));
-            }
-            if l.effort == 0.0 {
-                b.warn(format!(
-                    "joint `{}`: <limit effort=\"0\">: URDF allows it; iktc is kinematic and does not use efforts",
-                    j.name
-                ));
-            }
-            limit.effort = l.effort;
-        }
-        if raw.limit_attr("acceleration").is_some() {
-            if !(l.acceleration.is_finite() && l.acceleration > 0.0) {
-                return Err(bad(
-                    "acceleration",
-                    l.acceleration,
-                    format!("a finite acceleration limit > 0 [{vel_unit}²]"),
-                ));
-            }
-            limit.acceleration = l.acceleration;
-        }
+        given_rate_limits(j, raw, b, &mut limit)?;
     }
     Ok(limit)
+}
+
+/// The error of the `<limit>` attribute `attr` of joint `j`, its text as written (else
+/// `value`), and what was `expected`.
+fn bad_limit(
+    j: &urdf_rs::Joint,
+    raw: &RawJoint,
+    attr: &str,
+    value: f64,
+    expected: String,
+) -> Error {
+    Error::Urdf {
+        message: format!(
+            "joint `{}`: <limit {attr}=\"{}\">: expected {expected}",
+            j.name,
+            raw.limit_attr(attr)
+                .map_or_else(|| value.to_string(), str::to_string)
+        ),
+    }
+}
+
+/// The checked range (lower, upper) \[rad or m\] of a revolute or prismatic joint: finite,
+/// lower < upper.
+fn checked_range(j: &urdf_rs::Joint, raw: &RawJoint) -> Result<(f64, f64)> {
+    let l = &j.limit;
+    let (pos_unit, _) = units(j);
+    for (attr, v) in [("lower", l.lower), ("upper", l.upper)] {
+        if !v.is_finite() {
+            return Err(bad_limit(
+                j,
+                raw,
+                attr,
+                v,
+                format!("a finite position [{pos_unit}] (an unbounded revolute joint is type=\"continuous\")"),
+            ));
+        }
+    }
+    if l.lower > l.upper {
+        return Err(Error::InvalidLimit {
+            what: format!("joint `{}` (URDF <limit lower upper>)", j.name),
+            lower: l.lower,
+            upper: l.upper,
+        });
+    }
+    if l.lower == l.upper {
+        return Err(Error::Urdf {
+            message: format!(
+                "joint `{}` ({:?}) has the zero-width range [{}, {}] {pos_unit} (lower and upper default to 0 when missing); a joint that must not move is type=\"fixed\" or locked (ModelOptions::locked, --lock)",
+                j.name, j.joint_type, l.lower, l.upper
+            ),
+        });
+    }
+    Ok((l.lower, l.upper))
+}
+
+/// Sets the velocity \[rad/s or m/s\], effort \[N·m or N\] and acceleration \[rad/s² or m/s²\]
+/// limits of `limit` that the joint's `<limit>` writes, checked; warnings go to the builder.
+fn given_rate_limits(
+    j: &urdf_rs::Joint,
+    raw: &RawJoint,
+    b: &mut RobotBuilder,
+    limit: &mut JointLimit,
+) -> Result<()> {
+    let l = &j.limit;
+    let (_, vel_unit) = units(j);
+    let bad = |attr: &str, value: f64, expected: String| bad_limit(j, raw, attr, value, expected);
+    match raw.limit_attr("velocity") {
+        Some(_) if !(l.velocity.is_finite() && l.velocity > 0.0) => {
+            return Err(bad(
+                "velocity",
+                l.velocity,
+                format!("a finite velocity limit > 0 [{vel_unit}] (a joint that must not move is type=\"fixed\" or locked with --lock)"),
+            ))
+        }
+        Some(_) => limit.velocity = l.velocity,
+        None => b.warn(format!(
+            "joint `{}`: <limit> has no velocity; read as unbounded (URDF 1.2) unless ModelOptions::fallback_velocity or a robot profile's `velocity.default` sets one",
+            j.name
+        )),
+    }
+    if raw.limit_attr("effort").is_some() {
+        if !(l.effort.is_finite() && l.effort >= 0.0) {
+            return Err(bad(
+                "effort",
+                l.effort,
+                "a finite effort limit >= 0 [N·m or N]".into(),
+            ));
+        }
+        if l.effort == 0.0 {
+            b.warn(format!(
+                "joint `{}`: <limit effort=\"0\">: URDF allows it; iktc is kinematic and does not use efforts",
+                j.name
+            ));
+        }
+        limit.effort = l.effort;
+    }
+    if raw.limit_attr("acceleration").is_some() {
+        if !(l.acceleration.is_finite() && l.acceleration > 0.0) {
+            return Err(bad(
+                "acceleration",
+                l.acceleration,
+                format!("a finite acceleration limit > 0 [{vel_unit}²]"),
+            ));
+        }
+        limit.acceleration = l.acceleration;
+    }
+    Ok(())
 }
 
 /// Parses URDF `text` with `urdf-rs` after the raw pass ([`check_raw`]): a trailing NUL

@@ -149,9 +149,7 @@ pub(crate) fn check_raw(text: &str, limits: &ReadLimits) -> Result<RawUrdf> {
     limits.validate()?;
     let mut reader = quick_xml::Reader::from_str(text);
     let mut stack: Vec<Open> = Vec::new();
-    let mut joints: HashMap<String, RawJoint> = HashMap::new();
-    let mut unnamed_materials = Vec::new();
-    let mut ignored = Vec::new();
+    let mut raw = RawUrdf::default();
     loop {
         let at = usize::try_from(reader.buffer_position()).unwrap_or(usize::MAX);
         let event = reader.read_event().map_err(|e| {
@@ -171,21 +169,48 @@ pub(crate) fn check_raw(text: &str, limits: &ReadLimits) -> Result<RawUrdf> {
             _ => continue,
         };
         let tag = name_of(start);
-        let depth = stack.len() + 1;
-        if depth > limits.max_xml_depth {
-            return Err(Error::ResourceLimit {
-                what: format!("XML nesting depth of the URDF (at <{tag}>)"),
-                value: depth.to_string(),
-                limit: limits.max_xml_depth.to_string(),
-                option: "ReadLimits::max_xml_depth (Robot::from_urdf_str_with)".into(),
-            });
-        }
+        check_depth(&tag, stack.len() + 1, limits)?;
         let attrs = attributes(start)?;
         let name = attrs
             .iter()
             .find(|(k, _)| k == "name")
             .map(|(_, v)| v.clone())
             .unwrap_or_default();
+        raw.element(&stack, &tag, &attrs)?;
+        if tag == "material" && !attrs.iter().any(|(k, _)| k == "name") {
+            // The event starts at `at` with `<material`; found by search to be sure of it.
+            let tail = text.get(at..).unwrap_or("");
+            if let Some(i) = tail.find("<material") {
+                raw.unnamed_materials.push(at + i + "<material".len());
+            }
+        }
+        if tag == "joint" && stack.len() == 1 {
+            raw.joints.entry(name.clone()).or_default();
+        }
+        if !empty {
+            stack.push(Open { tag, name });
+        }
+    }
+    Ok(raw)
+}
+
+/// Errors when the element `tag` at nesting `depth` is deeper than `limits.max_xml_depth`.
+fn check_depth(tag: &str, depth: usize, limits: &ReadLimits) -> Result<()> {
+    if depth > limits.max_xml_depth {
+        return Err(Error::ResourceLimit {
+            what: format!("XML nesting depth of the URDF (at <{tag}>)"),
+            value: depth.to_string(),
+            limit: limits.max_xml_depth.to_string(),
+            option: "ReadLimits::max_xml_depth (Robot::from_urdf_str_with)".into(),
+        });
+    }
+    Ok(())
+}
+
+impl RawUrdf {
+    /// Checks the element `tag` with attributes `attrs` inside the open elements `stack`: as a
+    /// child of a robot's `<joint>` (recording its `<limit>`) or of a link's `<inertial>`.
+    fn element(&mut self, stack: &[Open], tag: &str, attrs: &[(String, String)]) -> Result<()> {
         // Parent and grandparent tags: a robot's joint is `robot › joint`, its children
         // `robot › joint › *`, an inertial's children `robot › link › inertial › *`.
         let parent = stack.last();
@@ -195,59 +220,49 @@ pub(crate) fn check_raw(text: &str, limits: &ReadLimits) -> Result<RawUrdf> {
             && stack.len() == 2;
         if in_robot_joint {
             let joint = parent.map_or("", |p| p.name.as_str());
-            if !JOINT_CHILDREN.contains(&tag.as_str()) {
-                match misspelled_joint_child(&tag) {
-                    Some(known) => {
-                        return Err(error(format!(
-                            "joint `{joint}` contains <{tag}>, which URDF does not define inside <joint> (a misspelled <{known}>?); expected one of {}",
-                            JOINT_CHILDREN.map(|t| format!("<{t}>")).join(", ")
-                        )))
-                    }
-                    None => ignored.push((joint.to_string(), tag.clone())),
-                }
-            }
-            if tag == "limit" {
-                if let Some((bad, _)) = attrs
-                    .iter()
-                    .find(|(k, _)| !LIMIT_ATTRIBUTES.contains(&k.as_str()))
-                {
-                    return Err(error(format!(
-                        "joint `{joint}`: <limit> has the attribute `{bad}`, which URDF does not define; expected {}",
-                        LIMIT_ATTRIBUTES.join(", ")
-                    )));
-                }
-                joints.entry(joint.to_string()).or_default().limit = Some(attrs.clone());
-            }
+            self.joint_child(joint, tag, attrs)?;
         }
         let in_inertial = stack.len() == 3
             && parent.is_some_and(|p| p.tag == "inertial")
             && grandparent.is_some_and(|g| g.tag == "link");
-        if in_inertial && !INERTIAL_CHILDREN.contains(&tag.as_str()) {
+        if in_inertial && !INERTIAL_CHILDREN.contains(&tag) {
             let link = grandparent.map_or("", |g| g.name.as_str());
             return Err(error(format!(
                 "link `{link}`: <inertial> contains <{tag}>, which URDF does not define there; expected <origin>, <mass> or <inertia>"
             )));
         }
-        if tag == "material" && !attrs.iter().any(|(k, _)| k == "name") {
-            // The event starts at `at` with `<material`; found by search to be sure of it.
-            let tail = text.get(at..).unwrap_or("");
-            if let Some(i) = tail.find("<material") {
-                unnamed_materials.push(at + i + "<material".len());
+        Ok(())
+    }
+
+    /// Checks the element `tag` inside the robot's joint `joint`: a misspelled one is an
+    /// error, an unknown one is recorded as ignored, a `<limit>` has its attributes checked
+    /// and recorded.
+    fn joint_child(&mut self, joint: &str, tag: &str, attrs: &[(String, String)]) -> Result<()> {
+        if !JOINT_CHILDREN.contains(&tag) {
+            match misspelled_joint_child(tag) {
+                Some(known) => {
+                    return Err(error(format!(
+                        "joint `{joint}` contains <{tag}>, which URDF does not define inside <joint> (a misspelled <{known}>?); expected one of {}",
+                        JOINT_CHILDREN.map(|t| format!("<{t}>")).join(", ")
+                    )))
+                }
+                None => self.ignored.push((joint.to_string(), tag.to_string())),
             }
         }
-        if tag == "joint" && stack.len() == 1 {
-            joints.entry(name.clone()).or_default();
+        if tag == "limit" {
+            if let Some((bad, _)) = attrs
+                .iter()
+                .find(|(k, _)| !LIMIT_ATTRIBUTES.contains(&k.as_str()))
+            {
+                return Err(error(format!(
+                    "joint `{joint}`: <limit> has the attribute `{bad}`, which URDF does not define; expected {}",
+                    LIMIT_ATTRIBUTES.join(", ")
+                )));
+            }
+            self.joints.entry(joint.to_string()).or_default().limit = Some(attrs.to_vec());
         }
-        if !empty {
-            stack.push(Open { tag, name });
-        }
+        Ok(())
     }
-    Ok(RawUrdf {
-        joints,
-        unnamed_materials,
-        ignored,
-        floating_root: None,
-    })
 }
 
 #[cfg(test)]

@@ -103,47 +103,21 @@ fn fresh(base: &str, taken: impl Fn(&str) -> bool) -> String {
 /// with other joints in its body, a ball joint, an unknown joint type, a bad number.
 pub(crate) fn read(root: &El, x: &Ctx) -> Result<Tree> {
     let mut t = Tree::default();
-    let mut tops: Vec<Item> = Vec::new();
-    for wb in root.elements("worldbody") {
-        let mut all = Vec::new();
-        items(wb, Isometry3::identity(), MAIN, x.c, x.defaults, &mut all)?;
-        tops.extend(all.into_iter().filter(|i| i.el.tag == "body"));
-    }
-    // A free joint: `<freejoint>`, or a `<joint>` whose type (or its class's) is `free`.
-    let has_free = |i: &Item| {
-        let class = i.el.attr("childclass").unwrap_or(i.class);
-        i.el.elements("freejoint").next().is_some()
-            || i.el.elements("joint").any(|j| {
-                Attrs::new(j, class, x.defaults).is_ok_and(|a| a.get("type") == Some("free"))
-            })
-    };
-    let free: Vec<usize> = (0..tops.len()).filter(|&i| has_free(&tops[i])).collect();
-    let name_of = |i: &Item| i.el.attr("name").unwrap_or("(unnamed)").to_string();
-    if free.len() > 1 {
-        return Err(crate::error::Error::Urdf {
-            message: format!(
-                "MJCF: {} top-level bodies have a free joint ({}); iktc models one floating base",
-                free.len(),
-                free.iter()
-                    .map(|&i| name_of(&tops[i]))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            ),
-        });
-    }
+    let tops = top_bodies(root, x)?;
+    let free = free_body(&tops, x)?;
     if tops.is_empty() {
         return Err(crate::error::Error::Urdf {
             message: "MJCF: <worldbody> has no <body>; expected the robot's root body".into(),
         });
     }
     let mut ids = 0usize;
-    if let [f] = free.as_slice() {
-        let kept = &tops[*f];
+    if let Some(f) = free {
+        let kept = &tops[f];
         for other in tops.iter().filter(|o| !std::ptr::eq(o.el, kept.el)) {
             t.warnings.push(format!(
                 "MJCF: top-level body `{}` left out: the robot is the body with the free joint, `{}`",
-                name_of(other),
-                name_of(kept)
+                item_name(other),
+                item_name(kept)
             ));
         }
         t.body(
@@ -156,18 +130,7 @@ pub(crate) fn read(root: &El, x: &Ctx) -> Result<Tree> {
         )?;
         return Ok(t);
     }
-    let alone = tops.len() == 1 && {
-        let b = &tops[0];
-        let a = Attrs::new(b.el, b.class, x.defaults)?;
-        let p = b.pre * pose(&a, x.c)?;
-        let no_joint = !b
-            .el
-            .children
-            .iter()
-            .any(|c| c.tag == "joint" || c.tag == "freejoint");
-        no_joint && p.translation.vector.norm() == 0.0 && p.rotation.angle() == 0.0
-    };
-    if alone {
+    if alone_at_origin(&tops, x)? {
         t.body(
             tops[0].el,
             None,
@@ -184,6 +147,65 @@ pub(crate) fn read(root: &El, x: &Ctx) -> Result<Tree> {
         t.body(b.el, Some(&world), &b.pre, b.class, x, &mut ids)?;
     }
     Ok(t)
+}
+
+/// The top-level bodies of every `<worldbody>` under `root`, `<frame>`s flattened.
+fn top_bodies<'a>(root: &'a El, x: &Ctx<'a>) -> Result<Vec<Item<'a>>> {
+    let mut tops: Vec<Item> = Vec::new();
+    for wb in root.elements("worldbody") {
+        let mut all = Vec::new();
+        items(wb, Isometry3::identity(), MAIN, x.c, x.defaults, &mut all)?;
+        tops.extend(all.into_iter().filter(|i| i.el.tag == "body"));
+    }
+    Ok(tops)
+}
+
+/// The name of a body item, `(unnamed)` without one.
+fn item_name(i: &Item) -> String {
+    i.el.attr("name").unwrap_or("(unnamed)").to_string()
+}
+
+/// The index of the one top-level body with a free joint, if any.
+///
+/// Errors: several top-level bodies with a free joint.
+fn free_body(tops: &[Item], x: &Ctx) -> Result<Option<usize>> {
+    // A free joint: `<freejoint>`, or a `<joint>` whose type (or its class's) is `free`.
+    let has_free = |i: &Item| {
+        let class = i.el.attr("childclass").unwrap_or(i.class);
+        i.el.elements("freejoint").next().is_some()
+            || i.el.elements("joint").any(|j| {
+                Attrs::new(j, class, x.defaults).is_ok_and(|a| a.get("type") == Some("free"))
+            })
+    };
+    let free: Vec<usize> = (0..tops.len()).filter(|&i| has_free(&tops[i])).collect();
+    if free.len() > 1 {
+        return Err(crate::error::Error::Urdf {
+            message: format!(
+                "MJCF: {} top-level bodies have a free joint ({}); iktc models one floating base",
+                free.len(),
+                free.iter()
+                    .map(|&i| item_name(&tops[i]))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        });
+    }
+    Ok(free.first().copied())
+}
+
+/// Whether `tops` is one body at the world origin without joints.
+fn alone_at_origin(tops: &[Item], x: &Ctx) -> Result<bool> {
+    Ok(tops.len() == 1 && {
+        let b = &tops[0];
+        let a = Attrs::new(b.el, b.class, x.defaults)?;
+        let p = b.pre * pose(&a, x.c)?;
+        let no_joint = !b
+            .el
+            .children
+            .iter()
+            .any(|c| c.tag == "joint" || c.tag == "freejoint");
+        no_joint && p.translation.vector.norm() == 0.0 && p.rotation.angle() == 0.0
+    })
 }
 
 /// One hinge or slide joint of a body, read.
@@ -227,7 +249,55 @@ impl Tree {
         let placed = pre * pose(&own, x.c)?;
         let mut list = Vec::new();
         items(el, Isometry3::identity(), class, x.c, x.defaults, &mut list)?;
-        // Joints.
+        let dofs = self.body_joints(el, &list, &name, parent, x)?;
+        // The body's link, and the chain of joints from the parent to it.
+        self.links.push(Link::massless(name.clone()));
+        let link_index = self.links.len() - 1;
+        if let Some(p) = parent {
+            self.chain(p, &name, placed, dofs);
+        }
+        // Geoms, sites, inertial.
+        let mut geoms = Vec::new();
+        for it in list.iter().filter(|i| i.el.tag == "geom") {
+            let a = Attrs::new(it.el, it.class, x.defaults)?;
+            geoms.push(geom(&a, &it.pre, x.c, x.meshes, x.materials)?);
+        }
+        for it in list.iter().filter(|i| i.el.tag == "site") {
+            let a = Attrs::new(it.el, it.class, x.defaults)?;
+            let Some(site) = it.el.attr("name") else {
+                continue;
+            };
+            self.frames
+                .push((site.to_string(), name.clone(), it.pre * pose(&a, x.c)?));
+        }
+        self.body_mass(&list, link_index, &geoms, x)?;
+        self.geoms
+            .extend(geoms.into_iter().map(|g| (name.clone(), g)));
+        for it in list.iter() {
+            if UNSUPPORTED.contains(&it.el.tag.as_str()) {
+                return Err(it.el.error("is not read by iktc (expected bodies, joints, geoms, sites, frames and an inertial)"));
+            }
+        }
+        for it in list.iter().filter(|i| i.el.tag == "body") {
+            self.body(it.el, Some(&name), &it.pre, it.class, x, ids)?;
+        }
+        Ok(())
+    }
+
+    /// Reads the joints among the items `list` of body `el`, named `name`, below `parent`:
+    /// its hinge and slide joints, in order; a free joint of the root body becomes
+    /// [`Tree::free`].
+    ///
+    /// Errors: a free joint below the top level or with other joints in its body, a ball
+    /// joint, an unknown joint type, a bad number.
+    fn body_joints(
+        &mut self,
+        el: &El,
+        list: &[Item],
+        name: &str,
+        parent: Option<&str>,
+        x: &Ctx,
+    ) -> Result<Vec<Dof>> {
         let mut dofs: Vec<Dof> = Vec::new();
         for it in list
             .iter()
@@ -270,26 +340,19 @@ impl Tree {
                 "body `{name}` has a free joint and other joints; a free joint must be its body's only joint"
             )));
         }
-        // The body's link, and the chain of joints from the parent to it.
-        self.links.push(Link::massless(name.clone()));
-        let link_index = self.links.len() - 1;
-        if let Some(p) = parent {
-            self.chain(p, &name, placed, dofs);
-        }
-        // Geoms, sites, inertial.
-        let mut geoms = Vec::new();
-        for it in list.iter().filter(|i| i.el.tag == "geom") {
-            let a = Attrs::new(it.el, it.class, x.defaults)?;
-            geoms.push(geom(&a, &it.pre, x.c, x.meshes, x.materials)?);
-        }
-        for it in list.iter().filter(|i| i.el.tag == "site") {
-            let a = Attrs::new(it.el, it.class, x.defaults)?;
-            let Some(site) = it.el.attr("name") else {
-                continue;
-            };
-            self.frames
-                .push((site.to_string(), name.clone(), it.pre * pose(&a, x.c)?));
-        }
+        Ok(dofs)
+    }
+
+    /// Sets the mass \[kg\], centre of mass \[m\] and inertia \[kg·m²\] of the link at
+    /// `link_index` from its body's `geoms` or its `<inertial>` among `list`, as the compiler's
+    /// `inertiafromgeom` says.
+    fn body_mass(
+        &mut self,
+        list: &[Item],
+        link_index: usize,
+        geoms: &[Geom],
+        x: &Ctx,
+    ) -> Result<()> {
         let inertial = list.iter().find(|i| i.el.tag == "inertial");
         let from_geom = match x.c.from_geom {
             super::spec::FromGeom::Always => true,
@@ -298,9 +361,10 @@ impl Tree {
         };
         let link = &mut self.links[link_index];
         if from_geom {
-            let (m, c, i) = combined(&geoms);
+            let (m, c, i) = combined(geoms);
             (link.mass, link.com, link.inertia) = (m, c, i);
             if geoms.iter().any(|g| g.mass_unknown) {
+                let name = &link.name;
                 self.warnings.push(format!(
                     "MJCF body `{name}`: no <inertial>, and the mass of its mesh geoms is not computed by iktc: its mass and centre of mass come from its other geoms only (give an <inertial>)"
                 ));
@@ -310,16 +374,6 @@ impl Tree {
             let (m, c, i) = inertia(&a, &it.pre, x.c)?;
             let link = &mut self.links[link_index];
             (link.mass, link.com, link.inertia) = (m, c, i);
-        }
-        self.geoms
-            .extend(geoms.into_iter().map(|g| (name.clone(), g)));
-        for it in list.iter() {
-            if UNSUPPORTED.contains(&it.el.tag.as_str()) {
-                return Err(it.el.error("is not read by iktc (expected bodies, joints, geoms, sites, frames and an inertial)"));
-            }
-        }
-        for it in list.iter().filter(|i| i.el.tag == "body") {
-            self.body(it.el, Some(&name), &it.pre, it.class, x, ids)?;
         }
         Ok(())
     }

@@ -69,26 +69,45 @@ pub(crate) fn geom(
     meshes: &HashMap<String, MeshAsset>,
     materials: &HashMap<String, [f64; 4]>,
 ) -> Result<Geom> {
-    let el = a.el;
     let kind = a.get("type").unwrap_or("sphere");
+    let size = read_sizes(a)?;
+    let (pose, half_from) = read_placement(a, kind, c)?;
+    let pose = pre * pose;
+    let shape = read_shape(a, kind, &size, half_from, meshes)?;
+    let (mass, mass_unknown) = read_mass(a, &shape)?;
+    let collides = read_collides(a)?;
+    let rgba = match numbers(a, "rgba", Some(4))? {
+        Some(v) => Some([v[0], v[1], v[2], v[3]]),
+        None => a.get("material").and_then(|m| materials.get(m).copied()),
+    };
+    Ok(Geom {
+        pose,
+        shape,
+        rgba,
+        collides,
+        mass,
+        mass_unknown,
+    })
+}
+
+/// The geom's `size` numbers \[m\]: up to 3, each >= 0 (none when not given).
+fn read_sizes(a: &Attrs) -> Result<Vec<f64>> {
     let size = numbers(a, "size", None)?.unwrap_or_default();
     if size.iter().any(|s| *s < 0.0) || size.len() > 3 {
-        return Err(el.error(format!(
+        return Err(a.el.error(format!(
             "size=\"{}\": expected up to 3 sizes >= 0 [m]",
             a.get("size").unwrap_or("")
         )));
     }
-    let s = |i: usize| -> Result<f64> {
-        size.get(i).copied().ok_or_else(|| {
-            el.error(format!(
-                "a {kind} needs {} size(s) [m], got {}",
-                i + 1,
-                size.len()
-            ))
-        })
-    };
+    Ok(size)
+}
+
+/// The geom's pose in the frames around it, and the half length \[m\] along its z that
+/// `fromto` gives (for a capsule, cylinder, box or ellipsoid), else from `pos` and its
+/// orientation.
+fn read_placement(a: &Attrs, kind: &str, c: &Compiler) -> Result<(Isometry3<f64>, Option<f64>)> {
     let fromto = numbers(a, "fromto", Some(6))?;
-    let (mut pose, half_from) = match &fromto {
+    Ok(match &fromto {
         Some(v) if matches!(kind, "capsule" | "cylinder" | "box" | "ellipsoid") => {
             let (p0, p1) = (
                 Vector3::new(v[0], v[1], v[2]),
@@ -96,7 +115,7 @@ pub(crate) fn geom(
             );
             let d = p1 - p0;
             let axis = Unit::try_new(d, MIN_NORM).ok_or_else(|| {
-                el.error("fromto: its two points coincide; expected a segment of length > 0 [m]")
+                a.el.error("fromto: its two points coincide; expected a segment of length > 0 [m]")
             })?;
             (
                 Isometry3::from_parts(Translation3::from((p0 + p1) / 2.0), z_to(&axis)),
@@ -110,15 +129,35 @@ pub(crate) fn geom(
             ),
             None,
         ),
+    })
+}
+
+/// The shape of a geom of type `kind` from its sizes `size` \[m\] (the half length along z
+/// `half_from` \[m\] when `fromto` gave it).
+fn read_shape(
+    a: &Attrs,
+    kind: &str,
+    size: &[f64],
+    half_from: Option<f64>,
+    meshes: &HashMap<String, MeshAsset>,
+) -> Result<Shape> {
+    let el = a.el;
+    let s = |i: usize| -> Result<f64> {
+        size.get(i).copied().ok_or_else(|| {
+            el.error(format!(
+                "a {kind} needs {} size(s) [m], got {}",
+                i + 1,
+                size.len()
+            ))
+        })
     };
-    pose = pre * pose;
     let half = |i: usize| -> Result<f64> {
         match half_from {
             Some(h) => Ok(h),
             None => s(i),
         }
     };
-    let shape = match kind {
+    Ok(match kind {
         "sphere" => Shape::Sphere(s(0)?),
         "capsule" => Shape::Capsule(s(0)?, half(1)?),
         "cylinder" => Shape::Cylinder(s(0)?, half(1)?),
@@ -144,46 +183,43 @@ pub(crate) fn geom(
                 "type=\"{other}\": expected plane, hfield, sphere, capsule, ellipsoid, cylinder, box, mesh or sdf"
             )))
         }
-    };
+    })
+}
+
+/// The geom's mass \[kg\] (`mass`, else `density` \[kg/m³\] × volume; 0 without a volume) and
+/// whether it is unknown (a mesh with a non-zero density or mass).
+fn read_mass(a: &Attrs, shape: &Shape) -> Result<(f64, bool)> {
     let positive = |attr: &str| -> Result<Option<f64>> {
         match numbers(a, attr, Some(1))? {
-            Some(v) if v[0] < 0.0 => Err(el.error(format!("{attr}=\"{}\": expected >= 0", v[0]))),
+            Some(v) if v[0] < 0.0 => Err(a.el.error(format!("{attr}=\"{}\": expected >= 0", v[0]))),
             v => Ok(v.map(|v| v[0])),
         }
     };
     let given_mass = positive("mass")?;
     let density = positive("density")?.unwrap_or(DEFAULT_DENSITY);
-    let volume = unit_mass(&shape).map(|(v, _)| v);
-    let (mass, mass_unknown) = match (given_mass, volume) {
+    let volume = unit_mass(shape).map(|(v, _)| v);
+    Ok(match (given_mass, volume) {
         (Some(m), Some(_)) => (m, false),
         (None, Some(v)) => (density * v, false),
         (m, None) => (
             0.0,
             matches!(shape, Shape::Mesh(_)) && m.unwrap_or(density) > 0.0,
         ),
-    };
+    })
+}
+
+/// Whether the geom collides: `contype` or `conaffinity` (integers, 1 when not given) non-zero.
+fn read_collides(a: &Attrs) -> Result<bool> {
     let int = |attr: &str| -> Result<i64> {
         match a.get(attr) {
             None => Ok(1),
             Some(v) => v
                 .trim()
                 .parse()
-                .map_err(|_| super::spec::bad(el, attr, v, "an integer")),
+                .map_err(|_| super::spec::bad(a.el, attr, v, "an integer")),
         }
     };
-    let collides = int("contype")? != 0 || int("conaffinity")? != 0;
-    let rgba = match numbers(a, "rgba", Some(4))? {
-        Some(v) => Some([v[0], v[1], v[2], v[3]]),
-        None => a.get("material").and_then(|m| materials.get(m).copied()),
-    };
-    Ok(Geom {
-        pose,
-        shape,
-        rgba,
-        collides,
-        mass,
-        mass_unknown,
-    })
+    Ok(int("contype")? != 0 || int("conaffinity")? != 0)
 }
 
 /// Volume \[m³\] and principal inertia per unit mass \[m²\] (about the geom's centre, in its

@@ -5,7 +5,7 @@ use nalgebra::{Isometry3, Matrix3};
 
 use super::body::Tree;
 use super::geom::{Geom, MeshAsset, Shape};
-use crate::model::JointKind;
+use crate::model::{JointKind, JointSpec, Link};
 use std::collections::HashMap;
 
 /// A URDF `<origin>` of `p` (rotation as roll, pitch, yaw \[rad\], `Rz·Ry·Rx`).
@@ -62,109 +62,111 @@ pub(crate) fn urdf_tree(
     t: &Tree,
     meshes: &HashMap<String, MeshAsset>,
 ) -> urdf_rs::Robot {
-    let links = t
-        .links
-        .iter()
-        .map(|l| {
-            let geoms: Vec<&Geom> = t
-                .geoms
-                .iter()
-                .filter(|(n, _)| *n == l.name)
-                .map(|(_, g)| g)
-                .collect();
-            let visual_only = geoms.iter().any(|g| !g.collides);
-            let visual = geoms
-                .iter()
-                .filter(|g| !visual_only || !g.collides)
-                .filter_map(|g| {
-                    Some(urdf_rs::Visual {
-                        name: None,
-                        origin: pose(&g.pose),
-                        geometry: geometry(g, meshes)?,
-                        material: g.rgba.map(|c| urdf_rs::Material {
-                            name: String::new(),
-                            color: Some(urdf_rs::Color {
-                                rgba: urdf_rs::Vec4(c),
-                            }),
-                            texture: None,
-                        }),
-                    })
-                })
-                .collect();
-            let collision = geoms
-                .iter()
-                .filter(|g| g.collides)
-                .filter_map(|g| {
-                    Some(urdf_rs::Collision {
-                        name: None,
-                        origin: pose(&g.pose),
-                        geometry: geometry(g, meshes)?,
-                    })
-                })
-                .collect();
-            urdf_rs::Link {
-                name: l.name.clone(),
-                inertial: urdf_rs::Inertial {
-                    origin: urdf_rs::Pose {
-                        xyz: urdf_rs::Vec3(l.com.into()),
-                        rpy: urdf_rs::Vec3([0.0; 3]),
-                    },
-                    mass: urdf_rs::Mass { value: l.mass },
-                    inertia: inertia(&l.inertia),
-                },
-                visual,
-                collision,
-            }
-        })
-        .collect();
-    let joints = t
-        .joints
-        .iter()
-        .map(|j| {
-            let (joint_type, axis) = match j.kind {
-                JointKind::Revolute { axis } if j.limit.lower.is_finite() => {
-                    (urdf_rs::JointType::Revolute, axis.into_inner())
-                }
-                JointKind::Revolute { axis } => (urdf_rs::JointType::Continuous, axis.into_inner()),
-                JointKind::Prismatic { axis } => (urdf_rs::JointType::Prismatic, axis.into_inner()),
-                JointKind::Fixed => (urdf_rs::JointType::Fixed, nalgebra::Vector3::x()),
-            };
-            urdf_rs::Joint {
-                name: j.name.clone(),
-                joint_type,
-                origin: pose(&j.origin),
-                parent: urdf_rs::LinkName {
-                    link: j.parent.clone(),
-                },
-                child: urdf_rs::LinkName {
-                    link: j.child.clone(),
-                },
-                axis: urdf_rs::Axis {
-                    xyz: urdf_rs::Vec3(axis.into()),
-                },
-                limit: urdf_rs::JointLimit {
-                    lower: j.limit.lower,
-                    upper: j.limit.upper,
-                    effort: j.limit.effort,
-                    velocity: j.limit.velocity,
-                    ..urdf_rs::JointLimit::default()
-                },
-                calibration: None,
-                dynamics: None,
-                mimic: j.mimic.as_ref().map(|(m, k, o)| urdf_rs::Mimic {
-                    joint: m.clone(),
-                    multiplier: Some(*k),
-                    offset: Some(*o),
-                }),
-                safety_controller: None,
-            }
-        })
-        .collect();
+    let links = t.links.iter().map(|l| link(l, t, meshes)).collect();
+    let joints = t.joints.iter().map(joint).collect();
     urdf_rs::Robot {
         name: name.to_string(),
         version: None,
         links,
         joints,
         materials: Vec::new(),
+    }
+}
+
+/// The URDF link of `l`: its inertial, and its geoms in `t` as visuals and collisions (see
+/// [`urdf_tree`]).
+fn link(l: &Link, t: &Tree, meshes: &HashMap<String, MeshAsset>) -> urdf_rs::Link {
+    let geoms: Vec<&Geom> = t
+        .geoms
+        .iter()
+        .filter(|(n, _)| *n == l.name)
+        .map(|(_, g)| g)
+        .collect();
+    let visual_only = geoms.iter().any(|g| !g.collides);
+    let visual = geoms
+        .iter()
+        .filter(|g| !visual_only || !g.collides)
+        .filter_map(|g| visual(g, meshes))
+        .collect();
+    let collision = geoms
+        .iter()
+        .filter(|g| g.collides)
+        .filter_map(|g| {
+            Some(urdf_rs::Collision {
+                name: None,
+                origin: pose(&g.pose),
+                geometry: geometry(g, meshes)?,
+            })
+        })
+        .collect();
+    urdf_rs::Link {
+        name: l.name.clone(),
+        inertial: urdf_rs::Inertial {
+            origin: urdf_rs::Pose {
+                xyz: urdf_rs::Vec3(l.com.into()),
+                rpy: urdf_rs::Vec3([0.0; 3]),
+            },
+            mass: urdf_rs::Mass { value: l.mass },
+            inertia: inertia(&l.inertia),
+        },
+        visual,
+        collision,
+    }
+}
+
+/// The URDF visual of a geom, coloured by its `rgba`; `None` for a shape URDF lacks.
+fn visual(g: &Geom, meshes: &HashMap<String, MeshAsset>) -> Option<urdf_rs::Visual> {
+    Some(urdf_rs::Visual {
+        name: None,
+        origin: pose(&g.pose),
+        geometry: geometry(g, meshes)?,
+        material: g.rgba.map(|c| urdf_rs::Material {
+            name: String::new(),
+            color: Some(urdf_rs::Color {
+                rgba: urdf_rs::Vec4(c),
+            }),
+            texture: None,
+        }),
+    })
+}
+
+/// The URDF joint of `j` (a hinge without range is `continuous`).
+fn joint(j: &JointSpec) -> urdf_rs::Joint {
+    let (joint_type, axis) = match j.kind {
+        JointKind::Revolute { axis } if j.limit.lower.is_finite() => {
+            (urdf_rs::JointType::Revolute, axis.into_inner())
+        }
+        JointKind::Revolute { axis } => (urdf_rs::JointType::Continuous, axis.into_inner()),
+        JointKind::Prismatic { axis } => (urdf_rs::JointType::Prismatic, axis.into_inner()),
+        JointKind::Fixed => (urdf_rs::JointType::Fixed, nalgebra::Vector3::x()),
+    };
+    urdf_rs::Joint {
+        name: j.name.clone(),
+        joint_type,
+        origin: pose(&j.origin),
+        parent: urdf_rs::LinkName {
+            link: j.parent.clone(),
+        },
+        child: urdf_rs::LinkName {
+            link: j.child.clone(),
+        },
+        axis: urdf_rs::Axis {
+            xyz: urdf_rs::Vec3(axis.into()),
+        },
+        limit: urdf_rs::JointLimit {
+            lower: j.limit.lower,
+            upper: j.limit.upper,
+            effort: j.limit.effort,
+            velocity: j.limit.velocity,
+            ..urdf_rs::JointLimit::default()
+        },
+        calibration: None,
+        dynamics: None,
+        mimic: j.mimic.as_ref().map(|(m, k, o)| urdf_rs::Mimic {
+            joint: m.clone(),
+            multiplier: Some(*k),
+            offset: Some(*o),
+        }),
+        safety_controller: None,
     }
 }
