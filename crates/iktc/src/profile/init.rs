@@ -847,19 +847,8 @@ fn write_feet(
     frames
 }
 
-/// The profile's text (see [`init_profile_toml_with`]).
-#[allow(clippy::too_many_arguments)]
-fn write_profile(
-    text: &str,
-    robot: &crate::model::Robot,
-    u: &urdf_rs::Robot,
-    t: &Tree,
-    g: &Guessed,
-    o: &InitOptions,
-    urdf_path: &str,
-    dir: Option<&std::path::Path>,
-) -> String {
-    let mut out = String::new();
+/// The profile's header: its name and URDF, and the base (floating when two feet were found).
+fn write_header(out: &mut String, u: &urdf_rs::Robot, g: &Guessed, urdf_path: &str) {
     let name = if u.name.is_empty() { "robot" } else { &u.name };
     out.push_str(&format!(
         "# Robot profile of `{name}`, written by `iktc profile init`: check every value marked\n\
@@ -880,6 +869,10 @@ fn write_profile(
             "no pair of feet was found"
         }
     ));
+}
+
+/// A `[[lock]]` at 0 for each movable joint named like a finger.
+fn write_finger_locks(out: &mut String, u: &urdf_rs::Robot) {
     let fingers = [
         "finger", "thumb", "index", "middle", "ring", "little", "pinky",
     ];
@@ -892,6 +885,23 @@ fn write_profile(
             quote(&j.name)
         ));
     }
+}
+
+/// The profile's text (see [`init_profile_toml_with`]).
+#[allow(clippy::too_many_arguments)]
+fn write_profile(
+    text: &str,
+    robot: &crate::model::Robot,
+    u: &urdf_rs::Robot,
+    t: &Tree,
+    g: &Guessed,
+    o: &InitOptions,
+    urdf_path: &str,
+    dir: Option<&std::path::Path>,
+) -> String {
+    let mut out = String::new();
+    write_header(&mut out, u, g, urdf_path);
+    write_finger_locks(&mut out, u);
     out.push('\n');
     let foot_frames = write_feet(&mut out, u, t, g, o, dir);
     for (key, end) in ["left_hand", "right_hand"].iter().zip(&g.hand_ends) {
