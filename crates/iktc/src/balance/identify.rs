@@ -200,6 +200,59 @@ pub struct Identification {
     pub status: LmStatus,
 }
 
+/// Each parameter's estimate with its standard error from the linearised covariance of the
+/// fit of `m` residuals.
+fn parameter_estimates(
+    params: &FullModelParams,
+    fit: &super::lm::LmResult,
+    m: usize,
+) -> Vec<ParameterEstimate> {
+    // Linearised covariance of ln p: σ² (JᵀJ)⁻¹, σ² = ‖r‖² / (m − n).
+    let dof = (m as f64 - 5.0).max(1.0);
+    let sigma2 = 2.0 * fit.cost / dof;
+    let cov = (fit.jacobian.transpose() * &fit.jacobian).try_inverse();
+    let values = [
+        params.ipcj.length,
+        params.ipcj.stiffness_per_mass,
+        params.ipcj.damping_per_mass,
+        params.lag,
+        params.pade,
+    ];
+    let names = [
+        ("l (pendulum length)", "m"),
+        ("K/m (stiffness per mass)", "N·m/(rad·kg)"),
+        ("b/m (damping per mass)", "N·m·s/(rad·kg)"),
+        ("τ_s (lag time constant)", "s"),
+        ("T (Padé parameter, delay 2T)", "s"),
+    ];
+    names
+        .iter()
+        .zip(values)
+        .enumerate()
+        .map(|(i, ((name, unit), value))| ParameterEstimate {
+            name,
+            unit,
+            value,
+            std_error: cov
+                .as_ref()
+                .map_or(f64::NAN, |c| value * (sigma2 * c[(i, i)]).max(0.0).sqrt()),
+        })
+        .collect()
+}
+
+/// The fit's error sums over the data: squared relative error, squared magnitude error
+/// \[dB²\] and squared phase error \[deg²\].
+fn fit_errors(data: &FrequencyData, params: &FullModelParams) -> (f64, f64, f64) {
+    let (mut rel, mut db, mut deg) = (0.0, 0.0, 0.0);
+    for (w, h) in data.omega.iter().zip(&data.response) {
+        let ratio = params.frequency_response(*w) / *h;
+        rel += (ratio - 1.0).norm_sqr();
+        db += (20.0 * ratio.norm().log10()).powi(2);
+        deg += ratio.arg().to_degrees().powi(2);
+    }
+    (rel, db, deg)
+}
+
 /// Identifies the full model's parameters from frequency-response data (Section 4.2).
 /// Errors if the data are too few, not finite, or the settings invalid.
 pub fn identify(data: &FrequencyData, settings: &IdentifySettings) -> Result<Identification> {
@@ -239,44 +292,8 @@ pub fn identify(data: &FrequencyData, settings: &IdentifySettings) -> Result<Ide
     })?;
     let params = from_log(&fit.x, g);
     params.validate()?;
-    // Linearised covariance of ln p: σ² (JᵀJ)⁻¹, σ² = ‖r‖² / (m − n).
-    let dof = (m as f64 - 5.0).max(1.0);
-    let sigma2 = 2.0 * fit.cost / dof;
-    let cov = (fit.jacobian.transpose() * &fit.jacobian).try_inverse();
-    let values = [
-        params.ipcj.length,
-        params.ipcj.stiffness_per_mass,
-        params.ipcj.damping_per_mass,
-        params.lag,
-        params.pade,
-    ];
-    let names = [
-        ("l (pendulum length)", "m"),
-        ("K/m (stiffness per mass)", "N·m/(rad·kg)"),
-        ("b/m (damping per mass)", "N·m·s/(rad·kg)"),
-        ("τ_s (lag time constant)", "s"),
-        ("T (Padé parameter, delay 2T)", "s"),
-    ];
-    let estimates = names
-        .iter()
-        .zip(values)
-        .enumerate()
-        .map(|(i, ((name, unit), value))| ParameterEstimate {
-            name,
-            unit,
-            value,
-            std_error: cov
-                .as_ref()
-                .map_or(f64::NAN, |c| value * (sigma2 * c[(i, i)]).max(0.0).sqrt()),
-        })
-        .collect();
-    let (mut rel, mut db, mut deg) = (0.0, 0.0, 0.0);
-    for (w, h) in data.omega.iter().zip(&data.response) {
-        let ratio = params.frequency_response(*w) / *h;
-        rel += (ratio - 1.0).norm_sqr();
-        db += (20.0 * ratio.norm().log10()).powi(2);
-        deg += ratio.arg().to_degrees().powi(2);
-    }
+    let estimates = parameter_estimates(&params, &fit, m);
+    let (rel, db, deg) = fit_errors(data, &params);
     let n = data.omega.len() as f64;
     Ok(Identification {
         params,

@@ -228,6 +228,67 @@ where
     }
 }
 
+/// Checks the settings, that there are parameters and residuals, and that `x0` is finite.
+fn check_problem(x0: &DVector<f64>, m: usize, settings: &LmSettings) -> Result<()> {
+    settings.validate()?;
+    if x0.is_empty() {
+        return Err(invalid("levenberg_marquardt parameters", 0.0, ">= 1"));
+    }
+    if m == 0 {
+        return Err(invalid("levenberg_marquardt residuals", 0.0, ">= 1"));
+    }
+    crate::error::check_all_finite("levenberg_marquardt x0", x0.as_slice())?;
+    Ok(())
+}
+
+/// The crate's solver with the settings' tolerances. The crate stops after
+/// `patience·(n + 1)` residual evaluations; this one is never reached before our own budget
+/// of `max_iterations` trials (plus the start).
+fn solver(settings: &LmSettings) -> LevenbergMarquardt<f64> {
+    LevenbergMarquardt::new()
+        .with_ftol(settings.relative_cost_tolerance)
+        .with_xtol(settings.relative_step_tolerance)
+        .with_gtol(settings.gradient_tolerance)
+        .with_stepbound(settings.initial_step_bound)
+        .with_patience(settings.max_iterations + 1)
+        .with_scale_diag(true)
+}
+
+/// The status of the solver's `termination`, and whether the answer is the point of the last
+/// Jacobian (a trial refused for the budget, `out_of_steps`) rather than the solver's `x`; an
+/// error for a numerical failure or a malformed problem.
+fn termination_status(
+    termination: &TerminationReason,
+    out_of_steps: bool,
+) -> Result<(LmStatus, bool)> {
+    Ok(match termination {
+        TerminationReason::ResidualsZero => (LmStatus::ResidualsZero, false),
+        TerminationReason::Converged { ftol: true, .. } => (LmStatus::CostConverged, false),
+        TerminationReason::Converged { .. } => (LmStatus::StepConverged, false),
+        TerminationReason::Orthogonal => (LmStatus::GradientConverged, false),
+        TerminationReason::NoImprovementPossible(_) => (LmStatus::NoImprovement, false),
+        TerminationReason::LostPatience => (LmStatus::MaxIterations, false),
+        // Our refusal of a trial beyond the budget: the solver's iterate is the point of the
+        // last Jacobian (the refused trial's parameters were not reset).
+        TerminationReason::User(_) if out_of_steps => (LmStatus::MaxIterations, true),
+        TerminationReason::Numerical(what) | TerminationReason::User(what) => {
+            return Err(Error::NonFinite {
+                what: format!("Levenberg–Marquardt {what}"),
+                value: f64::NAN,
+            });
+        }
+        TerminationReason::NoParameters
+        | TerminationReason::NoResiduals
+        | TerminationReason::WrongDimensions(_) => {
+            return Err(invalid(
+                "levenberg_marquardt problem",
+                f64::NAN,
+                &format!("well-formed ({:?})", termination),
+            ));
+        }
+    })
+}
+
 /// Minimises `½‖r(x)‖²` from `x0`. `residual(x, r)` fills `r` (length `m`) and returns an error
 /// for parameters where the model is undefined; such trial steps, and those whose residual is
 /// not finite, are treated as rejected. An error if the residual is undefined or not finite at
@@ -242,15 +303,8 @@ pub fn levenberg_marquardt<F>(
 where
     F: FnMut(&DVector<f64>, &mut DVector<f64>) -> Result<()>,
 {
-    settings.validate()?;
+    check_problem(&x0, m, settings)?;
     let n = x0.len();
-    if n == 0 {
-        return Err(invalid("levenberg_marquardt parameters", 0.0, ">= 1"));
-    }
-    if m == 0 {
-        return Err(invalid("levenberg_marquardt residuals", 0.0, ">= 1"));
-    }
-    crate::error::check_all_finite("levenberg_marquardt x0", x0.as_slice())?;
     let mut residual = residual;
     // The start: its errors are the caller's to see.
     let mut r0 = DVector::zeros(m);
@@ -267,46 +321,15 @@ where
         out_of_steps: Cell::new(false),
         error: RefCell::new(None),
     };
-    // The crate stops after `patience·(n + 1)` residual evaluations; this one is never reached
-    // before our own budget of `max_iterations` trials (plus the start).
-    let solver = LevenbergMarquardt::new()
-        .with_ftol(settings.relative_cost_tolerance)
-        .with_xtol(settings.relative_step_tolerance)
-        .with_gtol(settings.gradient_tolerance)
-        .with_stepbound(settings.initial_step_bound)
-        .with_patience(settings.max_iterations + 1)
-        .with_scale_diag(true);
-    let (problem, report) = solver.minimize(problem);
+    let (problem, report) = solver(settings).minimize(problem);
     if let Some(e) = problem.error.take() {
         return Err(e);
     }
-    let (x, status) = match report.termination {
-        TerminationReason::ResidualsZero => (problem.x, LmStatus::ResidualsZero),
-        TerminationReason::Converged { ftol: true, .. } => (problem.x, LmStatus::CostConverged),
-        TerminationReason::Converged { .. } => (problem.x, LmStatus::StepConverged),
-        TerminationReason::Orthogonal => (problem.x, LmStatus::GradientConverged),
-        TerminationReason::NoImprovementPossible(_) => (problem.x, LmStatus::NoImprovement),
-        TerminationReason::LostPatience => (problem.x, LmStatus::MaxIterations),
-        // Our refusal of a trial beyond the budget: the solver's iterate is the point of the
-        // last Jacobian (the refused trial's parameters were not reset).
-        TerminationReason::User(_) if problem.out_of_steps.get() => {
-            (problem.iterate.into_inner(), LmStatus::MaxIterations)
-        }
-        TerminationReason::Numerical(what) | TerminationReason::User(what) => {
-            return Err(Error::NonFinite {
-                what: format!("Levenberg–Marquardt {what}"),
-                value: f64::NAN,
-            });
-        }
-        TerminationReason::NoParameters
-        | TerminationReason::NoResiduals
-        | TerminationReason::WrongDimensions(_) => {
-            return Err(invalid(
-                "levenberg_marquardt problem",
-                f64::NAN,
-                &format!("well-formed ({:?})", report.termination),
-            ));
-        }
+    let (status, at_iterate) = termination_status(&report.termination, problem.out_of_steps.get())?;
+    let x = if at_iterate {
+        problem.iterate.into_inner()
+    } else {
+        problem.x
     };
     let iterations = problem.trials.get().saturating_sub(1);
     let mut residual = problem.residual.into_inner();

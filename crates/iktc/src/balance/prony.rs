@@ -76,12 +76,9 @@ impl PronySettings {
 /// Largest relative spread of the sample intervals accepted as uniform sampling \[–\].
 const UNIFORM_TOLERANCE: f64 = 1e-6;
 
-/// The dominant oscillatory mode (damping ratio ζ \[–\], natural frequency ω_n \[rad/s\]) of
-/// the response `y` sampled at the uniformly spaced times `t` \[s\], by Prony's method (see
-/// the [module documentation](self)); `None` if no pair of the fit turns by half a cycle over
-/// the record. Errors: `t` and `y` of different lengths, not finite, `t` not increasing
-/// uniformly, or too few samples for the settings.
-pub fn dominant_mode(t: &[f64], y: &[f64], settings: &PronySettings) -> Result<Option<Modal>> {
+/// Checks the settings and the samples (same lengths, finite, enough for the smoothing,
+/// decimation and order, uniformly spaced); returns the sample step \[s\].
+fn uniform_step(t: &[f64], y: &[f64], settings: &PronySettings) -> Result<f64> {
     settings.validate()?;
     check_dim("response samples y", t.len(), y.len())?;
     check_all_finite("response times t [s]", t)?;
@@ -114,13 +111,13 @@ pub fn dominant_mode(t: &[f64], y: &[f64], settings: &PronySettings) -> Result<O
             "> 0 and constant (uniform samples)",
         ));
     }
-    let yf: Vec<f64> = moving_average(&moving_average(y, s), s)
-        .into_iter()
-        .step_by(settings.decimation)
-        .collect();
+    Ok(dt)
+}
+
+/// The roots of the linear prediction `y_k = Σ a_i y_{k−i} + c`, k = p … n−1, of order `p`
+/// fitted to the filtered record `yf`.
+fn prediction_roots(yf: &[f64], p: usize) -> Result<Vec<Complex<f64>>> {
     let n = yf.len();
-    let h = dt * settings.decimation as f64;
-    // Linear prediction y_k = Σ a_i y_{k−i} + c, k = p … n−1.
     let rows = n - p;
     let mut a = DMatrix::<f64>::zeros(rows, p + 1);
     let mut b = DVector::<f64>::zeros(rows);
@@ -134,8 +131,13 @@ pub fn dominant_mode(t: &[f64], y: &[f64], settings: &PronySettings) -> Result<O
     let coef = least_squares(a, b)?;
     let mut poly = vec![1.0];
     poly.extend(coef.iter().take(p).map(|ai| -ai));
-    let z = Polynomial::new(&poly).roots();
-    // Amplitudes: y_k = Σ c_i z_i^k + c₀ over the filtered record.
+    Ok(Polynomial::new(&poly).roots())
+}
+
+/// The amplitudes of `y_k = Σ c_i z_i^k + c₀` over the filtered record `yf` (the last entry
+/// is `c₀`).
+fn amplitudes(yf: &[f64], z: &[Complex<f64>]) -> Result<DVector<Complex<f64>>> {
+    let n = yf.len();
     let mut v = DMatrix::<Complex<f64>>::zeros(n, z.len() + 1);
     for (j, zj) in z.iter().enumerate() {
         let mut zk = Complex::new(1.0, 0.0);
@@ -148,7 +150,25 @@ pub fn dominant_mode(t: &[f64], y: &[f64], settings: &PronySettings) -> Result<O
         v[(k, z.len())] = Complex::new(1.0, 0.0);
     }
     let yc = DVector::from_iterator(n, yf.iter().map(|x| Complex::new(*x, 0.0)));
-    let c = least_squares(v, yc)?;
+    least_squares(v, yc)
+}
+
+/// The dominant oscillatory mode (damping ratio ζ \[–\], natural frequency ω_n \[rad/s\]) of
+/// the response `y` sampled at the uniformly spaced times `t` \[s\], by Prony's method (see
+/// the [module documentation](self)); `None` if no pair of the fit turns by half a cycle over
+/// the record. Errors: `t` and `y` of different lengths, not finite, `t` not increasing
+/// uniformly, or too few samples for the settings.
+pub fn dominant_mode(t: &[f64], y: &[f64], settings: &PronySettings) -> Result<Option<Modal>> {
+    let dt = uniform_step(t, y, settings)?;
+    let (p, s) = (settings.order, settings.smoothing);
+    let yf: Vec<f64> = moving_average(&moving_average(y, s), s)
+        .into_iter()
+        .step_by(settings.decimation)
+        .collect();
+    let n = yf.len();
+    let h = dt * settings.decimation as f64;
+    let z = prediction_roots(&yf, p)?;
+    let c = amplitudes(&yf, &z)?;
     let span = h * (n - 1) as f64;
     let mut best: Option<(f64, Complex<f64>)> = None;
     for (zi, ci) in z.iter().zip(c.iter()) {

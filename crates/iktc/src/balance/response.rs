@@ -137,6 +137,81 @@ pub struct ResponseMetrics {
     pub fit_rms: f64,
 }
 
+/// The largest `|y|` \[m\] after the event and its time \[s\], the settling band \[m\], and the
+/// settling time \[s\] (the first sample after the last one outside the band; `None` when the
+/// last sample is outside).
+fn peak_and_settling(
+    after: &[(f64, f64)],
+    noise_std: f64,
+    settings: &ResponseSettings,
+) -> (f64, f64, f64, Option<f64>) {
+    let (peak_time, peak) = after.iter().fold((0.0, 0.0), |acc, (ti, yi)| {
+        if yi.abs() > acc.1 {
+            (*ti, yi.abs())
+        } else {
+            acc
+        }
+    });
+    let band = (settings.settle_fraction * peak).max(settings.noise_sigmas * noise_std);
+    let last_out = after.iter().rposition(|(_, yi)| yi.abs() > band);
+    let settling_time = match last_out {
+        None => Some(0.0),
+        Some(i) if i + 1 < after.len() => after.get(i + 1).map(|p| p.0),
+        Some(_) => None,
+    };
+    (peak_time, peak, band, settling_time)
+}
+
+/// The samples in the fit window (`fit_delay` to `fit_delay + fit_window` \[s\] after the
+/// event), times from the window's start; at least 8 needed.
+fn fit_window(after: &[(f64, f64)], settings: &ResponseSettings) -> Result<Vec<(f64, f64)>> {
+    let window: Vec<(f64, f64)> = after
+        .iter()
+        .filter(|(ti, _)| {
+            *ti >= settings.fit_delay && *ti <= settings.fit_delay + settings.fit_window
+        })
+        .map(|(ti, yi)| (*ti - settings.fit_delay, *yi))
+        .collect();
+    if window.len() < 8 {
+        return Err(Error::InsufficientData {
+            what: "response fit".into(),
+            message: format!(
+                "{} samples in the fit window, at least 8 needed",
+                window.len()
+            ),
+        });
+    }
+    Ok(window)
+}
+
+/// The grid search over damping ratio and log-spaced natural frequency \[rad/s\]: the
+/// `(cost, ζ, ω)` of the lowest cost.
+fn grid_search(window: &[(f64, f64)], settings: &ResponseSettings) -> (f64, f64, f64) {
+    let two = settings.modes == 2;
+    let ratio = settings.second_mode_ratio;
+    let mut best = (f64::INFINITY, 0.5, 1.0);
+    let (lw0, lw1) = (
+        settings.grid_min_frequency.ln(),
+        settings.grid_max_frequency.ln(),
+    );
+    for i in 0..settings.grid_damping {
+        let z = (i as f64 + 1.0) / (settings.grid_damping as f64 + 1.0);
+        for j in 0..settings.grid_frequency {
+            let w = (lw0 + (lw1 - lw0) * j as f64 / (settings.grid_frequency - 1) as f64).exp();
+            let modes: &[(f64, f64)] = if two {
+                &[(z, w), (z, ratio * w)]
+            } else {
+                &[(z, w)]
+            };
+            let c = modes_cost(window, modes);
+            if c < best.0 {
+                best = (c, z, w);
+            }
+        }
+    }
+    best
+}
+
 /// Analyses the response `y` \[m\] sampled at times `t` \[s\] (increasing) after an event at
 /// `t_event` \[s\]; `noise_std` \[m\] is the sensor noise's standard deviation (0 if none).
 pub fn analyse_response(
@@ -158,59 +233,12 @@ pub fn analyse_response(
         .filter(|(ti, _)| **ti >= t_event)
         .map(|(ti, yi)| (*ti - t_event, *yi))
         .collect();
-    let (peak_time, peak) = after.iter().fold((0.0, 0.0), |acc, (ti, yi)| {
-        if yi.abs() > acc.1 {
-            (*ti, yi.abs())
-        } else {
-            acc
-        }
-    });
-    let band = (settings.settle_fraction * peak).max(settings.noise_sigmas * noise_std);
-    let last_out = after.iter().rposition(|(_, yi)| yi.abs() > band);
-    let settling_time = match last_out {
-        None => Some(0.0),
-        Some(i) if i + 1 < after.len() => after.get(i + 1).map(|p| p.0),
-        Some(_) => None,
-    };
-    let window: Vec<(f64, f64)> = after
-        .iter()
-        .filter(|(ti, _)| {
-            *ti >= settings.fit_delay && *ti <= settings.fit_delay + settings.fit_window
-        })
-        .map(|(ti, yi)| (*ti - settings.fit_delay, *yi))
-        .collect();
-    if window.len() < 8 {
-        return Err(Error::InsufficientData {
-            what: "response fit".into(),
-            message: format!(
-                "{} samples in the fit window, at least 8 needed",
-                window.len()
-            ),
-        });
-    }
+    let (peak_time, peak, band, settling_time) = peak_and_settling(&after, noise_std, settings);
+    let window = fit_window(&after, settings)?;
     // Grid search, then refinement.
     let two = settings.modes == 2;
     let ratio = settings.second_mode_ratio;
-    let mut best = (f64::INFINITY, 0.5, 1.0);
-    let (lw0, lw1) = (
-        settings.grid_min_frequency.ln(),
-        settings.grid_max_frequency.ln(),
-    );
-    for i in 0..settings.grid_damping {
-        let z = (i as f64 + 1.0) / (settings.grid_damping as f64 + 1.0);
-        for j in 0..settings.grid_frequency {
-            let w = (lw0 + (lw1 - lw0) * j as f64 / (settings.grid_frequency - 1) as f64).exp();
-            let modes: &[(f64, f64)] = if two {
-                &[(z, w), (z, ratio * w)]
-            } else {
-                &[(z, w)]
-            };
-            let c = modes_cost(&window, modes);
-            if c < best.0 {
-                best = (c, z, w);
-            }
-        }
-    }
+    let best = grid_search(&window, settings);
     let logit = |z: f64| (z / (1.0 - z)).ln();
     let x0 = vec![logit(best.1), best.2.ln()];
     let m = window.len();

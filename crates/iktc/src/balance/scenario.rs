@@ -551,18 +551,18 @@ pub struct PushResult {
     pub health: HealthReport,
 }
 
-/// Runs the push test with and without the controller, and the static-gain runs.
-pub fn run_push(s: &PushScenario) -> Result<PushResult> {
-    s.validate()?;
-    let dt = s.sim.control_period;
-    let n = (s.duration / dt).round() as usize;
-    let k_push = (s.push_time / dt).round() as usize;
-    let plants = s.plants();
-    let time: Vec<f64> = (0..n).map(|k| k as f64 * dt).collect();
+/// One series of samples per plane (x–z, y–z).
+type PlaneSeries = [Vec<f64>; 2];
+
+/// The measured ZMP of both planes \[m\] over `n` ticks without the controller
+/// (u = u_ref = 0), pushed at tick `k_push`.
+fn open_loop_zmp(
+    s: &PushScenario,
+    plants: &[PlantParams; 2],
+    n: usize,
+    k_push: usize,
+) -> Result<[Vec<f64>; 2]> {
     let mut zmp_open = [Vec::with_capacity(n), Vec::with_capacity(n)];
-    let mut zmp_closed = [Vec::with_capacity(n), Vec::with_capacity(n)];
-    let mut com_offset = [Vec::with_capacity(n), Vec::with_capacity(n)];
-    // Without the controller: u = u_ref = 0.
     for (i, p) in plants.iter().enumerate() {
         let mut sim = SimPlant::new(*p, &seeded(&s.sim, i as u64))?;
         for k in 0..n {
@@ -573,7 +573,19 @@ pub fn run_push(s: &PushScenario) -> Result<PushResult> {
             sim.advance(0.0)?;
         }
     }
-    // With the controller (same noise sequence).
+    Ok(zmp_open)
+}
+
+/// The measured ZMP \[m\] and the controller's COM offset \[m\] of both planes over `n` ticks
+/// with the controller (the same noise sequence as without), pushed at tick `k_push`.
+fn closed_loop_zmp(
+    s: &PushScenario,
+    plants: &[PlantParams; 2],
+    n: usize,
+    k_push: usize,
+) -> Result<(PlaneSeries, PlaneSeries)> {
+    let mut zmp_closed = [Vec::with_capacity(n), Vec::with_capacity(n)];
+    let mut com_offset = [Vec::with_capacity(n), Vec::with_capacity(n)];
     let mut sims = [
         SimPlant::new(plants[0], &seeded(&s.sim, 0))?,
         SimPlant::new(plants[1], &seeded(&s.sim, 1))?,
@@ -593,16 +605,26 @@ pub fn run_push(s: &PushScenario) -> Result<PushResult> {
             sims[i].advance(out.u[i])?;
         }
     }
-    let polygon = s.support.polygon(s.phase)?;
-    let mut health = HealthMonitor::new(s.health)?;
+    Ok((zmp_closed, com_offset))
+}
+
+/// Checks both runs' measured ZMP (period `dt` \[s\]): finite, and inside the support polygon;
+/// returns each run's (without, with the controller) largest excursion outside it \[m\].
+fn check_zmp_runs(
+    dt: f64,
+    polygon: &SupportPolygon,
+    health: &mut HealthMonitor,
+    zmp_open: &[Vec<f64>; 2],
+    zmp_closed: &[Vec<f64>; 2],
+) -> Result<[f64; 2]> {
     let mut excursion = [0.0f64; 2];
     for (run, (zmp, frame)) in [
         (
-            &zmp_open,
+            zmp_open,
             "local frame of Fig. 11, run without the controller",
         ),
         (
-            &zmp_closed,
+            zmp_closed,
             "local frame of Fig. 11, run with the controller",
         ),
     ]
@@ -614,18 +636,30 @@ pub fn run_push(s: &PushScenario) -> Result<PushResult> {
             if health.check_finite(t, "measured ZMP [m]", &[], &[*x, *y])? == Verdict::Stop {
                 break;
             }
-            health.check_support(t, &polygon, (*x, *y), "ZMP", frame)?;
+            health.check_support(t, polygon, (*x, *y), "ZMP", frame)?;
             health.end_tick();
             excursion[run] = excursion[run].max(-polygon.margin((*x, *y)));
         }
     }
-    let t_push = k_push as f64 * dt;
+    Ok(excursion)
+}
+
+/// Each plane's push metrics: the responses without and with the controller (push at
+/// `t_push` \[s\]), the designed and the model's damping, and the static gains.
+fn plane_metrics(
+    s: &PushScenario,
+    plants: &[PlantParams; 2],
+    time: &[f64],
+    zmp_open: &[Vec<f64>; 2],
+    zmp_closed: &[Vec<f64>; 2],
+    t_push: f64,
+) -> Result<[PlanePushMetrics; 2]> {
     let mut metrics = Vec::with_capacity(2);
     for (i, plane) in Plane::BOTH.iter().enumerate() {
         let model = s.cases.get(*plane, s.phase);
-        let open = analyse_response(&time, &zmp_open[i], t_push, s.noise_std, &s.response)?;
+        let open = analyse_response(time, &zmp_open[i], t_push, s.noise_std, &s.response)?;
         let closed = analyse_response(
-            &time,
+            time,
             &zmp_closed[i],
             t_push,
             s.noise_std,
@@ -652,6 +686,26 @@ pub fn run_push(s: &PushScenario) -> Result<PushResult> {
                 what: "push metrics".into(),
                 message: "two planes expected".into(),
             })?;
+    Ok(metrics)
+}
+
+/// Runs the push test with and without the controller, and the static-gain runs.
+pub fn run_push(s: &PushScenario) -> Result<PushResult> {
+    s.validate()?;
+    let dt = s.sim.control_period;
+    let n = (s.duration / dt).round() as usize;
+    let k_push = (s.push_time / dt).round() as usize;
+    let plants = s.plants();
+    let time: Vec<f64> = (0..n).map(|k| k as f64 * dt).collect();
+    // Without the controller: u = u_ref = 0.
+    let zmp_open = open_loop_zmp(s, &plants, n, k_push)?;
+    // With the controller (same noise sequence).
+    let (zmp_closed, com_offset) = closed_loop_zmp(s, &plants, n, k_push)?;
+    let polygon = s.support.polygon(s.phase)?;
+    let mut health = HealthMonitor::new(s.health)?;
+    let excursion = check_zmp_runs(dt, &polygon, &mut health, &zmp_open, &zmp_closed)?;
+    let t_push = k_push as f64 * dt;
+    let metrics = plane_metrics(s, &plants, &time, &zmp_open, &zmp_closed, t_push)?;
     Ok(PushResult {
         scenario: *s,
         time,

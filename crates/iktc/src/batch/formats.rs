@@ -228,23 +228,7 @@ impl BodyMotion {
     /// [`Error::UnknownName`] for a body the robot lacks, and those of
     /// [`Kinematics::update`] (a non-finite value, a quaternion that is not unit).
     pub fn new(robot: &Robot, traj: &TrainingTrajectory, bodies: &[String]) -> Result<Self> {
-        let active: Vec<&str> = robot.active_joints().map(|j| j.name.as_str()).collect();
-        if traj
-            .joint_names
-            .iter()
-            .map(String::as_str)
-            .ne(active.iter().copied())
-        {
-            return Err(Error::InvalidSetting {
-                name: "the trajectory's joints".into(),
-                value: traj.joint_names.join(", "),
-                expected: format!(
-                    "the robot `{}`'s active joints in its order ({})",
-                    robot.name(),
-                    active.join(", ")
-                ),
-            });
-        }
+        let active = check_joint_order(robot, traj)?;
         let ids = bodies
             .iter()
             .map(|b| robot.frame_id(b))
@@ -264,18 +248,7 @@ impl BodyMotion {
             ang_vel_w: Vec::with_capacity(n),
         };
         for j in 0..n {
-            for (what, got) in [
-                ("joint positions of a frame", traj.joint_pos[j].len()),
-                ("joint rates of a frame", traj.joint_vel[j].len()),
-            ] {
-                if got != nj {
-                    return Err(Error::DimensionMismatch {
-                        what: what.into(),
-                        expected: nj,
-                        got,
-                    });
-                }
-            }
+            check_frame_width(traj, j, nj)?;
             let q = state.q.as_mut_slice();
             let qd = state.qd.as_mut_slice();
             if floating {
@@ -315,6 +288,45 @@ impl BodyMotion {
         }
         Ok(out)
     }
+}
+
+/// The robot's active joints, checked to be `traj`'s joints in the same order.
+fn check_joint_order<'a>(robot: &'a Robot, traj: &TrainingTrajectory) -> Result<Vec<&'a str>> {
+    let active: Vec<&str> = robot.active_joints().map(|j| j.name.as_str()).collect();
+    if traj
+        .joint_names
+        .iter()
+        .map(String::as_str)
+        .ne(active.iter().copied())
+    {
+        return Err(Error::InvalidSetting {
+            name: "the trajectory's joints".into(),
+            value: traj.joint_names.join(", "),
+            expected: format!(
+                "the robot `{}`'s active joints in its order ({})",
+                robot.name(),
+                active.join(", ")
+            ),
+        });
+    }
+    Ok(active)
+}
+
+/// Checks that frame `j` of `traj` has `nj` joint positions and `nj` joint rates.
+fn check_frame_width(traj: &TrainingTrajectory, j: usize, nj: usize) -> Result<()> {
+    for (what, got) in [
+        ("joint positions of a frame", traj.joint_pos[j].len()),
+        ("joint rates of a frame", traj.joint_vel[j].len()),
+    ] {
+        if got != nj {
+            return Err(Error::DimensionMismatch {
+                what: what.into(),
+                expected: nj,
+                got,
+            });
+        }
+    }
+    Ok(())
 }
 
 fn flat<const K: usize>(rows: &[Vec<[f64; K]>]) -> Vec<f64> {

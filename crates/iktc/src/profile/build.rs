@@ -169,6 +169,28 @@ impl RobotProfile {
         Ok(out)
     }
 
+    /// Checks that every joint with an acceleration, velocity or jerk limit is one of the
+    /// robot's `movable` joints.
+    fn check_limited_joints(&self, movable: &[String]) -> Result<()> {
+        let limited = self
+            .acceleration
+            .limits
+            .keys()
+            .map(|j| ("acceleration", j))
+            .chain(self.velocity.limits.keys().map(|j| ("velocity", j)))
+            .chain(self.jerk.limits.keys().map(|j| ("jerk", j)));
+        for (key, j) in limited {
+            if !movable.contains(j) {
+                return Err(profile_error(
+                    &format!("{key}.limits.{j}"),
+                    j,
+                    format!("no such movable joint; joints are {}", list(movable)),
+                ));
+            }
+        }
+        Ok(())
+    }
+
     /// Builds the robot: the URDF (key `urdf`) with the profile's base, locked joints and
     /// acceleration limits, then checks every frame and joint the profile names
     /// ([`RobotProfile::check_robot`]).
@@ -190,22 +212,7 @@ impl RobotProfile {
             .filter(|j| !matches!(j.kind, JointKind::Fixed))
             .map(|j| j.name.clone())
             .collect();
-        let limited = self
-            .acceleration
-            .limits
-            .keys()
-            .map(|j| ("acceleration", j))
-            .chain(self.velocity.limits.keys().map(|j| ("velocity", j)))
-            .chain(self.jerk.limits.keys().map(|j| ("jerk", j)));
-        for (key, j) in limited {
-            if !movable.contains(j) {
-                return Err(profile_error(
-                    &format!("{key}.limits.{j}"),
-                    j,
-                    format!("no such movable joint; joints are {}", list(&movable)),
-                ));
-            }
-        }
+        self.check_limited_joints(&movable)?;
         let options = ModelOptions {
             base: self.base,
             locked: self.expand_locks(&movable)?,

@@ -159,28 +159,15 @@ fn held(joints: usize, ep: Vector3<f64>, er: Vector3<f64>) -> (Vector3<f64>, Vec
     (keep(ep, 0), keep(er, 3))
 }
 
-/// A start posture for a floating biped whose feet frames are `feet` (see [`CROUCH`]): the
-/// movable joints from the root to each foot that are not on both legs' paths (a waist below
-/// the hips is held), solved by damped least squares for the rows of the foot's pose relative
-/// to the base that the leg can hold ([`foot_rows`]), each joint within its range. `None` when
-/// the URDF does not build, a leg has fewer than three such joints, or the solve does not
-/// reach the held rows within 1 mm and 0.01 rad.
-fn crouch_posture(
-    text: &str,
-    dir: Option<&std::path::Path>,
+/// A leg's joint: name, q index, v index, lower and upper bound, the link the joint moves.
+type LegJoint = (String, usize, usize, f64, f64, String);
+
+/// Per leg: its foot frame and its movable joints from the foot up to the root, foot first.
+fn leg_chains(
+    robot: &crate::model::Robot,
     u: &urdf_rs::Robot,
     feet: &[&str],
-) -> Option<Vec<(String, f64)>> {
-    use crate::model::{BaseKind, Kinematics, ModelOptions, Robot, State};
-    let options = ModelOptions {
-        base: BaseKind::Floating,
-        ..ModelOptions::default()
-    };
-    let robot = Robot::from_description_str(text, dir, &options).ok()?;
-    let mut state = State::neutral(&robot);
-    // Per leg: its foot frame and its joints (name, q index, v index, lower, upper, the link
-    // the joint moves), foot first.
-    type LegJoint = (String, usize, usize, f64, f64, String);
+) -> Option<Vec<(crate::model::FrameId, Vec<LegJoint>)>> {
     let mut chains: Vec<(crate::model::FrameId, Vec<LegJoint>)> = Vec::new();
     for foot in feet {
         let (mut joints, mut link) = (Vec::new(), foot.to_string());
@@ -203,6 +190,82 @@ fn crouch_posture(
         }
         chains.push((robot.frame_id(foot).ok()?, joints));
     }
+    Some(chains)
+}
+
+/// Solves one leg's joints by damped least squares (at most 500 iterations) for the held rows
+/// of `foot`'s `target` pose; `None` when the result is not within 1 mm and 0.01 rad.
+fn solve_leg(
+    robot: &crate::model::Robot,
+    kin: &mut crate::model::Kinematics,
+    state: &mut crate::model::State,
+    jac: &mut DMatrix<f64>,
+    foot: crate::model::FrameId,
+    joints: &[LegJoint],
+    target: &nalgebra::Isometry3<f64>,
+) -> Option<()> {
+    let mut reached = false;
+    for _ in 0..500 {
+        kin.update(robot, state).ok()?;
+        let pose = kin.frame_pose(robot, foot).ok()?;
+        let ep = target.translation.vector - pose.translation.vector;
+        let er = (target.rotation * pose.rotation.inverse()).scaled_axis();
+        let (ep, er) = held(joints.len(), ep, er);
+        if ep.norm() < 1e-9 && er.norm() < 1e-9 {
+            reached = true;
+            break;
+        }
+        kin.frame_jacobian(robot, foot, jac).ok()?;
+        let rows = foot_rows(joints.len());
+        let m = rows.len();
+        let j = DMatrix::from_fn(m, joints.len(), |r, c| jac[(rows[r], joints[c].2)]);
+        let full: Vec<f64> = ep.iter().chain(er.iter()).copied().collect();
+        let e = DVector::from_iterator(m, rows.iter().map(|r| full[*r]));
+        let a = &j * j.transpose() + DMatrix::identity(m, m) * 1e-6;
+        let mut dq = j.transpose() * a.lu().solve(&e)?;
+        // At most MAX_STEP per joint and iteration: near the straight leg's singularity a
+        // full step overshoots into the joints' limits.
+        let largest = dq.amax();
+        if largest > MAX_STEP {
+            dq *= MAX_STEP / largest;
+        }
+        for ((_, iq, _, lo, hi, _), d) in joints.iter().zip(dq.iter()) {
+            state.q[*iq] = (state.q[*iq] + d).clamp(*lo, *hi);
+        }
+    }
+    kin.update(robot, state).ok()?;
+    let pose = kin.frame_pose(robot, foot).ok()?;
+    let (ep, er) = held(
+        joints.len(),
+        target.translation.vector - pose.translation.vector,
+        (target.rotation * pose.rotation.inverse()).scaled_axis(),
+    );
+    if !(reached || (ep.norm() < 1e-3 && er.norm() < 1e-2)) {
+        return None;
+    }
+    Some(())
+}
+
+/// A start posture for a floating biped whose feet frames are `feet` (see [`CROUCH`]): the
+/// movable joints from the root to each foot that are not on both legs' paths (a waist below
+/// the hips is held), solved by damped least squares for the rows of the foot's pose relative
+/// to the base that the leg can hold ([`foot_rows`]), each joint within its range. `None` when
+/// the URDF does not build, a leg has fewer than three such joints, or the solve does not
+/// reach the held rows within 1 mm and 0.01 rad.
+fn crouch_posture(
+    text: &str,
+    dir: Option<&std::path::Path>,
+    u: &urdf_rs::Robot,
+    feet: &[&str],
+) -> Option<Vec<(String, f64)>> {
+    use crate::model::{BaseKind, Kinematics, ModelOptions, Robot, State};
+    let options = ModelOptions {
+        base: BaseKind::Floating,
+        ..ModelOptions::default()
+    };
+    let robot = Robot::from_description_str(text, dir, &options).ok()?;
+    let mut state = State::neutral(&robot);
+    let chains = leg_chains(&robot, u, feet)?;
     // A joint on both legs' paths (a waist below the hips) is the body's, not a leg's: held.
     let [(_, a), (_, b)] = chains.as_slice() else {
         return None;
@@ -249,45 +312,9 @@ fn crouch_posture(
     }
     let mut jac = DMatrix::zeros(6, robot.nv());
     for ((foot, joints, _), target) in legs.iter().zip(&targets) {
-        let mut reached = false;
-        for _ in 0..500 {
-            kin.update(&robot, &state).ok()?;
-            let pose = kin.frame_pose(&robot, *foot).ok()?;
-            let ep = target.translation.vector - pose.translation.vector;
-            let er = (target.rotation * pose.rotation.inverse()).scaled_axis();
-            let (ep, er) = held(joints.len(), ep, er);
-            if ep.norm() < 1e-9 && er.norm() < 1e-9 {
-                reached = true;
-                break;
-            }
-            kin.frame_jacobian(&robot, *foot, &mut jac).ok()?;
-            let rows = foot_rows(joints.len());
-            let m = rows.len();
-            let j = DMatrix::from_fn(m, joints.len(), |r, c| jac[(rows[r], joints[c].2)]);
-            let full: Vec<f64> = ep.iter().chain(er.iter()).copied().collect();
-            let e = DVector::from_iterator(m, rows.iter().map(|r| full[*r]));
-            let a = &j * j.transpose() + DMatrix::identity(m, m) * 1e-6;
-            let mut dq = j.transpose() * a.lu().solve(&e)?;
-            // At most MAX_STEP per joint and iteration: near the straight leg's singularity a
-            // full step overshoots into the joints' limits.
-            let largest = dq.amax();
-            if largest > MAX_STEP {
-                dq *= MAX_STEP / largest;
-            }
-            for ((_, iq, _, lo, hi, _), d) in joints.iter().zip(dq.iter()) {
-                state.q[*iq] = (state.q[*iq] + d).clamp(*lo, *hi);
-            }
-        }
-        kin.update(&robot, &state).ok()?;
-        let pose = kin.frame_pose(&robot, *foot).ok()?;
-        let (ep, er) = held(
-            joints.len(),
-            target.translation.vector - pose.translation.vector,
-            (target.rotation * pose.rotation.inverse()).scaled_axis(),
-        );
-        if !(reached || (ep.norm() < 1e-3 && er.norm() < 1e-2)) {
-            return None;
-        }
+        solve_leg(
+            &robot, &mut kin, &mut state, &mut jac, *foot, joints, target,
+        )?;
     }
     let mut out = Vec::new();
     for (_, joints, _) in &legs {
@@ -499,32 +526,32 @@ const FOOT_WORDS: [&str; 3] = ["foot", "ankle", "sole"];
 /// Link words naming a hand frame.
 const HAND_WORDS: [&str; 7] = ["hand", "palm", "wrist", "end_effector", "eef", "tcp", "tip"];
 
-impl Guessed {
-    fn new(
-        t: &Tree,
-        parts: &Parts,
-        o: &InitOptions,
-        dir: Option<&std::path::Path>,
-        u: &urdf_rs::Robot,
-    ) -> Result<Guessed> {
-        let links: Vec<TreeLink> = t
-            .names
-            .iter()
-            .enumerate()
-            .map(|(i, n)| TreeLink {
-                name: n.clone(),
-                lower: n.to_lowercase(),
-                depth: depth(t, i),
-            })
-            .collect();
-        let by_name = |l: Option<&TreeLink>| l.and_then(|l| t.index(&l.name));
-        let side_name = ["left", "right"];
-        let feet = match &o.feet {
-            Some([l, r]) => Some([
-                (given(t, "feet.left.frame", l)?, "given".to_string()),
-                (given(t, "feet.right.frame", r)?, "given".to_string()),
-            ]),
-            None => match parts.feet {
+/// A frame to add at the far end of a bare forearm: its parent link, its position there \[m\],
+/// and where that came from.
+type HandEnd = (usize, Vector3<f64>, &'static str);
+
+/// Per side, the hand frame, or the frame to add at a bare forearm's far end.
+type HandGuess = ([Option<Chosen>; 2], [Option<HandEnd>; 2]);
+
+/// The feet: given by the flags, else the leg chains' lowest ends (or a link named like a
+/// foot at such an end's origin), else the deepest links named like a foot on each side.
+fn guess_feet(
+    t: &Tree,
+    parts: &Parts,
+    o: &InitOptions,
+    dir: Option<&std::path::Path>,
+    u: &urdf_rs::Robot,
+    links: &[TreeLink],
+) -> Result<Option<[Chosen; 2]>> {
+    let by_name = |l: Option<&TreeLink>| l.and_then(|l| t.index(&l.name));
+    let side_name = ["left", "right"];
+    Ok(match &o.feet {
+        Some([l, r]) => Some([
+            (given(t, "feet.left.frame", l)?, "given".to_string()),
+            (given(t, "feet.right.frame", r)?, "given".to_string()),
+        ]),
+        None => {
+            match parts.feet {
                 Some(f) => Some(f.map(|i| {
                     // A link named like a foot at the end's own origin (an alias of its
                     // frame), not a contact point fixed away from it.
@@ -546,57 +573,124 @@ impl Guessed {
                 })),
                 None => {
                     let words = [FOOT_WORDS[0], FOOT_WORDS[1], FOOT_WORDS[2], "toe"];
-                    let l = by_name(deepest(&links, &words, Some(Side::Left)));
-                    let r = by_name(deepest(&links, &words, Some(Side::Right)));
+                    let l = by_name(deepest(links, &words, Some(Side::Left)));
+                    let r = by_name(deepest(links, &words, Some(Side::Right)));
                     l.zip(r).map(|(l, r)| {
-                        [(l, 0), (r, 1)].map(|(i, s)| {
-                            let (frame, _) = foot_guess(u, t, i, dir);
-                            let why = if frame == i {
-                                format!("deepest link named like a foot on the {}", side_name[s])
-                            } else {
-                                format!("the link `{}` (deepest named like a foot on the {}) is fixed to", t.names[i], side_name[s])
-                            };
-                            (frame, why)
-                        })
+                    [(l, 0), (r, 1)].map(|(i, s)| {
+                        let (frame, _) = foot_guess(u, t, i, dir);
+                        let why = if frame == i {
+                            format!("deepest link named like a foot on the {}", side_name[s])
+                        } else {
+                            format!("the link `{}` (deepest named like a foot on the {}) is fixed to", t.names[i], side_name[s])
+                        };
+                        (frame, why)
                     })
-                }
-            },
-        };
-        let mut hands: [Option<Chosen>; 2] = [None, None];
-        let mut hand_ends = [None, None];
-        match (&o.hands, parts.hands) {
-            (Some([l, r]), _) => {
-                hands = [
-                    Some((given(t, "frames.left_hand", l)?, "given".to_string())),
-                    Some((given(t, "frames.right_hand", r)?, "given".to_string())),
-                ];
-            }
-            (None, Some(h)) => {
-                for s in 0..2 {
-                    let frame = named_frame(t, h[s], &HAND_WORDS);
-                    let bare = parts.arm_joints[s] <= FOREARM_JOINTS
-                        && !named_like(&t.names[frame], &HAND_WORDS);
-                    match bare.then(|| hand_point(u, t, h[s], dir)).flatten() {
-                        Some((xyz, why)) => hand_ends[s] = Some((h[s], xyz, why)),
-                        None => {
-                            hands[s] = Some((frame, format!("the far end of the arm chain on the {} ({} joints from the torso)", side_name[s], parts.arm_joints[s])));
-                        }
-                    }
+                })
                 }
             }
-            (None, None) => {
-                for (s, side) in [Side::Left, Side::Right].into_iter().enumerate() {
-                    if let Some(i) = by_name(deepest(&links, &HAND_WORDS, Some(side))) {
-                        hands[s] = Some((i, "a link named like it".to_string()));
-                        continue;
-                    }
-                    let forearm = ["elbow", "forearm", "lower_arm", "lowerarm"];
-                    if let Some(i) = by_name(deepest(&links, &forearm, Some(side))) {
-                        hand_ends[s] = hand_point(u, t, i, dir).map(|(xyz, why)| (i, xyz, why));
+        }
+    })
+}
+
+/// Per side, the hand frame or, on a bare forearm, the frame to add at its far end (parent
+/// link, position \[m\], source): given by the flags, else the arm chains' far ends, else the
+/// deepest links named like a hand (or a forearm).
+fn guess_hands(
+    t: &Tree,
+    parts: &Parts,
+    o: &InitOptions,
+    dir: Option<&std::path::Path>,
+    u: &urdf_rs::Robot,
+    links: &[TreeLink],
+) -> Result<HandGuess> {
+    let by_name = |l: Option<&TreeLink>| l.and_then(|l| t.index(&l.name));
+    let side_name = ["left", "right"];
+    let mut hands: [Option<Chosen>; 2] = [None, None];
+    let mut hand_ends = [None, None];
+    match (&o.hands, parts.hands) {
+        (Some([l, r]), _) => {
+            hands = [
+                Some((given(t, "frames.left_hand", l)?, "given".to_string())),
+                Some((given(t, "frames.right_hand", r)?, "given".to_string())),
+            ];
+        }
+        (None, Some(h)) => {
+            for s in 0..2 {
+                let frame = named_frame(t, h[s], &HAND_WORDS);
+                let bare = parts.arm_joints[s] <= FOREARM_JOINTS
+                    && !named_like(&t.names[frame], &HAND_WORDS);
+                match bare.then(|| hand_point(u, t, h[s], dir)).flatten() {
+                    Some((xyz, why)) => hand_ends[s] = Some((h[s], xyz, why)),
+                    None => {
+                        hands[s] = Some((
+                            frame,
+                            format!(
+                                "the far end of the arm chain on the {} ({} joints from the torso)",
+                                side_name[s], parts.arm_joints[s]
+                            ),
+                        ));
                     }
                 }
             }
         }
+        (None, None) => {
+            for (s, side) in [Side::Left, Side::Right].into_iter().enumerate() {
+                if let Some(i) = by_name(deepest(links, &HAND_WORDS, Some(side))) {
+                    hands[s] = Some((i, "a link named like it".to_string()));
+                    continue;
+                }
+                let forearm = ["elbow", "forearm", "lower_arm", "lowerarm"];
+                if let Some(i) = by_name(deepest(links, &forearm, Some(side))) {
+                    hand_ends[s] = hand_point(u, t, i, dir).map(|(xyz, why)| (i, xyz, why));
+                }
+            }
+        }
+    }
+    Ok((hands, hand_ends))
+}
+
+/// The pelvis: given by the flag, else a link named like a pelvis fixed to the base, else the
+/// base.
+fn guess_pelvis(t: &Tree, o: &InitOptions) -> Result<Chosen> {
+    Ok(match &o.pelvis {
+        Some(n) => (given(t, "frames.pelvis", n)?, "given".to_string()),
+        None => t
+            .fixed_below(0)
+            .into_iter()
+            .find(|i| named_like(&t.names[*i], &["pelvis"]))
+            .map(|i| {
+                let why = if i == 0 {
+                    "the base (the root link)"
+                } else {
+                    "named like a pelvis, fixed to the base"
+                };
+                (i, why.to_string())
+            })
+            .unwrap_or((0, "the base (the root link)".to_string())),
+    })
+}
+
+impl Guessed {
+    fn new(
+        t: &Tree,
+        parts: &Parts,
+        o: &InitOptions,
+        dir: Option<&std::path::Path>,
+        u: &urdf_rs::Robot,
+    ) -> Result<Guessed> {
+        let links: Vec<TreeLink> = t
+            .names
+            .iter()
+            .enumerate()
+            .map(|(i, n)| TreeLink {
+                name: n.clone(),
+                lower: n.to_lowercase(),
+                depth: depth(t, i),
+            })
+            .collect();
+        let by_name = |l: Option<&TreeLink>| l.and_then(|l| t.index(&l.name));
+        let feet = guess_feet(t, parts, o, dir, u, &links)?;
+        let (hands, hand_ends) = guess_hands(t, parts, o, dir, u, &links)?;
         let pick_part = |key: &str,
                          given_name: &Option<String>,
                          shape: Option<usize>,
@@ -626,22 +720,7 @@ impl Guessed {
             "the end of the chain going up from the torso (or the highest link fixed to it)",
             &["head", "neck"],
         )?;
-        let pelvis = match &o.pelvis {
-            Some(n) => (given(t, "frames.pelvis", n)?, "given".to_string()),
-            None => t
-                .fixed_below(0)
-                .into_iter()
-                .find(|i| named_like(&t.names[*i], &["pelvis"]))
-                .map(|i| {
-                    let why = if i == 0 {
-                        "the base (the root link)"
-                    } else {
-                        "named like a pelvis, fixed to the base"
-                    };
-                    (i, why.to_string())
-                })
-                .unwrap_or((0, "the base (the root link)".to_string())),
-        };
+        let pelvis = guess_pelvis(t, o)?;
         Ok(Guessed {
             feet,
             hands,
@@ -768,19 +847,8 @@ fn write_feet(
     frames
 }
 
-/// The profile's text (see [`init_profile_toml_with`]).
-#[allow(clippy::too_many_arguments)]
-fn write_profile(
-    text: &str,
-    robot: &crate::model::Robot,
-    u: &urdf_rs::Robot,
-    t: &Tree,
-    g: &Guessed,
-    o: &InitOptions,
-    urdf_path: &str,
-    dir: Option<&std::path::Path>,
-) -> String {
-    let mut out = String::new();
+/// The profile's header: its name and URDF, and the base (floating when two feet were found).
+fn write_header(out: &mut String, u: &urdf_rs::Robot, g: &Guessed, urdf_path: &str) {
     let name = if u.name.is_empty() { "robot" } else { &u.name };
     out.push_str(&format!(
         "# Robot profile of `{name}`, written by `iktc profile init`: check every value marked\n\
@@ -801,6 +869,10 @@ fn write_profile(
             "no pair of feet was found"
         }
     ));
+}
+
+/// A `[[lock]]` at 0 for each movable joint named like a finger.
+fn write_finger_locks(out: &mut String, u: &urdf_rs::Robot) {
     let fingers = [
         "finger", "thumb", "index", "middle", "ring", "little", "pinky",
     ];
@@ -813,6 +885,23 @@ fn write_profile(
             quote(&j.name)
         ));
     }
+}
+
+/// The profile's text (see [`init_profile_toml_with`]).
+#[allow(clippy::too_many_arguments)]
+fn write_profile(
+    text: &str,
+    robot: &crate::model::Robot,
+    u: &urdf_rs::Robot,
+    t: &Tree,
+    g: &Guessed,
+    o: &InitOptions,
+    urdf_path: &str,
+    dir: Option<&std::path::Path>,
+) -> String {
+    let mut out = String::new();
+    write_header(&mut out, u, g, urdf_path);
+    write_finger_locks(&mut out, u);
     out.push('\n');
     let foot_frames = write_feet(&mut out, u, t, g, o, dir);
     for (key, end) in ["left_hand", "right_hand"].iter().zip(&g.hand_ends) {

@@ -302,6 +302,151 @@ pub struct ImitationTasks {
     pub upper_body: JointsHandle,
 }
 
+/// Clamps the joint references into the (narrowed) ranges shrunk by `margin` \[rad\]; a
+/// clamped sample's rate and acceleration become 0.
+fn clamp_joint_references(
+    robot: &Robot,
+    limits: &JointLimits,
+    refs: &mut RobotReferences,
+    margin: f64,
+) -> Result<()> {
+    for (name, track) in refs.joint_names.iter().zip(refs.joints.iter_mut()) {
+        let v = robot.joint_v_index(name)?;
+        if let Some(d) = limits.get(v) {
+            let (lo, hi) = crate::motion::shrunk_range(d.position_min, d.position_max, margin);
+            for (p, (v, a)) in track
+                .position
+                .iter_mut()
+                .zip(track.velocity.iter_mut().zip(track.acceleration.iter_mut()))
+            {
+                if *p < lo || *p > hi {
+                    *p = p.clamp(lo, hi);
+                    *v = 0.0;
+                    *a = 0.0;
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The initial state: the neutral posture with `cfg.initial_posture` and the first joint
+/// references; refused when outside the (narrowed) limits unless recovery was asked for.
+fn initial_state(
+    robot: &Robot,
+    cfg: &ImitateConfig,
+    refs: &RobotReferences,
+    limits: &JointLimits,
+) -> Result<State> {
+    let mut state = State::neutral(robot);
+    for (name, value) in &cfg.initial_posture {
+        state.set_joint(robot, name, *value)?;
+    }
+    for (name, track) in refs.joint_names.iter().zip(&refs.joints) {
+        if let Some(p) = track.position.first() {
+            state.set_joint(robot, name, *p)?;
+        }
+    }
+    // A start outside the (narrowed) limits is refused unless recovery was asked for.
+    let mut pos = vec![0.0; robot.nv()];
+    if cfg.bounds.outside_limits() == OutsideLimits::Error {
+        state.dof_positions(robot, &mut pos)?;
+        limits.check_state(&pos, state.qd.as_slice())?;
+    }
+    Ok(state)
+}
+
+/// Places the base so that the lowest foot frame is `ankle_height` \[m\] above z = 0; returns
+/// the kinematics of the placed state and the feet's poses.
+fn stand_on_ground(
+    robot: &Robot,
+    cfg: &ImitateConfig,
+    state: &mut State,
+) -> Result<(Kinematics, Vec<Isometry3<f64>>)> {
+    let mut kin = Kinematics::new(robot, state)?;
+    let feet_ids = cfg
+        .feet
+        .iter()
+        .map(|f| robot.frame_id(f))
+        .collect::<Result<Vec<_>>>()?;
+    let lowest = feet_ids
+        .iter()
+        .map(|f| kin.frame_pose(robot, *f).map(|p| p.translation.z))
+        .collect::<Result<Vec<_>>>()?
+        .into_iter()
+        .fold(f64::INFINITY, f64::min);
+    let mut base = state.base_pose(robot);
+    base.translation.vector.z += cfg.support.ankle_height - lowest;
+    state.set_base_pose(robot, &base)?;
+    kin.update(robot, state)?;
+    let feet0 = feet_ids
+        .iter()
+        .map(|f| kin.frame_pose(robot, *f))
+        .collect::<Result<Vec<_>>>()?;
+    Ok((kin, feet0))
+}
+
+/// The COM reference: over the centre of the initial feet's support polygon (the mean of its
+/// corners), at the COM's height \[m\].
+fn com_over_support(
+    kin: &Kinematics,
+    feet0: &[Isometry3<f64>],
+    cfg: &ImitateConfig,
+) -> Result<Vector3<f64>> {
+    let polygon = support_polygon(feet0, &cfg.support)?;
+    let corners = polygon.vertices();
+    let centre = corners
+        .iter()
+        .fold((0.0, 0.0), |a, p| (a.0 + p.0, a.1 + p.1));
+    let count = corners.len().max(1) as f64;
+    Ok(Vector3::new(
+        centre.0 / count,
+        centre.1 / count,
+        kin.com().z,
+    ))
+}
+
+/// The controller with the stack of Table 1, each task created holding where the robot stands.
+fn build_stack(
+    robot: &Robot,
+    cfg: &ImitateConfig,
+    state: &State,
+    limits: JointLimits,
+    refs: &RobotReferences,
+) -> Result<(Controller, ImitationTasks)> {
+    let mut b = ControllerBuilder::new(std::sync::Arc::new(robot.clone()), state)?;
+    b.gains(cfg.gains)
+        .limits(limits)
+        .settings(ControllerSettings {
+            method: cfg.method,
+            bounds: cfg.bounds,
+            solver: cfg.solver,
+        });
+    b.level(LEVEL_NAMES[0]);
+    let feet = cfg
+        .feet
+        .iter()
+        .map(|f| b.frame(f, Axes::ALL))
+        .collect::<Result<Vec<_>>>()?;
+    let com = b.level(LEVEL_NAMES[1]).com([true, true, false])?;
+    let pelvis_attitude = b
+        .level(LEVEL_NAMES[2])
+        .frame(&cfg.pelvis, Axes::ORIENTATION)?;
+    let pelvis_height = b.level(LEVEL_NAMES[3]).frame(&cfg.pelvis, Axes::Z)?;
+    let names: Vec<&str> = refs.joint_names.iter().map(|s| s.as_str()).collect();
+    let upper_body = b.level(LEVEL_NAMES[4]).joints(&names)?;
+    Ok((
+        b.build()?,
+        ImitationTasks {
+            feet,
+            com,
+            pelvis_attitude,
+            pelvis_height,
+            upper_body,
+        },
+    ))
+}
+
 /// The closed loop of one imitation run: a [`Controller`] with the stack of Table 1, its
 /// references and its state, sized once.
 #[derive(Debug, Clone)]
@@ -344,106 +489,18 @@ impl ImitationController {
         let mut refs = refs.clone();
         // Limits, with the narrowed ranges.
         let limits = JointLimits::from_robot(robot)?.narrowed(&cfg.narrow)?;
-        // Clamp the joint references into the (narrowed) ranges.
-        for (name, track) in refs.joint_names.iter().zip(refs.joints.iter_mut()) {
-            let v = robot.joint_v_index(name)?;
-            if let Some(d) = limits.get(v) {
-                let (lo, hi) = crate::motion::shrunk_range(
-                    d.position_min,
-                    d.position_max,
-                    cfg.reference_margin,
-                );
-                for (p, (v, a)) in track
-                    .position
-                    .iter_mut()
-                    .zip(track.velocity.iter_mut().zip(track.acceleration.iter_mut()))
-                {
-                    if *p < lo || *p > hi {
-                        *p = p.clamp(lo, hi);
-                        *v = 0.0;
-                        *a = 0.0;
-                    }
-                }
-            }
-        }
-        // Initial state.
-        let mut state = State::neutral(robot);
-        for (name, value) in &cfg.initial_posture {
-            state.set_joint(robot, name, *value)?;
-        }
-        for (name, track) in refs.joint_names.iter().zip(&refs.joints) {
-            if let Some(p) = track.position.first() {
-                state.set_joint(robot, name, *p)?;
-            }
-        }
-        // A start outside the (narrowed) limits is refused unless recovery was asked for.
-        let mut pos = vec![0.0; robot.nv()];
-        if cfg.bounds.outside_limits() == OutsideLimits::Error {
-            state.dof_positions(robot, &mut pos)?;
-            limits.check_state(&pos, state.qd.as_slice())?;
-        }
-        let mut kin = Kinematics::new(robot, &state)?;
-        let feet_ids = cfg
-            .feet
-            .iter()
-            .map(|f| robot.frame_id(f))
-            .collect::<Result<Vec<_>>>()?;
-        let lowest = feet_ids
-            .iter()
-            .map(|f| kin.frame_pose(robot, *f).map(|p| p.translation.z))
-            .collect::<Result<Vec<_>>>()?
-            .into_iter()
-            .fold(f64::INFINITY, f64::min);
-        let mut base = state.base_pose(robot);
-        base.translation.vector.z += cfg.support.ankle_height - lowest;
-        state.set_base_pose(robot, &base)?;
-        kin.update(robot, &state)?;
-        let feet0 = feet_ids
-            .iter()
-            .map(|f| kin.frame_pose(robot, *f))
-            .collect::<Result<Vec<_>>>()?;
-        let polygon = support_polygon(&feet0, &cfg.support)?;
-        let corners = polygon.vertices();
-        let centre = corners
-            .iter()
-            .fold((0.0, 0.0), |a, p| (a.0 + p.0, a.1 + p.1));
-        let count = corners.len().max(1) as f64;
-        let com_ref = Vector3::new(centre.0 / count, centre.1 / count, kin.com().z);
+        clamp_joint_references(robot, &limits, &mut refs, cfg.reference_margin)?;
+        let mut state = initial_state(robot, cfg, &refs, &limits)?;
+        let (kin, feet0) = stand_on_ground(robot, cfg, &mut state)?;
+        let com_ref = com_over_support(&kin, &feet0, cfg)?;
         let com_start = kin.com();
         let pelvis_id = robot.frame_id(&cfg.pelvis)?;
         let pelvis0 = kin.frame_pose(robot, pelvis_id)?;
-        // Tasks, each created holding where the robot stands.
-        let mut b = ControllerBuilder::new(std::sync::Arc::new(robot.clone()), &state)?;
-        b.gains(cfg.gains)
-            .limits(limits)
-            .settings(ControllerSettings {
-                method: cfg.method,
-                bounds: cfg.bounds,
-                solver: cfg.solver,
-            });
-        b.level(LEVEL_NAMES[0]);
-        let feet = cfg
-            .feet
-            .iter()
-            .map(|f| b.frame(f, Axes::ALL))
-            .collect::<Result<Vec<_>>>()?;
-        let com = b.level(LEVEL_NAMES[1]).com([true, true, false])?;
-        let pelvis_attitude = b
-            .level(LEVEL_NAMES[2])
-            .frame(&cfg.pelvis, Axes::ORIENTATION)?;
-        let pelvis_height = b.level(LEVEL_NAMES[3]).frame(&cfg.pelvis, Axes::Z)?;
-        let names: Vec<&str> = refs.joint_names.iter().map(|s| s.as_str()).collect();
-        let upper_body = b.level(LEVEL_NAMES[4]).joints(&names)?;
+        let (ctl, tasks) = build_stack(robot, cfg, &state, limits, &refs)?;
         let m = refs.joint_names.len();
         Ok(Self {
-            ctl: b.build()?,
-            tasks: ImitationTasks {
-                feet,
-                com,
-                pelvis_attitude,
-                pelvis_height,
-                upper_body,
-            },
+            ctl,
+            tasks,
             dt: cfg.dt,
             refs,
             state,

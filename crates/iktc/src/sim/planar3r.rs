@@ -194,9 +194,8 @@ pub fn reference(t: f64) -> ([f64; 3], [f64; 3], [f64; 3]) {
     }
 }
 
-/// Runs the experiment.
-pub fn run_planar3r(cfg: &Planar3rConfig) -> Result<Planar3rRun> {
-    let n_steps = cfg.run_limits.ticks("the 3R run", cfg.duration, cfg.dt)?;
+/// Checks that the priority lists each of Px, Py and θ3 exactly once.
+fn check_priority(cfg: &Planar3rConfig) -> Result<()> {
     let mut sorted = cfg.priority.map(|t| t.index());
     sorted.sort();
     if sorted != [0, 1, 2] {
@@ -206,6 +205,27 @@ pub fn run_planar3r(cfg: &Planar3rConfig) -> Result<Planar3rRun> {
             expected: "each of Px, Py, theta3 exactly once".into(),
         });
     }
+    Ok(())
+}
+
+/// The tip's frame reference for the task-space reference `(x, ẋ, ẍ)`: (Px \[m\], Py \[m\],
+/// θ3 \[rad\]) and their rates and accelerations.
+fn tip_reference(x: &[f64; 3], xd: &[f64; 3], xdd: &[f64; 3]) -> FrameReference {
+    let pose = Isometry3::from_parts(
+        Translation3::new(x[0], x[1], 0.0),
+        UnitQuaternion::from_axis_angle(&Vector3::z_axis(), x[2]),
+    );
+    FrameReference {
+        pose,
+        velocity: Vector6::new(xd[0], xd[1], 0.0, 0.0, 0.0, xd[2]),
+        acceleration: Vector6::new(xdd[0], xdd[1], 0.0, 0.0, 0.0, xdd[2]),
+    }
+}
+
+/// Runs the experiment.
+pub fn run_planar3r(cfg: &Planar3rConfig) -> Result<Planar3rRun> {
+    let n_steps = cfg.run_limits.ticks("the 3R run", cfg.duration, cfg.dt)?;
+    check_priority(cfg)?;
     let robot = planar3r();
     let deg = std::f64::consts::PI / 180.0;
     let mut state = State::neutral(&robot);
@@ -239,15 +259,7 @@ pub fn run_planar3r(cfg: &Planar3rConfig) -> Result<Planar3rRun> {
         let t = k as f64 * cfg.dt;
         let (x, xd, xdd) = reference(t);
         let start = Instant::now();
-        let pose = Isometry3::from_parts(
-            Translation3::new(x[0], x[1], 0.0),
-            UnitQuaternion::from_axis_angle(&Vector3::z_axis(), x[2]),
-        );
-        let r = FrameReference {
-            pose,
-            velocity: Vector6::new(xd[0], xd[1], 0.0, 0.0, 0.0, xd[2]),
-            acceleration: Vector6::new(xdd[0], xdd[1], 0.0, 0.0, 0.0, xdd[2]),
-        };
+        let r = tip_reference(&x, &xd, &xdd);
         for h in &tasks {
             ctl.set_frame_reference(*h, r)?;
         }

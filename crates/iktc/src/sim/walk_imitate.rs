@@ -39,7 +39,7 @@ use crate::balance::{
 };
 use crate::controller::FrameHandle;
 use crate::error::{Error, Result};
-use crate::model::{Robot, State};
+use crate::model::{FrameId, Kinematics, Robot, State};
 use crate::motion::RobotReferences;
 use crate::resources::MAX_ZMP_PASSES;
 use crate::task::{ComReference, FrameReference};
@@ -332,6 +332,65 @@ fn ankle_reference(
     }
 }
 
+/// Checks the settings [`WalkingController::new`] needs before anything is built: the
+/// preview's period equal to the control period \[s\], two feet, and the ZMP passes within
+/// [`MAX_ZMP_PASSES`].
+fn check_walk_settings(cfg: &WalkImitateConfig) -> Result<()> {
+    let dt = cfg.imitate.dt;
+    if (cfg.preview.dt - dt).abs() > 1e-12 {
+        return Err(Error::InvalidSetting {
+            name: "preview.dt".into(),
+            value: cfg.preview.dt.to_string(),
+            expected: format!("the control period {dt} s"),
+        });
+    }
+    if cfg.imitate.feet.len() != 2 {
+        return Err(Error::InvalidSetting {
+            name: "imitate.feet".into(),
+            value: cfg.imitate.feet.join(","),
+            expected: "two feet: right, then left".into(),
+        });
+    }
+    if cfg.zmp_passes > MAX_ZMP_PASSES {
+        return Err(Error::InvalidSetting {
+            name: "zmp_passes (CLI --zmp-passes)".into(),
+            value: cfg.zmp_passes.to_string(),
+            expected: format!("at most {MAX_ZMP_PASSES} passes (resources::MAX_ZMP_PASSES)"),
+        });
+    }
+    Ok(())
+}
+
+/// The footstep plan (in place when `step_length` is 0, else forward) and its walking pattern,
+/// the pattern's duration \[s\] checked against the run limits.
+fn plan_walk(
+    cfg: &WalkImitateConfig,
+    walk: &WalkSettings,
+    preview: &PreviewSettings,
+) -> Result<(FootstepPlan, WalkingPattern)> {
+    let dt = cfg.imitate.dt;
+    let plan = if cfg.step_length == 0.0 {
+        FootstepPlan::in_place(cfg.steps, walk)?
+    } else {
+        FootstepPlan::forward(cfg.steps, cfg.step_length, walk)?
+    };
+    let pattern = WalkingPattern::new(&plan, walk, preview)?;
+    cfg.imitate
+        .run_limits
+        .ticks("the walk", pattern.duration(), dt)?;
+    Ok((plan, pattern))
+}
+
+/// The four cases with the pendulum length set to `l` \[m\].
+fn cases_with_length(cases: &CaseParams, l: f64) -> CaseParams {
+    CaseParams {
+        xz_ssp: with_length(&cases.xz_ssp, l),
+        xz_dsp: with_length(&cases.xz_dsp, l),
+        yz_ssp: with_length(&cases.yz_ssp, l),
+        yz_dsp: with_length(&cases.yz_dsp, l),
+    }
+}
+
 /// What one tick of the [`WalkingController`] decided.
 #[derive(Debug, Clone, Copy)]
 pub struct WalkTick {
@@ -392,27 +451,7 @@ impl WalkingController {
     /// four cases with the COM height as pendulum length).
     pub fn new(robot: &Robot, refs: &RobotReferences, cfg: &WalkImitateConfig) -> Result<Self> {
         let dt = cfg.imitate.dt;
-        if (cfg.preview.dt - dt).abs() > 1e-12 {
-            return Err(Error::InvalidSetting {
-                name: "preview.dt".into(),
-                value: cfg.preview.dt.to_string(),
-                expected: format!("the control period {dt} s"),
-            });
-        }
-        if cfg.imitate.feet.len() != 2 {
-            return Err(Error::InvalidSetting {
-                name: "imitate.feet".into(),
-                value: cfg.imitate.feet.join(","),
-                expected: "two feet: right, then left".into(),
-            });
-        }
-        if cfg.zmp_passes > MAX_ZMP_PASSES {
-            return Err(Error::InvalidSetting {
-                name: "zmp_passes (CLI --zmp-passes)".into(),
-                value: cfg.zmp_passes.to_string(),
-                expected: format!("at most {MAX_ZMP_PASSES} passes (resources::MAX_ZMP_PASSES)"),
-            });
-        }
+        check_walk_settings(cfg)?;
         // Before the footsteps are planned: the walk lasts at least steps × ssp_duration.
         cfg.imitate.run_limits.ticks(
             "the walk",
@@ -450,22 +489,8 @@ impl WalkingController {
             dt,
             ..cfg.preview
         };
-        let plan = if cfg.step_length == 0.0 {
-            FootstepPlan::in_place(cfg.steps, &walk)?
-        } else {
-            FootstepPlan::forward(cfg.steps, cfg.step_length, &walk)?
-        };
-        let pattern = WalkingPattern::new(&plan, &walk, &preview)?;
-        cfg.imitate
-            .run_limits
-            .ticks("the walk", pattern.duration(), dt)?;
-        let l = com0.z;
-        let cases = CaseParams {
-            xz_ssp: with_length(&cfg.cases.xz_ssp, l),
-            xz_dsp: with_length(&cfg.cases.xz_dsp, l),
-            yz_ssp: with_length(&cfg.cases.yz_ssp, l),
-            yz_dsp: with_length(&cfg.cases.yz_dsp, l),
-        };
+        let (plan, pattern) = plan_walk(cfg, &walk, &preview)?;
+        let cases = cases_with_length(&cfg.cases, com0.z);
         let bal = BalanceController::new(&cases, &cfg.balance, SupportPhase::Double)?;
         let s0 = pattern.sample(0.0)?;
         let blend0 = Vector2::new(
@@ -776,7 +801,7 @@ pub fn run_walk_imitate(
         let start = Instant::now();
         let wt = wc.tick(k, dev)?;
         let tick_us = start.elapsed().as_secs_f64() * 1e6;
-        let s = wt.sample;
+        let s = &wt.sample;
         let rot = Rotation2::new(wt.local_yaw);
         let ctl = wc.imitation();
         let kin = ctl.kinematics();
@@ -788,41 +813,13 @@ pub fn run_walk_imitate(
             s.zmp_model.0 + origin.x + zdev.x,
             s.zmp_model.1 + origin.y + zdev.y,
         );
-        let state: &State = ctl.state();
-        let mut verdict = Verdict::Continue;
-        for (what, values) in [
-            ("joint position q [rad]", ctl.dof_positions()),
-            ("velocity q̇ [rad/s]", state.qd.as_slice()),
-            ("commanded acceleration q̈ [rad/s²]", ctl.qdd().as_slice()),
-            ("COM [m]", com.as_slice()),
-            ("measured ZMP [m]", &[zm.0, zm.1][..]),
-        ] {
-            if verdict == Verdict::Continue {
-                verdict = health.check_finite(t, what, &dof_names, values)?;
-            }
-        }
-        if verdict == Verdict::Stop {
+        if check_tick_finite(&mut health, t, &dof_names, ctl, &com, zm)? == Verdict::Stop {
             break;
         }
         wc.pattern().support_polygon_into(t, &mut polygon)?;
         let zmp_margin = polygon.margin((zm.0 - origin.x, zm.1 - origin.y));
-        let mut feet = [[0.0; 3]; 2];
         let frefs = wc.feet_references();
-        for ((slot, id), (r, name)) in feet.iter_mut().zip([feet_ids[1], feet_ids[0]]).zip(
-            frefs
-                .iter()
-                .zip([&cfg.imitate.feet[1], &cfg.imitate.feet[0]]),
-        ) {
-            let pose = kin.frame_pose(robot, id)?;
-            let p = pose.translation.vector;
-            *slot = [p.x, p.y, p.z];
-            health.check_foot(
-                t,
-                name,
-                (p - r.pose.translation.vector).norm(),
-                pose.rotation.angle_to(&r.pose.rotation),
-            )?;
-        }
+        let feet = check_feet(robot, cfg, kin, &mut health, t, &feet_ids, &frefs)?;
         health.check_support(
             t,
             &polygon,
@@ -831,78 +828,191 @@ pub fn run_walk_imitate(
             "world axes, origin between the initial sole centres",
         )?;
         health.end_tick();
-        let fr = |r: &FrameReference| {
-            let p = r.pose.translation.vector;
-            [p.x, p.y, p.z]
-        };
-        steps.push(WalkStep {
+        let measured = TickMeasure {
             t,
-            phase: s.phase,
-            zmp_reference: [s.zmp_reference.0 + origin.x, s.zmp_reference.1 + origin.y],
-            zmp_model: [s.zmp_model.0 + origin.x, s.zmp_model.1 + origin.y],
-            zmp_measured: [zm.0, zm.1],
+            com,
+            zmp_measured: zm,
             zmp_margin,
             zmp_deviation: dev,
-            com_pattern: [wt.com_nominal.x, wt.com_nominal.y],
-            com_reference: [wt.com_reference.x, wt.com_reference.y],
-            com: [com.x, com.y, com.z],
-            com_offset: [wt.com_offset.x, wt.com_offset.y],
-            feet_reference: [fr(&frefs[0]), fr(&frefs[1])],
-            feet,
-            support: polygon
-                .vertices()
-                .iter()
-                .map(|(x, y)| [x + origin.x, y + origin.y])
-                .collect(),
-            corrected_from: wt.corrected_from,
-            qp_solves: wt.qp_solves,
             tick_us,
-            links: kin
-                .link_poses()
-                .iter()
-                .map(|p| [p.translation.x, p.translation.y, p.translation.z])
-                .collect(),
-            link_rotations: kin
-                .link_poses()
-                .iter()
-                .map(|p| p.rotation.coords.into())
-                .collect(),
-            q: ctl.dof_positions().to_vec(),
-            qd: state.qd.as_slice().to_vec(),
-            qdd: ctl.qdd().as_slice().to_vec(),
-        });
+            feet,
+        };
+        steps.push(walk_step(&wt, ctl, origin, &polygon, &frefs, measured));
         wc.integrate()?;
     }
+    finish_walk_run(robot, cfg, &wc, steps, health.report())
+}
+
+/// Checks one tick's state, commanded acceleration, COM and measured ZMP `zm` \[m\] for
+/// non-finite values at time `t` \[s\], in that order, stopping at the first verdict to stop.
+fn check_tick_finite(
+    health: &mut HealthMonitor,
+    t: f64,
+    dof_names: &[String],
+    ctl: &ImitationController,
+    com: &Vector3<f64>,
+    zm: (f64, f64),
+) -> Result<Verdict> {
+    let state: &State = ctl.state();
+    let mut verdict = Verdict::Continue;
+    for (what, values) in [
+        ("joint position q [rad]", ctl.dof_positions()),
+        ("velocity q̇ [rad/s]", state.qd.as_slice()),
+        ("commanded acceleration q̈ [rad/s²]", ctl.qdd().as_slice()),
+        ("COM [m]", com.as_slice()),
+        ("measured ZMP [m]", &[zm.0, zm.1][..]),
+    ] {
+        if verdict == Verdict::Continue {
+            verdict = health.check_finite(t, what, dof_names, values)?;
+        }
+    }
+    Ok(verdict)
+}
+
+/// Checks each foot's ankle (right, then left) against its reference at time `t` \[s\]:
+/// position error \[m\] and rotation error \[rad\]; returns the ankles' positions \[m\] in the
+/// order of the references (left, right).
+fn check_feet(
+    robot: &Robot,
+    cfg: &WalkImitateConfig,
+    kin: &Kinematics,
+    health: &mut HealthMonitor,
+    t: f64,
+    feet_ids: &[FrameId],
+    frefs: &[FrameReference; 2],
+) -> Result<[[f64; 3]; 2]> {
+    let mut feet = [[0.0; 3]; 2];
+    for ((slot, id), (r, name)) in feet.iter_mut().zip([feet_ids[1], feet_ids[0]]).zip(
+        frefs
+            .iter()
+            .zip([&cfg.imitate.feet[1], &cfg.imitate.feet[0]]),
+    ) {
+        let pose = kin.frame_pose(robot, id)?;
+        let p = pose.translation.vector;
+        *slot = [p.x, p.y, p.z];
+        health.check_foot(
+            t,
+            name,
+            (p - r.pose.translation.vector).norm(),
+            pose.rotation.angle_to(&r.pose.rotation),
+        )?;
+    }
+    Ok(feet)
+}
+
+/// What one tick of [`run_walk_imitate`] measured beside the controller's state: time \[s\],
+/// the COM before the plants' step \[m\], measured ZMP (world axes) \[m\], its support margin \[m\], the plant's ZMP deviation (local
+/// frame) \[m\], the tick's wall-clock time \[µs\] and the ankles' positions \[m\].
+struct TickMeasure {
+    t: f64,
+    com: Vector3<f64>,
+    zmp_measured: (f64, f64),
+    zmp_margin: f64,
+    zmp_deviation: [f64; 2],
+    tick_us: f64,
+    feet: [[f64; 3]; 2],
+}
+
+/// The recorded [`WalkStep`] of one tick: the pattern's sample and the controller's state,
+/// shifted from the pattern's frame to world axes by `origin` \[m\].
+fn walk_step(
+    wt: &WalkTick,
+    ctl: &ImitationController,
+    origin: Vector2<f64>,
+    polygon: &SupportPolygon,
+    frefs: &[FrameReference; 2],
+    m: TickMeasure,
+) -> WalkStep {
+    let s = &wt.sample;
+    let kin = ctl.kinematics();
+    let com = m.com;
+    let state: &State = ctl.state();
+    let fr = |r: &FrameReference| {
+        let p = r.pose.translation.vector;
+        [p.x, p.y, p.z]
+    };
+    WalkStep {
+        t: m.t,
+        phase: s.phase,
+        zmp_reference: [s.zmp_reference.0 + origin.x, s.zmp_reference.1 + origin.y],
+        zmp_model: [s.zmp_model.0 + origin.x, s.zmp_model.1 + origin.y],
+        zmp_measured: [m.zmp_measured.0, m.zmp_measured.1],
+        zmp_margin: m.zmp_margin,
+        zmp_deviation: m.zmp_deviation,
+        com_pattern: [wt.com_nominal.x, wt.com_nominal.y],
+        com_reference: [wt.com_reference.x, wt.com_reference.y],
+        com: [com.x, com.y, com.z],
+        com_offset: [wt.com_offset.x, wt.com_offset.y],
+        feet_reference: [fr(&frefs[0]), fr(&frefs[1])],
+        feet: m.feet,
+        support: polygon
+            .vertices()
+            .iter()
+            .map(|(x, y)| [x + origin.x, y + origin.y])
+            .collect(),
+        corrected_from: wt.corrected_from,
+        qp_solves: wt.qp_solves,
+        tick_us: m.tick_us,
+        links: kin
+            .link_poses()
+            .iter()
+            .map(|p| [p.translation.x, p.translation.y, p.translation.z])
+            .collect(),
+        link_rotations: kin
+            .link_poses()
+            .iter()
+            .map(|p| p.rotation.coords.into())
+            .collect(),
+        q: ctl.dof_positions().to_vec(),
+        qd: state.qd.as_slice().to_vec(),
+        qdd: ctl.qdd().as_slice().to_vec(),
+    }
+}
+
+/// The footstep list of `plan` in world axes (shifted by `origin` \[m\]): the initial left and
+/// right feet, then the steps; each `[x, y, yaw]` \[m, m, rad\].
+fn world_footsteps(plan: &FootstepPlan, origin: Vector2<f64>) -> Vec<(Side, [f64; 3])> {
+    let mut v = vec![
+        (
+            Side::Left,
+            [
+                plan.initial(Side::Left).x + origin.x,
+                plan.initial(Side::Left).y + origin.y,
+                plan.initial(Side::Left).yaw,
+            ],
+        ),
+        (
+            Side::Right,
+            [
+                plan.initial(Side::Right).x + origin.x,
+                plan.initial(Side::Right).y + origin.y,
+                plan.initial(Side::Right).yaw,
+            ],
+        ),
+    ];
+    for f in plan.steps() {
+        v.push((
+            f.side,
+            [f.pose.x + origin.x, f.pose.y + origin.y, f.pose.yaw],
+        ));
+    }
+    v
+}
+
+/// The [`WalkRun`] of the recorded `steps`: the world footsteps, the pattern's phases and the
+/// summary (with the plan's ZMP figures and the controller's ZMP corrections).
+fn finish_walk_run(
+    robot: &Robot,
+    cfg: &WalkImitateConfig,
+    wc: &WalkingController,
+    steps: Vec<WalkStep>,
+    health: HealthReport,
+) -> Result<WalkRun> {
+    let origin = wc.origin();
     let plan = wc.plan();
     let pattern = wc.pattern();
     let ctl = wc.imitation();
-    let footsteps = {
-        let mut v = vec![
-            (
-                Side::Left,
-                [
-                    plan.initial(Side::Left).x + origin.x,
-                    plan.initial(Side::Left).y + origin.y,
-                    plan.initial(Side::Left).yaw,
-                ],
-            ),
-            (
-                Side::Right,
-                [
-                    plan.initial(Side::Right).x + origin.x,
-                    plan.initial(Side::Right).y + origin.y,
-                    plan.initial(Side::Right).yaw,
-                ],
-            ),
-        ];
-        for f in plan.steps() {
-            v.push((
-                f.side,
-                [f.pose.x + origin.x, f.pose.y + origin.y, f.pose.yaw],
-            ));
-        }
-        v
-    };
+    let footsteps = world_footsteps(plan, origin);
     let phases = pattern
         .timeline()
         .phases()
@@ -916,7 +1026,7 @@ pub fn run_walk_imitate(
         ctl,
         &steps,
         pattern.duration(),
-        health.report(),
+        health,
         plan_zmp,
     )?;
     summary.zmp_corrections = wc.zmp_corrections().to_vec();
@@ -983,18 +1093,15 @@ fn plan_zmp_figures(
     Ok((single, double, worst))
 }
 
-#[allow(clippy::too_many_arguments)]
-fn summarize(
+/// Each actuated joint's margins to its limits over the recorded `steps` (period `dt` \[s\]),
+/// and the worst position, velocity and acceleration margins.
+fn joint_margins(
     robot: &Robot,
-    cfg: &WalkImitateConfig,
     ctl: &ImitationController,
     steps: &[WalkStep],
-    duration: f64,
-    health: HealthReport,
-    plan_zmp: (usize, usize, f64),
-) -> Result<WalkSummary> {
-    let dt = cfg.imitate.dt;
-    let names = robot.dof_names();
+    dt: f64,
+    names: &[String],
+) -> (Vec<JointMargin>, [f64; 3]) {
     let mut margins = Vec::new();
     let mut worst = [f64::NEG_INFINITY; 3];
     for (d, lim) in ctl.limits().dofs().iter().enumerate().skip(robot.base_nv()) {
@@ -1016,7 +1123,12 @@ fn summarize(
             &m,
         ));
     }
-    // Stance feet: error against the reference, and drift within each stance interval.
+    (margins, worst)
+}
+
+/// Stance feet over the recorded `steps`: the largest horizontal error against the reference
+/// and the largest drift within a stance interval \[m\].
+fn stance_feet_errors(steps: &[WalkStep]) -> (f64, f64) {
     let mut max_err = 0.0f64;
     let mut max_slip = 0.0f64;
     for (foot, side) in [Side::Left, Side::Right].into_iter().enumerate() {
@@ -1041,6 +1153,23 @@ fn summarize(
             }
         }
     }
+    (max_err, max_slip)
+}
+
+#[allow(clippy::too_many_arguments)]
+fn summarize(
+    robot: &Robot,
+    cfg: &WalkImitateConfig,
+    ctl: &ImitationController,
+    steps: &[WalkStep],
+    duration: f64,
+    health: HealthReport,
+    plan_zmp: (usize, usize, f64),
+) -> Result<WalkSummary> {
+    let dt = cfg.imitate.dt;
+    let names = robot.dof_names();
+    let (margins, worst) = joint_margins(robot, ctl, steps, dt, &names);
+    let (max_err, max_slip) = stance_feet_errors(steps);
     let min_margin = steps
         .iter()
         .map(|s| s.zmp_margin)

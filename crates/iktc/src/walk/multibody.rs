@@ -84,19 +84,16 @@ pub fn configuration_zmp(
     multibody_zmp(&link_masses(robot), &poses, dt, ground, gravity)
 }
 
-/// The ZMP \[m\] (world x, y) on the ground plane `z = ground` \[m\] of bodies with masses
-/// `bodies` whose frames are `poses[k][i]` (world) at `t_k = k dt` \[s\], under gravity
-/// `gravity` \[m/s²\] (module documentation); `None` at a sample whose total vertical force
-/// `Σ m_i (z̈_i + g)` is not positive (the bodies falling at least as fast as gravity: the
-/// ground would have to pull). Errors: fewer than three samples, a sample without one pose per
-/// body, a non-positive `dt` or `gravity`, non-finite poses.
-pub fn multibody_zmp(
+/// Checks [`multibody_zmp`]'s inputs: at least three samples, a positive and finite `dt`
+/// \[s\] and `gravity` \[m/s²\], a finite `ground` \[m\], one pose per body in each sample, finite
+/// poses.
+fn check_inputs(
     bodies: &[BodyMass],
     poses: &[Vec<Isometry3<f64>>],
     dt: f64,
     ground: f64,
     gravity: f64,
-) -> Result<Vec<Option<[f64; 2]>>> {
+) -> Result<()> {
     let n = poses.len();
     if n < 3 {
         return Err(Error::InsufficientData {
@@ -139,6 +136,24 @@ pub fn multibody_zmp(
             }
         }
     }
+    Ok(())
+}
+
+/// The ZMP \[m\] (world x, y) on the ground plane `z = ground` \[m\] of bodies with masses
+/// `bodies` whose frames are `poses[k][i]` (world) at `t_k = k dt` \[s\], under gravity
+/// `gravity` \[m/s²\] (module documentation); `None` at a sample whose total vertical force
+/// `Σ m_i (z̈_i + g)` is not positive (the bodies falling at least as fast as gravity: the
+/// ground would have to pull). Errors: fewer than three samples, a sample without one pose per
+/// body, a non-positive `dt` or `gravity`, non-finite poses.
+pub fn multibody_zmp(
+    bodies: &[BodyMass],
+    poses: &[Vec<Isometry3<f64>>],
+    dt: f64,
+    ground: f64,
+    gravity: f64,
+) -> Result<Vec<Option<[f64; 2]>>> {
+    check_inputs(bodies, poses, dt, ground, gravity)?;
+    let n = poses.len();
     let com = |k: usize, i: usize| (poses[k][i] * Point3::from(bodies[i].com)).coords;
     let rot = |k: usize, i: usize| poses[k][i].rotation;
     // Angular momentum of body i at sample k (1 ≤ k ≤ n − 2).

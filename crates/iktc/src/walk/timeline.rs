@@ -16,7 +16,7 @@
 
 use serde::Serialize;
 
-use super::footstep::{FootstepPlan, Pose2};
+use super::footstep::{Footstep, FootstepPlan, Pose2};
 use super::settings::{Side, WalkSettings};
 use crate::error::Result;
 
@@ -126,6 +126,34 @@ fn centre(p: Pose2) -> (f64, f64) {
     (p.x, p.y)
 }
 
+/// The double support after step `i` of `steps`, the feet at `left` and `right`: its ZMP
+/// target \[m\] (the next stance foot's centre, or between the feet after the last step), its
+/// duration and its ZMP shift's duration \[s\].
+fn dsp_after(
+    steps: &[Footstep],
+    i: usize,
+    left: Pose2,
+    right: Pose2,
+    settings: &WalkSettings,
+) -> ((f64, f64), f64, f64) {
+    let foot = |l: Pose2, r: Pose2, side: Side| match side {
+        Side::Left => l,
+        Side::Right => r,
+    };
+    match steps.get(i + 1) {
+        Some(next) => (
+            centre(foot(left, right, next.side.opposite())),
+            settings.dsp_duration,
+            settings.dsp_duration,
+        ),
+        None => (
+            midpoint(left, right),
+            settings.final_dsp_duration,
+            settings.dsp_duration,
+        ),
+    }
+}
+
 impl Timeline {
     /// Builds the timeline of `plan` with the durations of `settings` (validated).
     pub fn new(plan: &FootstepPlan, settings: &WalkSettings) -> Result<Self> {
@@ -180,18 +208,7 @@ impl Timeline {
                 Side::Left => left = step.pose,
                 Side::Right => right = step.pose,
             }
-            let (target, duration, shift) = match steps.get(i + 1) {
-                Some(next) => (
-                    centre(foot(left, right, next.side.opposite())),
-                    settings.dsp_duration,
-                    settings.dsp_duration,
-                ),
-                None => (
-                    midpoint(left, right),
-                    settings.final_dsp_duration,
-                    settings.dsp_duration,
-                ),
-            };
+            let (target, duration, shift) = dsp_after(steps, i, left, right, settings);
             phases.push(PhaseInterval {
                 phase: Phase::DoubleSupport,
                 start: t,

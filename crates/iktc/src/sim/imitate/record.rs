@@ -2,19 +2,20 @@
 
 use std::time::Instant;
 
-use nalgebra::{DMatrix, UnitQuaternion};
+use nalgebra::{DMatrix, UnitQuaternion, Vector3};
 use serde::Serialize;
 
 use super::support::support_polygon;
 use super::{ImitateConfig, ImitationController, LEVEL_NAMES};
 use crate::error::Result;
 use crate::limits::NarrowedJoint;
-use crate::model::{JointLimit, Robot};
+use crate::model::{FrameId, JointLimit, Robot};
 use crate::motion::RobotReferences;
 use crate::sim::health::{HealthMonitor, HealthReport, Verdict};
 pub use crate::sim::margins::JointMargin;
 use crate::sim::margins::{dof_margins, held_limit, median, percentile};
 use crate::solver::{Fallback, Method};
+use crate::walk::SupportPolygon;
 
 /// One recorded tick (state at its start, command applied over it).
 #[derive(Debug, Clone, Serialize)]
@@ -254,13 +255,7 @@ pub fn run_imitate(
     let mut ctl = ImitationController::new(robot, refs, cfg)?;
     let n = ctl.references().len();
     let nv = robot.nv();
-    let limits: Vec<JointLimit> = ctl
-        .limits()
-        .dofs()
-        .iter()
-        .zip(robot.dof_limits())
-        .map(|(d, l)| held_limit(d, l.effort))
-        .collect();
+    let limits = held_limits(robot, &ctl);
     let feet_ids = cfg
         .feet
         .iter()
@@ -268,8 +263,6 @@ pub fn run_imitate(
         .collect::<Result<Vec<_>>>()?;
     let pelvis = robot.frame_id(&cfg.pelvis)?;
     let polygon = support_polygon(ctl.feet0(), &cfg.support)?;
-    let pos_tol = cfg.on_limit_position;
-    let frac = cfg.on_limit_fraction;
     let mut health = HealthMonitor::new(cfg.health)?;
     let dof_names = robot.dof_names();
     let mut com_jacobian = DMatrix::zeros(3, nv);
@@ -286,119 +279,28 @@ pub fn run_imitate(
             })
         })?;
         let tick_us = start.elapsed().as_secs_f64() * 1e6;
-        let rep = ctl.report();
         let kin = ctl.kinematics();
-        let state = ctl.state();
-        let mut level_error = [0.0; 5];
-        let mut correction = [0.0; 5];
-        let mut level_residual = [0.0; 5];
-        for (i, r) in rep.task_error_norms.iter().enumerate().take(5) {
-            level_residual[i] = *r;
-        }
-        for (i, e) in ctl.equations().iter().enumerate().take(5) {
-            level_error[i] = e.error.norm();
-            correction[i] = rep.corrections.get(i).map_or(0.0, |c| c.norm());
-        }
         let com = kin.com();
-        let mut verdict = Verdict::Continue;
-        for (what, values) in [
-            ("joint position q [rad]", ctl.dof_positions()),
-            ("velocity q̇ [rad/s]", state.qd.as_slice()),
-            ("commanded acceleration q̈ [rad/s²]", ctl.qdd().as_slice()),
-            ("COM [m]", com.as_slice()),
-        ] {
-            if verdict == Verdict::Continue {
-                verdict = health.check_finite(t, what, &dof_names, values)?;
-            }
-        }
-        if verdict == Verdict::Stop {
+        if check_state_finite(&mut health, t, &dof_names, &ctl, &com)? == Verdict::Stop {
             break;
         }
-        let mut foot_drift = 0.0f64;
-        let mut foot_rotation_drift = 0.0f64;
-        for ((id, p0), name) in feet_ids.iter().zip(ctl.feet0()).zip(&cfg.feet) {
-            let p = kin.frame_pose(robot, *id)?;
-            let (dp, dr) = (
-                (p.translation.vector - p0.translation.vector).norm(),
-                p.rotation.angle_to(&p0.rotation),
-            );
-            health.check_foot(t, name, dp, dr)?;
-            foot_drift = foot_drift.max(dp);
-            foot_rotation_drift = foot_rotation_drift.max(dr);
-        }
-        kin.com_jacobian(robot, &mut com_jacobian)?;
-        let cdd = &com_jacobian * ctl.qdd() + kin.com_drift();
-        let lever = com.z / (crate::balance::STANDARD_GRAVITY + cdd.z);
-        let zmp = [com.x - lever * cdd.x, com.y - lever * cdd.y];
+        let (foot_drift, foot_rotation_drift) =
+            check_feet_drift(robot, cfg, &ctl, &feet_ids, &mut health, t)?;
+        let zmp = cart_table_zmp(robot, &ctl, &com, &mut com_jacobian)?;
         health.check_support(t, &polygon, (com.x, com.y), "COM", "world axes")?;
         health.end_tick();
-        let pp = kin.frame_pose(robot, pelvis)?;
-        let r = ctl.references();
-        let kk = k.min(r.len().saturating_sub(1));
-        let desired_att = r.attitude[kk] * ctl.pelvis0().rotation;
-        let q = ctl.dof_positions().to_vec();
-        let qd = state.qd.as_slice().to_vec();
-        let qdd = ctl.qdd().as_slice().to_vec();
-        let mut on_limit = Vec::new();
-        for d in robot.base_nv()..nv {
-            let l = &limits[d];
-            let at_pos = q[d] <= l.lower + pos_tol || q[d] >= l.upper - pos_tol;
-            let at_vel = qd[d].abs() >= (1.0 - frac) * l.velocity;
-            let at_acc = qdd[d].abs() >= (1.0 - frac) * l.acceleration;
-            if at_pos || at_vel || at_acc {
-                on_limit.push(d);
-            }
-        }
-        let bx = ctl.acceleration_box();
-        steps.push(ImitateStep {
+        let measured = TickMeasure {
+            k,
             t,
-            base: {
-                let b = state.base_pose(robot);
-                let (p, r) = (b.translation.vector, b.rotation.coords);
-                [p.x, p.y, p.z, r.x, r.y, r.z, r.w]
-            },
-            box_lower: bx.lower.as_slice().to_vec(),
-            box_upper: bx.upper.as_slice().to_vec(),
-            q,
-            qd,
-            qdd,
-            level_error,
-            level_residual,
-            correction,
-            corrected_from: match (rep.method, rep.corrected_from) {
-                (Method::Iktc, c) => c,
-                _ => level_residual
-                    .iter()
-                    .position(|r| *r > cfg.corrected_tolerance),
-            },
+            tick_us,
+            com,
+            zmp,
             foot_drift,
             foot_rotation_drift,
-            com: [com.x, com.y, com.z],
-            com_margin: polygon.margin((com.x, com.y)),
-            zmp,
-            zmp_margin: polygon.margin((zmp[0], zmp[1])),
-            pelvis_height_desired: ctl.pelvis0().translation.z + r.height.position[kk],
-            pelvis_height: pp.translation.z,
-            pelvis_rpy_desired: rpy(&desired_att),
-            pelvis_rpy: rpy(&pp.rotation),
-            links: kin
-                .link_poses()
-                .iter()
-                .map(|p| [p.translation.x, p.translation.y, p.translation.z])
-                .collect(),
-            link_rotations: kin
-                .link_poses()
-                .iter()
-                .map(|p| p.rotation.coords.into())
-                .collect(),
-            on_limit,
-            qp_solves: rep.qp_solves,
-            empty_dofs: rep.empty_box_dofs,
-            recovering: bx.recovering_dofs().collect(),
-            fallback: rep.fallback.is_some(),
-            fallback_kind: rep.fallback,
-            tick_us,
-        });
+        };
+        steps.push(imitate_step(
+            robot, cfg, &ctl, &limits, &polygon, pelvis, measured,
+        )?);
         ctl.integrate()?;
     }
     let summary = summarize(
@@ -419,18 +321,220 @@ pub fn run_imitate(
     })
 }
 
-/// The summary of recorded steps (see [`ImitateSummary`]).
-pub(crate) fn summarize(
+/// Each dof's limits as the run holds them ([`held_limit`], the effort from the model).
+fn held_limits(robot: &Robot, ctl: &ImitationController) -> Vec<JointLimit> {
+    ctl.limits()
+        .dofs()
+        .iter()
+        .zip(robot.dof_limits())
+        .map(|(d, l)| held_limit(d, l.effort))
+        .collect()
+}
+
+/// The cart-table ZMP \[m\] of the commanded motion, ground z = 0: `p_xy = c_xy − c_z c̈_xy /
+/// (g + c̈_z)` with `c̈ = J_c q̈ + J̇_c q̇` (`com_jacobian` is the 3 × nv scratch for `J_c`).
+fn cart_table_zmp(
+    robot: &Robot,
+    ctl: &ImitationController,
+    com: &Vector3<f64>,
+    com_jacobian: &mut DMatrix<f64>,
+) -> Result<[f64; 2]> {
+    let kin = ctl.kinematics();
+    kin.com_jacobian(robot, com_jacobian)?;
+    let cdd = &*com_jacobian * ctl.qdd() + kin.com_drift();
+    let lever = com.z / (crate::balance::STANDARD_GRAVITY + cdd.z);
+    Ok([com.x - lever * cdd.x, com.y - lever * cdd.y])
+}
+
+/// Checks q, q̇, the commanded q̈ and the COM \[m\] for non-finite values at time `t` \[s\],
+/// in that order, stopping at the first verdict to stop.
+fn check_state_finite(
+    health: &mut HealthMonitor,
+    t: f64,
+    dof_names: &[String],
+    ctl: &ImitationController,
+    com: &Vector3<f64>,
+) -> Result<Verdict> {
+    let state = ctl.state();
+    let mut verdict = Verdict::Continue;
+    for (what, values) in [
+        ("joint position q [rad]", ctl.dof_positions()),
+        ("velocity q̇ [rad/s]", state.qd.as_slice()),
+        ("commanded acceleration q̈ [rad/s²]", ctl.qdd().as_slice()),
+        ("COM [m]", com.as_slice()),
+    ] {
+        if verdict == Verdict::Continue {
+            verdict = health.check_finite(t, what, dof_names, values)?;
+        }
+    }
+    Ok(verdict)
+}
+
+/// Checks each foot frame against its initial (held) pose at time `t` \[s\]; returns the
+/// largest position drift \[m\] and rotation drift \[rad\] of the feet.
+fn check_feet_drift(
+    robot: &Robot,
+    cfg: &ImitateConfig,
+    ctl: &ImitationController,
+    feet_ids: &[FrameId],
+    health: &mut HealthMonitor,
+    t: f64,
+) -> Result<(f64, f64)> {
+    let kin = ctl.kinematics();
+    let mut foot_drift = 0.0f64;
+    let mut foot_rotation_drift = 0.0f64;
+    for ((id, p0), name) in feet_ids.iter().zip(ctl.feet0()).zip(&cfg.feet) {
+        let p = kin.frame_pose(robot, *id)?;
+        let (dp, dr) = (
+            (p.translation.vector - p0.translation.vector).norm(),
+            p.rotation.angle_to(&p0.rotation),
+        );
+        health.check_foot(t, name, dp, dr)?;
+        foot_drift = foot_drift.max(dp);
+        foot_rotation_drift = foot_rotation_drift.max(dr);
+    }
+    Ok((foot_drift, foot_rotation_drift))
+}
+
+/// What one tick of [`run_imitate`] measured beside the controller's state: tick `k`, time
+/// \[s\], wall-clock time \[µs\], COM \[m\], cart-table ZMP \[m\] and the feet's largest
+/// position \[m\] and rotation \[rad\] drift.
+struct TickMeasure {
+    k: usize,
+    t: f64,
+    tick_us: f64,
+    com: Vector3<f64>,
+    zmp: [f64; 2],
+    foot_drift: f64,
+    foot_rotation_drift: f64,
+}
+
+/// Each level's error ‖x_d − x‖, correction and residual of the last tick (first five levels).
+fn level_figures(ctl: &ImitationController) -> ([f64; 5], [f64; 5], [f64; 5]) {
+    let rep = ctl.report();
+    let mut level_error = [0.0; 5];
+    let mut correction = [0.0; 5];
+    let mut level_residual = [0.0; 5];
+    for (i, r) in rep.task_error_norms.iter().enumerate().take(5) {
+        level_residual[i] = *r;
+    }
+    for (i, e) in ctl.equations().iter().enumerate().take(5) {
+        level_error[i] = e.error.norm();
+        correction[i] = rep.corrections.get(i).map_or(0.0, |c| c.norm());
+    }
+    (level_error, correction, level_residual)
+}
+
+/// The actuated dofs at a limit: position within `on_limit_position` \[rad\] of a bound, or
+/// rate or acceleration within `on_limit_fraction` of its bound.
+fn dofs_on_limit(
+    robot: &Robot,
+    cfg: &ImitateConfig,
+    limits: &[JointLimit],
+    q: &[f64],
+    qd: &[f64],
+    qdd: &[f64],
+) -> Vec<usize> {
+    let pos_tol = cfg.on_limit_position;
+    let frac = cfg.on_limit_fraction;
+    let mut on_limit = Vec::new();
+    for d in robot.base_nv()..robot.nv() {
+        let l = &limits[d];
+        let at_pos = q[d] <= l.lower + pos_tol || q[d] >= l.upper - pos_tol;
+        let at_vel = qd[d].abs() >= (1.0 - frac) * l.velocity;
+        let at_acc = qdd[d].abs() >= (1.0 - frac) * l.acceleration;
+        if at_pos || at_vel || at_acc {
+            on_limit.push(d);
+        }
+    }
+    on_limit
+}
+
+/// The recorded [`ImitateStep`] of one tick: the controller's state and report, the pelvis
+/// against its reference, and what the tick measured.
+fn imitate_step(
+    robot: &Robot,
+    cfg: &ImitateConfig,
+    ctl: &ImitationController,
+    limits: &[JointLimit],
+    polygon: &SupportPolygon,
+    pelvis: FrameId,
+    m: TickMeasure,
+) -> Result<ImitateStep> {
+    let rep = ctl.report();
+    let kin = ctl.kinematics();
+    let state = ctl.state();
+    let (level_error, correction, level_residual) = level_figures(ctl);
+    let com = m.com;
+    let pp = kin.frame_pose(robot, pelvis)?;
+    let r = ctl.references();
+    let kk = m.k.min(r.len().saturating_sub(1));
+    let desired_att = r.attitude[kk] * ctl.pelvis0().rotation;
+    let q = ctl.dof_positions().to_vec();
+    let qd = state.qd.as_slice().to_vec();
+    let qdd = ctl.qdd().as_slice().to_vec();
+    let on_limit = dofs_on_limit(robot, cfg, limits, &q, &qd, &qdd);
+    let bx = ctl.acceleration_box();
+    Ok(ImitateStep {
+        t: m.t,
+        base: {
+            let b = state.base_pose(robot);
+            let (p, r) = (b.translation.vector, b.rotation.coords);
+            [p.x, p.y, p.z, r.x, r.y, r.z, r.w]
+        },
+        box_lower: bx.lower.as_slice().to_vec(),
+        box_upper: bx.upper.as_slice().to_vec(),
+        q,
+        qd,
+        qdd,
+        level_error,
+        level_residual,
+        correction,
+        corrected_from: match (rep.method, rep.corrected_from) {
+            (Method::Iktc, c) => c,
+            _ => level_residual
+                .iter()
+                .position(|r| *r > cfg.corrected_tolerance),
+        },
+        foot_drift: m.foot_drift,
+        foot_rotation_drift: m.foot_rotation_drift,
+        com: [com.x, com.y, com.z],
+        com_margin: polygon.margin((com.x, com.y)),
+        zmp: m.zmp,
+        zmp_margin: polygon.margin((m.zmp[0], m.zmp[1])),
+        pelvis_height_desired: ctl.pelvis0().translation.z + r.height.position[kk],
+        pelvis_height: pp.translation.z,
+        pelvis_rpy_desired: rpy(&desired_att),
+        pelvis_rpy: rpy(&pp.rotation),
+        links: kin
+            .link_poses()
+            .iter()
+            .map(|p| [p.translation.x, p.translation.y, p.translation.z])
+            .collect(),
+        link_rotations: kin
+            .link_poses()
+            .iter()
+            .map(|p| p.rotation.coords.into())
+            .collect(),
+        on_limit,
+        qp_solves: rep.qp_solves,
+        empty_dofs: rep.empty_box_dofs,
+        recovering: bx.recovering_dofs().collect(),
+        fallback: rep.fallback.is_some(),
+        fallback_kind: rep.fallback,
+        tick_us: m.tick_us,
+    })
+}
+
+/// Each actuated joint's margins to its limits over the recorded `steps`.
+fn joint_margins(
     robot: &Robot,
     cfg: &ImitateConfig,
     steps: &[ImitateStep],
     limits: &[JointLimit],
-    level_dims: &[usize],
-    health: HealthReport,
-) -> ImitateSummary {
-    let names = robot.dof_names();
-    let nb = robot.base_nv();
-    let joints: Vec<JointMargin> = (nb..robot.nv())
+    names: &[String],
+) -> Vec<JointMargin> {
+    (robot.base_nv()..robot.nv())
         .map(|d| {
             let col = |f: &dyn Fn(&ImitateStep) -> f64| steps.iter().map(f).collect::<Vec<f64>>();
             let q = col(&|s| s.q[d]);
@@ -439,9 +543,18 @@ pub(crate) fn summarize(
             let m = dof_margins(d, &q, &qd, &qdd, cfg.dt, &limits[d]);
             JointMargin::new(names.get(d).cloned().unwrap_or_default(), &m)
         })
-        .collect();
-    let worst =
-        |f: &dyn Fn(&JointMargin) -> f64| joints.iter().map(f).fold(f64::NEG_INFINITY, f64::max);
+        .collect()
+}
+
+/// The steps with some actuated dof at its position limit (within `on_limit_position` \[rad\]),
+/// its rate limit and its acceleration limit (within `on_limit_fraction`).
+fn binding_steps(
+    robot: &Robot,
+    cfg: &ImitateConfig,
+    steps: &[ImitateStep],
+    limits: &[JointLimit],
+) -> [usize; 3] {
+    let nb = robot.base_nv();
     let (pos_tol, frac) = (cfg.on_limit_position, cfg.on_limit_fraction);
     let count = |f: &dyn Fn(&ImitateStep, usize) -> bool| {
         steps
@@ -454,25 +567,16 @@ pub(crate) fn summarize(
     let velocity_binding_steps = count(&|s, d| s.qd[d].abs() >= (1.0 - frac) * limits[d].velocity);
     let acceleration_binding_steps =
         count(&|s, d| s.qdd[d].abs() >= (1.0 - frac) * limits[d].acceleration);
-    let narrowed_dofs: Vec<usize> = cfg
-        .narrow
-        .iter()
-        .filter_map(|n| robot.joint_v_index(&n.joint).ok())
-        .collect();
-    let narrowed_at = |s: &ImitateStep| {
-        narrowed_dofs
-            .iter()
-            .any(|&d| s.q[d] <= limits[d].lower + pos_tol || s.q[d] >= limits[d].upper - pos_tol)
-    };
-    // Corrected from a level at or above the pelvis height (index 3).
-    let pelvis_corrected = |s: &ImitateStep| matches!(s.corrected_from, Some(l) if l <= 3);
-    // Corrected from the pelvis attitude (index 2) or below.
-    let lower_corrected: Vec<&ImitateStep> = steps
-        .iter()
-        .filter(|s| matches!(s.corrected_from, Some(l) if l >= 2))
-        .collect();
-    let ticks: Vec<f64> = steps.iter().map(|s| s.tick_us).collect();
-    let levels = (0..level_dims.len().min(5))
+    [
+        position_binding_steps,
+        velocity_binding_steps,
+        acceleration_binding_steps,
+    ]
+}
+
+/// Each level's (the first five) error figures and corrected steps over the recorded `steps`.
+fn level_summaries(steps: &[ImitateStep], level_dims: &[usize]) -> Vec<LevelSummary> {
+    (0..level_dims.len().min(5))
         .map(|i| {
             let errs: Vec<f64> = steps.iter().map(|s| s.level_error[i]).collect();
             let corrected: Vec<f64> = steps
@@ -493,22 +597,145 @@ pub(crate) fn summarize(
                     .map(|(a, b)| [*a, *b]),
             }
         })
-        .collect();
-    let com_min_margin = steps
+        .collect()
+}
+
+/// The smoothness of the commanded q̈ of `dofs` over the recorded `steps`.
+fn joints_smoothness_of(
+    cfg: &ImitateConfig,
+    steps: &[ImitateStep],
+    names: &[String],
+    dofs: Vec<usize>,
+) -> Vec<crate::sim::JointSmoothness> {
+    crate::sim::smoothness::joints_smoothness(
+        dofs,
+        0..steps.len(),
+        cfg.dt,
+        |k, d| steps[k].qdd[d],
+        |d| names.get(d).cloned().unwrap_or_default(),
+    )
+}
+
+/// Over the steps corrected from the pelvis attitude (index 2) or below: the largest feet
+/// error, feet residual, COM residual and COM error (task units).
+fn lower_corrected_figures(steps: &[ImitateStep]) -> [f64; 4] {
+    let lower_corrected: Vec<&ImitateStep> = steps
         .iter()
-        .map(|s| s.com_margin)
-        .fold(f64::INFINITY, f64::min);
-    let smoothness_of = |dofs: Vec<usize>| {
-        crate::sim::smoothness::joints_smoothness(
-            dofs,
-            0..steps.len(),
-            cfg.dt,
-            |k, d| steps[k].qdd[d],
-            |d| names.get(d).cloned().unwrap_or_default(),
-        )
+        .filter(|s| matches!(s.corrected_from, Some(l) if l >= 2))
+        .collect();
+    [
+        lower_corrected
+            .iter()
+            .map(|s| s.level_error[0])
+            .fold(0.0, f64::max),
+        lower_corrected
+            .iter()
+            .map(|s| s.level_residual[0])
+            .fold(0.0, f64::max),
+        lower_corrected
+            .iter()
+            .map(|s| s.level_residual[1])
+            .fold(0.0, f64::max),
+        lower_corrected
+            .iter()
+            .map(|s| s.level_error[1])
+            .fold(0.0, f64::max),
+    ]
+}
+
+/// How many steps fell back, by kind ([`fallback_name`]).
+fn fallbacks_by_kind(steps: &[ImitateStep]) -> std::collections::BTreeMap<String, usize> {
+    steps
+        .iter()
+        .filter_map(|s| s.fallback_kind)
+        .fold(Default::default(), |mut m, f| {
+            *m.entry(fallback_name(f)).or_insert(0) += 1;
+            m
+        })
+}
+
+/// The steps with a narrowed dof at its position limit (within `on_limit_position` \[rad\]),
+/// the steps corrected from a level at or above the pelvis height (index 3), and the steps
+/// with both.
+fn narrowed_counts(
+    cfg: &ImitateConfig,
+    steps: &[ImitateStep],
+    limits: &[JointLimit],
+    narrowed_dofs: &[usize],
+) -> [usize; 3] {
+    let pos_tol = cfg.on_limit_position;
+    let narrowed_at = |s: &ImitateStep| {
+        narrowed_dofs
+            .iter()
+            .any(|&d| s.q[d] <= limits[d].lower + pos_tol || s.q[d] >= limits[d].upper - pos_tol)
     };
-    let smoothness = smoothness_of((nb..robot.nv()).collect());
-    let narrowed_smoothness = smoothness_of(narrowed_dofs.clone());
+    // Corrected from a level at or above the pelvis height (index 3).
+    let pelvis_corrected = |s: &ImitateStep| matches!(s.corrected_from, Some(l) if l <= 3);
+    [
+        steps.iter().filter(|s| narrowed_at(s)).count(),
+        steps.iter().filter(|s| pelvis_corrected(s)).count(),
+        steps
+            .iter()
+            .filter(|s| pelvis_corrected(s) && narrowed_at(s))
+            .count(),
+    ]
+}
+
+/// The smallest COM and ZMP margins inside the support polygon over the recorded `steps` \[m\].
+fn min_margins(steps: &[ImitateStep]) -> (f64, f64) {
+    (
+        steps
+            .iter()
+            .map(|s| s.com_margin)
+            .fold(f64::INFINITY, f64::min),
+        steps
+            .iter()
+            .map(|s| s.zmp_margin)
+            .fold(f64::INFINITY, f64::min),
+    )
+}
+
+/// The feet's largest position \[m\] and rotation \[rad\] drift over the recorded `steps`.
+fn max_foot_drifts(steps: &[ImitateStep]) -> (f64, f64) {
+    (
+        steps.iter().map(|s| s.foot_drift).fold(0.0, f64::max),
+        steps
+            .iter()
+            .map(|s| s.foot_rotation_drift)
+            .fold(0.0, f64::max),
+    )
+}
+
+/// The summary of recorded steps (see [`ImitateSummary`]).
+pub(crate) fn summarize(
+    robot: &Robot,
+    cfg: &ImitateConfig,
+    steps: &[ImitateStep],
+    limits: &[JointLimit],
+    level_dims: &[usize],
+    health: HealthReport,
+) -> ImitateSummary {
+    let names = robot.dof_names();
+    let nb = robot.base_nv();
+    let joints = joint_margins(robot, cfg, steps, limits, &names);
+    let worst =
+        |f: &dyn Fn(&JointMargin) -> f64| joints.iter().map(f).fold(f64::NEG_INFINITY, f64::max);
+    let [position_binding_steps, velocity_binding_steps, acceleration_binding_steps] =
+        binding_steps(robot, cfg, steps, limits);
+    let narrowed_dofs: Vec<usize> = cfg
+        .narrow
+        .iter()
+        .filter_map(|n| robot.joint_v_index(&n.joint).ok())
+        .collect();
+    let [narrowed_at_limit_steps, pelvis_corrected_steps, pelvis_corrected_while_narrowed_at_limit] =
+        narrowed_counts(cfg, steps, limits, &narrowed_dofs);
+    let lower = lower_corrected_figures(steps);
+    let ticks: Vec<f64> = steps.iter().map(|s| s.tick_us).collect();
+    let levels = level_summaries(steps, level_dims);
+    let (com_min_margin, zmp_min_margin) = min_margins(steps);
+    let (foot_drift, foot_rotation_drift) = max_foot_drifts(steps);
+    let smoothness = joints_smoothness_of(cfg, steps, &names, (nb..robot.nv()).collect());
+    let narrowed_smoothness = joints_smoothness_of(cfg, steps, &names, narrowed_dofs.clone());
     ImitateSummary {
         solver: cfg.method.name().into(),
         bounds: cfg.bounds.name().into(),
@@ -527,56 +754,29 @@ pub(crate) fn summarize(
         position_binding_steps,
         velocity_binding_steps,
         acceleration_binding_steps,
-        narrowed_at_limit_steps: steps.iter().filter(|s| narrowed_at(s)).count(),
-        pelvis_corrected_steps: steps.iter().filter(|s| pelvis_corrected(s)).count(),
+        narrowed_at_limit_steps,
+        pelvis_corrected_steps,
         level_switches: crate::sim::LevelSwitches::count(
             &steps.iter().map(|s| s.corrected_from).collect::<Vec<_>>(),
         ),
         smoothness,
         narrowed_smoothness,
-        pelvis_corrected_while_narrowed_at_limit: steps
-            .iter()
-            .filter(|s| pelvis_corrected(s) && narrowed_at(s))
-            .count(),
-        feet_error_while_lower_corrected: lower_corrected
-            .iter()
-            .map(|s| s.level_error[0])
-            .fold(0.0, f64::max),
-        feet_residual_while_lower_corrected: lower_corrected
-            .iter()
-            .map(|s| s.level_residual[0])
-            .fold(0.0, f64::max),
-        com_residual_while_lower_corrected: lower_corrected
-            .iter()
-            .map(|s| s.level_residual[1])
-            .fold(0.0, f64::max),
-        com_error_while_lower_corrected: lower_corrected
-            .iter()
-            .map(|s| s.level_error[1])
-            .fold(0.0, f64::max),
-        foot_drift: steps.iter().map(|s| s.foot_drift).fold(0.0, f64::max),
-        foot_rotation_drift: steps
-            .iter()
-            .map(|s| s.foot_rotation_drift)
-            .fold(0.0, f64::max),
+        pelvis_corrected_while_narrowed_at_limit,
+        feet_error_while_lower_corrected: lower[0],
+        feet_residual_while_lower_corrected: lower[1],
+        com_residual_while_lower_corrected: lower[2],
+        com_error_while_lower_corrected: lower[3],
+        foot_drift,
+        foot_rotation_drift,
         com_inside_support: com_min_margin > 0.0,
         com_min_margin,
-        zmp_min_margin: steps
-            .iter()
-            .map(|s| s.zmp_margin)
-            .fold(f64::INFINITY, f64::min),
+        zmp_min_margin,
         health,
         levels,
         empty_box_steps: steps.iter().filter(|s| s.empty_dofs > 0).count(),
         fallback_steps: steps.iter().filter(|s| s.fallback).count(),
         recovering_steps: steps.iter().filter(|s| !s.recovering.is_empty()).count(),
-        fallbacks_by_kind: steps.iter().filter_map(|s| s.fallback_kind).fold(
-            Default::default(),
-            |mut m, f| {
-                *m.entry(fallback_name(f)).or_insert(0) += 1;
-                m
-            },
-        ),
+        fallbacks_by_kind: fallbacks_by_kind(steps),
         qp_per_step_mean: steps.iter().map(|s| s.qp_solves as f64).sum::<f64>()
             / steps.len().max(1) as f64,
         qp_per_step_max: steps.iter().map(|s| s.qp_solves).max().unwrap_or(0),
