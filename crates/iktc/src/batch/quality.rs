@@ -17,7 +17,7 @@ use serde::Serialize;
 use crate::error::{Error, Result};
 use crate::model::Robot;
 use crate::profile::Foot;
-use crate::retarget::{KeypointRun, RetargetQuality, KEYPOINT_LEVELS};
+use crate::retarget::{Fidelity, KeypointRun, RetargetQuality, KEYPOINT_LEVELS};
 use crate::sim::{ImitateRun, ImitateSummary};
 
 /// A sole corner deeper than this below the ground counts as penetrating in the share of frames
@@ -302,30 +302,9 @@ impl KeypointFigures {
             .points
             .iter()
             .max_by(|a, b| a.mean_cm.total_cmp(&b.mean_cm));
-        let margins = [q.position_margin, q.velocity_margin, q.acceleration_margin];
-        let mut failures: Vec<String> = ["position", "velocity", "acceleration"]
-            .iter()
-            .zip(margins)
-            .filter(|(_, m)| m.is_nan() || *m > MARGIN_ROUNDING)
-            .map(|(what, m)| format!("a joint's {what} limit exceeded by {m:.3e}"))
-            .collect();
+        let failures = keypoint_failures(q);
         let fid = q.fidelity.as_ref();
-        match fid {
-            Some(f) => failures.extend(f.failures.iter().cloned()),
-            None => failures.push("no neutral figures".into()),
-        }
-        let gap = |names: &[&str]| -> f64 {
-            let v: Vec<f64> = fid
-                .map(|f| {
-                    f.posture
-                        .iter()
-                        .filter(|p| names.contains(&p.name.as_str()))
-                        .map(|p| p.robot_median - p.person_median)
-                        .collect()
-                })
-                .unwrap_or_default();
-            v.iter().sum::<f64>() / v.len().max(1) as f64
-        };
+        let gap = |names: &[&str]| posture_gap(fid, names);
         let c = fid.map(|f| &f.contacts);
         Self {
             route: "keypoints",
@@ -373,13 +352,7 @@ impl KeypointFigures {
                 .map(|l| run.sacrificed.of(l))
                 .sum::<usize>() as f64
                 / ticks,
-            most_sacrificed: run
-                .sacrificed
-                .levels
-                .iter()
-                .filter(|(_, n)| *n > 0)
-                .max_by_key(|(_, n)| *n)
-                .map_or_else(String::new, |(l, _)| l.clone()),
+            most_sacrificed: most_sacrificed(run),
             most_on_limit: q
                 .on_limit
                 .first()
@@ -391,6 +364,49 @@ impl KeypointFigures {
             posture_fit_error: q.posture_fit_deg.map(f64::to_radians),
         }
     }
+}
+
+/// What keeps a keypoint run from being healthy: each joint limit exceeded by more than
+/// rounding (position, velocity, acceleration margins), then the neutral figures' failures,
+/// or their absence.
+fn keypoint_failures(q: &RetargetQuality) -> Vec<String> {
+    let margins = [q.position_margin, q.velocity_margin, q.acceleration_margin];
+    let mut failures: Vec<String> = ["position", "velocity", "acceleration"]
+        .iter()
+        .zip(margins)
+        .filter(|(_, m)| m.is_nan() || *m > MARGIN_ROUNDING)
+        .map(|(what, m)| format!("a joint's {what} limit exceeded by {m:.3e}"))
+        .collect();
+    match q.fidelity.as_ref() {
+        Some(f) => failures.extend(f.failures.iter().cloned()),
+        None => failures.push("no neutral figures".into()),
+    }
+    failures
+}
+
+/// The mean over the posture figures `names` of the robot's median minus the person's (the
+/// figures' unit: ° for angles, cm for heights); 0 without neutral figures.
+fn posture_gap(fid: Option<&Fidelity>, names: &[&str]) -> f64 {
+    let v: Vec<f64> = fid
+        .map(|f| {
+            f.posture
+                .iter()
+                .filter(|p| names.contains(&p.name.as_str()))
+                .map(|p| p.robot_median - p.person_median)
+                .collect()
+        })
+        .unwrap_or_default();
+    v.iter().sum::<f64>() / v.len().max(1) as f64
+}
+
+/// The level sacrificed on the most ticks (empty if none was).
+fn most_sacrificed(run: &KeypointRun) -> String {
+    run.sacrificed
+        .levels
+        .iter()
+        .filter(|(_, n)| *n > 0)
+        .max_by_key(|(_, n)| *n)
+        .map_or_else(String::new, |(l, _)| l.clone())
 }
 
 /// The quality figures of a joint-route imitation, flat.

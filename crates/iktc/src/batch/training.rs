@@ -54,6 +54,36 @@ pub struct TrainingTrajectory {
     pub body_pos: Vec<Vec<[f64; 3]>>,
 }
 
+/// The tick `k` a frame at `x` control periods after the first tick falls after, of
+/// `ticks`, and its fraction `s` ∈ \[0, 1) towards the next (0 at and after the last tick); a
+/// frame within rounding of a tick is that tick (copied, not interpolated).
+fn tick_and_fraction(ticks: usize, x: f64) -> (usize, f64) {
+    let mut x = x.max(0.0);
+    if (x - x.round()).abs() <= TICK_ROUNDING {
+        x = x.round();
+    }
+    let k = (x.floor() as usize).min(ticks - 1);
+    let s = if k + 1 < ticks { x - k as f64 } else { 0.0 };
+    (k, s)
+}
+
+/// The base orientation at fraction `s` between the recorded bases `a` and `b` (position then
+/// quaternion x, y, z, w): exactly `a`'s recorded quaternion at s = 0 (not renormalised); a
+/// slerp renormalised against round-off otherwise (and the nearer end for opposite
+/// orientations, where it is undefined).
+fn base_rotation(a: &[f64; 7], b: &[f64; 7], s: f64) -> UnitQuaternion<f64> {
+    if s == 0.0 {
+        return UnitQuaternion::new_unchecked(Quaternion::new(a[6], a[3], a[4], a[5]));
+    }
+    let quat =
+        |v: &[f64; 7]| UnitQuaternion::from_quaternion(Quaternion::new(v[6], v[3], v[4], v[5]));
+    let (ra, rb) = (quat(a), quat(b));
+    let r = ra
+        .try_slerp(&rb, s, 0.0)
+        .unwrap_or(if s < 0.5 { ra } else { rb });
+    UnitQuaternion::new_normalize(r.into_inner())
+}
+
 fn lerp(a: f64, b: f64, s: f64) -> f64 {
     a + s * (b - a)
 }
@@ -233,36 +263,10 @@ impl TrainingTrajectory {
         let mut kin = Kinematics::new(robot, &state)?;
         for j in 0..frames {
             let t = first.t + j as f64 / rate;
-            let mut x = ((t - first.t) / dt).max(0.0);
-            // A frame within rounding of a tick is that tick (copied, not interpolated).
-            if (x - x.round()).abs() <= TICK_ROUNDING {
-                x = x.round();
-            }
-            let k = (x.floor() as usize).min(steps.len() - 1);
+            let (k, s) = tick_and_fraction(steps.len(), (t - first.t) / dt);
             let (a, b) = (&steps[k], &steps[(k + 1).min(steps.len() - 1)]);
-            let s = if k + 1 < steps.len() {
-                x - k as f64
-            } else {
-                0.0
-            };
             let pos = [0, 1, 2].map(|i| lerp(a.base[i], b.base[i], s));
-            let quat = |v: &[f64; 7]| {
-                UnitQuaternion::from_quaternion(Quaternion::new(v[6], v[3], v[4], v[5]))
-            };
-            let (ra, rb) = (quat(&a.base), quat(&b.base));
-            // Exactly the recorded tick at s = 0; a slerp renormalised against round-off
-            // otherwise (and the nearer end for opposite orientations, where it is undefined).
-            let r = if s == 0.0 {
-                // The recorded quaternion itself, not renormalised.
-                UnitQuaternion::new_unchecked(Quaternion::new(
-                    a.base[6], a.base[3], a.base[4], a.base[5],
-                ))
-            } else {
-                let r = ra
-                    .try_slerp(&rb, s, 0.0)
-                    .unwrap_or(if s < 0.5 { ra } else { rb });
-                UnitQuaternion::new_normalize(r.into_inner())
-            };
+            let r = base_rotation(&a.base, &b.base, s);
             let q: Vec<f64> = (0..nv - nb)
                 .map(|d| lerp(a.joints[d], b.joints[d], s))
                 .collect();

@@ -772,43 +772,7 @@ fn write_feet(
         );
         return Vec::new();
     };
-    // Each foot's geometry; the profile takes one sole and ankle height for both feet, so a
-    // foot without geometry takes the other's, and two that differ take their mean.
-    let geometry: Vec<Option<FootGeometry>> = feet
-        .iter()
-        .map(|(i, _)| {
-            // An alias fixed at the foot link's origin gives the sole of the whole foot body.
-            let mut body = *i;
-            while let Some((p, false)) = t.parent[body] {
-                if !alias(t, p, *i) {
-                    break;
-                }
-                body = p;
-            }
-            sole_of(u, t, body, dir).map(|((a, b, c, h), why)| (a, b, c, h, why.to_string()))
-        })
-        .collect();
-    let both = match (&geometry[0], &geometry[1]) {
-        (Some(l), Some(r)) if (l.0, l.1, l.2, l.3) == (r.0, r.1, r.2, r.3) => Some(l.clone()),
-        (Some(l), Some(r)) => Some((
-            0.5 * (l.0 + r.0),
-            0.5 * (l.1 + r.1),
-            0.5 * (l.2 + r.2),
-            0.5 * (l.3 + r.3),
-            format!(
-                "the mean of both feet's geometry (left {:.4} x {:.4} m, right {:.4} x {:.4} m)",
-                l.0, l.1, r.0, r.1
-            ),
-        )),
-        (Some(g), None) | (None, Some(g)) => Some((
-            g.0,
-            g.1,
-            g.2,
-            g.3,
-            format!("{} (one foot's: the other has no geometry)", g.4),
-        )),
-        (None, None) => None,
-    };
+    let both = both_feet_geometry(u, t, feet, dir);
     let mut frames = Vec::new();
     for (side, (i, why)) in ["left", "right"].iter().zip(feet) {
         frames.push(t.names[*i].clone());
@@ -845,6 +809,51 @@ fn write_feet(
         ));
     }
     frames
+}
+
+/// The sole and ankle height the profile gives both feet: each foot's geometry from its body
+/// (an alias fixed at the foot link's origin gives the sole of the whole foot body); a foot
+/// without geometry takes the other's, and two that differ take their mean.
+fn both_feet_geometry(
+    u: &urdf_rs::Robot,
+    t: &Tree,
+    feet: &[(usize, String)],
+    dir: Option<&std::path::Path>,
+) -> Option<FootGeometry> {
+    let geometry: Vec<Option<FootGeometry>> = feet
+        .iter()
+        .map(|(i, _)| {
+            let mut body = *i;
+            while let Some((p, false)) = t.parent[body] {
+                if !alias(t, p, *i) {
+                    break;
+                }
+                body = p;
+            }
+            sole_of(u, t, body, dir).map(|((a, b, c, h), why)| (a, b, c, h, why.to_string()))
+        })
+        .collect();
+    match (&geometry[0], &geometry[1]) {
+        (Some(l), Some(r)) if (l.0, l.1, l.2, l.3) == (r.0, r.1, r.2, r.3) => Some(l.clone()),
+        (Some(l), Some(r)) => Some((
+            0.5 * (l.0 + r.0),
+            0.5 * (l.1 + r.1),
+            0.5 * (l.2 + r.2),
+            0.5 * (l.3 + r.3),
+            format!(
+                "the mean of both feet's geometry (left {:.4} x {:.4} m, right {:.4} x {:.4} m)",
+                l.0, l.1, r.0, r.1
+            ),
+        )),
+        (Some(g), None) | (None, Some(g)) => Some((
+            g.0,
+            g.1,
+            g.2,
+            g.3,
+            format!("{} (one foot's: the other has no geometry)", g.4),
+        )),
+        (None, None) => None,
+    }
 }
 
 /// The profile's header: its name and URDF, and the base (floating when two feet were found).
