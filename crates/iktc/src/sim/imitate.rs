@@ -15,6 +15,7 @@
 mod record;
 mod support;
 
+pub(crate) use record::{check_state_finite, link_frames};
 pub use record::{run_imitate, ImitateRun, ImitateStep, ImitateSummary, JointMargin, LevelSummary};
 pub use support::{sole_pose, support_polygon, SupportSettings};
 

@@ -30,7 +30,7 @@ use nalgebra::{
 use serde::Serialize;
 
 use super::health::{HealthMonitor, HealthReport, Verdict};
-use super::imitate::{ImitateConfig, ImitationController};
+use super::imitate::{check_state_finite, link_frames, ImitateConfig, ImitationController};
 use super::margins::{dof_margins, held_limit, median, percentile, JointMargin};
 use super::walk_plants::WalkPlants;
 use crate::balance::{
@@ -813,7 +813,15 @@ pub fn run_walk_imitate(
             s.zmp_model.0 + origin.x + zdev.x,
             s.zmp_model.1 + origin.y + zdev.y,
         );
-        if check_tick_finite(&mut health, t, &dof_names, ctl, &com, zm)? == Verdict::Stop {
+        if check_state_finite(
+            &mut health,
+            t,
+            &dof_names,
+            ctl,
+            &com,
+            &[("measured ZMP [m]", &[zm.0, zm.1])],
+        )? == Verdict::Stop
+        {
             break;
         }
         wc.pattern().support_polygon_into(t, &mut polygon)?;
@@ -841,32 +849,6 @@ pub fn run_walk_imitate(
         wc.integrate()?;
     }
     finish_walk_run(robot, cfg, &wc, steps, health.report())
-}
-
-/// Checks one tick's state, commanded acceleration, COM and measured ZMP `zm` \[m\] for
-/// non-finite values at time `t` \[s\], in that order, stopping at the first verdict to stop.
-fn check_tick_finite(
-    health: &mut HealthMonitor,
-    t: f64,
-    dof_names: &[String],
-    ctl: &ImitationController,
-    com: &Vector3<f64>,
-    zm: (f64, f64),
-) -> Result<Verdict> {
-    let state: &State = ctl.state();
-    let mut verdict = Verdict::Continue;
-    for (what, values) in [
-        ("joint position q [rad]", ctl.dof_positions()),
-        ("velocity q̇ [rad/s]", state.qd.as_slice()),
-        ("commanded acceleration q̈ [rad/s²]", ctl.qdd().as_slice()),
-        ("COM [m]", com.as_slice()),
-        ("measured ZMP [m]", &[zm.0, zm.1][..]),
-    ] {
-        if verdict == Verdict::Continue {
-            verdict = health.check_finite(t, what, dof_names, values)?;
-        }
-    }
-    Ok(verdict)
 }
 
 /// Checks each foot's ankle (right, then left) against its reference at time `t` \[s\]:
@@ -926,6 +908,7 @@ fn walk_step(
     let s = &wt.sample;
     let kin = ctl.kinematics();
     let com = m.com;
+    let (links, link_rotations) = link_frames(kin);
     let state: &State = ctl.state();
     let fr = |r: &FrameReference| {
         let p = r.pose.translation.vector;
@@ -953,16 +936,8 @@ fn walk_step(
         corrected_from: wt.corrected_from,
         qp_solves: wt.qp_solves,
         tick_us: m.tick_us,
-        links: kin
-            .link_poses()
-            .iter()
-            .map(|p| [p.translation.x, p.translation.y, p.translation.z])
-            .collect(),
-        link_rotations: kin
-            .link_poses()
-            .iter()
-            .map(|p| p.rotation.coords.into())
-            .collect(),
+        links,
+        link_rotations,
         q: ctl.dof_positions().to_vec(),
         qd: state.qd.as_slice().to_vec(),
         qdd: ctl.qdd().as_slice().to_vec(),

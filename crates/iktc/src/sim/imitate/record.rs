@@ -9,7 +9,7 @@ use super::support::support_polygon;
 use super::{ImitateConfig, ImitationController, LEVEL_NAMES};
 use crate::error::Result;
 use crate::limits::NarrowedJoint;
-use crate::model::{FrameId, JointLimit, Robot};
+use crate::model::{FrameId, JointLimit, Kinematics, Robot};
 use crate::motion::RobotReferences;
 use crate::sim::health::{HealthMonitor, HealthReport, Verdict};
 pub use crate::sim::margins::JointMargin;
@@ -281,7 +281,7 @@ pub fn run_imitate(
         let tick_us = start.elapsed().as_secs_f64() * 1e6;
         let kin = ctl.kinematics();
         let com = kin.com();
-        if check_state_finite(&mut health, t, &dof_names, &ctl, &com)? == Verdict::Stop {
+        if check_state_finite(&mut health, t, &dof_names, &ctl, &com, &[])? == Verdict::Stop {
             break;
         }
         let (foot_drift, foot_rotation_drift) =
@@ -346,23 +346,39 @@ fn cart_table_zmp(
     Ok([com.x - lever * cdd.x, com.y - lever * cdd.y])
 }
 
-/// Checks q, q̇, the commanded q̈ and the COM \[m\] for non-finite values at time `t` \[s\],
-/// in that order, stopping at the first verdict to stop.
-fn check_state_finite(
+/// Every link's position \[m\] and rotation (quaternion x, y, z, w) in `kin`, for a step's
+/// record.
+pub(crate) fn link_frames(kin: &Kinematics) -> (Vec<[f64; 3]>, Vec<[f64; 4]>) {
+    kin.link_poses()
+        .iter()
+        .map(|p| {
+            let t = p.translation.vector;
+            let r: [f64; 4] = p.rotation.coords.into();
+            ([t.x, t.y, t.z], r)
+        })
+        .unzip()
+}
+
+/// Checks q, q̇, the commanded q̈, the COM \[m\] and then each of `extra` (name with unit,
+/// values) for non-finite values at time `t` \[s\], in that order, stopping at the first
+/// verdict to stop.
+pub(crate) fn check_state_finite(
     health: &mut HealthMonitor,
     t: f64,
     dof_names: &[String],
     ctl: &ImitationController,
     com: &Vector3<f64>,
+    extra: &[(&str, &[f64])],
 ) -> Result<Verdict> {
     let state = ctl.state();
-    let mut verdict = Verdict::Continue;
-    for (what, values) in [
+    let rows = [
         ("joint position q [rad]", ctl.dof_positions()),
         ("velocity q̇ [rad/s]", state.qd.as_slice()),
         ("commanded acceleration q̈ [rad/s²]", ctl.qdd().as_slice()),
         ("COM [m]", com.as_slice()),
-    ] {
+    ];
+    let mut verdict = Verdict::Continue;
+    for &(what, values) in rows.iter().chain(extra) {
         if verdict == Verdict::Continue {
             verdict = health.check_finite(t, what, dof_names, values)?;
         }
@@ -474,6 +490,7 @@ fn imitate_step(
     let qd = state.qd.as_slice().to_vec();
     let qdd = ctl.qdd().as_slice().to_vec();
     let on_limit = dofs_on_limit(robot, cfg, limits, &q, &qd, &qdd);
+    let (links, link_rotations) = link_frames(kin);
     let bx = ctl.acceleration_box();
     Ok(ImitateStep {
         t: m.t,
@@ -506,16 +523,8 @@ fn imitate_step(
         pelvis_height: pp.translation.z,
         pelvis_rpy_desired: rpy(&desired_att),
         pelvis_rpy: rpy(&pp.rotation),
-        links: kin
-            .link_poses()
-            .iter()
-            .map(|p| [p.translation.x, p.translation.y, p.translation.z])
-            .collect(),
-        link_rotations: kin
-            .link_poses()
-            .iter()
-            .map(|p| p.rotation.coords.into())
-            .collect(),
+        links,
+        link_rotations,
         on_limit,
         qp_solves: rep.qp_solves,
         empty_dofs: rep.empty_box_dofs,
